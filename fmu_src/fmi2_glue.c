@@ -1,0 +1,450 @@
+/* FMI 2.0 Co-Simulation interface, shared by every model. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "fmu_core.h"
+
+/* Modes each function may be called in: FMI 2.0.4, section 4.2.4 (state
+ * machine of a Co-Simulation slave). Step Mode stands for stepComplete,
+ * stepFailed and stepCanceled: this slave never returns fmi2Pending, so
+ * there is no stepInProgress. */
+#define INST MODE_INSTANTIATED
+#define INIT MODE_INITIALIZATION
+#define STEP MODE_STEP
+#define TERM MODE_TERMINATED
+#define ERR  MODE_ERROR
+#define NONE 0
+
+#define MODES_SetDebugLogging           (INST | INIT | STEP | TERM | ERR)
+#define MODES_SetupExperiment           (INST)
+#define MODES_EnterInitializationMode   (INST)
+#define MODES_ExitInitializationMode    (INIT)
+#define MODES_Terminate                 (STEP)
+#define MODES_Reset                     (INST | INIT | STEP | TERM | ERR)
+#define MODES_GetReal                   (INIT | STEP | TERM | ERR)
+#define MODES_GetInteger                MODES_GetReal
+#define MODES_GetBoolean                MODES_GetReal
+#define MODES_GetString                 MODES_GetReal
+#define MODES_SetReal                   (INST | INIT | STEP)
+#define MODES_SetInteger                MODES_SetReal
+#define MODES_SetBoolean                MODES_SetReal
+#define MODES_SetString                 MODES_SetReal
+#define MODES_GetFMUstate               (INST | INIT | STEP | TERM | ERR)
+#define MODES_SetFMUstate               MODES_GetFMUstate
+#define MODES_FreeFMUstate              MODES_GetFMUstate
+#define MODES_SerializedFMUstateSize    MODES_GetFMUstate
+#define MODES_SerializeFMUstate         MODES_GetFMUstate
+#define MODES_DeSerializeFMUstate       MODES_GetFMUstate
+#define MODES_GetDirectionalDerivative  (INIT | STEP | TERM | ERR)
+#define MODES_SetRealInputDerivatives   (INST | INIT | STEP)
+#define MODES_GetRealOutputDerivatives  (STEP | TERM | ERR)
+#define MODES_DoStep                    (STEP)
+#define MODES_CancelStep                NONE
+#define MODES_GetStatus                 (STEP | TERM)
+#define MODES_GetRealStatus             MODES_GetStatus
+#define MODES_GetIntegerStatus          MODES_GetStatus
+#define MODES_GetBooleanStatus          MODES_GetStatus
+#define MODES_GetStringStatus           MODES_GetStatus
+
+typedef struct {
+    FmuInstance base; /* first: an fmi2Component is an FmuInstance */
+    fmi2CallbackFunctions functions;
+} Fmi2Instance;
+
+/* An FMU state: a tagged copy of the core, so that a foreign pointer is
+ * refused rather than read. */
+#define STATE_TAG 0x524c5332u
+typedef struct {
+    uint32_t tag;
+    FmuCore core;
+} Fmi2State;
+
+/* Errors and warnings are logged even with loggingOn = false: a failed call
+ * must say why. */
+#define ALWAYS_LOGGED (LOG_ERROR | LOG_WARNING)
+
+#define BEGIN(name)                                                           \
+    FmuInstance *I = (FmuInstance *)c;                                        \
+    static const char FN[] = "fmi2" #name;                                    \
+    if (!I) return fmi2Error;                                                 \
+    if (fmu_check_mode(I, FN, MODES_##name) != FMU_OK) return fmi2Error
+
+#define CHECK(expression)                                                     \
+    do {                                                                      \
+        const FmuStatus status_ = (expression);                               \
+        if (status_ > FMU_WARNING) return (fmi2Status)status_;                \
+    } while (0)
+
+static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
+    const Fmi2Instance *g = (const Fmi2Instance *)instance;
+    g->functions.logger(g->functions.componentEnvironment, instance->instanceName, (fmi2Status)status, category, message);
+}
+
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn) {
+    (void)fmuResourceLocation;
+    (void)visible;
+    if (!functions || !functions->allocateMemory || !functions->freeMemory) {
+        return NULL; /* nothing to allocate with, nobody to tell */
+    }
+    const char *reason = NULL;
+    if (!instanceName || !*instanceName) {
+        reason = "instanceName is missing";
+    } else if (fmuType != fmi2CoSimulation) {
+        reason = "this FMU supports Co-Simulation only";
+    } else if (!fmuGUID || strcmp(fmuGUID, fmuModel.token) != 0) {
+        reason = "the GUID does not match this FMU's model description";
+    }
+    if (reason) {
+        if (functions->logger) {
+            functions->logger(functions->componentEnvironment, instanceName ? instanceName : "?", fmi2Error,
+                              "logStatusError", reason);
+        }
+        return NULL;
+    }
+    Fmi2Instance *g = functions->allocateMemory(1, sizeof *g);
+    char *name = functions->allocateMemory(strlen(instanceName) + 1, 1);
+    if (!g || !name) {
+        if (g) functions->freeMemory(g);
+        if (name) functions->freeMemory(name);
+        return NULL;
+    }
+    strcpy(name, instanceName);
+    g->functions = *functions;
+    g->base.instanceName = name;
+    g->base.environment = functions->componentEnvironment;
+    g->base.logFunction = functions->logger ? log_to_importer : NULL;
+    g->base.logCategories = (loggingOn ? LOG_ALL : 0) | ALWAYS_LOGGED;
+    fmu_init_instance(&g->base);
+    return g;
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    Fmi2Instance *g = c;
+    if (!g) return;
+    const fmi2CallbackFreeMemory release = g->functions.freeMemory;
+    release((void *)g->base.instanceName);
+    release(g);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
+    BEGIN(SetDebugLogging);
+    return (fmi2Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, ALWAYS_LOGGED);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    (void)toleranceDefined;
+    (void)tolerance;
+    BEGIN(SetupExperiment);
+    if (stopTimeDefined && !(stopTime >= startTime)) {
+        return (fmi2Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
+    }
+    return (fmi2Status)fmu_setup_experiment(I, startTime);
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    BEGIN(EnterInitializationMode);
+    return (fmi2Status)fmu_enter_initialization(I);
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    BEGIN(ExitInitializationMode);
+    return (fmi2Status)fmu_exit_initialization(I);
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) {
+    BEGIN(Terminate);
+    I->core.mode = MODE_TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c) {
+    BEGIN(Reset);
+    fmu_reset(I);
+    return fmi2OK;
+}
+
+/* ---- variable access ---------------------------------------------------- */
+
+#define GET_VALUES(TYPE_MASK, CONVERT)                                        \
+    CHECK(fmu_check_array(I, FN, nvr, vr, value));                            \
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
+    for (size_t i = 0; i < nvr; i++) value[i] = CONVERT(fmu_get(I, vr[i]));   \
+    return fmi2OK
+
+#define SET_VALUES(TYPE_MASK, CONVERT)                                        \
+    CHECK(fmu_check_array(I, FN, nvr, vr, value));                            \
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], CONVERT(value[i]))); \
+    for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], CONVERT(value[i]));   \
+    return fmi2OK
+
+#define AS_REAL(x) ((fmi2Real)(x))
+#define AS_INTEGER(x) ((fmi2Integer)(x))
+#define AS_BOOLEAN(x) ((x) != 0 ? fmi2True : fmi2False)
+#define BOOLEAN_AS_REAL(x) ((x) != fmi2False ? 1.0 : 0.0)
+#define INTEGER_TYPES (TYPE_BIT(FMU_INTEGER) | TYPE_BIT(FMU_ENUMERATION))
+#define NO_STRING(x) ((x) ? 0.0 : 0.0)
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    BEGIN(GetReal);
+    GET_VALUES(TYPE_BIT(FMU_REAL), AS_REAL);
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+    BEGIN(GetInteger);
+    GET_VALUES(INTEGER_TYPES, AS_INTEGER);
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+    BEGIN(GetBoolean);
+    GET_VALUES(TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN);
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    BEGIN(GetString);
+    CHECK(fmu_check_array(I, FN, nvr, vr, value));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i]));
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    BEGIN(SetReal);
+    SET_VALUES(TYPE_BIT(FMU_REAL), AS_REAL);
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+    BEGIN(SetInteger);
+    SET_VALUES(INTEGER_TYPES, AS_REAL);
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
+    BEGIN(SetBoolean);
+    SET_VALUES(TYPE_BIT(FMU_BOOLEAN), BOOLEAN_AS_REAL);
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+    BEGIN(SetString);
+    CHECK(fmu_check_array(I, FN, nvr, vr, value));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i], 0.0));
+    return fmi2OK;
+}
+
+/* ---- FMU states ---------------------------------------------------------- */
+
+static Fmi2State *new_state(FmuInstance *I) {
+    Fmi2Instance *g = (Fmi2Instance *)I;
+    Fmi2State *state = g->functions.allocateMemory(1, sizeof *state);
+    if (state) state->tag = STATE_TAG;
+    return state;
+}
+
+static FmuStatus check_state(FmuInstance *I, const char *function, const Fmi2State *state) {
+    if (!state) {
+        return fmu_error(I, function, "the FMU state is NULL");
+    }
+    if (state->tag != STATE_TAG) {
+        return fmu_error(I, function, "not an FMU state of this FMU");
+    }
+    return FMU_OK;
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
+    BEGIN(GetFMUstate);
+    if (!FMUstate) return (fmi2Status)fmu_error(I, FN, "the FMU state pointer is NULL");
+    Fmi2State *state = *FMUstate;
+    if (state) {
+        CHECK(check_state(I, FN, state));
+    } else if (!(state = new_state(I))) {
+        return (fmi2Status)fmu_error(I, FN, "out of memory");
+    }
+    state->core = I->core;
+    *FMUstate = state;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
+    BEGIN(SetFMUstate);
+    CHECK(check_state(I, FN, FMUstate));
+    fmu_restore(I, &((const Fmi2State *)FMUstate)->core);
+    return fmi2OK;
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
+    BEGIN(FreeFMUstate);
+    if (!FMUstate || !*FMUstate) return fmi2OK;
+    CHECK(check_state(I, FN, *FMUstate));
+    ((Fmi2State *)*FMUstate)->tag = 0;
+    ((Fmi2Instance *)I)->functions.freeMemory(*FMUstate);
+    *FMUstate = NULL;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
+    BEGIN(SerializedFMUstateSize);
+    CHECK(check_state(I, FN, FMUstate));
+    if (!size) return (fmi2Status)fmu_error(I, FN, "the size pointer is NULL");
+    *size = fmu_serialized_size(I);
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
+    BEGIN(SerializeFMUstate);
+    CHECK(check_state(I, FN, FMUstate));
+    if (!serializedState) return (fmi2Status)fmu_error(I, FN, "the byte array is NULL");
+    if (size < fmu_serialized_size(I)) {
+        return (fmi2Status)fmu_error(I, FN, "the byte array has %zu bytes; the state needs %zu", size, fmu_serialized_size(I));
+    }
+    fmu_serialize(I, &((const Fmi2State *)FMUstate)->core, (unsigned char *)serializedState);
+    return fmi2OK;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate *FMUstate) {
+    BEGIN(DeSerializeFMUstate);
+    FmuCore core;
+    if (!FMUstate) return (fmi2Status)fmu_error(I, FN, "the FMU state pointer is NULL");
+    CHECK(fmu_deserialize(I, FN, (const unsigned char *)serializedState, size, &core));
+    Fmi2State *state = *FMUstate;
+    if (state) {
+        CHECK(check_state(I, FN, state));
+    } else if (!(state = new_state(I))) {
+        return (fmi2Status)fmu_error(I, FN, "out of memory");
+    }
+    state->core = core;
+    *FMUstate = state;
+    return fmi2OK;
+}
+
+/* ---- Co-Simulation -------------------------------------------------------- */
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    BEGIN(DoStep);
+    return (fmi2Status)fmu_do_step(I, FN, currentCommunicationPoint, communicationStepSize);
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c) {
+    BEGIN(CancelStep);
+    return fmi2Error; /* unreachable: no mode allows it */
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
+    (void)s;
+    (void)value;
+    BEGIN(GetStatus);
+    return fmi2Discard; /* doStep never returns fmi2Pending */
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
+    BEGIN(GetRealStatus);
+    if (s != fmi2LastSuccessfulTime) return fmi2Discard;
+    if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL");
+    *value = I->core.time;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
+    (void)s;
+    (void)value;
+    BEGIN(GetIntegerStatus);
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
+    BEGIN(GetBooleanStatus);
+    if (s != fmi2Terminated) return fmi2Discard;
+    if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL");
+    *value = fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
+    (void)s;
+    (void)value;
+    BEGIN(GetStringStatus);
+    return fmi2Discard;
+}
+
+/* ---- not provided: derivatives and Model Exchange ----------------------- */
+
+static fmi2Status unsupported(fmi2Component c, const char *function, const char *what) {
+    if (!c) return fmi2Error;
+    return (fmi2Status)fmu_error(c, function, "%s", what);
+}
+
+#define NO_DERIVATIVES "this FMU provides no derivatives (see the model description)"
+#define NO_ME "this FMU supports Co-Simulation only, not Model Exchange"
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
+    (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown; (void)dvUnknown;
+    return unsupported(c, "fmi2GetDirectionalDerivative", NO_DERIVATIVES);
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[]) {
+    (void)vr; (void)nvr; (void)order; (void)value;
+    return unsupported(c, "fmi2SetRealInputDerivatives", NO_DERIVATIVES);
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[]) {
+    (void)vr; (void)nvr; (void)order; (void)value;
+    return unsupported(c, "fmi2GetRealOutputDerivatives", NO_DERIVATIVES);
+}
+
+fmi2Status fmi2EnterEventMode(fmi2Component c) {
+    return unsupported(c, "fmi2EnterEventMode", NO_ME);
+}
+
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
+    (void)eventInfo;
+    return unsupported(c, "fmi2NewDiscreteStates", NO_ME);
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
+    return unsupported(c, "fmi2EnterContinuousTimeMode", NO_ME);
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
+    (void)noSetFMUStatePriorToCurrentPoint; (void)enterEventMode; (void)terminateSimulation;
+    return unsupported(c, "fmi2CompletedIntegratorStep", NO_ME);
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
+    (void)time;
+    return unsupported(c, "fmi2SetTime", NO_ME);
+}
+
+fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
+    (void)x; (void)nx;
+    return unsupported(c, "fmi2SetContinuousStates", NO_ME);
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
+    (void)derivatives; (void)nx;
+    return unsupported(c, "fmi2GetDerivatives", NO_ME);
+}
+
+fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
+    (void)eventIndicators; (void)ni;
+    return unsupported(c, "fmi2GetEventIndicators", NO_ME);
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
+    (void)x; (void)nx;
+    return unsupported(c, "fmi2GetContinuousStates", NO_ME);
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
+    (void)x_nominal; (void)nx;
+    return unsupported(c, "fmi2GetNominalsOfContinuousStates", NO_ME);
+}

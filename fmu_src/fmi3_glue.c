@@ -1,0 +1,518 @@
+/* FMI 3.0 Co-Simulation interface (no event mode, no clocks), shared by
+ * every model. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi3Functions.h"
+#include "fmu_core.h"
+
+/* Modes each function may be called in: FMI 3.0.2, section 4.2 (state
+ * machine of Co-Simulation without Event Mode). After an fmi3Error only
+ * fmi3SetFMUState, fmi3Reset and fmi3FreeInstance lead on (section 2.2.3);
+ * the FMU-state helpers that serve that recovery are allowed too. */
+#define INST MODE_INSTANTIATED
+#define INIT MODE_INITIALIZATION
+#define STEP MODE_STEP
+#define TERM MODE_TERMINATED
+#define ERR  MODE_ERROR
+
+#define MODES_SetDebugLogging           (INST | INIT | STEP | TERM | ERR)
+#define MODES_EnterInitializationMode   (INST)
+#define MODES_ExitInitializationMode    (INIT)
+#define MODES_Terminate                 (STEP)
+#define MODES_Reset                     (INST | INIT | STEP | TERM | ERR)
+#define MODES_Get                       (INIT | STEP | TERM)
+#define MODES_Set                       (INST | INIT | STEP)
+#define MODES_GetFMUState               (INST | INIT | STEP | TERM)
+#define MODES_SetFMUState               (INST | INIT | STEP | TERM | ERR)
+#define MODES_FreeFMUState              (INST | INIT | STEP | TERM | ERR)
+#define MODES_SerializedFMUStateSize    (INST | INIT | STEP | TERM | ERR)
+#define MODES_SerializeFMUState         (INST | INIT | STEP | TERM | ERR)
+#define MODES_DeserializeFMUState       (INST | INIT | STEP | TERM | ERR)
+#define MODES_DoStep                    (STEP)
+
+typedef struct {
+    FmuInstance base; /* first: an fmi3Instance is an FmuInstance */
+    fmi3LogMessageCallback logMessage;
+    char name[];
+} Fmi3Instance;
+
+#define STATE_TAG 0x524c5333u
+typedef struct {
+    uint32_t tag;
+    FmuCore core;
+} Fmi3State;
+
+#define BEGIN(function, modes)                                                \
+    FmuInstance *I = (FmuInstance *)instance;                                 \
+    static const char FN[] = function;                                        \
+    if (!I) return fmi3Error;                                                 \
+    if (fmu_check_mode(I, FN, modes) != FMU_OK) return fmi3Error
+
+#define CHECK(expression)                                                     \
+    do {                                                                      \
+        const FmuStatus status_ = (expression);                               \
+        if (status_ > FMU_WARNING) return (fmi3Status)status_;                \
+    } while (0)
+
+static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
+    const Fmi3Instance *g = (const Fmi3Instance *)instance;
+    g->logMessage(instance->environment, (fmi3Status)status, category, message);
+}
+
+const char *fmi3GetVersion(void) { return fmi3Version; }
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
+                                         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                         fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
+                                         const fmi3ValueReference requiredIntermediateVariables[],
+                                         size_t nRequiredIntermediateVariables,
+                                         fmi3InstanceEnvironment instanceEnvironment,
+                                         fmi3LogMessageCallback logMessage,
+                                         fmi3IntermediateUpdateCallback intermediateUpdate) {
+    (void)resourcePath; (void)visible; (void)earlyReturnAllowed;
+    (void)requiredIntermediateVariables; (void)intermediateUpdate;
+    const char *reason = NULL;
+    if (!instanceName || !*instanceName) {
+        reason = "instanceName is missing";
+    } else if (!instantiationToken || strcmp(instantiationToken, fmuModel.token) != 0) {
+        reason = "the instantiationToken does not match this FMU's model description";
+    } else if (eventModeUsed) {
+        reason = "this FMU has no Event Mode (hasEventMode = false)";
+    } else if (nRequiredIntermediateVariables > 0) {
+        reason = "this FMU provides no intermediate update";
+    }
+    if (reason) {
+        if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", reason);
+        return NULL;
+    }
+    Fmi3Instance *g = calloc(1, sizeof *g + strlen(instanceName) + 1);
+    if (!g) return NULL;
+    strcpy(g->name, instanceName);
+    g->logMessage = logMessage;
+    g->base.instanceName = g->name;
+    g->base.environment = instanceEnvironment;
+    g->base.logFunction = logMessage ? log_to_importer : NULL;
+    g->base.logCategories = loggingOn ? LOG_ALL : 0;
+    fmu_init_instance(&g->base);
+    return g;
+}
+
+void fmi3FreeInstance(fmi3Instance instance) {
+    free(instance);
+}
+
+fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories, const fmi3String categories[]) {
+    BEGIN("fmi3SetDebugLogging", MODES_SetDebugLogging);
+    return (fmi3Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, 0);
+}
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
+                                       fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    (void)toleranceDefined;
+    (void)tolerance;
+    BEGIN("fmi3EnterInitializationMode", MODES_EnterInitializationMode);
+    if (stopTimeDefined && !(stopTime >= startTime)) {
+        return (fmi3Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
+    }
+    CHECK(fmu_setup_experiment(I, startTime));
+    return (fmi3Status)fmu_enter_initialization(I);
+}
+
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
+    BEGIN("fmi3ExitInitializationMode", MODES_ExitInitializationMode);
+    return (fmi3Status)fmu_exit_initialization(I);
+}
+
+fmi3Status fmi3Terminate(fmi3Instance instance) {
+    BEGIN("fmi3Terminate", MODES_Terminate);
+    I->core.mode = MODE_TERMINATED;
+    return fmi3OK;
+}
+
+fmi3Status fmi3Reset(fmi3Instance instance) {
+    BEGIN("fmi3Reset", MODES_Reset);
+    fmu_reset(I);
+    return fmi3OK;
+}
+
+/* ---- variable access ---------------------------------------------------- */
+
+static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3ValueReference vr[], size_t nvr,
+                              const void *values, size_t nValues) {
+    if (fmu_check_array(I, function, nvr, vr, values) != FMU_OK) return FMU_ERROR;
+    if (nValues != nvr) {
+        return fmu_error(I, function, "nValues = %zu, but the %zu variables are scalars", nValues, nvr);
+    }
+    return FMU_OK;
+}
+
+#define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI)                              \
+    fmi3Status fmi3Get##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
+                             TYPE values[], size_t nValues) {                 \
+        BEGIN("fmi3Get" #NAME, MODES_Get);                                    \
+        CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
+        for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
+        for (size_t i = 0; i < nvr; i++) values[i] = TO_FMI(fmu_get(I, vr[i])); \
+        return fmi3OK;                                                        \
+    }                                                                         \
+    fmi3Status fmi3Set##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
+                             const TYPE values[], size_t nValues) {           \
+        BEGIN("fmi3Set" #NAME, MODES_Set);                                    \
+        CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
+        for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], (double)values[i])); \
+        for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], (double)values[i]); \
+        return fmi3OK;                                                        \
+    }
+
+#define AS_FLOAT64(x) (x)
+#define AS_INT(x) (x)
+#define AS_BOOLEAN(x) ((x) != 0)
+#define NONE TYPE_BIT(FMU_UNSUPPORTED_TYPE)
+
+ACCESSORS(Float64, fmi3Float64, TYPE_BIT(FMU_REAL), AS_FLOAT64)
+ACCESSORS(Int32, fmi3Int32, TYPE_BIT(FMU_INTEGER), (fmi3Int32)AS_INT)
+ACCESSORS(Int64, fmi3Int64, TYPE_BIT(FMU_ENUMERATION), (fmi3Int64)AS_INT)
+ACCESSORS(Boolean, fmi3Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN)
+/* no variables of these types: any value reference is refused */
+ACCESSORS(Float32, fmi3Float32, NONE, (fmi3Float32)AS_INT)
+ACCESSORS(Int8, fmi3Int8, NONE, (fmi3Int8)AS_INT)
+ACCESSORS(UInt8, fmi3UInt8, NONE, (fmi3UInt8)AS_INT)
+ACCESSORS(Int16, fmi3Int16, NONE, (fmi3Int16)AS_INT)
+ACCESSORS(UInt16, fmi3UInt16, NONE, (fmi3UInt16)AS_INT)
+ACCESSORS(UInt32, fmi3UInt32, NONE, (fmi3UInt32)AS_INT)
+ACCESSORS(UInt64, fmi3UInt64, NONE, (fmi3UInt64)AS_INT)
+
+fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                         fmi3String values[], size_t nValues) {
+    BEGIN("fmi3GetString", MODES_Get);
+    CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NONE, vr[i]));
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                         const fmi3String values[], size_t nValues) {
+    BEGIN("fmi3SetString", MODES_Set);
+    CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NONE, vr[i], 0.0));
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                         size_t valueSizes[], fmi3Binary values[], size_t nValues) {
+    BEGIN("fmi3GetBinary", MODES_Get);
+    CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
+    if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NONE, vr[i]));
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                         const size_t valueSizes[], const fmi3Binary values[], size_t nValues) {
+    BEGIN("fmi3SetBinary", MODES_Set);
+    CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
+    if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NONE, vr[i], 0.0));
+    return fmi3OK;
+}
+
+/* ---- FMU states ---------------------------------------------------------- */
+
+static FmuStatus check_state(FmuInstance *I, const char *function, const Fmi3State *state) {
+    if (!state) {
+        return fmu_error(I, function, "the FMU state is NULL");
+    }
+    if (state->tag != STATE_TAG) {
+        return fmu_error(I, function, "not an FMU state of this FMU");
+    }
+    return FMU_OK;
+}
+
+static FmuStatus store_state(FmuInstance *I, const char *function, fmi3FMUState *FMUState, const FmuCore *core) {
+    Fmi3State *state = *FMUState;
+    if (state) {
+        if (check_state(I, function, state) != FMU_OK) return FMU_ERROR;
+    } else if (!(state = malloc(sizeof *state))) {
+        return fmu_error(I, function, "out of memory");
+    }
+    state->tag = STATE_TAG;
+    state->core = *core;
+    *FMUState = state;
+    return FMU_OK;
+}
+
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
+    BEGIN("fmi3GetFMUState", MODES_GetFMUState);
+    if (!FMUState) return (fmi3Status)fmu_error(I, FN, "the FMU state pointer is NULL");
+    return (fmi3Status)store_state(I, FN, FMUState, &I->core);
+}
+
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) {
+    BEGIN("fmi3SetFMUState", MODES_SetFMUState);
+    CHECK(check_state(I, FN, FMUState));
+    fmu_restore(I, &((const Fmi3State *)FMUState)->core);
+    return fmi3OK;
+}
+
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
+    BEGIN("fmi3FreeFMUState", MODES_FreeFMUState);
+    if (!FMUState || !*FMUState) return fmi3OK;
+    CHECK(check_state(I, FN, *FMUState));
+    ((Fmi3State *)*FMUState)->tag = 0;
+    free(*FMUState);
+    *FMUState = NULL;
+    return fmi3OK;
+}
+
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size) {
+    BEGIN("fmi3SerializedFMUStateSize", MODES_SerializedFMUStateSize);
+    CHECK(check_state(I, FN, FMUState));
+    if (!size) return (fmi3Status)fmu_error(I, FN, "the size pointer is NULL");
+    *size = fmu_serialized_size(I);
+    return fmi3OK;
+}
+
+fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
+    BEGIN("fmi3SerializeFMUState", MODES_SerializeFMUState);
+    CHECK(check_state(I, FN, FMUState));
+    if (!serializedState) return (fmi3Status)fmu_error(I, FN, "the byte array is NULL");
+    if (size < fmu_serialized_size(I)) {
+        return (fmi3Status)fmu_error(I, FN, "the byte array has %zu bytes; the state needs %zu", size, fmu_serialized_size(I));
+    }
+    fmu_serialize(I, &((const Fmi3State *)FMUState)->core, serializedState);
+    return fmi3OK;
+}
+
+fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size, fmi3FMUState *FMUState) {
+    BEGIN("fmi3DeserializeFMUState", MODES_DeserializeFMUState);
+    FmuCore core;
+    if (!FMUState) return (fmi3Status)fmu_error(I, FN, "the FMU state pointer is NULL");
+    CHECK(fmu_deserialize(I, FN, serializedState, size, &core));
+    return (fmi3Status)store_state(I, FN, FMUState, &core);
+}
+
+/* ---- Co-Simulation -------------------------------------------------------- */
+
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
+                      fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
+                      fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    BEGIN("fmi3DoStep", MODES_DoStep);
+    if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
+        return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
+    }
+    const FmuStatus status = fmu_do_step(I, FN, currentCommunicationPoint, communicationStepSize);
+    *eventHandlingNeeded = fmi3False;
+    *terminateSimulation = fmi3False;
+    *earlyReturn = fmi3False;
+    *lastSuccessfulTime = I->core.time;
+    return (fmi3Status)status;
+}
+
+/* ---- not provided --------------------------------------------------------- */
+
+static fmi3Status unsupported(fmi3Instance instance, const char *function, const char *what) {
+    if (!instance) return fmi3Error;
+    return (fmi3Status)fmu_error(instance, function, "%s", what);
+}
+
+#define NO_DERIVATIVES "this FMU provides no derivatives or dependencies (see the model description)"
+#define NO_EVENTS "this FMU has no Event Mode, clocks or configuration mode (hasEventMode = false)"
+#define NO_ME "this FMU supports Co-Simulation only"
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
+                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                          fmi3InstanceEnvironment instanceEnvironment,
+                                          fmi3LogMessageCallback logMessage) {
+    (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible;
+    if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_ME);
+    return NULL;
+}
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
+                                               fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                               fmi3InstanceEnvironment instanceEnvironment,
+                                               fmi3LogMessageCallback logMessage,
+                                               fmi3ClockUpdateCallback clockUpdate,
+                                               fmi3LockPreemptionCallback lockPreemption,
+                                               fmi3UnlockPreemptionCallback unlockPreemption) {
+    (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible;
+    (void)clockUpdate; (void)lockPreemption; (void)unlockPreemption;
+    if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_ME);
+    return NULL;
+}
+
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
+    return unsupported(instance, "fmi3EnterEventMode", NO_EVENTS);
+}
+
+fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
+    (void)vr; (void)nvr; (void)values;
+    return unsupported(instance, "fmi3GetClock", NO_EVENTS);
+}
+
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
+    (void)vr; (void)nvr; (void)values;
+    return unsupported(instance, "fmi3SetClock", NO_EVENTS);
+}
+
+fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t *n) {
+    (void)vr; (void)n;
+    return unsupported(instance, "fmi3GetNumberOfVariableDependencies", NO_DERIVATIVES);
+}
+
+fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent, size_t elementIndicesOfDependent[],
+                                       fmi3ValueReference independents[], size_t elementIndicesOfIndependents[],
+                                       fmi3DependencyKind dependencyKinds[], size_t nDependencies) {
+    (void)dependent; (void)elementIndicesOfDependent; (void)independents;
+    (void)elementIndicesOfIndependents; (void)dependencyKinds; (void)nDependencies;
+    return unsupported(instance, "fmi3GetVariableDependencies", NO_DERIVATIVES);
+}
+
+fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                        const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                        size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
+    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
+    (void)sensitivity; (void)nSensitivity;
+    return unsupported(instance, "fmi3GetDirectionalDerivative", NO_DERIVATIVES);
+}
+
+fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                    const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                    size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
+    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
+    (void)sensitivity; (void)nSensitivity;
+    return unsupported(instance, "fmi3GetAdjointDerivative", NO_DERIVATIVES);
+}
+
+fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
+    return unsupported(instance, "fmi3EnterConfigurationMode", NO_EVENTS);
+}
+
+fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
+    return unsupported(instance, "fmi3ExitConfigurationMode", NO_EVENTS);
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                  fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
+    (void)vr; (void)nvr; (void)intervals; (void)qualifiers;
+    return unsupported(instance, "fmi3GetIntervalDecimal", NO_EVENTS);
+}
+
+fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                   fmi3UInt64 counters[], fmi3UInt64 resolutions[], fmi3IntervalQualifier qualifiers[]) {
+    (void)vr; (void)nvr; (void)counters; (void)resolutions; (void)qualifiers;
+    return unsupported(instance, "fmi3GetIntervalFraction", NO_EVENTS);
+}
+
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 shifts[]) {
+    (void)vr; (void)nvr; (void)shifts;
+    return unsupported(instance, "fmi3GetShiftDecimal", NO_EVENTS);
+}
+
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                fmi3UInt64 counters[], fmi3UInt64 resolutions[]) {
+    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    return unsupported(instance, "fmi3GetShiftFraction", NO_EVENTS);
+}
+
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 intervals[]) {
+    (void)vr; (void)nvr; (void)intervals;
+    return unsupported(instance, "fmi3SetIntervalDecimal", NO_EVENTS);
+}
+
+fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                   const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
+    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    return unsupported(instance, "fmi3SetIntervalFraction", NO_EVENTS);
+}
+
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 shifts[]) {
+    (void)vr; (void)nvr; (void)shifts;
+    return unsupported(instance, "fmi3SetShiftDecimal", NO_EVENTS);
+}
+
+fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
+    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    return unsupported(instance, "fmi3SetShiftFraction", NO_EVENTS);
+}
+
+fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance) {
+    return unsupported(instance, "fmi3EvaluateDiscreteStates", NO_EVENTS);
+}
+
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
+                                    fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
+                                    fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
+                                    fmi3Float64 *nextEventTime) {
+    (void)discreteStatesNeedUpdate; (void)terminateSimulation; (void)nominalsOfContinuousStatesChanged;
+    (void)valuesOfContinuousStatesChanged; (void)nextEventTimeDefined; (void)nextEventTime;
+    return unsupported(instance, "fmi3UpdateDiscreteStates", NO_EVENTS);
+}
+
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
+    return unsupported(instance, "fmi3EnterContinuousTimeMode", NO_ME);
+}
+
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
+    (void)noSetFMUStatePriorToCurrentPoint; (void)enterEventMode; (void)terminateSimulation;
+    return unsupported(instance, "fmi3CompletedIntegratorStep", NO_ME);
+}
+
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
+    (void)time;
+    return unsupported(instance, "fmi3SetTime", NO_ME);
+}
+
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[], size_t nContinuousStates) {
+    (void)continuousStates; (void)nContinuousStates;
+    return unsupported(instance, "fmi3SetContinuousStates", NO_ME);
+}
+
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t nContinuousStates) {
+    (void)derivatives; (void)nContinuousStates;
+    return unsupported(instance, "fmi3GetContinuousStateDerivatives", NO_ME);
+}
+
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t nEventIndicators) {
+    (void)eventIndicators; (void)nEventIndicators;
+    return unsupported(instance, "fmi3GetEventIndicators", NO_ME);
+}
+
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t nContinuousStates) {
+    (void)continuousStates; (void)nContinuousStates;
+    return unsupported(instance, "fmi3GetContinuousStates", NO_ME);
+}
+
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nContinuousStates) {
+    (void)nominals; (void)nContinuousStates;
+    return unsupported(instance, "fmi3GetNominalsOfContinuousStates", NO_ME);
+}
+
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventIndicators) {
+    (void)nEventIndicators;
+    return unsupported(instance, "fmi3GetNumberOfEventIndicators", NO_ME);
+}
+
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates) {
+    (void)nContinuousStates;
+    return unsupported(instance, "fmi3GetNumberOfContinuousStates", NO_ME);
+}
+
+fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
+    return unsupported(instance, "fmi3EnterStepMode", NO_EVENTS);
+}
+
+fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                    const fmi3Int32 orders[], fmi3Float64 values[], size_t nValues) {
+    (void)vr; (void)nvr; (void)orders; (void)values; (void)nValues;
+    return unsupported(instance, "fmi3GetOutputDerivatives", NO_DERIVATIVES);
+}
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
+    (void)clockReference; (void)activationTime;
+    return unsupported(instance, "fmi3ActivateModelPartition", NO_ME);
+}

@@ -1,0 +1,443 @@
+#include "fmu_core.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+const char *const fmu_log_category_names[3] = { "logStatusError", "logStatusWarning", "logEvents" };
+
+#define SERIAL_MAGIC "RLFS"
+#define SERIAL_VERSION 1u
+/* magic, version, model hash, payload size; CRC-32 after the payload */
+#define SERIAL_HEADER 16u
+#define SERIAL_TRAILER 4u
+
+const char *fmu_mode_name(int mode) {
+    switch (mode) {
+    case MODE_INSTANTIATED: return "Instantiated";
+    case MODE_INITIALIZATION: return "Initialization Mode";
+    case MODE_STEP: return "Step Mode";
+    case MODE_TERMINATED: return "Terminated";
+    case MODE_ERROR: return "Error (after a failed call)";
+    default: return "unknown";
+    }
+}
+
+static const char *type_name(FmuType type) {
+    switch (type) {
+    case FMU_REAL: return "Real";
+    case FMU_INTEGER: return "Integer";
+    case FMU_BOOLEAN: return "Boolean";
+    case FMU_ENUMERATION: return "Enumeration";
+    default: return "unsupported";
+    }
+}
+
+void fmu_init_instance(FmuInstance *instance) {
+    instance->model = &fmuModel;
+    fmu_reset(instance);
+}
+
+void fmu_reset(FmuInstance *instance) {
+    FmuCore *core = &instance->core;
+    const ModelDefinition *model = instance->model;
+    memset(core, 0, sizeof *core);
+    for (unsigned i = 0; i < model->count; i++) {
+        core->values[i] = model->variables[i].start;
+    }
+    core->mode = MODE_INSTANTIATED;
+    memset(&instance->prepared, 0, sizeof instance->prepared);
+    instance->prepared.period = NAN;
+    instance->configDirty = true;
+}
+
+static void log_message(FmuInstance *instance, FmuStatus status, const char *fmt, va_list args) {
+    const int category = status >= FMU_ERROR ? LOG_ERROR : status == FMU_WARNING ? LOG_WARNING : LOG_EVENTS;
+    const char *name = fmu_log_category_names[category == LOG_ERROR ? 0 : category == LOG_WARNING ? 1 : 2];
+    char message[512];
+
+    if (!instance->logFunction || !(instance->logCategories & category)) {
+        return;
+    }
+    vsnprintf(message, sizeof message, fmt, args);
+    /* FMI 2 loggers may treat the message as a format string */
+    for (char *c = message; *c; c++) {
+        if (*c == '%') *c = '?';
+    }
+    instance->logFunction(instance, status, name, message);
+}
+
+void fmu_log(FmuInstance *instance, FmuStatus status, const char *fmt, ...) {
+    va_list args;
+    va_start(args, fmt);
+    log_message(instance, status, fmt, args);
+    va_end(args);
+}
+
+FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, bool loggingOn,
+                                size_t nCategories, const char *const categories[], int alwaysOn) {
+    int enabled = 0;
+    if (nCategories > 0 && !categories) {
+        return fmu_error(instance, function, "the category array is NULL");
+    }
+    for (size_t i = 0; i < nCategories; i++) {
+        int bit = 0;
+        for (int k = 0; k < 3; k++) {
+            if (categories[i] && strcmp(categories[i], fmu_log_category_names[k]) == 0) bit = 1 << k;
+        }
+        if (!bit) {
+            return fmu_error(instance, function, "unknown log category \"%s\"", categories[i] ? categories[i] : "(null)");
+        }
+        enabled |= bit;
+    }
+    if (loggingOn && nCategories == 0) {
+        enabled = LOG_ALL;
+    }
+    instance->logCategories = (loggingOn ? enabled : 0) | alwaysOn;
+    return FMU_OK;
+}
+
+FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt, ...) {
+    char reason[400];
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(reason, sizeof reason, fmt, args);
+    va_end(args);
+    fmu_log(instance, FMU_ERROR, "%s: %s", function, reason);
+    instance->core.mode = MODE_ERROR;
+    return FMU_ERROR;
+}
+
+FmuStatus fmu_check_mode(FmuInstance *instance, const char *function, int allowedModes) {
+    if (instance->core.mode & allowedModes) {
+        return FMU_OK;
+    }
+    return fmu_error(instance, function, "not allowed in %s", fmu_mode_name(instance->core.mode));
+}
+
+FmuStatus fmu_check_array(FmuInstance *instance, const char *function, size_t n, const void *vr, const void *values) {
+    if (n > 0 && !vr) {
+        return fmu_error(instance, function, "the value reference array is NULL");
+    }
+    if (n > 0 && !values) {
+        return fmu_error(instance, function, "the value array is NULL");
+    }
+    return FMU_OK;
+}
+
+static FmuStatus check_variable(FmuInstance *instance, const char *function, int typeMask, unsigned vr) {
+    const ModelDefinition *model = instance->model;
+    if (vr >= model->count) {
+        return fmu_error(instance, function, "unknown value reference %u", vr);
+    }
+    if (!(TYPE_BIT(model->variables[vr].type) & typeMask)) {
+        return fmu_error(instance, function, "%s (value reference %u) is a %s variable, which %s cannot access",
+                         model->variables[vr].name, vr, type_name(model->variables[vr].type), function);
+    }
+    return FMU_OK;
+}
+
+/* Kernel configuration from the current values. */
+static void configure(FmuInstance *instance) {
+    instance->model->configure(instance->core.values, &instance->prepared.config);
+    instance->configDirty = false;
+}
+
+static void prepare(FmuInstance *instance, double period) {
+    RlConfig config = instance->prepared.config;
+    rl_prepare(&instance->prepared, &config, period);
+}
+
+static double sub_cycle_time(const RlConfig *config) {
+    const double c = config->cycleTime.value;
+    return c > 0 && isfinite(c) ? c : 0.0;
+}
+
+/* Outputs at the start from the current parameters and inputs. */
+static void initialize_block(FmuInstance *instance) {
+    FmuCore *core = &instance->core;
+    configure(instance);
+    const double cycle = sub_cycle_time(&instance->prepared.config);
+    /* with cycleTime 0 the cycle length is only known at the first step */
+    prepare(instance, cycle > 0 ? cycle : NAN);
+    rl_init(&core->block, &instance->prepared.config, core->values[instance->model->inputVr]);
+    instance->model->publish(&core->block, &instance->prepared, core->values);
+}
+
+FmuStatus fmu_check_get(FmuInstance *instance, const char *function, int typeMask, unsigned vr) {
+    return check_variable(instance, function, typeMask, vr);
+}
+
+double fmu_get(FmuInstance *instance, unsigned vr) {
+    if (instance->core.mode == MODE_INITIALIZATION && instance->configDirty &&
+        instance->model->variables[vr].causality == FMU_OUTPUT) {
+        initialize_block(instance);
+    }
+    return instance->core.values[vr];
+}
+
+FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value) {
+    FmuStatus status = check_variable(instance, function, typeMask, vr);
+    if (status != FMU_OK) {
+        return status;
+    }
+    const FmuVariable *v = &instance->model->variables[vr];
+    if (v->causality == FMU_OUTPUT || v->causality == FMU_INDEPENDENT) {
+        return fmu_error(instance, function, "%s is an %s and cannot be set", v->name,
+                         v->causality == FMU_OUTPUT ? "output" : "independent variable");
+    }
+    if (v->variability == FMU_FIXED && !(instance->core.mode & (MODE_INSTANTIATED | MODE_INITIALIZATION))) {
+        return fmu_error(instance, function, "%s is a fixed parameter and cannot be set after initialization", v->name);
+    }
+    if (!(value >= v->min && value <= v->max)) {
+        return fmu_error(instance, function, "%s = %.17g is outside its range [%g, %g]", v->name, value, v->min, v->max);
+    }
+    return FMU_OK;
+}
+
+void fmu_set(FmuInstance *instance, unsigned vr, double value) {
+    instance->core.values[vr] = value;
+    if (vr != instance->model->inputVr) {
+        instance->configDirty = true;
+    }
+}
+
+FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime) {
+    if (!isfinite(startTime)) {
+        return fmu_error(instance, "setup", "startTime %g is not finite", startTime);
+    }
+    instance->core.startTime = startTime;
+    instance->core.time = startTime;
+    instance->core.values[0] = startTime;
+    return FMU_OK;
+}
+
+FmuStatus fmu_enter_initialization(FmuInstance *instance) {
+    instance->core.mode = MODE_INITIALIZATION;
+    instance->configDirty = true;
+    return FMU_OK;
+}
+
+/* Log a change of the status word once; an error status is a warning. */
+static FmuStatus report_status(FmuInstance *instance) {
+    const RlPrepared *p = &instance->prepared;
+    if (p->status == instance->core.reportedStatus) {
+        return p->status >= 0x8000 ? FMU_WARNING : FMU_OK;
+    }
+    instance->core.reportedStatus = p->status;
+    if (p->status >= 0x8000) {
+        const FmuVariable *cause = &instance->model->variables[p->statusSource];
+        fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds",
+                (unsigned)p->status, rl_status_text(p->status), cause->name, instance->core.values[p->statusSource]);
+        return FMU_WARNING;
+    }
+    fmu_log(instance, FMU_OK, "status 16#%04X: %s", (unsigned)p->status, rl_status_text(p->status));
+    return FMU_OK;
+}
+
+FmuStatus fmu_exit_initialization(FmuInstance *instance) {
+    initialize_block(instance);
+    instance->core.mode = MODE_STEP;
+    instance->core.cycles = 0;
+    const FmuStatus status = report_status(instance);
+    return status == FMU_WARNING ? FMU_OK : status;
+}
+
+FmuStatus fmu_do_step(FmuInstance *instance, const char *function, double t, double h) {
+    FmuCore *core = &instance->core;
+
+    if (!(h > 0) || !isfinite(h)) {
+        return fmu_error(instance, function, "communicationStepSize must be finite and > 0, not %g", h);
+    }
+    if (!isfinite(t) || fabs(t - core->time) > RL_TIME_TOLERANCE * fmax(fabs(core->time), h)) {
+        return fmu_error(instance, function, "currentCommunicationPoint %.17g is not the FMU's time %.17g", t, core->time);
+    }
+    const double end = t + h;
+    if (instance->configDirty) {
+        configure(instance);
+        instance->prepared.period = NAN;
+    }
+    const double u = core->values[instance->model->inputVr];
+    const double cycle = sub_cycle_time(&instance->prepared.config);
+
+    if (cycle > 0) {
+        /* cycle ends t0 + n*cycleTime in (t, end], each computed afresh */
+        const double last = floor((end - core->startTime) / cycle + RL_TIME_TOLERANCE);
+        const double pending = last - (double)core->cycles;
+        if (!(pending <= FMU_MAX_CYCLES_PER_STEP)) {
+            return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
+                             h, pending, cycle, FMU_MAX_CYCLES_PER_STEP);
+        }
+        if (pending >= 1) {
+            if (instance->prepared.period != cycle) {
+                prepare(instance, cycle);
+            }
+            const uint64_t lastCycle = (uint64_t)last;
+            for (uint64_t n = core->cycles + 1; n <= lastCycle; n++) {
+                rl_cycle(&core->block, &instance->prepared, u, (double)n * cycle);
+            }
+            core->cycles = lastCycle;
+            instance->model->publish(&core->block, &instance->prepared, core->values);
+        }
+    } else {
+        if (instance->prepared.period != h) {
+            prepare(instance, h);
+        }
+        rl_cycle(&core->block, &instance->prepared, u, end - core->startTime);
+        instance->model->publish(&core->block, &instance->prepared, core->values);
+    }
+    core->time = end;
+    core->values[0] = end;
+    return report_status(instance);
+}
+
+void fmu_restore(FmuInstance *instance, const FmuCore *state) {
+    instance->core = *state;
+    instance->configDirty = true;
+    instance->prepared.period = NAN;
+}
+
+/* ---- serialization ---------------------------------------------------- */
+
+static uint32_t crc32(const unsigned char *data, size_t size) {
+    uint32_t crc = 0xFFFFFFFFu;
+    for (size_t i = 0; i < size; i++) {
+        crc ^= data[i];
+        for (int k = 0; k < 8; k++) {
+            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+        }
+    }
+    return ~crc;
+}
+
+static uint32_t model_hash(const ModelDefinition *model) {
+    uint32_t hash = 2166136261u; /* FNV-1a */
+    for (const char *c = model->token; *c; c++) {
+        hash = (hash ^ (unsigned char)*c) * 16777619u;
+    }
+    return hash;
+}
+
+static unsigned char *put_u32(unsigned char *p, uint32_t v) {
+    for (int i = 0; i < 4; i++) *p++ = (unsigned char)(v >> (8 * i));
+    return p;
+}
+
+static unsigned char *put_u64(unsigned char *p, uint64_t v) {
+    for (int i = 0; i < 8; i++) *p++ = (unsigned char)(v >> (8 * i));
+    return p;
+}
+
+static unsigned char *put_f64(unsigned char *p, double v) {
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    return put_u64(p, bits);
+}
+
+static uint32_t get_u32(const unsigned char **p) {
+    uint32_t v = 0;
+    for (int i = 0; i < 4; i++) v |= (uint32_t)(*p)[i] << (8 * i);
+    *p += 4;
+    return v;
+}
+
+static uint64_t get_u64(const unsigned char **p) {
+    uint64_t v = 0;
+    for (int i = 0; i < 8; i++) v |= (uint64_t)(*p)[i] << (8 * i);
+    *p += 8;
+    return v;
+}
+
+static double get_f64(const unsigned char **p) {
+    const uint64_t bits = get_u64(p);
+    double v;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+static size_t payload_size(const ModelDefinition *model) {
+    return 4 + 8 * (size_t)model->count      /* values */
+         + 8 + 8 + 1 + 8 + 8 + 8             /* block */
+         + 8 + 8 + 8 + 4 + 4;                /* startTime, time, cycles, mode, status */
+}
+
+size_t fmu_serialized_size(const FmuInstance *instance) {
+    return SERIAL_HEADER + payload_size(instance->model) + SERIAL_TRAILER;
+}
+
+void fmu_serialize(const FmuInstance *instance, const FmuCore *s, unsigned char *out) {
+    const ModelDefinition *model = instance->model;
+    unsigned char *p = out;
+    memcpy(p, SERIAL_MAGIC, 4);
+    p += 4;
+    p = put_u32(p, SERIAL_VERSION);
+    p = put_u32(p, model_hash(model));
+    p = put_u32(p, (uint32_t)payload_size(model));
+    p = put_u32(p, model->count);
+    for (unsigned i = 0; i < model->count; i++) p = put_f64(p, s->values[i]);
+    p = put_f64(p, s->block.y);
+    p = put_f64(p, s->block.uPrevious);
+    *p++ = s->block.rampActive ? 1 : 0;
+    p = put_u64(p, s->block.runCycles);
+    p = put_f64(p, s->block.runPeriod);
+    p = put_f64(p, s->block.runBase);
+    p = put_f64(p, s->startTime);
+    p = put_f64(p, s->time);
+    p = put_u64(p, s->cycles);
+    p = put_u32(p, (uint32_t)s->mode);
+    p = put_u32(p, (uint32_t)s->reportedStatus);
+    put_u32(p, crc32(out, (size_t)(p - out)));
+}
+
+FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const unsigned char *in, size_t size, FmuCore *out) {
+    const ModelDefinition *model = instance->model;
+    const size_t expected = fmu_serialized_size(instance);
+    const unsigned char *p = in;
+
+    if (!in) {
+        return fmu_error(instance, function, "the serialized state is NULL");
+    }
+    if (size < SERIAL_HEADER || memcmp(in, SERIAL_MAGIC, 4) != 0) {
+        return fmu_error(instance, function, "not a serialized state of this FMU (%zu bytes, no header)", size);
+    }
+    p += 4;
+    const uint32_t version = get_u32(&p);
+    if (version != SERIAL_VERSION) {
+        return fmu_error(instance, function, "serialized state has format version %u; this FMU reads version %u",
+                         (unsigned)version, SERIAL_VERSION);
+    }
+    if (get_u32(&p) != model_hash(model)) {
+        return fmu_error(instance, function, "serialized state belongs to another model or version, not %s %s",
+                         model->identifier, model->token);
+    }
+    if (size != expected || get_u32(&p) != payload_size(model)) {
+        return fmu_error(instance, function, "serialized state has %zu bytes; expected %zu (truncated or padded)", size, expected);
+    }
+    const unsigned char *trailer = in + size - SERIAL_TRAILER;
+    if (crc32(in, size - SERIAL_TRAILER) != get_u32(&trailer)) {
+        return fmu_error(instance, function, "serialized state is corrupted (checksum mismatch)");
+    }
+    FmuCore s;
+    memset(&s, 0, sizeof s);
+    if (get_u32(&p) != model->count) {
+        return fmu_error(instance, function, "serialized state has the wrong number of variables");
+    }
+    for (unsigned i = 0; i < model->count; i++) s.values[i] = get_f64(&p);
+    s.block.y = get_f64(&p);
+    s.block.uPrevious = get_f64(&p);
+    s.block.rampActive = *p++ != 0;
+    s.block.runCycles = get_u64(&p);
+    s.block.runPeriod = get_f64(&p);
+    s.block.runBase = get_f64(&p);
+    s.startTime = get_f64(&p);
+    s.time = get_f64(&p);
+    s.cycles = get_u64(&p);
+    s.mode = (int)get_u32(&p);
+    s.reportedStatus = (int)get_u32(&p);
+    if (s.mode != MODE_INSTANTIATED && s.mode != MODE_INITIALIZATION && s.mode != MODE_STEP &&
+        s.mode != MODE_TERMINATED && s.mode != MODE_ERROR) {
+        return fmu_error(instance, function, "serialized state has an invalid mode %d", s.mode);
+    }
+    *out = s;
+    return FMU_OK;
+}

@@ -1,0 +1,95 @@
+/* Rate limiter kernel: the cycle logic of SPEC section 3, shared by every
+ * model. Pure C99: no FMI types, no allocation, no globals. */
+#ifndef RATE_LIMITER_H
+#define RATE_LIMITER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Status words (Siemens convention: 0x8000 and above are errors). */
+enum {
+    RL_STATUS_OK                = 0x0000,
+    RL_STATUS_RATE_NEGATIVE     = 0x8200,
+    RL_STATUS_RATE_NAN          = 0x8201,
+    RL_STATUS_RATE_PERIOD       = 0x8202,
+    RL_STATUS_DURATION          = 0x8203,
+    RL_STATUS_NO_CYCLE          = 0x8601
+};
+
+enum { RL_ZERO_RATE_HOLD = 1, RL_ZERO_RATE_NO_LIMIT = 2 };
+
+enum { RL_INIT_VALUE = 1, RL_INIT_INPUT = 2, RL_INIT_INPUT_DELAYED = 3 };
+
+/* Relative tolerance for time comparisons (cycle ends, duration, delay). */
+#define RL_TIME_TOLERANCE 1e-9
+
+/* A value and the id of the variable it came from (the caller's id, e.g. a
+ * value reference), so that an error can name its cause. */
+typedef struct {
+    double value;
+    int source;
+} RlValue;
+
+/* Everything but the signal u: parameters and slowly changing inputs, with
+ * "or Par" inputs already resolved (rl_resolve). */
+typedef struct {
+    RlValue rateUp, rateDown;  /* change per ratePeriod */
+    RlValue ratePeriod;        /* s; 0 = change per cycle */
+    RlValue duration;          /* s; 0 = never jump */
+    RlValue cycleTime;         /* s; only validated here */
+    bool bypass;
+    double bypassValue;        /* non-finite: output follows u */
+    int zeroRate;              /* RL_ZERO_RATE_* */
+    int initMode;              /* RL_INIT_* */
+    double initValue;
+    double initDelay;          /* s */
+    /* true: a non-finite u passes at once (rule 1). false (Siemens): u is
+     * only compared with the output, so NaN holds and +-inf ramps. */
+    bool passNonFinite;
+} RlConfig;
+
+/* Per-configuration values derived once, not every cycle. */
+typedef struct {
+    RlConfig config;
+    double period;             /* T the limits were computed for */
+    double maxUp, maxDown;     /* per-cycle limits; +inf = no limit */
+    double durationReached;    /* runningTime at or above this jumps */
+    double initDelayEnd;       /* elapsed time up to which initMode 3 tracks */
+    int status;
+    int statusSource;          /* id of the variable that caused status */
+} RlPrepared;
+
+/* The block's memory between cycles. runningTime is counted in whole cycles
+ * of one length (runCycles * runPeriod, plus runBase when T changed), so
+ * that it does not drift. */
+typedef struct {
+    double y;
+    double uPrevious;
+    bool rampActive;
+    uint64_t runCycles;
+    double runPeriod;
+    double runBase;
+} RlState;
+
+/* Rule 0: an "or Par" input that is NaN falls back to its parameter. */
+RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource);
+
+/* Status word of a configuration (first match of the status table). */
+int rl_status(const RlConfig *config, int *source);
+
+/* Derive limits and status for cycles of length period (> 0). */
+void rl_prepare(RlPrepared *prepared, const RlConfig *config, double period);
+
+/* Output at initialisation for the input u. */
+void rl_init(RlState *state, const RlConfig *config, double u);
+
+/* One cycle of length prepared->period; elapsed is the time from the start
+ * to the end of this cycle. */
+void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed);
+
+double rl_running_time(const RlState *state);
+
+/* Short meaning of a status word, for log messages. */
+const char *rl_status_text(int status);
+
+#endif

@@ -1,0 +1,256 @@
+#!/usr/bin/env python3
+"""Generate the FMI 2 and FMI 3 model descriptions, the FMI 3 build
+description and the C variable table of one model from its TOML file, the
+single source of truth for every variable.
+
+    generate.py MODEL.toml OUTDIR --fmi2-sources a.c ... --fmi3-sources b.c ...
+
+writes OUTDIR/fmi2/modelDescription.xml, OUTDIR/fmi3/modelDescription.xml,
+OUTDIR/fmi3/buildDescription.xml and OUTDIR/<Model>_variables.h.
+Only the Python standard library is used, so the build needs nothing else.
+"""
+import argparse
+import hashlib
+import math
+import sys
+import tomllib
+import uuid
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+GENERATION_TOOL = "rate-limiter-fmus modelDescription/generate.py"
+
+TYPES = {"Real", "Integer", "Boolean", "Enumeration"}
+CAUSALITIES = {"independent", "parameter", "input", "output"}
+VARIABILITIES = {"continuous", "discrete", "fixed", "tunable"}
+FMI3_ELEMENT = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enumeration": "Enumeration"}
+UNITS = {"s": 'BaseUnit s="1"', "1/s": 'BaseUnit s="-1"'}
+LOG_CATEGORIES = [
+    ("logStatusError", "Errors: a call that failed and why"),
+    ("logStatusWarning", "Warnings: a change of the block's status word"),
+    ("logEvents", "Information: initialisation and status cleared"),
+]
+
+
+def load(path):
+    model = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    variables = model["variable"]
+    for index, v in enumerate(variables):
+        where = f"{path}: variable {v.get('name')!r}"
+        if v["vr"] != index:
+            sys.exit(f"{where}: value references must be 0, 1, 2, ... in file order")
+        if v["type"] not in TYPES or v["causality"] not in CAUSALITIES or v["variability"] not in VARIABILITIES:
+            sys.exit(f"{where}: unknown type, causality or variability")
+        if v["type"] == "Enumeration" and v.get("declaredType") not in model.get("enumerations", {}):
+            sys.exit(f"{where}: Enumeration needs a declaredType from [enumerations]")
+        if v["causality"] in ("input", "parameter") and "start" not in v:
+            sys.exit(f"{where}: inputs and parameters need a start value")
+        if v["causality"] in ("output", "independent") and "start" in v:
+            sys.exit(f"{where}: outputs are calculated and take no start value")
+        if v.get("unit") and v["unit"] not in UNITS:
+            sys.exit(f"{where}: unit {v['unit']!r} is not defined in generate.py")
+    names = [v["name"] for v in variables]
+    if len(set(names)) != len(names):
+        sys.exit(f"{path}: variable names must be unique")
+    return model
+
+
+def token(path):
+    digest = hashlib.md5(Path(path).read_bytes()).digest()
+    return "{" + str(uuid.UUID(bytes=digest)) + "}"
+
+
+def xml_number(value):
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "NaN"
+        if math.isinf(value):
+            return "INF" if value > 0 else "-INF"
+        return repr(value)
+    return str(value)
+
+
+def c_number(value):
+    if isinstance(value, bool):
+        return "1.0" if value else "0.0"
+    value = float(value)
+    if math.isnan(value):
+        return "NAN"
+    if math.isinf(value):
+        return "INFINITY" if value > 0 else "-INFINITY"
+    return repr(value)
+
+
+def attributes(**pairs):
+    return "".join(f" {k}={quoteattr(xml_number(v) if not isinstance(v, str) else v)}"
+                   for k, v in pairs.items() if v is not None)
+
+
+def used_units(model):
+    return sorted({v["unit"] for v in model["variable"] if v.get("unit")})
+
+
+def common_head(model, version):
+    m = model["model"]
+    out = []
+    units = used_units(model)
+    if units:
+        out.append("  <UnitDefinitions>")
+        for unit in units:
+            out.append(f"    <Unit name={quoteattr(unit)}><{UNITS[unit]}/></Unit>")
+        out.append("  </UnitDefinitions>")
+    enums = model.get("enumerations", {})
+    if enums:
+        out.append("  <TypeDefinitions>")
+        for name, enum in enums.items():
+            items = "".join(f"\n{'      ' if version == 2 else '    '}  <Item{attributes(name=i['name'], value=i['value'], description=i.get('description'))}/>"
+                            for i in enum["items"])
+            if version == 2:
+                out.append(f"    <SimpleType{attributes(name=name, description=enum.get('description'))}>")
+                out.append(f"      <Enumeration>{items}\n      </Enumeration>")
+                out.append("    </SimpleType>")
+            else:
+                out.append(f"    <EnumerationType{attributes(name=name, description=enum.get('description'))}>{items}\n    </EnumerationType>")
+        out.append("  </TypeDefinitions>")
+    out.append("  <LogCategories>")
+    for name, description in LOG_CATEGORIES:
+        out.append(f"    <Category{attributes(name=name, description=description)}/>")
+    out.append("  </LogCategories>")
+    de = m.get("defaultExperiment", {})
+    out.append(f"  <DefaultExperiment{attributes(startTime=de.get('startTime'), stopTime=de.get('stopTime'), stepSize=de.get('stepSize'))}/>")
+    return out
+
+
+def fmi2_description(model, guid, sources):
+    m = model["model"]
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<fmiModelDescription fmiVersion="2.0"{attributes(modelName=m["identifier"], guid=guid, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat" numberOfEventIndicators="0">',
+           f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">',
+           "    <SourceFiles>"]
+    out += [f"      <File{attributes(name=s)}/>" for s in sources]
+    out += ["    </SourceFiles>", "  </CoSimulation>"]
+    out += common_head(model, 2)
+    out.append("  <ModelVariables>")
+    for index, v in enumerate(model["variable"], start=1):
+        out.append(f"    <!-- index {index} -->")
+        out.append(f'    <ScalarVariable{attributes(name=v["name"], valueReference=v["vr"], description=v.get("description"), causality=v["causality"], variability=v["variability"])}>')
+        element = v["type"]
+        out.append(f'      <{element}{attributes(declaredType=v.get("declaredType"), unit=v.get("unit"), min=v.get("min"), max=v.get("max"), start=v.get("start"))}/>')
+        out.append("    </ScalarVariable>")
+    out.append("  </ModelVariables>")
+    outputs = [i for i, v in enumerate(model["variable"], start=1) if v["causality"] == "output"]
+    out.append("  <ModelStructure>")
+    out.append("    <Outputs>")
+    out += [f'      <Unknown index="{i}"/>' for i in outputs]
+    out.append("    </Outputs>")
+    out.append("    <InitialUnknowns>")
+    out += [f'      <Unknown index="{i}"/>' for i in outputs]
+    out.append("    </InitialUnknowns>")
+    out.append("  </ModelStructure>")
+    out.append("</fmiModelDescription>")
+    return "\n".join(out) + "\n"
+
+
+def fmi3_description(model, instantiation_token):
+    m = model["model"]
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<fmiModelDescription fmiVersion="3.0"{attributes(modelName=m["identifier"], instantiationToken=instantiation_token, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat">',
+           f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false" hasEventMode="false" providesIntermediateUpdate="false"/>']
+    out += common_head(model, 3)
+    out.append("  <ModelVariables>")
+    for v in model["variable"]:
+        element = FMI3_ELEMENT[v["type"]]
+        out.append(f'    <{element}{attributes(name=v["name"], valueReference=v["vr"], description=v.get("description"), causality=v["causality"], variability=v["variability"], declaredType=v.get("declaredType"), unit=v.get("unit"), min=v.get("min"), max=v.get("max"), start=v.get("start"))}/>')
+    out.append("  </ModelVariables>")
+    outputs = [v["vr"] for v in model["variable"] if v["causality"] == "output"]
+    out.append("  <ModelStructure>")
+    out += [f'    <Output valueReference="{vr}"/>' for vr in outputs]
+    out += [f'    <InitialUnknown valueReference="{vr}"/>' for vr in outputs]
+    out.append("  </ModelStructure>")
+    out.append("</fmiModelDescription>")
+    return "\n".join(out) + "\n"
+
+
+def fmi3_build_description(model, sources):
+    identifier = model["model"]["identifier"]
+    files = "\n".join(f"      <SourceFile{attributes(name=s)}/>" for s in sources)
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<fmiBuildDescription fmiVersion="3.0">
+  <BuildConfiguration modelIdentifier={quoteattr(identifier)}>
+    <SourceFileSet language="C99">
+{files}
+    </SourceFileSet>
+  </BuildConfiguration>
+</fmiBuildDescription>
+"""
+
+
+C_TYPE = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER", "Boolean": "FMU_BOOLEAN", "Enumeration": "FMU_ENUMERATION"}
+C_CAUSALITY = {"independent": "FMU_INDEPENDENT", "parameter": "FMU_PARAMETER", "input": "FMU_INPUT", "output": "FMU_OUTPUT"}
+C_VARIABILITY = {"continuous": "FMU_CONTINUOUS", "discrete": "FMU_DISCRETE", "fixed": "FMU_FIXED", "tunable": "FMU_TUNABLE"}
+
+
+def c_header(model, instantiation_token, toml_name):
+    identifier = model["model"]["identifier"]
+    guard = f"{identifier.upper()}_VARIABLES_H"
+    enum = "\n".join(f"    VR_{v['name']} = {v['vr']}," for v in model["variable"])
+    rows = []
+    for v in model["variable"]:
+        low = v.get("min", -math.inf)
+        high = v.get("max", math.inf)
+        if v["type"] == "Enumeration":
+            values = [i["value"] for i in model["enumerations"][v["declaredType"]]["items"]]
+            low, high = max(min(values), low), min(max(values), high)
+        rows.append(f'    {{ "{v["name"]}", {C_TYPE[v["type"]]}, {C_CAUSALITY[v["causality"]]}, '
+                    f'{C_VARIABILITY[v["variability"]]}, {c_number(v.get("start", 0.0))}, {c_number(low)}, {c_number(high)} }},')
+    table = "\n".join(rows)
+    return f"""/* Generated by modelDescription/generate.py from {toml_name}; do not edit. */
+#ifndef {guard}
+#define {guard}
+
+#include <math.h>
+#include "fmu_core.h"
+
+#define MODEL_IDENTIFIER "{identifier}"
+#define MODEL_TOKEN "{instantiation_token}"
+
+enum {{
+{enum}
+    MODEL_VARIABLE_COUNT = {len(model["variable"])}
+}};
+
+static const FmuVariable modelVariables[MODEL_VARIABLE_COUNT] = {{
+{table}
+}};
+
+#endif
+"""
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("model", type=Path)
+    parser.add_argument("outdir", type=Path)
+    parser.add_argument("--fmi2-sources", nargs="+", default=[])
+    parser.add_argument("--fmi3-sources", nargs="+", default=[])
+    args = parser.parse_args()
+
+    model = load(args.model)
+    tok = token(args.model)
+    identifier = model["model"]["identifier"]
+    files = {
+        args.outdir / "fmi2" / "modelDescription.xml": fmi2_description(model, tok, args.fmi2_sources),
+        args.outdir / "fmi3" / "modelDescription.xml": fmi3_description(model, tok),
+        args.outdir / "fmi3" / "buildDescription.xml": fmi3_build_description(model, args.fmi3_sources),
+        args.outdir / f"{identifier}_variables.h": c_header(model, tok, args.model.name),
+    }
+    for path, text in files.items():
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if not path.exists() or path.read_text(encoding="utf-8") != text:
+            path.write_text(text, encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()
