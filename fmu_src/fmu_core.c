@@ -189,7 +189,9 @@ FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMas
     if (v->variability == FMU_FIXED && !(instance->core.mode & (MODE_INSTANTIATED | MODE_INITIALIZATION))) {
         return fmu_error(instance, function, "%s is a fixed parameter and cannot be set after initialization", v->name);
     }
-    if (!(value >= v->min && value <= v->max)) {
+    /* a declared range also refuses NaN; without one NaN means "not connected" */
+    const bool ranged = v->min > -INFINITY || v->max < INFINITY;
+    if (ranged && !(value >= v->min && value <= v->max)) {
         return fmu_error(instance, function, "%s = %.17g is outside its range [%g, %g]", v->name, value, v->min, v->max);
     }
     return FMU_OK;

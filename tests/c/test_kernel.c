@@ -1,1 +1,407 @@
-int main(void){return 0;}
+/* Unit tests of the rate limiter kernel: every rule (0 to 6) and every
+ * status code of SPEC section 3. Expected values are worked by hand. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rate_limiter.h"
+
+static int failures = 0;
+static int checks = 0;
+
+#define CHECK_EQ(actual, expected) check_eq(__FILE__, __LINE__, #actual, (double)(actual), (double)(expected))
+#define CHECK_TRUE(condition) check_eq(__FILE__, __LINE__, #condition, (condition) ? 1.0 : 0.0, 1.0)
+
+/* exact comparison; NaN equals NaN */
+static void check_eq(const char *file, int line, const char *what, double actual, double expected) {
+    checks++;
+    if (actual == expected || (isnan(actual) && isnan(expected))) return;
+    failures++;
+    printf("%s:%d: %s is %.17g, expected %.17g\n", file, line, what, actual, expected);
+}
+
+enum { SRC_RATE_UP = 2, SRC_RATE_DOWN = 3, SRC_DURATION = 6, SRC_RATE_UP_PAR = 7, SRC_RATE_DOWN_PAR = 8,
+       SRC_DURATION_PAR = 10, SRC_RATE_PERIOD = 11, SRC_CYCLE_TIME = 13 };
+
+/* The unified block's defaults: rates 1 per 1 s, no duration, init = input. */
+static RlConfig defaults(void) {
+    RlConfig c;
+    memset(&c, 0, sizeof c);
+    c.rateUp = (RlValue){ 1.0, SRC_RATE_UP_PAR };
+    c.rateDown = (RlValue){ 1.0, SRC_RATE_DOWN_PAR };
+    c.ratePeriod = (RlValue){ 1.0, SRC_RATE_PERIOD };
+    c.duration = (RlValue){ 0.0, SRC_DURATION_PAR };
+    c.cycleTime = (RlValue){ 0.0, SRC_CYCLE_TIME };
+    c.bypassValue = NAN;
+    c.zeroRate = RL_ZERO_RATE_HOLD;
+    c.initMode = RL_INIT_INPUT;
+    c.passNonFinite = true;
+    return c;
+}
+
+typedef struct {
+    RlConfig config;
+    RlPrepared prepared;
+    RlState state;
+    double period;
+    long cycles;
+} Block;
+
+static void start(Block *b, const RlConfig *c, double u, double period) {
+    b->config = *c;
+    b->period = period;
+    b->cycles = 0;
+    rl_prepare(&b->prepared, c, period);
+    rl_init(&b->state, c, u);
+}
+
+static double cycle(Block *b, double u) {
+    b->cycles++;
+    rl_cycle(&b->state, &b->prepared, u, (double)b->cycles * b->period);
+    return b->state.y;
+}
+
+static void reconfigure(Block *b, const RlConfig *c) {
+    b->config = *c;
+    rl_prepare(&b->prepared, c, b->period);
+}
+
+static void test_rule0_resolve(void) {
+    RlValue v = rl_resolve(NAN, SRC_RATE_UP, 3.0, SRC_RATE_UP_PAR);
+    CHECK_EQ(v.value, 3.0);
+    CHECK_EQ(v.source, SRC_RATE_UP_PAR);
+    v = rl_resolve(2.0, SRC_RATE_UP, 3.0, SRC_RATE_UP_PAR);
+    CHECK_EQ(v.value, 2.0);
+    CHECK_EQ(v.source, SRC_RATE_UP);
+    v = rl_resolve(INFINITY, SRC_RATE_UP, 3.0, SRC_RATE_UP_PAR); /* only NaN falls back */
+    CHECK_EQ(v.value, INFINITY);
+    v = rl_resolve(NAN, SRC_RATE_UP, NAN, SRC_RATE_UP_PAR);
+    CHECK_TRUE(isnan(v.value));
+}
+
+static void test_rule0_limits(void) {
+    RlConfig c = defaults();
+    RlPrepared p;
+    c.rateUp.value = 10.0;
+    c.rateDown.value = 4.0;
+    c.ratePeriod.value = 2.0;
+    rl_prepare(&p, &c, 0.5);           /* 10 * 0.5 / 2 and 4 * 0.5 / 2 */
+    CHECK_EQ(p.maxUp, 2.5);
+    CHECK_EQ(p.maxDown, 1.0);
+    c.ratePeriod.value = 0.0;          /* per cycle, whatever T */
+    rl_prepare(&p, &c, 0.5);
+    CHECK_EQ(p.maxUp, 10.0);
+    CHECK_EQ(p.maxDown, 4.0);
+    c.rateUp.value = INFINITY;         /* +inf: no limit */
+    rl_prepare(&p, &c, 0.5);
+    CHECK_EQ(p.maxUp, INFINITY);
+    c.rateUp.value = 0.0;              /* 0: hold (zeroRate 1) ... */
+    rl_prepare(&p, &c, 0.5);
+    CHECK_EQ(p.maxUp, 0.0);
+    c.zeroRate = RL_ZERO_RATE_NO_LIMIT; /* ... or no limit (zeroRate 2) */
+    rl_prepare(&p, &c, 0.5);
+    CHECK_EQ(p.maxUp, INFINITY);
+    CHECK_EQ(p.maxDown, 4.0);
+    /* Siemens seed: 10 per second at 1 s / 100 ms / 10 ms adds 10 / 1 / 0.1 */
+    c = defaults();
+    c.rateUp.value = 10.0;
+    rl_prepare(&p, &c, 1.0);
+    CHECK_EQ(p.maxUp, 10.0);
+    rl_prepare(&p, &c, 0.1);
+    CHECK_EQ(p.maxUp, 1.0);
+    rl_prepare(&p, &c, 0.01);
+    CHECK_EQ(p.maxUp, 0.1);
+}
+
+static void test_status_codes(void) {
+    RlConfig c = defaults();
+    int source = -1;
+    CHECK_EQ(rl_status(&c, &source), RL_STATUS_OK);
+    CHECK_EQ(source, 0);
+
+    c = defaults(); c.rateDown.value = -1.0;
+    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(source, SRC_RATE_DOWN_PAR);
+    c = defaults(); c.rateUp = (RlValue){ -0.5, SRC_RATE_UP };
+    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(source, SRC_RATE_UP);
+    c = defaults(); c.rateUp.value = -INFINITY;
+    CHECK_EQ(rl_status(&c, &source), 0x8200);
+
+    c = defaults(); c.rateUp.value = NAN;
+    CHECK_EQ(rl_status(&c, &source), 0x8201);
+    CHECK_EQ(source, SRC_RATE_UP_PAR);
+    c = defaults(); c.rateDown.value = NAN;
+    CHECK_EQ(rl_status(&c, &source), 0x8201);
+    CHECK_EQ(source, SRC_RATE_DOWN_PAR);
+    /* first match wins: a negative rate before a NaN one */
+    c = defaults(); c.rateUp.value = NAN; c.rateDown.value = -1.0;
+    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(source, SRC_RATE_DOWN_PAR);
+
+    c = defaults(); c.ratePeriod.value = -1.0;
+    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    CHECK_EQ(source, SRC_RATE_PERIOD);
+    c.ratePeriod.value = INFINITY;
+    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    c.ratePeriod.value = NAN;
+    CHECK_EQ(rl_status(&c, &source), 0x8202);
+
+    c = defaults(); c.duration = (RlValue){ -3.0, SRC_DURATION };
+    CHECK_EQ(rl_status(&c, &source), 0x8203);
+    CHECK_EQ(source, SRC_DURATION);
+    c.duration = (RlValue){ NAN, SRC_DURATION_PAR };
+    CHECK_EQ(rl_status(&c, &source), 0x8203);
+    CHECK_EQ(source, SRC_DURATION_PAR);
+    c.duration.value = INFINITY;       /* never reached, but valid */
+    CHECK_EQ(rl_status(&c, &source), RL_STATUS_OK);
+
+    c = defaults(); c.cycleTime.value = -0.01;
+    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    CHECK_EQ(source, SRC_CYCLE_TIME);
+    c.cycleTime.value = INFINITY;
+    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    c.cycleTime.value = NAN;
+    CHECK_EQ(rl_status(&c, &source), 0x8601);
+
+    /* the table's order: rate before ratePeriod before duration before cycle */
+    c = defaults(); c.cycleTime.value = -1; c.duration.value = -1; c.ratePeriod.value = -1;
+    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    c.ratePeriod.value = 1;
+    CHECK_EQ(rl_status(&c, &source), 0x8203);
+    c.duration.value = 0;
+    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    CHECK_TRUE(strlen(rl_status_text(0x8203)) > 0);
+}
+
+static void test_initialisation(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = 7.0;
+    start(&b, &c, 3.0, 1.0);
+    CHECK_EQ(b.state.y, 7.0);
+    CHECK_EQ(rl_running_time(&b.state), 0.0);
+    CHECK_EQ(cycle(&b, 3.0), 6.0);     /* ramps down from initValue at 1/s */
+    c.initMode = RL_INIT_INPUT;
+    start(&b, &c, 3.0, 1.0);
+    CHECK_EQ(b.state.y, 3.0);
+    c.initMode = RL_INIT_INPUT_DELAYED;
+    start(&b, &c, 3.0, 1.0);
+    CHECK_EQ(b.state.y, 3.0);
+}
+
+static void test_rule1_non_finite_input(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.duration.value = 100.0;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, 10.0), 1.0);
+    CHECK_EQ(rl_running_time(&b.state), 1.0);
+    CHECK_TRUE(isnan(cycle(&b, NAN)));       /* passes at once */
+    CHECK_EQ(rl_running_time(&b.state), 0.0); /* and resets runningTime */
+    CHECK_TRUE(!b.state.rampActive);
+    CHECK_EQ(cycle(&b, INFINITY), INFINITY);
+    CHECK_EQ(cycle(&b, -INFINITY), -INFINITY);
+    CHECK_EQ(cycle(&b, 5.0), 5.0);            /* rule 4: valid after invalid */
+
+    /* rule 1 wins over a configuration error (rule 5) and bypass (rule 2) */
+    c.rateUp.value = -1.0;
+    c.bypass = true;
+    c.bypassValue = 2.0;
+    reconfigure(&b, &c);
+    CHECK_TRUE(isnan(cycle(&b, NAN)));
+}
+
+static void test_siemens_comparison(void) {
+    /* passNonFinite false: u is only compared with the output */
+    Block b;
+    RlConfig c = defaults();
+    c.passNonFinite = false;
+    c.rateUp.value = c.rateDown.value = 2.0;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, 10.0), 2.0);
+    CHECK_EQ(cycle(&b, NAN), 2.0);            /* neither > nor <: hold */
+    CHECK_EQ(cycle(&b, NAN), 2.0);
+    CHECK_EQ(cycle(&b, INFINITY), 4.0);       /* ramps towards +inf */
+    CHECK_EQ(cycle(&b, -INFINITY), 2.0);
+    CHECK_EQ(cycle(&b, 3.0), 3.0);            /* a number again: ramps */
+}
+
+static void test_rule2_bypass(void) {
+    Block b;
+    RlConfig c = defaults();
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, 10.0), 1.0);
+    c.bypass = true;
+    c.bypassValue = 8.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 10.0), 8.0);           /* jumps to bypassValue */
+    CHECK_TRUE(!b.state.rampActive);
+    CHECK_EQ(rl_running_time(&b.state), 0.0);
+    c.bypassValue = NAN;                      /* no bypass value: y = u */
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 4.0), 4.0);
+    c.bypassValue = INFINITY;                 /* not finite: y = u */
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 4.5), 4.5);
+    c.bypassValue = -2.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 4.5), -2.0);
+    c.bypass = false;                         /* released: ramps from -2 */
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 4.5), -1.0);
+    CHECK_TRUE(b.state.rampActive);
+    CHECK_EQ(cycle(&b, 4.5), 0.0);
+    /* bypass wins over a configuration error */
+    c.bypass = true;
+    c.bypassValue = 9.0;
+    c.ratePeriod.value = -1.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 4.5), 9.0);
+}
+
+static void test_rule3_init_delay(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.initMode = RL_INIT_INPUT_DELAYED;
+    c.initDelay = 0.3;
+    start(&b, &c, 0.0, 0.1);
+    CHECK_EQ(cycle(&b, 5.0), 5.0);            /* ends at 0.1 */
+    CHECK_EQ(cycle(&b, -5.0), -5.0);          /* 0.2 */
+    CHECK_EQ(cycle(&b, 6.0), 6.0);            /* 3 * 0.1 = 0.30000000000000004: at 0.3 within rounding */
+    CHECK_TRUE(!b.state.rampActive);
+    CHECK_EQ(cycle(&b, 10.0), 6.1);           /* 0.4: ramps at 1/s */
+    CHECK_TRUE(b.state.rampActive);
+    /* initMode 2 ignores initDelay */
+    c.initMode = RL_INIT_INPUT;
+    start(&b, &c, 0.0, 0.1);
+    CHECK_EQ(cycle(&b, 5.0), 0.1);
+}
+
+static void test_rule4_invalid_previous_output(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = NAN;
+    start(&b, &c, 3.0, 1.0);
+    CHECK_TRUE(isnan(b.state.y));
+    CHECK_EQ(cycle(&b, 3.0), 3.0);
+    /* rule 4 comes before a configuration error */
+    c.rateUp.value = -1;
+    start(&b, &c, 3.0, 1.0);
+    CHECK_EQ(cycle(&b, 4.0), 4.0);
+}
+
+static void test_rule5_configuration_error_holds(void) {
+    Block b;
+    RlConfig c = defaults();
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, 10.0), 1.0);
+    c.rateDown.value = -1.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(b.prepared.status, 0x8200);
+    CHECK_EQ(cycle(&b, 10.0), 1.0);
+    CHECK_EQ(cycle(&b, -3.0), 1.0);
+    CHECK_TRUE(!b.state.rampActive);
+    c.rateDown.value = 1.0;                   /* fixed: ramps on from the held value */
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, -3.0), 0.0);
+}
+
+static void test_rule6_ramp(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.rateUp.value = 2.0;
+    c.rateDown.value = 0.5;
+    start(&b, &c, 0.0, 0.5);
+    CHECK_EQ(cycle(&b, 3.0), 1.0);            /* +2/s * 0.5 s */
+    CHECK_TRUE(b.state.rampActive);
+    CHECK_EQ(rl_running_time(&b.state), 0.5);
+    CHECK_EQ(cycle(&b, 3.0), 2.0);
+    CHECK_EQ(rl_running_time(&b.state), 1.0);
+    CHECK_EQ(cycle(&b, 3.0), 3.0);            /* reaches u, no overshoot */
+    CHECK_TRUE(!b.state.rampActive);
+    CHECK_EQ(rl_running_time(&b.state), 1.5);
+    CHECK_EQ(cycle(&b, 3.0), 3.0);            /* y == u: the timer value remains */
+    CHECK_EQ(rl_running_time(&b.state), 1.5);
+    CHECK_EQ(cycle(&b, 2.5), 2.75);           /* -0.5/s * 0.5 s; new u resets the timer */
+    CHECK_EQ(rl_running_time(&b.state), 0.5);
+    CHECK_EQ(cycle(&b, 2.5), 2.5);
+    CHECK_EQ(cycle(&b, 2.5), 2.5);
+    CHECK_TRUE(!b.state.rampActive);
+
+    /* zeroRate 1: a rate of 0 holds that direction only */
+    c = defaults();
+    c.rateUp.value = 0.0;
+    start(&b, &c, 1.0, 1.0);
+    CHECK_EQ(cycle(&b, 5.0), 1.0);
+    CHECK_TRUE(b.state.rampActive);
+    CHECK_EQ(cycle(&b, -5.0), 0.0);
+    /* zeroRate 2: no limit */
+    c.zeroRate = RL_ZERO_RATE_NO_LIMIT;
+    start(&b, &c, 1.0, 1.0);
+    CHECK_EQ(cycle(&b, 5.0), 5.0);
+    CHECK_TRUE(!b.state.rampActive);
+}
+
+static void test_rule6_duration(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.rateUp.value = 0.1;
+    c.duration.value = 3.0;
+    start(&b, &c, 0.0, 0.1);
+    for (int k = 1; k < 30; k++) {
+        cycle(&b, 100.0);
+        CHECK_TRUE(b.state.y < 100.0);
+    }
+    CHECK_EQ(rl_running_time(&b.state), 29 * 0.1);
+    CHECK_EQ(cycle(&b, 100.0), 100.0);        /* 30 cycles of 0.1 s reach 3 s */
+    CHECK_TRUE(!b.state.rampActive);
+    CHECK_EQ(rl_running_time(&b.state), 30 * 0.1);
+    CHECK_EQ(cycle(&b, 100.0), 100.0);
+    CHECK_EQ(rl_running_time(&b.state), 30 * 0.1); /* remains */
+
+    /* 48 h Duration at 10 ms: the jump comes at cycle 25,920,000 exactly */
+    c = defaults();
+    c.rateUp.value = 1e-9;
+    c.duration.value = 259200.0;
+    start(&b, &c, 0.0, 0.01);
+    long jump = 0;
+    for (long k = 1; k <= 25920001 && !jump; k++) {
+        if (cycle(&b, 1e6) == 1e6) jump = k;
+    }
+    CHECK_EQ(jump, 25920000);
+    CHECK_EQ(rl_running_time(&b.state), 259200.0);
+}
+
+static void test_running_time_period_change(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.rateUp.value = 0.001;
+    start(&b, &c, 0.0, 0.25);
+    cycle(&b, 1.0);
+    cycle(&b, 1.0);
+    b.period = 0.5;                           /* variable steps: T changes */
+    reconfigure(&b, &c);
+    rl_cycle(&b.state, &b.prepared, 1.0, 1.0);
+    CHECK_EQ(rl_running_time(&b.state), 1.0); /* 0.25 + 0.25 + 0.5 */
+}
+
+int main(void) {
+    test_rule0_resolve();
+    test_rule0_limits();
+    test_status_codes();
+    test_initialisation();
+    test_rule1_non_finite_input();
+    test_siemens_comparison();
+    test_rule2_bypass();
+    test_rule3_init_delay();
+    test_rule4_invalid_previous_output();
+    test_rule5_configuration_error_holds();
+    test_rule6_ramp();
+    test_rule6_duration();
+    test_running_time_period_change();
+    printf("%d passed, %d failed\n", checks - failures, failures);
+    return failures ? 1 : 0;
+}
