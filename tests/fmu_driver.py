@@ -1,0 +1,121 @@
+"""A thin, version-neutral driver over fmpy's low-level FMI 2 / FMI 3 API
+that keeps every log message the FMU sends, for the tests."""
+import os
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+from fmpy import calloc, free
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+from fmpy.fmi3 import FMU3Slave
+
+REPO = Path(__file__).resolve().parent.parent
+BUILD_DIR = Path(os.environ.get("RL_BUILD_DIR", REPO / "build"))
+
+_unzipped = {}
+
+
+def fmu_file(model, version):
+    return BUILD_DIR / f"fmi{version}" / f"{model}.fmu"
+
+
+def unzipped(model, version):
+    """The FMU extracted once per test session."""
+    key = (model, version)
+    if key not in _unzipped:
+        _unzipped[key] = extract(str(fmu_file(model, version)))
+    return _unzipped[key]
+
+
+class Instance:
+    """One FMU instance. Values are read and written by variable name."""
+
+    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None):
+        self.version = version
+        self.unzipdir = unzipdir or unzipped(model, version)
+        self.md = read_model_description(self.unzipdir)
+        self.variables = {v.name: v for v in self.md.modelVariables}
+        self.messages = []
+        self.t = 0.0
+        identifier = self.md.coSimulation.modelIdentifier
+        if version == 2:
+            self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                                 modelIdentifier=identifier, instanceName=name)
+            self.callbacks = fmi2CallbackFunctions()
+            self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log2)
+            self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+            self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+            self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging)
+        else:
+            self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                                 modelIdentifier=identifier, instanceName=name)
+            self.fmu.instantiate(loggingOn=logging, logMessage=self._log3)
+
+    def _log2(self, environment, name, status, category, message):
+        self.messages.append((status, category.decode(), message.decode()))
+
+    def _log3(self, environment, status, category, message):
+        self.messages.append((status, category.decode(), message.decode()))
+
+    def vr(self, name):
+        return self.variables[name].valueReference
+
+    def _accessors(self, variable):
+        f, kind = self.fmu, variable.type
+        if self.version == 2:
+            table = {"Real": (f.getReal, f.setReal), "Integer": (f.getInteger, f.setInteger),
+                     "Enumeration": (f.getInteger, f.setInteger), "Boolean": (f.getBoolean, f.setBoolean)}
+        else:
+            table = {"Float64": (f.getFloat64, f.setFloat64), "Int32": (f.getInt32, f.setInt32),
+                     "Enumeration": (f.getInt64, f.setInt64), "Boolean": (f.getBoolean, f.setBoolean)}
+        return table[kind]
+
+    def set(self, **values):
+        for name, value in values.items():
+            variable = self.variables[name]
+            setter = self._accessors(variable)[1]
+            if variable.type in ("Integer", "Int32", "Enumeration"):
+                value = int(value)
+            elif variable.type == "Boolean":
+                value = bool(value)
+            setter([variable.valueReference], [value])
+
+    def get(self, name):
+        variable = self.variables[name]
+        value = self._accessors(variable)[0]([variable.valueReference])[0]
+        return bool(value) if variable.type == "Boolean" else value
+
+    def outputs(self, names):
+        return {n: self.get(n) for n in names}
+
+    def start(self, start_time=0.0, **start_values):
+        """Set start values, then initialise at start_time."""
+        self.set(**start_values)
+        self.t = start_time
+        if self.version == 2:
+            self.fmu.setupExperiment(startTime=start_time)
+            self.fmu.enterInitializationMode()
+        else:
+            self.fmu.enterInitializationMode(startTime=start_time)
+        self.fmu.exitInitializationMode()
+
+    def step(self, h):
+        self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=h)
+        self.t += h
+
+    def errors(self):
+        return [m for m in self.messages if m[0] >= 3]
+
+    def free(self):
+        """Free the instance (fmpy also unloads the library)."""
+        self.fmu.freeInstance()
+
+
+def call_status(function, *args, **kwargs):
+    """The FMI status of an fmpy call: 0 if it passed, else what it raised."""
+    try:
+        function(*args, **kwargs)
+        return 0
+    except FMICallException as exception:
+        return exception.status

@@ -1,0 +1,163 @@
+"""SPEC section 5: every misuse gets an error status and one log message
+naming the function; the instance keeps its last good state, refuses
+further calls until recovered (FMU state or reset), then runs on."""
+import ctypes
+import math
+
+import pytest
+from fmpy.fmi2 import FMU2Slave
+
+from fmu_driver import Instance, call_status, unzipped
+from test_state import state_api
+
+
+def set_raw(fmu, vr, value, kind="Real"):
+    f = fmu.fmu
+    if fmu.version == 2:
+        setter = {"Real": f.setReal, "Integer": f.setInteger, "Boolean": f.setBoolean}[kind]
+    else:
+        setter = {"Real": f.setFloat64, "Integer": f.setInt64, "Boolean": f.setBoolean}[kind]
+    return call_status(setter, [vr], [value])
+
+
+def get_raw(fmu, vr, kind):
+    f = fmu.fmu
+    names = {2: {"Real": "getReal", "Integer": "getInteger", "Boolean": "getBoolean"},
+             3: {"Real": "getFloat64", "Integer": "getInt32", "Boolean": "getBoolean"}}
+    getter = getattr(f, names[fmu.version][kind])
+    return call_status(getter, [vr])
+
+
+def null_arrays(fmu):
+    f = fmu.fmu
+    if fmu.version == 2:
+        return call_status(f.fmi2SetReal, f.component, None, 1, None)
+    return call_status(f.fmi3SetFloat64, f.component, None, 1, None, 1)
+
+
+def foreign_state(fmu):
+    junk = ctypes.create_string_buffer(256)
+    return call_status(state_api(fmu)["set"], ctypes.cast(junk, ctypes.c_void_p))
+
+
+# name: (misuse, words the log message must contain)
+MISUSES = {
+    "step size zero": (lambda f: call_status(f.fmu.doStep, f.t, 0.0), "communicationStepSize"),
+    "step size negative": (lambda f: call_status(f.fmu.doStep, f.t, -0.5), "communicationStepSize"),
+    "step size NaN": (lambda f: call_status(f.fmu.doStep, f.t, math.nan), "communicationStepSize"),
+    "step size infinite": (lambda f: call_status(f.fmu.doStep, f.t, math.inf), "communicationStepSize"),
+    "communication point not the FMU's time": (lambda f: call_status(f.fmu.doStep, f.t + 0.1, 0.5), "currentCommunicationPoint"),
+    "communication point NaN": (lambda f: call_status(f.fmu.doStep, math.nan, 0.5), "currentCommunicationPoint"),
+    "unknown value reference": (lambda f: set_raw(f, 999, 1.0), "unknown value reference 999"),
+    "wrong type (get)": (lambda f: get_raw(f, f.vr("y"), "Integer"), "Real variable"),
+    "wrong type (set)": (lambda f: set_raw(f, f.vr("u"), True, "Boolean"), "Real variable"),
+    "setting an output": (lambda f: set_raw(f, f.vr("y"), 1.0), "output"),
+    "fixed parameter after initialisation": (lambda f: set_raw(f, f.vr("cycleTime"), 0.1), "fixed parameter"),
+    "enumeration out of range": (lambda f: set_raw(f, f.vr("zeroRate"), 7, "Integer"), "outside its range"),
+    "null arrays": (null_arrays, "NULL"),
+    "call in the wrong state": (lambda f: call_status(f.fmu.exitInitializationMode), "not allowed in Step Mode"),
+    "foreign FMU state": (foreign_state, "not an FMU state"),
+}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("misuse", sorted(MISUSES))
+def test_misuse_is_an_error_and_the_instance_recovers(version, misuse):
+    fmu = Instance("RateLimiter", version)
+    fmu.start(rateUpPar=2.0)
+    fmu.set(u=5.0)
+    fmu.step(0.5)                                   # y = 1
+    api = state_api(fmu)
+    good, t = api["get"](), fmu.t
+    action, words = MISUSES[misuse]
+
+    assert action(fmu) == 3
+    errors = fmu.errors()
+    assert len(errors) == 1, errors
+    assert words in errors[0][2] and f"fmi{version}" in errors[0][2], errors[0]
+
+    # the standard's Error state: no further stepping until recovered
+    assert call_status(fmu.step, 0.5) == 3
+    assert "not allowed in Error" in fmu.errors()[-1][2]
+    if version == 2:                                # FMI 2 allows get in Error: last good values
+        assert fmu.get("y") == 1.0 and fmu.get("cycleTime") == 0.0 and fmu.get("zeroRate") == 1
+    api["set"](good)
+    fmu.t = t
+    fmu.step(0.5)
+    assert fmu.get("y") == 2.0
+    api["free"](good)
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_reset_recovers_from_error(version):
+    fmu = Instance("RateLimiter", version)
+    fmu.start(rateUpPar=2.0)
+    assert call_status(fmu.fmu.doStep, 0.0, -1.0) == 3
+    fmu.fmu.reset()
+    fmu.start(rateUpPar=4.0)
+    fmu.set(u=5.0)
+    fmu.step(0.5)
+    assert fmu.get("y") == 2.0
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_nan_values_in_a_set_of_several_are_all_or_nothing(version):
+    fmu = Instance("RateLimiter", version)
+    fmu.start()
+    f = fmu.fmu
+    setter = f.setReal if version == 2 else f.setFloat64
+    assert call_status(setter, [fmu.vr("rateUpPar"), 999], [5.0, 1.0]) == 3
+    if version == 2:
+        assert fmu.get("rateUpPar") == 1.0         # the valid first value was not applied either
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_status_change_is_a_warning_logged_once(version):
+    fmu = Instance("RateLimiter", version)
+    fmu.start()
+    fmu.set(rateUpPar=-1.0)
+    for _ in range(3):
+        fmu.step(0.5)                               # runs on: a warning is not an error
+    warnings = [m for m in fmu.messages if m[0] == 1]
+    assert len(warnings) == 1 and "16#8200" in warnings[0][2] and "rateUpPar" in warnings[0][2]
+    assert fmu.get("status") == 0x8200 and fmu.get("error") is True
+    fmu.set(rateUpPar=1.0)
+    fmu.step(0.5)
+    assert fmu.get("status") == 0 and len([m for m in fmu.messages if m[0] == 1]) == 1
+    fmu.free()
+
+
+def test_wrong_guid_is_refused_with_a_message():
+    unzipdir = unzipped("RateLimiter", 2)
+    messages = []
+    fmu = FMU2Slave(guid="{00000000-0000-0000-0000-000000000000}", unzipDirectory=unzipdir,
+                    modelIdentifier="RateLimiter", instanceName="wrong")
+    from fmpy import calloc, free
+    from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
+                           fmi2CallbackLoggerTYPE)
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append(m.decode()))
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    with pytest.raises(Exception):
+        fmu.instantiate(callbacks=callbacks)
+    assert messages and "GUID" in messages[0]
+    fmu.freeLibrary()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_many_instances_are_independent(version):
+    unzipdir = unzipped("RateLimiter", version)
+    instances = [Instance("RateLimiter", version, name=f"i{k}", unzipdir=unzipdir) for k in range(50)]
+    for k, fmu in enumerate(instances):
+        fmu.start(rateUpPar=float(k + 1))
+        fmu.set(u=1000.0)
+    for fmu in instances:
+        fmu.step(1.0)
+    assert [fmu.get("y") for fmu in instances] == [float(k + 1) for k in range(50)]
+    for fmu in instances:
+        fmu.fmu.terminate()
+        fmu.fmu.fmi2FreeInstance(fmu.fmu.component) if version == 2 else fmu.fmu.fmi3FreeInstance(fmu.fmu.component)

@@ -1,0 +1,113 @@
+"""The FMUs as an importer sees them: fmpy validate, the declared
+capabilities, the TOML single source of truth against both model
+descriptions and the compiled-in C table, exported symbols, sources."""
+import math
+import subprocess
+import tomllib
+import zipfile
+
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+from fmu_driver import REPO, Instance, fmu_file, unzipped
+
+MODELS = sorted(p.stem for p in (REPO / "modelDescription").glob("*.toml"))
+FMI3_TYPE = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enumeration": "Enumeration"}
+PLATFORM = {2: "linux64", 3: "x86_64-linux"}
+
+
+def toml(model):
+    return tomllib.loads((REPO / "modelDescription" / f"{model}.toml").read_text())
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_fmpy_validate_finds_no_problem(model, version):
+    assert validate_fmu(str(fmu_file(model, version))) == []
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_capabilities(model, version):
+    cs = read_model_description(str(fmu_file(model, version))).coSimulation
+    assert cs.modelIdentifier == model
+    assert cs.canHandleVariableCommunicationStepSize
+    assert cs.canGetAndSetFMUstate
+    assert cs.canSerializeFMUstate
+    assert not cs.canBeInstantiatedOnlyOncePerProcess
+
+
+def same_start(declared, start):
+    if declared is None:
+        return start is None
+    if isinstance(declared, bool):
+        return start in ("true", "false", True, False) and (start in ("true", True)) == declared
+    a = float(start)
+    return (math.isnan(a) and math.isnan(declared)) or a == declared
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_model_description_is_the_toml(model, version):
+    source = toml(model)
+    md = read_model_description(str(fmu_file(model, version)))
+    variables = md.modelVariables
+    assert [v.name for v in variables] == [v["name"] for v in source["variable"]]
+    for v, s in zip(variables, source["variable"]):
+        assert v.valueReference == s["vr"]
+        assert v.causality == s["causality"]
+        assert v.variability == s["variability"]
+        assert v.type == (s["type"] if version == 2 else FMI3_TYPE[s["type"]])
+        assert (v.unit or (v.declaredType.unit if v.declaredType else None)) == s.get("unit")
+        assert same_start(s.get("start"), v.start), (v.name, v.start, s.get("start"))
+        if "declaredType" in s:
+            assert v.declaredType.name == s["declaredType"]
+    outputs = [v["vr"] for v in source["variable"] if v["causality"] == "output"]
+    assert [u.variable.valueReference for u in md.outputs] == outputs
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_compiled_variable_table_is_the_toml(model, version):
+    """Start values read back from the binary equal the TOML's, and every
+    output is readable, so the C table agrees with the model description."""
+    fmu = Instance(model, version)
+    try:
+        if version == 2:
+            fmu.fmu.setupExperiment(startTime=0.0)
+            fmu.fmu.enterInitializationMode()
+        else:
+            fmu.fmu.enterInitializationMode(startTime=0.0)
+        for s in toml(model)["variable"]:
+            value = fmu.get(s["name"])
+            if "start" in s:
+                assert same_start(s["start"], value), (s["name"], value)
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_binary_exports_fmi_only_and_needs_libc_only(model, version):
+    binary = f"{unzipped(model, version)}/binaries/{PLATFORM[version]}/{model}.so"
+    symbols = subprocess.run(["nm", "-D", "--defined-only", binary], capture_output=True, text=True, check=True)
+    names = [line.split()[-1] for line in symbols.stdout.splitlines()]
+    assert names and all(n.startswith(f"fmi{version}") for n in names), [n for n in names if not n.startswith("fmi")]
+    dynamic = subprocess.run(["readelf", "-d", binary], capture_output=True, text=True, check=True).stdout
+    needed = sorted(line.split("[")[1].rstrip("]") for line in dynamic.splitlines() if "(NEEDED)" in line)
+    assert set(needed) <= {"libc.so.6", "libm.so.6"}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_sources_are_shipped(model, version):
+    with zipfile.ZipFile(fmu_file(model, version)) as z:
+        names = set(z.namelist())
+    md = read_model_description(str(fmu_file(model, version)))
+    files = md.buildConfigurations[0].sourceFileSets[0].sourceFiles
+    assert f"{model}.c" in files and "rate_limiter.c" in files
+    assert all(f"sources/{f}" in names for f in files)
+    assert f"sources/{model}_variables.h" in names
+    if version == 3:
+        assert "sources/buildDescription.xml" in names
