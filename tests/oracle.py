@@ -166,3 +166,114 @@ class RateLimiterOracle:
             "status": self.status,
             "subFunctionStatus": self.vr[self.culprit] if error else 0,
         }
+
+
+# -- SPEC section 4: the vendor blocks, each read as the unified block -------
+nan = math.nan
+
+
+def siemens(v):
+    ob = v["callOB"]
+    ob_valid = 30 <= ob <= 38 or ob >= 123
+    unified = {
+        "u": v["value"], "rateUp": v["setChangeRate"], "rateDown": v["setChangeRate"],
+        "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
+        "bypass": v["enDefaultOutValue"], "bypassValue": v["defaultOutValue"], "bypassValuePar": nan,
+        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"] if ob_valid else nan,
+        "initMode": 1, "initValue": 0.0, "initDelay": 0.0,
+    }
+    culprits = {"rateUp": "setChangeRate", "rateDown": "setChangeRate", "rateUpPar": "setChangeRate",
+                "rateDownPar": "setChangeRate", "cycleTime": "cycleTime" if ob_valid else "callOB"}
+    return unified, culprits
+
+
+def irmn4(v):
+    restart = bool(v["OutSave"]) and finite(v["SavedOut"])
+    duration = v["Duration"]
+    duration_par = v["DurationPar"]
+    unified = {
+        "u": v["In"], "rateUp": v["UpRate"], "rateDown": v["DownRate"], "rateUpPar": v["UpRatePar"],
+        "rateDownPar": v["DownRatePar"], "ratePeriod": 1.0, "zeroRate": 2,
+        "bypass": v["EnableBypass"], "bypassValue": v["BypassValue"], "bypassValuePar": v["BypassValuePar"],
+        # the block's range: a longer Duration is 259200 s
+        "duration": min(duration, 259200.0) if not math.isnan(duration) else nan,
+        "durationPar": min(duration_par, 259200.0), "cycleTime": v["cycleTime"],
+        "initMode": 1 if restart else 2, "initValue": v["SavedOut"], "initDelay": 0.0,
+    }
+    culprits = {"rateUp": "UpRate", "rateDown": "DownRate", "rateUpPar": "UpRatePar",
+                "rateDownPar": "DownRatePar", "duration": "Duration", "durationPar": "DurationPar",
+                "cycleTime": "cycleTime"}
+    return unified, culprits
+
+
+def codesys(v):
+    unified = {
+        "u": v["rIn"], "rateUp": v["rVariation"], "rateDown": v["rVariation"], "rateUpPar": nan,
+        "rateDownPar": nan, "ratePeriod": v["tTime"], "zeroRate": 1, "bypass": False, "bypassValue": nan,
+        "bypassValuePar": nan, "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"],
+        "initMode": v["eInitial"], "initValue": v["rInitValue"], "initDelay": v["tInitDelay"],
+    }
+    culprits = {"rateUp": "rVariation", "rateDown": "rVariation", "ratePeriod": "tTime", "cycleTime": "cycleTime"}
+    return unified, culprits
+
+
+VENDORS = {
+    "LGF_LimRateOfChangeCI": {
+        "translate": siemens, "compare_only": True,
+        "defaults": {"value": 0.0, "setChangeRate": 0.0, "defaultOutValue": 0.0, "enDefaultOutValue": False,
+                     "callOB": 30, "cycleTime": 0.0},
+        "outputs": {"delayedValue": "y", "error": "error", "status": "status", "subFunctionStatus": "subFunctionStatus"},
+    },
+    "RateLimit": {
+        "translate": irmn4, "compare_only": False,
+        "defaults": {"EnableBypass": False, "In": 0.0, "Duration": nan, "BypassValue": nan, "UpRate": nan,
+                     "DownRate": nan, "DurationPar": 0.0, "BypassValuePar": nan, "UpRatePar": 0.0,
+                     "DownRatePar": 0.0, "OutSave": False, "SavedOut": nan, "cycleTime": 0.0},
+        "outputs": {"Out": "y", "RunningTime": "runningTime"},
+    },
+    "Ramp": {
+        "translate": codesys, "compare_only": False,
+        "defaults": {"rIn": 0.0, "rVariation": 100.0, "tTime": 10.0, "rInitValue": 0.0, "eInitial": 2,
+                     "tInitDelay": 5.0, "cycleTime": 0.0},
+        "outputs": {"rOut": "y", "xRampActive": "rampActive"},
+    },
+}
+
+
+class VendorOracle:
+    """A vendor block: its own variables, translated onto the unified oracle
+    before every step, as SPEC section 4 describes it."""
+
+    def __init__(self, model, vr, start=None, start_time=0.0):
+        self.spec = VENDORS[model]
+        self.vendor_vr = vr
+        self.values = dict(self.spec["defaults"])
+        self.values.update(start or {})
+        unified, culprits = self.spec["translate"](self.values)
+        self.unified = RateLimiterOracle(self.culprit_vrs(culprits), unified, start_time,
+                                         compare_only=self.spec["compare_only"])
+
+    def culprit_vrs(self, culprits):
+        return {name: self.vendor_vr[vendor] for name, vendor in culprits.items()}
+
+    def do_step(self, t, h, inputs=None):
+        self.values.update(inputs or {})
+        unified, culprits = self.spec["translate"](self.values)
+        self.unified.values.update(unified)
+        self.unified.vr = self.culprit_vrs(culprits)
+        self.unified.do_step(t, h)
+        return self.outputs()
+
+    def outputs(self):
+        out = self.unified.outputs()
+        return {vendor: out[name] for vendor, name in self.spec["outputs"].items()}
+
+
+def oracle_for(model, vr, start=None, start_time=0.0):
+    if model == "RateLimiter":
+        return RateLimiterOracle(vr, start, start_time)
+    return VendorOracle(model, vr, start, start_time)
+
+
+def output_names(model):
+    return list(OUTPUTS) if model == "RateLimiter" else list(VENDORS[model]["outputs"])

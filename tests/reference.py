@@ -72,18 +72,31 @@ def literal_value(literal):
     return int(number) if number.is_integer() and "." not in literal and "e" not in literal.lower() else number
 
 
+def read_inputs(path, stop_time):
+    """The input table; fmpy needs two samples, so a single row is held
+    until StopTime by a copy there (the same signal)."""
+    if not path.exists():
+        return None
+    inputs = np.atleast_1d(read_csv(path))
+    if len(inputs) == 1:
+        last = inputs.copy()
+        last["time"] = stop_time
+        inputs = np.concatenate([inputs, last])
+    return inputs
+
+
 def load(folder):
     folder = Path(folder)
     model = folder.parent.name
-    inputs_path = folder / f"{model}_in.csv"
     readme = folder / "README.md"
+    options = read_ref_opt_file(folder / f"{model}_ref.opt")
     return Scenario(
         model=model,
         name=folder.name,
         folder=folder,
-        options=read_ref_opt_file(folder / f"{model}_ref.opt"),
+        options=options,
         start_values=read_start_values(folder / f"{model}_start.csv"),
-        inputs=read_csv(inputs_path) if inputs_path.exists() else None,
+        inputs=read_inputs(folder / f"{model}_in.csv", options["StopTime"]),
         reference=read_csv(folder / f"{model}_ref.csv"),
         description=readme.read_text().strip().splitlines()[0].lstrip("# ") if readme.exists() else "",
     )

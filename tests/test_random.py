@@ -8,7 +8,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fmu_driver import Instance
-from oracle import OUTPUTS, RateLimiterOracle
+from oracle import oracle_for, output_names
 
 nan, inf = math.nan, math.inf
 SPECIAL = [0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 10.0, nan, inf, -inf]
@@ -42,30 +42,75 @@ changes = st.fixed_dictionaries({}, optional={
 })
 steps = st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), changes), min_size=1, max_size=40)
 
+cycle_times = st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0])
+times = st.sampled_from([0.0, 0.3, 1.0, 2.0, 10.0])
+VENDOR_STRATEGIES = {
+    "LGF_LimRateOfChangeCI": (
+        st.fixed_dictionaries({"value": reals, "setChangeRate": rates, "defaultOutValue": reals,
+                               "enDefaultOutValue": st.booleans(),
+                               "callOB": st.sampled_from([30, 35, 38, 123, 200, 1, 29, 39, 122, -5]),
+                               "cycleTime": cycle_times}),
+        st.fixed_dictionaries({}, optional={"value": reals, "setChangeRate": rates, "defaultOutValue": reals,
+                                            "enDefaultOutValue": st.booleans()})),
+    "RateLimit": (
+        st.fixed_dictionaries({"In": reals, "UpRatePar": rates, "DownRatePar": rates,
+                               "DurationPar": st.sampled_from([0.0, 0.5, 1.0, 3.0, 259200.0]),
+                               "BypassValuePar": st.one_of(st.just(nan), reals), "OutSave": st.booleans(),
+                               "SavedOut": st.one_of(st.just(nan), reals), "cycleTime": cycle_times}),
+        st.fixed_dictionaries({}, optional={"In": reals, "UpRate": st.one_of(st.just(nan), rates),
+                                            "DownRate": st.one_of(st.just(nan), rates),
+                                            "EnableBypass": st.booleans(),
+                                            "BypassValue": st.one_of(st.just(nan), reals),
+                                            "Duration": st.sampled_from([nan, 0.0, 0.5, 2.0, 300000.0, -1.0, inf]),
+                                            "UpRatePar": rates})),
+    "Ramp": (
+        st.fixed_dictionaries({"rIn": reals, "rVariation": st.sampled_from([0.0, 0.5, 1.0, 100.0]) | st.floats(0, 100),
+                               "tTime": times, "rInitValue": reals, "eInitial": st.sampled_from([1, 2, 3]),
+                               "tInitDelay": times, "cycleTime": cycle_times}),
+        st.fixed_dictionaries({}, optional={"rIn": reals, "rVariation": st.floats(0, 100), "tTime": times})),
+}
+
 
 def agree(fmu_value, oracle_value):
     a, b = float(fmu_value), float(oracle_value)
     return (math.isnan(a) and math.isnan(b)) or a == b
 
 
-@pytest.mark.parametrize("version", [2, 3])
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(start=parameters, run=steps)
-def test_fmu_agrees_with_oracle(version, start, run):
-    fmu = Instance("RateLimiter", version)
+def run_against_oracle(model, version, start, run):
+    fmu = Instance(model, version)
     try:
         vr = {name: fmu.vr(name) for name in fmu.variables}
         fmu.start(**start)
-        oracle = RateLimiterOracle(vr, start)
+        oracle = oracle_for(model, vr, start)
+        names = output_names(model)
         expected = oracle.outputs()
-        for name in OUTPUTS:
+        for name in names:
             assert agree(fmu.get(name), expected[name]), ("init", name, fmu.get(name), expected[name])
         for k, (h, inputs) in enumerate(run):
             t = fmu.t
             fmu.set(**inputs)
             fmu.step(h)
             expected = oracle.do_step(t, h, inputs)
-            for name in OUTPUTS:
+            for name in names:
                 assert agree(fmu.get(name), expected[name]), (k, t, h, name, fmu.get(name), expected[name])
     finally:
         fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(start=parameters, run=steps)
+def test_rate_limiter_agrees_with_oracle(version, start, run):
+    run_against_oracle("RateLimiter", version, start, run)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", sorted(VENDOR_STRATEGIES))
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_vendor_model_agrees_with_oracle(model, version, data):
+    start_strategy, change_strategy = VENDOR_STRATEGIES[model]
+    start = data.draw(start_strategy, label="start")
+    run = data.draw(st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), change_strategy),
+                             min_size=1, max_size=40), label="run")
+    run_against_oracle(model, version, start, run)

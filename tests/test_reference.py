@@ -8,16 +8,18 @@ import pytest
 
 from fmu_driver import fmu_file, unzipped
 from fmpy import read_model_description
-from oracle import RateLimiterOracle
+from oracle import oracle_for, output_names
 from reference import compare, discover, same, simulate
 
 SCENARIOS = discover()
-UNIFIED = [s for s in SCENARIOS if s.model == "RateLimiter"]
 
 
-def test_enough_hand_worked_scenarios():
-    assert len(UNIFIED) >= 12
-    for s in UNIFIED:
+@pytest.mark.parametrize("model,least", [("RateLimiter", 12), ("LGF_LimRateOfChangeCI", 8),
+                                         ("RateLimit", 8), ("Ramp", 8)])
+def test_enough_hand_worked_scenarios(model, least):
+    scenarios = [s for s in SCENARIOS if s.model == model]
+    assert len(scenarios) >= least
+    for s in scenarios:
         assert s.description, f"{s.id} has no README.md"
 
 
@@ -48,18 +50,21 @@ def inputs_at(scenario, t):
         return {}
     rows = [r for r in scenario.inputs if r["time"] < t or math.isclose(r["time"], t)]
     row = rows[-1] if rows else scenario.inputs[0]
-    return {name: (bool(row[name]) if name == "bypass" else float(row[name]))
+    return {name: (bool(row[name]) if name in BOOLEAN_INPUTS else float(row[name]))
             for name in scenario.inputs.dtype.names[1:]}
 
 
-@pytest.mark.parametrize("scenario", UNIFIED, ids=lambda s: s.id)
+BOOLEAN_INPUTS = {"bypass", "enDefaultOutValue", "EnableBypass"}
+
+
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.id)
 def test_oracle_matches_reference(scenario):
-    md = read_model_description(unzipped("RateLimiter", 2))
+    md = read_model_description(unzipped(scenario.model, 2))
     vr = {v.name: v.valueReference for v in md.modelVariables}
     t0 = scenario.options["StartTime"]
     start = dict(scenario.start_values)
     start.update(inputs_at(scenario, t0))
-    oracle = RateLimiterOracle(vr, start, t0)
+    oracle = oracle_for(scenario.model, vr, start, t0)
     trace = {t0: oracle.outputs()}
     t = t0
     for point in communication_points(scenario):

@@ -1,0 +1,35 @@
+/* LGF_LimRateOfChangeCI (Siemens, SPEC section 4): one rate per second for
+ * both directions (0 holds), enDefaultOutValue as the bypass, output from 0,
+ * a NaN value compared rather than passed, callOB validated. */
+#include "LGF_LimRateOfChangeCI_variables.h"
+
+/* the cyclic interrupt OBs: 30..38, or 123 and above */
+static bool cyclic_interrupt_ob(double ob) {
+    return (ob >= 30 && ob <= 38) || ob >= 123;
+}
+
+static void configure(const double *v, RlConfig *c) {
+    c->rateUp = c->rateDown = (RlValue){ v[VR_setChangeRate], VR_setChangeRate };
+    c->ratePeriod = (RlValue){ 1.0, VR_setChangeRate };
+    c->duration = (RlValue){ 0.0, 0 };
+    c->cycleTime = cyclic_interrupt_ob(v[VR_callOB]) ? (RlValue){ v[VR_cycleTime], VR_cycleTime }
+                                                     : (RlValue){ NAN, VR_callOB };
+    c->bypass = v[VR_enDefaultOutValue] != 0;
+    c->bypassValue = v[VR_defaultOutValue];
+    c->zeroRate = RL_ZERO_RATE_HOLD;
+    c->initMode = RL_INIT_VALUE;
+    c->initValue = 0.0;
+    c->initDelay = 0.0;
+    c->passNonFinite = false;
+}
+
+static void publish(const RlState *block, const RlPrepared *p, double *v) {
+    v[VR_delayedValue] = block->y;
+    v[VR_error] = p->status >= 0x8000;
+    v[VR_status] = p->status;
+    v[VR_subFunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
+}
+
+const ModelDefinition fmuModel = {
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_value, configure, publish
+};

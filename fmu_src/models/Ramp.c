@@ -1,0 +1,28 @@
+/* Ramp (CODESYS, SPEC section 4): rVariation per tTime in both directions,
+ * per task cycle when tTime = 0, rVariation 0 holds; eInitial and
+ * tInitDelay are the kernel's init modes. */
+#include "Ramp_variables.h"
+
+static void configure(const double *v, RlConfig *c) {
+    c->rateUp = c->rateDown = (RlValue){ v[VR_rVariation], VR_rVariation };
+    c->ratePeriod = (RlValue){ v[VR_tTime], VR_tTime };
+    c->duration = (RlValue){ 0.0, 0 };
+    c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };
+    c->bypass = false;
+    c->bypassValue = NAN;
+    c->zeroRate = RL_ZERO_RATE_HOLD;
+    c->initMode = (int)v[VR_eInitial];
+    c->initValue = v[VR_rInitValue];
+    c->initDelay = v[VR_tInitDelay];
+    c->passNonFinite = true;
+}
+
+static void publish(const RlState *block, const RlPrepared *p, double *v) {
+    (void)p;
+    v[VR_rOut] = block->y;
+    v[VR_xRampActive] = block->rampActive;
+}
+
+const ModelDefinition fmuModel = {
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_rIn, configure, publish
+};

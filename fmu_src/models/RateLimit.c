@@ -1,0 +1,35 @@
+/* RateLimit (Honeywell IRMN4, SPEC section 4): rates per second, 0 = no
+ * limit, null (NaN) inputs fall back to their parameters, Duration capped at
+ * the block's 259200 s, OutSave/SavedOut restart. */
+#include "RateLimit_variables.h"
+
+#define DURATION_MAX 259200.0
+
+static void configure(const double *v, RlConfig *c) {
+    c->rateUp = rl_resolve(v[VR_UpRate], VR_UpRate, v[VR_UpRatePar], VR_UpRatePar);
+    c->rateDown = rl_resolve(v[VR_DownRate], VR_DownRate, v[VR_DownRatePar], VR_DownRatePar);
+    c->ratePeriod = (RlValue){ 1.0, VR_UpRatePar };
+    c->duration = rl_resolve(v[VR_Duration], VR_Duration, v[VR_DurationPar], VR_DurationPar);
+    if (c->duration.value > DURATION_MAX) {
+        c->duration.value = DURATION_MAX;
+    }
+    c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };
+    c->bypass = v[VR_EnableBypass] != 0;
+    c->bypassValue = rl_resolve(v[VR_BypassValue], VR_BypassValue, v[VR_BypassValuePar], VR_BypassValuePar).value;
+    c->zeroRate = RL_ZERO_RATE_NO_LIMIT;
+    const bool restart = v[VR_OutSave] != 0 && isfinite(v[VR_SavedOut]);
+    c->initMode = restart ? RL_INIT_VALUE : RL_INIT_INPUT;
+    c->initValue = v[VR_SavedOut];
+    c->initDelay = 0.0;
+    c->passNonFinite = true;
+}
+
+static void publish(const RlState *block, const RlPrepared *p, double *v) {
+    (void)p;
+    v[VR_Out] = block->y;
+    v[VR_RunningTime] = rl_running_time(block);
+}
+
+const ModelDefinition fmuModel = {
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_In, configure, publish
+};
