@@ -111,6 +111,12 @@ class Instance:
         """Free the instance (fmpy also unloads the library)."""
         self.fmu.freeInstance()
 
+    def release(self):
+        """Free the instance but keep the library loaded, for when other
+        instances of the same FMU are still running."""
+        free_instance = self.fmu.fmi2FreeInstance if self.version == 2 else self.fmu.fmi3FreeInstance
+        free_instance(self.fmu.component)
+
 
 def call_status(function, *args, **kwargs):
     """The FMI status of an fmpy call: 0 if it passed, else what it raised."""

@@ -160,4 +160,4 @@ def test_many_instances_are_independent(version):
     assert [fmu.get("y") for fmu in instances] == [float(k + 1) for k in range(50)]
     for fmu in instances:
         fmu.fmu.terminate()
-        fmu.fmu.fmi2FreeInstance(fmu.fmu.component) if version == 2 else fmu.fmu.fmi3FreeInstance(fmu.fmu.component)
+        fmu.release()
