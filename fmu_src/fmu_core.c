@@ -224,7 +224,7 @@ FmuStatus fmu_enter_initialization(FmuInstance *instance) {
 static FmuStatus report_status(FmuInstance *instance) {
     const RlPrepared *p = &instance->prepared;
     if (p->status == instance->core.reportedStatus) {
-        return p->status >= 0x8000 ? FMU_WARNING : FMU_OK;
+        return FMU_OK;
     }
     instance->core.reportedStatus = p->status;
     if (p->status >= 0x8000) {
@@ -241,8 +241,7 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     initialize_block(instance);
     instance->core.mode = MODE_STEP;
     instance->core.cycles = 0;
-    const FmuStatus status = report_status(instance);
-    return status == FMU_WARNING ? FMU_OK : status;
+    return report_status(instance);
 }
 
 FmuStatus fmu_do_step(FmuInstance *instance, const char *function, double t, double h) {

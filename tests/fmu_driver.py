@@ -1,5 +1,6 @@
 """A thin, version-neutral driver over fmpy's low-level FMI 2 / FMI 3 API
 that keeps every log message the FMU sends, for the tests."""
+import ctypes
 import os
 from pathlib import Path
 
@@ -103,6 +104,23 @@ class Instance:
     def step(self, h):
         self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=h)
         self.t += h
+
+    def raw_step(self, h):
+        """doStep through ctypes alone, returning the FMI status (fmpy's
+        wrapper hides warnings)."""
+        dll, flag, when = self.fmu.dll, ctypes.c_bool(), ctypes.c_double()
+        if self.version == 2:
+            do_step = dll.fmi2DoStep
+            do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+            status = do_step(self.fmu.component, self.t, h, 1)
+        else:
+            do_step = dll.fmi3DoStep
+            do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [ctypes.c_void_p] * 4
+            status = do_step(self.fmu.component, self.t, h, True, ctypes.byref(flag), ctypes.byref(flag),
+                             ctypes.byref(flag), ctypes.byref(when))
+        if status <= 1:
+            self.t += h
+        return status
 
     def errors(self):
         return [m for m in self.messages if m[0] >= 3]
