@@ -189,7 +189,6 @@ fmi2Status fmi2Reset(fmi2Component c) {
 #define AS_BOOLEAN(x) ((x) != 0 ? fmi2True : fmi2False)
 #define BOOLEAN_AS_REAL(x) ((x) != fmi2False ? 1.0 : 0.0)
 #define INTEGER_TYPES (TYPE_BIT(FMU_INTEGER) | TYPE_BIT(FMU_ENUMERATION))
-#define NO_STRING(x) ((x) ? 0.0 : 0.0)
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     BEGIN(GetReal);
