@@ -1,7 +1,6 @@
 """The source FMU: binaries removed, compiled by `fmpy compile` as an
 importer on another platform would, gives the same bits as the shipped
 binary."""
-import shutil
 import subprocess
 import sys
 import zipfile
