@@ -1,6 +1,8 @@
 # add_fmu(<Model> <2|3>): build/fmi<2|3>/<Model>.fmu from the model's TOML
 # file, its mapping fmu_src/models/<Model>.c, the kernel and the shared glue.
 # The .fmu is a zip made by CMake alone, with fixed time stamps.
+# A fixture passes its own TOML, C sources (relative to the source tree) and
+# output folder: add_fmu(<Model> <2|3> TOML t SOURCES a.c ... OUTPUT_DIR d).
 
 add_custom_target(fmus ALL)
 
@@ -8,44 +10,59 @@ set(FMU_ZIP_MTIME "2000-01-01 00:00:00 UTC")
 set(GENERATOR ${CMAKE_SOURCE_DIR}/modelDescription/generate.py)
 
 function(add_fmu model version)
+  cmake_parse_arguments(PARSE_ARGV 2 ARG "" "TOML;OUTPUT_DIR" "SOURCES")
   set(gen ${CMAKE_BINARY_DIR}/gen/${model})
   set(stage ${CMAKE_BINARY_DIR}/stage/fmi${version}/${model})
   set(toml ${CMAKE_SOURCE_DIR}/modelDescription/${model}.toml)
   set(header ${gen}/${model}_variables.h)
-  set(glue fmu_src/fmi${version}_glue.c)
-  set(model_source fmu_src/models/${model}.c)
+  set(sources ${CORE_SOURCES} ${CORE_HEADERS} fmu_src/fmi${version}_glue.c fmu_src/models/${model}.c)
+  set(out_dir ${CMAKE_BINARY_DIR}/fmi${version})
+  if(ARG_TOML)
+    set(toml ${CMAKE_SOURCE_DIR}/${ARG_TOML})
+    set(sources ${ARG_SOURCES})
+    set(out_dir ${ARG_OUTPUT_DIR})
+  endif()
+  set(c_names)
+  foreach(s IN LISTS sources)
+    if(s MATCHES "\\.c$")
+      get_filename_component(n ${s} NAME)
+      list(APPEND c_names ${n})
+    endif()
+  endforeach()
   if(version EQUAL 2)
     set(platform linux64)
   else()
     set(platform x86_64-linux)
   endif()
 
-  # one generator run per model makes both versions' files
+  # one generator run per model makes both versions' files (their source
+  # lists differ only in the version named)
   if(NOT TARGET ${model}_description)
-    get_filename_component(m_name ${model_source} NAME)
+    string(REPLACE "fmi${version}" "fmi2" c_names2 "${c_names}")
+    string(REPLACE "fmi${version}" "fmi3" c_names3 "${c_names}")
     add_custom_command(
       OUTPUT ${gen}/fmi2/modelDescription.xml ${gen}/fmi3/modelDescription.xml
              ${gen}/fmi3/buildDescription.xml ${header}
       COMMAND ${Python3_EXECUTABLE} ${GENERATOR} ${toml} ${gen}
-              --fmi2-sources rate_limiter.c fmu_core.c fmi2_glue.c ${m_name}
-              --fmi3-sources rate_limiter.c fmu_core.c fmi3_glue.c ${m_name}
+              --fmi2-sources ${c_names2} --fmi3-sources ${c_names3}
       DEPENDS ${toml} ${GENERATOR}
       COMMENT "Generating the model descriptions of ${model}")
     add_custom_target(${model}_description DEPENDS ${header})
   endif()
 
   set(lib ${model}_fmi${version})
-  add_library(${lib} SHARED ${CORE_SOURCES} ${glue} ${model_source} ${header})
+  set(c_sources ${sources})
+  list(FILTER c_sources INCLUDE REGEX "\\.c$")
+  add_library(${lib} SHARED ${c_sources} ${header})
   add_dependencies(${lib} ${model}_description)
-  target_include_directories(${lib} PRIVATE fmu_src ${gen} ${FMI_HEADERS_DIR})
+  target_include_directories(${lib} PRIVATE ${CMAKE_SOURCE_DIR}/fmu_src ${gen} ${FMI_HEADERS_DIR})
   target_link_libraries(${lib} PRIVATE m)
   target_link_options(${lib} PRIVATE -Wl,-z,defs)
   set_target_properties(${lib} PROPERTIES
     OUTPUT_NAME ${model} PREFIX ""
     LIBRARY_OUTPUT_DIRECTORY ${stage}/binaries/${platform})
 
-  set(sources ${CORE_SOURCES} ${CORE_HEADERS} ${glue} ${model_source})
-  list(TRANSFORM sources PREPEND ${CMAKE_SOURCE_DIR}/)
+  list(TRANSFORM sources PREPEND ${CMAKE_SOURCE_DIR}/ REGEX "^[^/]")
   set(copies
     COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/sources
     COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
@@ -61,11 +78,11 @@ function(add_fmu model version)
   endif()
   list(SORT entries)
 
-  set(fmu ${CMAKE_BINARY_DIR}/fmi${version}/${model}.fmu)
+  set(fmu ${out_dir}/${model}.fmu)
   add_custom_command(
     OUTPUT ${fmu}
     ${copies}
-    COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/fmi${version}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${out_dir}
     COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" -- ${entries}
     WORKING_DIRECTORY ${stage}
     DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml

@@ -68,7 +68,7 @@ typedef struct {
     FmuInstance *I = (FmuInstance *)c;                                        \
     static const char FN[] = "fmi2" #name;                                    \
     if (!I) return fmi2Error;                                                 \
-    if (fmu_check_mode(I, FN, MODES_##name) != FMU_OK) return fmi2Error
+    if (!(I->core.mode & (MODES_##name))) return (fmi2Status)fmu_mode_error(I, FN)
 
 #define CHECK(expression)                                                     \
     do {                                                                      \
@@ -172,59 +172,68 @@ fmi2Status fmi2Reset(fmi2Component c) {
 
 /* ---- variable access ---------------------------------------------------- */
 
-#define GET_VALUES(TYPE_MASK, CONVERT)                                        \
-    CHECK(fmu_check_array(I, FN, nvr, vr, value));                            \
-    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
-    for (size_t i = 0; i < nvr; i++) value[i] = CONVERT(fmu_get(I, vr[i]));   \
-    return fmi2OK
-
-#define SET_VALUES(TYPE_MASK, CONVERT)                                        \
-    CHECK(fmu_check_array(I, FN, nvr, vr, value));                            \
-    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], CONVERT(value[i]))); \
-    for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], CONVERT(value[i]));   \
-    return fmi2OK
-
 #define AS_REAL(x) ((fmi2Real)(x))
 #define AS_INTEGER(x) ((fmi2Integer)(x))
 #define AS_BOOLEAN(x) ((x) != 0 ? fmi2True : fmi2False)
 #define BOOLEAN_AS_REAL(x) ((x) != fmi2False ? 1.0 : 0.0)
 #define INTEGER_TYPES (TYPE_BIT(FMU_INTEGER) | TYPE_BIT(FMU_ENUMERATION))
 
-fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    BEGIN(GetReal);
-    GET_VALUES(TYPE_BIT(FMU_REAL), AS_REAL);
-}
+/* One value is the common call: straight-line code without a frame; any
+ * other count goes through the loops (all checked before any is set). */
+#define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI, FROM_FMI)                    \
+    __attribute__((noinline)) static fmi2Status get_##NAME(FmuInstance *I, const char *FN, \
+        const fmi2ValueReference vr[], size_t nvr, TYPE value[]) {            \
+        CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
+        for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
+        for (size_t i = 0; i < nvr; i++) value[i] = TO_FMI(fmu_get(I, vr[i])); \
+        return fmi2OK;                                                        \
+    }                                                                         \
+    __attribute__((noinline)) static fmi2Status set_##NAME(FmuInstance *I, const char *FN, \
+        const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) {      \
+        CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
+        for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], FROM_FMI(value[i]))); \
+        for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], FROM_FMI(value[i])); \
+        return fmi2OK;                                                        \
+    }                                                                         \
+    fmi2Status fmi2Get##NAME(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
+        BEGIN(Get##NAME);                                                     \
+        if (nvr == 1 && vr && value) {                                        \
+            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastOutputVr) { \
+                value[0] = TO_FMI(fmu_get(I, vr[0]));                         \
+                return fmi2OK;                                                \
+            }                                                                 \
+            if (!fmu_readable(I, TYPE_MASK, vr[0]))                           \
+                return (fmi2Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], 0.0, false); \
+            value[0] = TO_FMI(fmu_get(I, vr[0]));                             \
+            return fmi2OK;                                                    \
+        }                                                                     \
+        return get_##NAME(I, FN, vr, nvr, value);                             \
+    }                                                                         \
+    fmi2Status fmi2Set##NAME(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
+        BEGIN(Set##NAME);                                                     \
+        if (nvr == 1 && vr && value) {                                        \
+            const double v_ = FROM_FMI(value[0]);                             \
+            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastInputVr) { \
+                fmu_set_input(I, v_);                                         \
+                return fmi2OK;                                                \
+            }                                                                 \
+            if (!fmu_settable(I, TYPE_MASK, vr[0], v_))                       \
+                return (fmi2Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], v_, true); \
+            fmu_set(I, vr[0], v_);                                            \
+            return fmi2OK;                                                    \
+        }                                                                     \
+        return set_##NAME(I, FN, vr, nvr, value);                             \
+    }
 
-fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-    BEGIN(GetInteger);
-    GET_VALUES(INTEGER_TYPES, AS_INTEGER);
-}
-
-fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
-    BEGIN(GetBoolean);
-    GET_VALUES(TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN);
-}
+ACCESSORS(Real, fmi2Real, TYPE_BIT(FMU_REAL), AS_REAL, AS_REAL)
+ACCESSORS(Integer, fmi2Integer, INTEGER_TYPES, AS_INTEGER, AS_REAL)
+ACCESSORS(Boolean, fmi2Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN, BOOLEAN_AS_REAL)
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
     BEGIN(GetString);
     CHECK(fmu_check_array(I, FN, nvr, vr, value));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i]));
     return fmi2OK;
-}
-
-fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    BEGIN(SetReal);
-    SET_VALUES(TYPE_BIT(FMU_REAL), AS_REAL);
-}
-
-fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-    BEGIN(SetInteger);
-    SET_VALUES(INTEGER_TYPES, AS_REAL);
-}
-
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
-    BEGIN(SetBoolean);
-    SET_VALUES(TYPE_BIT(FMU_BOOLEAN), BOOLEAN_AS_REAL);
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
@@ -262,7 +271,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     } else if (!(state = new_state(I))) {
         return (fmi2Status)fmu_error(I, FN, "out of memory");
     }
-    state->core = I->core;
+    fmu_snapshot(I, &state->core);
     *FMUstate = state;
     return fmi2OK;
 }

@@ -47,7 +47,7 @@ typedef struct {
     FmuInstance *I = (FmuInstance *)instance;                                 \
     static const char FN[] = function;                                        \
     if (!I) return fmi3Error;                                                 \
-    if (fmu_check_mode(I, FN, modes) != FMU_OK) return fmi3Error
+    if (!(I->core.mode & (modes))) return (fmi3Status)fmu_mode_error(I, FN)
 
 #define CHECK(expression)                                                     \
     do {                                                                      \
@@ -147,22 +147,53 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
     return FMU_OK;
 }
 
+/* One value is the common call: straight-line code without a frame; any
+ * other count goes through the loops (all checked before any is set). */
 #define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI)                              \
-    fmi3Status fmi3Get##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
-                             TYPE values[], size_t nValues) {                 \
-        BEGIN("fmi3Get" #NAME, MODES_Get);                                    \
+    __attribute__((noinline)) static fmi3Status get_##NAME(FmuInstance *I, const char *FN, \
+        const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
         CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) values[i] = TO_FMI(fmu_get(I, vr[i])); \
         return fmi3OK;                                                        \
     }                                                                         \
-    fmi3Status fmi3Set##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
-                             const TYPE values[], size_t nValues) {           \
-        BEGIN("fmi3Set" #NAME, MODES_Set);                                    \
+    __attribute__((noinline)) static fmi3Status set_##NAME(FmuInstance *I, const char *FN, \
+        const fmi3ValueReference vr[], size_t nvr, const TYPE values[], size_t nValues) { \
         CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], (double)values[i])); \
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], (double)values[i]); \
         return fmi3OK;                                                        \
+    }                                                                         \
+    fmi3Status fmi3Get##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
+                             TYPE values[], size_t nValues) {                 \
+        BEGIN("fmi3Get" #NAME, MODES_Get);                                    \
+        if (nvr == 1 && nValues == 1 && vr && values) {                       \
+            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastOutputVr) { \
+                values[0] = TO_FMI(fmu_get(I, vr[0]));                        \
+                return fmi3OK;                                                \
+            }                                                                 \
+            if (!fmu_readable(I, TYPE_MASK, vr[0]))                           \
+                return (fmi3Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], 0.0, false); \
+            values[0] = TO_FMI(fmu_get(I, vr[0]));                            \
+            return fmi3OK;                                                    \
+        }                                                                     \
+        return get_##NAME(I, FN, vr, nvr, values, nValues);                   \
+    }                                                                         \
+    fmi3Status fmi3Set##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
+                             const TYPE values[], size_t nValues) {           \
+        BEGIN("fmi3Set" #NAME, MODES_Set);                                    \
+        if (nvr == 1 && nValues == 1 && vr && values) {                       \
+            const double v_ = (double)values[0];                              \
+            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastInputVr) { \
+                fmu_set_input(I, v_);                                         \
+                return fmi3OK;                                                \
+            }                                                                 \
+            if (!fmu_settable(I, TYPE_MASK, vr[0], v_))                       \
+                return (fmi3Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], v_, true); \
+            fmu_set(I, vr[0], v_);                                            \
+            return fmi3OK;                                                    \
+        }                                                                     \
+        return set_##NAME(I, FN, vr, nvr, values, nValues);                   \
     }
 
 #define AS_FLOAT64(x) (x)
@@ -245,7 +276,9 @@ static FmuStatus store_state(FmuInstance *I, const char *function, fmi3FMUState 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
     BEGIN("fmi3GetFMUState", MODES_GetFMUState);
     if (!FMUState) return (fmi3Status)fmu_error(I, FN, "the FMU state pointer is NULL");
-    return (fmi3Status)store_state(I, FN, FMUState, &I->core);
+    FmuCore core;
+    fmu_snapshot(I, &core);
+    return (fmi3Status)store_state(I, FN, FMUState, &core);
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) {

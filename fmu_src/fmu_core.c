@@ -1,5 +1,7 @@
 #include "fmu_core.h"
 
+#include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -49,6 +51,15 @@ void fmu_reset(FmuInstance *instance) {
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
     instance->configDirty = true;
+    instance->fastPeriod = NAN;
+    instance->outputsStale = false;
+    instance->cycleTime = 0.0;
+    instance->subCycling = false;
+    instance->inputVr = model->inputVr;
+    const FmuVariable *u = &model->variables[model->inputVr], *y = &model->variables[model->outputVr];
+    instance->fastInputVr = u->type == FMU_REAL && u->causality == FMU_INPUT && u->variability != FMU_FIXED &&
+                            u->min == -INFINITY && u->max == INFINITY ? model->inputVr : UINT_MAX;
+    instance->fastOutputVr = y->type == FMU_REAL && y->causality == FMU_OUTPUT ? model->outputVr : UINT_MAX;
 }
 
 static void log_message(FmuInstance *instance, FmuStatus status, const char *fmt, va_list args) {
@@ -108,80 +119,28 @@ FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt
     return FMU_ERROR;
 }
 
-FmuStatus fmu_check_mode(FmuInstance *instance, const char *function, int allowedModes) {
-    if (instance->core.mode & allowedModes) {
-        return FMU_OK;
-    }
+FmuStatus fmu_mode_error(FmuInstance *instance, const char *function) {
     return fmu_error(instance, function, "not allowed in %s", fmu_mode_name(instance->core.mode));
 }
 
-FmuStatus fmu_check_array(FmuInstance *instance, const char *function, size_t n, const void *vr, const void *values) {
-    if (n > 0 && !vr) {
-        return fmu_error(instance, function, "the value reference array is NULL");
-    }
-    if (n > 0 && !values) {
-        return fmu_error(instance, function, "the value array is NULL");
-    }
-    return FMU_OK;
+FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr) {
+    return fmu_error(instance, function, vr ? "the value array is NULL" : "the value reference array is NULL");
 }
 
-static FmuStatus check_variable(FmuInstance *instance, const char *function, int typeMask, unsigned vr) {
+/* Why fmu_check_get or fmu_check_set refused a value reference. */
+FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set) {
     const ModelDefinition *model = instance->model;
     if (vr >= model->count) {
         return fmu_error(instance, function, "unknown value reference %u", vr);
     }
-    if (!(TYPE_BIT(model->variables[vr].type) & typeMask)) {
+    const FmuVariable *v = &model->variables[vr];
+    if (!(TYPE_BIT(v->type) & typeMask)) {
         return fmu_error(instance, function, "%s (value reference %u) is a %s variable, which %s cannot access",
-                         model->variables[vr].name, vr, type_name(model->variables[vr].type), function);
+                         v->name, vr, type_name(v->type), function);
     }
-    return FMU_OK;
-}
-
-/* Kernel configuration from the current values. */
-static void configure(FmuInstance *instance) {
-    instance->model->configure(instance->core.values, &instance->prepared.config);
-    instance->configDirty = false;
-}
-
-static void prepare(FmuInstance *instance, double period) {
-    RlConfig config = instance->prepared.config;
-    rl_prepare(&instance->prepared, &config, period);
-}
-
-static double sub_cycle_time(const RlConfig *config) {
-    const double c = config->cycleTime.value;
-    return c > 0 && isfinite(c) ? c : 0.0;
-}
-
-/* Outputs at the start from the current parameters and inputs. */
-static void initialize_block(FmuInstance *instance) {
-    FmuCore *core = &instance->core;
-    configure(instance);
-    const double cycle = sub_cycle_time(&instance->prepared.config);
-    /* with cycleTime 0 the cycle length is only known at the first step */
-    prepare(instance, cycle > 0 ? cycle : NAN);
-    rl_init(&core->block, &instance->prepared.config, core->values[instance->model->inputVr]);
-    instance->model->publish(&core->block, &instance->prepared, core->values);
-}
-
-FmuStatus fmu_check_get(FmuInstance *instance, const char *function, int typeMask, unsigned vr) {
-    return check_variable(instance, function, typeMask, vr);
-}
-
-double fmu_get(FmuInstance *instance, unsigned vr) {
-    if (instance->core.mode == MODE_INITIALIZATION && instance->configDirty &&
-        instance->model->variables[vr].causality == FMU_OUTPUT) {
-        initialize_block(instance);
+    if (!set) {
+        return fmu_error(instance, function, "%s cannot be read", v->name);
     }
-    return instance->core.values[vr];
-}
-
-FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value) {
-    FmuStatus status = check_variable(instance, function, typeMask, vr);
-    if (status != FMU_OK) {
-        return status;
-    }
-    const FmuVariable *v = &instance->model->variables[vr];
     if (v->causality == FMU_OUTPUT || v->causality == FMU_INDEPENDENT) {
         return fmu_error(instance, function, "%s is an %s and cannot be set", v->name,
                          v->causality == FMU_OUTPUT ? "output" : "independent variable");
@@ -189,19 +148,57 @@ FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMas
     if (v->variability == FMU_FIXED && !(instance->core.mode & (MODE_INSTANTIATED | MODE_INITIALIZATION))) {
         return fmu_error(instance, function, "%s is a fixed parameter and cannot be set after initialization", v->name);
     }
-    /* a declared range also refuses NaN; without one NaN means "not connected" */
-    const bool ranged = v->min > -INFINITY || v->max < INFINITY;
-    if (ranged && !(value >= v->min && value <= v->max)) {
-        return fmu_error(instance, function, "%s = %.17g is outside its range [%g, %g]", v->name, value, v->min, v->max);
-    }
-    return FMU_OK;
+    return fmu_error(instance, function, "%s = %.17g is outside its range [%g, %g]", v->name, value, v->min, v->max);
 }
 
-void fmu_set(FmuInstance *instance, unsigned vr, double value) {
-    instance->core.values[vr] = value;
-    if (vr != instance->model->inputVr) {
-        instance->configDirty = true;
+/* Kernel configuration from the current values; the cycle length and
+ * limits are derived again at the next cycle. */
+__attribute__((noinline)) static void configure(FmuInstance *instance) {
+    instance->model->configure(instance->core.values, &instance->prepared.config);
+    const double c = instance->prepared.config.cycleTime.value;
+    instance->cycleTime = c > 0 && isfinite(c) ? c : 0.0;
+    instance->subCycling = instance->cycleTime > 0;
+    instance->prepared.period = NAN;
+    instance->configDirty = false;
+}
+
+/* not inline: keeps the step's frame small */
+__attribute__((noinline)) static void prepare(FmuInstance *instance, double period) {
+    instance->fastPeriod = NAN;
+    RlConfig config = instance->prepared.config;
+    rl_prepare(&instance->prepared, &config, period);
+    /* the status is known from here; the block's outputs after a cycle */
+    if (instance->model->publishStatus) {
+        instance->model->publishStatus(&instance->prepared, instance->core.values);
     }
+}
+
+static void publish(FmuInstance *instance) {
+    instance->model->publish(&instance->core.block, instance->core.values);
+    instance->outputsStale = false;
+}
+
+/* Outputs at the start from the current parameters and inputs. */
+static void initialize_block(FmuInstance *instance) {
+    FmuCore *core = &instance->core;
+    configure(instance);
+    /* with cycleTime 0 the cycle length is only known at the first step */
+    prepare(instance, instance->cycleTime > 0 ? instance->cycleTime : NAN);
+    rl_init(&core->block, &instance->prepared.config, core->values[instance->model->inputVr]);
+    publish(instance);
+}
+
+void fmu_refresh_outputs(FmuInstance *instance) {
+    if (instance->core.mode == MODE_INITIALIZATION) {
+        initialize_block(instance);
+    } else {
+        publish(instance);
+    }
+}
+
+void fmu_snapshot(FmuInstance *instance, FmuCore *state) {
+    if (instance->outputsStale) fmu_refresh_outputs(instance);
+    *state = instance->core;
 }
 
 FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime) {
@@ -217,15 +214,14 @@ FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime) {
 FmuStatus fmu_enter_initialization(FmuInstance *instance) {
     instance->core.mode = MODE_INITIALIZATION;
     instance->configDirty = true;
+    instance->fastPeriod = NAN;
+    instance->outputsStale = true;
     return FMU_OK;
 }
 
 /* Log a change of the status word once; an error status is a warning. */
-static FmuStatus report_status(FmuInstance *instance) {
+__attribute__((noinline)) static FmuStatus log_status(FmuInstance *instance) {
     const RlPrepared *p = &instance->prepared;
-    if (p->status == instance->core.reportedStatus) {
-        return FMU_OK;
-    }
     instance->core.reportedStatus = p->status;
     if (p->status >= 0x8000) {
         const FmuVariable *cause = &instance->model->variables[p->statusSource];
@@ -237,6 +233,11 @@ static FmuStatus report_status(FmuInstance *instance) {
     return FMU_OK;
 }
 
+static inline FmuStatus report_status(FmuInstance *instance) {
+    return instance->prepared.status == instance->core.reportedStatus ? FMU_OK : log_status(instance);
+}
+
+
 FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     initialize_block(instance);
     instance->core.mode = MODE_STEP;
@@ -244,58 +245,70 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     return report_status(instance);
 }
 
-FmuStatus fmu_do_step(FmuInstance *instance, const char *function, double t, double h) {
+/* Sub-cycling (cycleTime > 0): the cycles that end in (t, end], each end
+ * t0 + n*cycleTime computed afresh from the whole cycle count n. */
+__attribute__((noinline)) static FmuStatus run_cycles(FmuInstance *instance, const char *function, double end, double h, double u) {
+    FmuCore *core = &instance->core;
+    const double cycle = instance->cycleTime;
+    const double last = floor((end - core->startTime) / cycle + RL_TIME_TOLERANCE);
+    const double pending = last - (double)core->cycles;
+    if (!(pending <= FMU_MAX_CYCLES_PER_STEP)) {
+        return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
+                         h, pending, cycle, FMU_MAX_CYCLES_PER_STEP);
+    }
+    if (pending >= 1) {
+        if (instance->prepared.period != cycle) {
+            prepare(instance, cycle);
+        }
+        rl_run(&core->block, &instance->prepared, u, core->cycles + 1, (uint64_t)last, cycle);
+        core->cycles = (uint64_t)last;
+        instance->outputsStale = true;
+    }
+    return FMU_OK;
+}
+
+/* Every step but the common one: checks that failed, a changed
+ * configuration or step size, sub-cycling, a status to report. */
+FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h) {
     FmuCore *core = &instance->core;
 
-    if (!(h > 0) || !isfinite(h)) {
+    if (!(h > 0 && h <= DBL_MAX)) {
         return fmu_error(instance, function, "communicationStepSize must be finite and > 0, not %g", h);
     }
-    if (!isfinite(t) || fabs(t - core->time) > RL_TIME_TOLERANCE * fmax(fabs(core->time), h)) {
+    if (!fmu_time_matches(t, core->time, h)) {
         return fmu_error(instance, function, "currentCommunicationPoint %.17g is not the FMU's time %.17g", t, core->time);
     }
-    const double end = t + h;
     if (instance->configDirty) {
         configure(instance);
-        instance->prepared.period = NAN;
     }
+    const double end = t + h;
     const double u = core->values[instance->model->inputVr];
-    const double cycle = sub_cycle_time(&instance->prepared.config);
-
-    if (cycle > 0) {
-        /* cycle ends t0 + n*cycleTime in (t, end], each computed afresh */
-        const double last = floor((end - core->startTime) / cycle + RL_TIME_TOLERANCE);
-        const double pending = last - (double)core->cycles;
-        if (!(pending <= FMU_MAX_CYCLES_PER_STEP)) {
-            return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
-                             h, pending, cycle, FMU_MAX_CYCLES_PER_STEP);
-        }
-        if (pending >= 1) {
-            if (instance->prepared.period != cycle) {
-                prepare(instance, cycle);
-            }
-            const uint64_t lastCycle = (uint64_t)last;
-            for (uint64_t n = core->cycles + 1; n <= lastCycle; n++) {
-                rl_cycle(&core->block, &instance->prepared, u, (double)n * cycle);
-            }
-            core->cycles = lastCycle;
-            instance->model->publish(&core->block, &instance->prepared, core->values);
-        }
+    if (instance->cycleTime > 0) {
+        if (run_cycles(instance, function, end, h, u) != FMU_OK) return FMU_ERROR;
     } else {
+        /* one cycle of length h */
         if (instance->prepared.period != h) {
             prepare(instance, h);
         }
         rl_cycle(&core->block, &instance->prepared, u, end - core->startTime);
-        instance->model->publish(&core->block, &instance->prepared, core->values);
+        instance->outputsStale = true;
     }
     core->time = end;
     core->values[0] = end;
+    if (!instance->subCycling) {
+        instance->fastPeriod = h; /* prepared for h, configuration current */
+        instance->fastTolerance = RL_TIME_TOLERANCE * h;
+    }
     return report_status(instance);
 }
 
 void fmu_restore(FmuInstance *instance, const FmuCore *state) {
     instance->core = *state;
     instance->configDirty = true;
+    instance->fastPeriod = NAN;
     instance->prepared.period = NAN;
+    /* a state taken in Initialization Mode initializes again on a get */
+    instance->outputsStale = state->mode == MODE_INITIALIZATION;
 }
 
 /* ---- serialization ---------------------------------------------------- */

@@ -5,6 +5,7 @@
 #ifndef FMU_CORE_H
 #define FMU_CORE_H
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -56,8 +57,11 @@ typedef struct {
     const FmuVariable *variables;
     unsigned count;
     unsigned inputVr;  /* the cycle input u */
+    unsigned outputVr; /* the output y: the block's state y */
     void (*configure)(const double *values, RlConfig *config);
-    void (*publish)(const RlState *block, const RlPrepared *prepared, double *values);
+    /* outputs of the block's state, and (NULL: none) of the status */
+    void (*publish)(const RlState *block, double *values);
+    void (*publishStatus)(const RlPrepared *prepared, double *values);
 } ModelDefinition;
 
 extern const ModelDefinition fmuModel;
@@ -80,6 +84,18 @@ struct FmuInstance {
     FmuCore core;
     RlPrepared prepared;
     bool configDirty;       /* a parameter or input other than u changed */
+    bool outputsStale;      /* cycles ran since the outputs were published */
+    bool subCycling;        /* cycleTime > 0 */
+    /* Step size of the common step (fmu_step_fast), NaN until a step has
+     * prepared it and whenever anything it relies on changes; and its
+     * time tolerance, RL_TIME_TOLERANCE * h, never more than the general
+     * step's (which adds |time|), so the fast step accepts less, not more. */
+    double fastPeriod, fastTolerance;
+    double cycleTime;       /* sub-cycle length, 0 = one cycle per step */
+    unsigned inputVr;       /* model->inputVr, one load nearer */
+    /* The calls of every step need no table lookup: u when it is an
+     * unranged Real input, y when it is a Real output (else UINT_MAX). */
+    unsigned fastInputVr, fastOutputVr;
     const ModelDefinition *model;
     FmuLogFunction *logFunction;
     int logCategories;      /* enabled categories */
@@ -101,30 +117,139 @@ FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, boo
 /* The single error path: log why, enter the error mode, return FMU_ERROR. */
 FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt, ...);
 
-/* State table check: FMU_OK, or logs and returns FMU_ERROR. */
-FmuStatus fmu_check_mode(FmuInstance *instance, const char *function, int allowedModes);
+/* The checks on the path of every set, doStep and get are inline, and
+ * their error paths (which say why) are not: a call that passes costs a
+ * few compares. */
 
-FmuStatus fmu_check_array(FmuInstance *instance, const char *function, size_t n, const void *vr, const void *values);
+/* Out-of-line error paths of the inline checks below. */
+__attribute__((cold)) FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
+FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr);
+__attribute__((cold)) FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set);
+/* Publish the outputs (Initialization Mode: initialize the block first). */
+void fmu_refresh_outputs(FmuInstance *instance);
+
+/* State table check: FMU_OK, or logs and returns FMU_ERROR. */
+static inline FmuStatus fmu_check_mode(FmuInstance *instance, const char *function, int allowedModes) {
+    return (instance->core.mode & allowedModes) ? FMU_OK : fmu_mode_error(instance, function);
+}
+
+static inline FmuStatus fmu_check_array(FmuInstance *instance, const char *function, size_t n, const void *vr,
+                                        const void *values) {
+    return n == 0 || (vr && values) ? FMU_OK : fmu_array_error(instance, function, vr);
+}
 
 /* Variable access, value by value, values carried as double: every type
  * here (Real, Integer, Boolean, Enumeration) is exact in a double.
  * fmu_check_set validates one value without changing anything, so that a
  * call setting several values is all or nothing. */
 #define TYPE_BIT(type) (1 << (type))
-FmuStatus fmu_check_get(FmuInstance *instance, const char *function, int typeMask, unsigned vr);
-double fmu_get(FmuInstance *instance, unsigned vr);
-FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value);
-void fmu_set(FmuInstance *instance, unsigned vr, double value);
+
+static inline bool fmu_readable(const FmuInstance *instance, int typeMask, unsigned vr) {
+    const ModelDefinition *model = instance->model;
+    return vr < model->count && (TYPE_BIT(model->variables[vr].type) & typeMask);
+}
+
+static inline FmuStatus fmu_check_get(FmuInstance *instance, const char *function, int typeMask, unsigned vr) {
+    return fmu_readable(instance, typeMask, vr) ? FMU_OK : fmu_access_error(instance, function, typeMask, vr, 0.0, false);
+}
+
+/* Outputs are published when read, not after every step: a step costs no
+ * stores that nobody reads. The block's output is its state y; the others
+ * are published together. In Initialization Mode they follow the inputs
+ * and parameters set so far. */
+static inline double fmu_get(FmuInstance *instance, unsigned vr) {
+    if (instance->outputsStale) {
+        if (vr == instance->model->outputVr && instance->core.mode != MODE_INITIALIZATION) {
+            return instance->core.block.y;
+        }
+        if (instance->model->variables[vr].causality == FMU_OUTPUT) {
+            fmu_refresh_outputs(instance);
+        }
+    }
+    return instance->core.values[vr];
+}
+
+/* A declared range also refuses NaN; without one NaN means "not connected". */
+static inline bool fmu_in_range(const FmuVariable *v, double value) {
+    return (value >= v->min && value <= v->max) || (v->min == -INFINITY && v->max == INFINITY);
+}
+
+static inline bool fmu_settable(const FmuInstance *instance, int typeMask, unsigned vr, double value) {
+    const ModelDefinition *model = instance->model;
+    if (vr >= model->count) {
+        return false;
+    }
+    const FmuVariable *v = &model->variables[vr];
+    return (TYPE_BIT(v->type) & typeMask) && (v->causality == FMU_INPUT || v->causality == FMU_PARAMETER) &&
+           (v->variability != FMU_FIXED || (instance->core.mode & (MODE_INSTANTIATED | MODE_INITIALIZATION))) &&
+           fmu_in_range(v, value);
+}
+
+static inline FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMask, unsigned vr,
+                                      double value) {
+    return fmu_settable(instance, typeMask, vr, value) ? FMU_OK
+                                                       : fmu_access_error(instance, function, typeMask, vr, value, true);
+}
+
+/* fmu_set of u when vr == fastInputVr: nothing to check. */
+static inline void fmu_set_input(FmuInstance *instance, double value) {
+    instance->core.values[instance->inputVr] = value;
+    if (instance->core.mode == MODE_INITIALIZATION) {
+        instance->outputsStale = true;
+    }
+}
+
+static inline void fmu_set(FmuInstance *instance, unsigned vr, double value) {
+    instance->core.values[vr] = value;
+    if (vr != instance->inputVr) {
+        instance->configDirty = true;
+        instance->fastPeriod = NAN;
+    }
+    if (instance->core.mode == MODE_INITIALIZATION) {
+        instance->outputsStale = true;
+    }
+}
 
 FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime);
 FmuStatus fmu_enter_initialization(FmuInstance *instance);
 FmuStatus fmu_exit_initialization(FmuInstance *instance);
-FmuStatus fmu_do_step(FmuInstance *instance, const char *function, double t, double h);
+/* currentCommunicationPoint within rounding of the FMU's time (NaN and
+ * infinity are not) */
+static inline bool fmu_time_matches(double t, double time, double h) {
+    return fabs(t - time) <= RL_TIME_TOLERANCE * (fabs(time) + h);
+}
+
+/* The common step, inline in the glue: the same step size as the step
+ * before (so h is valid), no sub-cycling, nothing changed but u. False:
+ * nothing done, take fmu_do_step. */
+static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
+    FmuCore *core = &instance->core;
+    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance)) {
+        return false;
+    }
+    const double end = t + h;
+    /* stores first: the kernel call is then the last thing done */
+    instance->outputsStale = true;
+    core->time = end;
+    core->values[0] = end;
+    rl_cycle(&core->block, &instance->prepared, core->values[instance->inputVr], end - core->startTime);
+    return true; /* no status change: that needs a new configuration */
+}
+
+/* Any step, with every check and the status report. */
+FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h);
+
+static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function, double t, double h) {
+    return fmu_step_fast(instance, t, h) ? FMU_OK : fmu_do_step_general(instance, function, t, h);
+}
 
 /* Serialized FMU state: header, payload, CRC-32. */
 size_t fmu_serialized_size(const FmuInstance *instance);
 void fmu_serialize(const FmuInstance *instance, const FmuCore *state, unsigned char *out);
 FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const unsigned char *in, size_t size, FmuCore *out);
+
+/* The current core, outputs published, for an FMU state. */
+void fmu_snapshot(FmuInstance *instance, FmuCore *state);
 
 /* Make a restored core the current one. */
 void fmu_restore(FmuInstance *instance, const FmuCore *state);

@@ -1,5 +1,6 @@
 #include "rate_limiter.h"
 
+#include <float.h>
 #include <math.h>
 
 RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource) {
@@ -56,24 +57,19 @@ void rl_prepare(RlPrepared *p, const RlConfig *c, double period) {
     p->maxDown = cycle_limit(c->rateDown.value, c, period);
     p->durationReached = c->duration.value * (1.0 - RL_TIME_TOLERANCE);
     p->initDelayEnd = c->initDelay + RL_TIME_TOLERANCE * period;
+    p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && p->status < 0x8000;
+    p->durationLimited = c->duration.value > 0;
+}
+
+void rl_period_changed(RlState *s, double period) {
+    s->runBase += (double)s->runCycles * s->runPeriod;
+    s->runCycles = 0;
+    s->runPeriod = period;
 }
 
 static void running_reset(RlState *s) {
     s->runCycles = 0;
     s->runBase = 0.0;
-}
-
-static void running_add(RlState *s, double period) {
-    if (period != s->runPeriod) {
-        s->runBase += (double)s->runCycles * s->runPeriod;
-        s->runCycles = 0;
-        s->runPeriod = period;
-    }
-    s->runCycles++;
-}
-
-double rl_running_time(const RlState *s) {
-    return s->runBase + (double)s->runCycles * s->runPeriod;
 }
 
 void rl_init(RlState *s, const RlConfig *c, double u) {
@@ -85,34 +81,9 @@ void rl_init(RlState *s, const RlConfig *c, double u) {
     s->runBase = 0.0;
 }
 
-/* Rule 6: ramp towards u, or jump once the duration has run out. */
-static double ramp(RlState *s, const RlPrepared *p, double u) {
-    const double yp = s->y;
-
-    if (u != s->uPrevious) {
-        running_reset(s);
-    }
-    if (yp != u) {
-        running_add(s, p->period);
-    }
-    if (p->config.duration.value > 0 && rl_running_time(s) >= p->durationReached) {
-        return u;
-    }
-    if (u > yp) {
-        const double limited = yp + p->maxUp;
-        return limited < u ? limited : u;
-    }
-    if (u < yp) {
-        const double limited = yp - p->maxDown;
-        return limited > u ? limited : u;
-    }
-    return yp;
-}
-
-void rl_cycle(RlState *s, const RlPrepared *p, double u, double elapsed) {
+void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
     const RlConfig *c = &p->config;
     double y;
-    bool ruled = false; /* decided by rule 6 */
 
     if (c->passNonFinite && !isfinite(u)) {
         y = u;
@@ -129,13 +100,45 @@ void rl_cycle(RlState *s, const RlPrepared *p, double u, double elapsed) {
     } else if (p->status >= 0x8000) {
         y = s->y;
     } else {
-        y = ramp(s, p, u);
-        ruled = true;
+        rl_ramp(s, p, u);
+        return;
     }
-
-    s->rampActive = ruled && y != u;
+    s->rampActive = false;
     s->y = y;
     s->uPrevious = u;
+}
+
+void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t last, double cycleTime) {
+    if (first > last) {
+        return;
+    }
+    rl_cycle(s, p, u, (double)first * cycleTime);
+    if (!(p->plain && fabs(u - s->y) <= DBL_MAX)) {
+        for (uint64_t n = first + 1; n <= last; n++) {
+            rl_cycle(s, p, u, (double)n * cycleTime);
+        }
+        return;
+    }
+    /* u held and only rule 6 applies: after the first cycle uPrevious is u
+     * and runPeriod is T, so each cycle is rl_ramp without its resets; once
+     * y reaches u nothing changes any more. */
+    double y = s->y;
+    uint64_t cycles = s->runCycles;
+    for (uint64_t n = first + 1; n <= last && y != u; n++) {
+        cycles++;
+        if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
+            y = u;
+        } else if (u > y) {
+            const double limited = y + p->maxUp;
+            y = limited < u ? limited : u;
+        } else {
+            const double limited = y - p->maxDown;
+            y = limited > u ? limited : u;
+        }
+    }
+    s->y = y;
+    s->runCycles = cycles;
+    s->rampActive = y != u;
 }
 
 const char *rl_status_text(int status) {

@@ -3,6 +3,8 @@
 #ifndef RATE_LIMITER_H
 #define RATE_LIMITER_H
 
+#include <float.h>
+#include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -57,6 +59,9 @@ typedef struct {
     double initDelayEnd;       /* elapsed time up to which initMode 3 tracks */
     int status;
     int statusSource;          /* id of the variable that caused status */
+    bool plain;                /* no bypass, no delayed init, no error: only
+                                  rule 6 can apply to a finite u and y */
+    bool durationLimited;      /* duration > 0 */
 } RlPrepared;
 
 /* The block's memory between cycles. runningTime is counted in whole cycles
@@ -83,11 +88,56 @@ void rl_prepare(RlPrepared *prepared, const RlConfig *config, double period);
 /* Output at initialisation for the input u. */
 void rl_init(RlState *state, const RlConfig *config, double u);
 
-/* One cycle of length prepared->period; elapsed is the time from the start
- * to the end of this cycle. */
-void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed);
+/* Time the output has been ramping towards the current u. */
+static inline double rl_running_time(const RlState *state) {
+    return state->runBase + (double)state->runCycles * state->runPeriod;
+}
 
-double rl_running_time(const RlState *state);
+/* runningTime goes on in cycles of a new length. */
+void rl_period_changed(RlState *state, double period);
+
+/* Rule 6: ramp towards u, or jump once the duration has run out. */
+static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
+    double y = s->y;
+    if (u != s->uPrevious) {
+        s->runCycles = 0;
+        s->runBase = 0.0;
+    }
+    if (y != u) {
+        if (p->period != s->runPeriod) rl_period_changed(s, p->period);
+        s->runCycles++;
+    }
+    if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
+        y = u;
+    } else if (u > y) {
+        const double limited = y + p->maxUp;
+        y = limited < u ? limited : u;
+    } else if (u < y) {
+        const double limited = y - p->maxDown;
+        y = limited > u ? limited : u;
+    }
+    s->rampActive = y != u;
+    s->y = y;
+    s->uPrevious = u;
+}
+
+/* Rules 1-6 in their order. */
+void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
+
+/* One cycle of length prepared->period; elapsed is the time from the start
+ * to the end of this cycle. Inline, as the common case (finite u and y, no
+ * bypass, delay or error: only rule 6 applies) is a few instructions. */
+static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed) {
+    if (prepared->plain && fabs(u - state->y) <= DBL_MAX) {
+        rl_ramp(state, prepared, u);
+    } else {
+        rl_cycle_rules(state, prepared, u, elapsed);
+    }
+}
+
+/* Cycles first..last (of length cycleTime, ending at n * cycleTime) with u
+ * held: the same as rl_cycle for each, in fewer instructions. */
+void rl_run(RlState *state, const RlPrepared *prepared, double u, uint64_t first, uint64_t last, double cycleTime);
 
 /* Short meaning of a status word, for log messages. */
 const char *rl_status_text(int status);

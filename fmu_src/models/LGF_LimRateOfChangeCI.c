@@ -23,13 +23,16 @@ static void configure(const double *v, RlConfig *c) {
     c->passNonFinite = false;
 }
 
-static void publish(const RlState *block, const RlPrepared *p, double *v) {
+static void publish(const RlState *block, double *v) {
     v[VR_delayedValue] = block->y;
+}
+
+static void publish_status(const RlPrepared *p, double *v) {
     v[VR_error] = p->status >= 0x8000;
     v[VR_status] = p->status;
     v[VR_subFunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_value, configure, publish
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_value, VR_delayedValue, configure, publish, publish_status
 };

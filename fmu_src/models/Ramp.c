@@ -17,12 +17,11 @@ static void configure(const double *v, RlConfig *c) {
     c->passNonFinite = true;
 }
 
-static void publish(const RlState *block, const RlPrepared *p, double *v) {
-    (void)p;
+static void publish(const RlState *block, double *v) {
     v[VR_rOut] = block->y;
     v[VR_xRampActive] = block->rampActive;
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_rIn, configure, publish
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_rIn, VR_rOut, configure, publish, NULL
 };

@@ -24,12 +24,11 @@ static void configure(const double *v, RlConfig *c) {
     c->passNonFinite = true;
 }
 
-static void publish(const RlState *block, const RlPrepared *p, double *v) {
-    (void)p;
+static void publish(const RlState *block, double *v) {
     v[VR_Out] = block->y;
     v[VR_RunningTime] = rl_running_time(block);
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_In, configure, publish
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_In, VR_Out, configure, publish, NULL
 };

@@ -17,15 +17,18 @@ static void configure(const double *v, RlConfig *c) {
     c->passNonFinite = true;
 }
 
-static void publish(const RlState *block, const RlPrepared *p, double *v) {
+static void publish(const RlState *block, double *v) {
     v[VR_y] = block->y;
     v[VR_rampActive] = block->rampActive;
     v[VR_runningTime] = rl_running_time(block);
+}
+
+static void publish_status(const RlPrepared *p, double *v) {
     v[VR_error] = p->status >= 0x8000;
     v[VR_status] = p->status;
     v[VR_subFunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_u, configure, publish
+    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_u, VR_y, configure, publish, publish_status
 };

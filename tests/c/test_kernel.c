@@ -388,6 +388,64 @@ static void test_running_time_period_change(void) {
     CHECK_EQ(rl_running_time(&b.state), 1.0); /* 0.25 + 0.25 + 0.5 */
 }
 
+static void check_same_state(const RlState *a, const RlState *b) {
+    CHECK_EQ(a->y, b->y);
+    CHECK_EQ(a->uPrevious, b->uPrevious);
+    CHECK_EQ(a->rampActive, b->rampActive);
+    CHECK_EQ(a->runCycles, b->runCycles);
+    CHECK_EQ(a->runPeriod, b->runPeriod);
+    CHECK_EQ(a->runBase, b->runBase);
+}
+
+/* The fast paths against the rules in order, over a grid of configurations,
+ * start values and inputs: rl_cycle (inline common case) must equal
+ * rl_cycle_rules, and rl_run over n cycles must equal n rl_cycle calls. */
+static void test_fast_paths_equal_rules(void) {
+    const double rates[] = { 0.0, 0.3, 1e308, -1.0 };
+    const double durations[] = { 0.0, 0.05, 1.0 };
+    const double starts[] = { 0.0, NAN, INFINITY };
+    const double inputs[][2] = { { 5.0, -5.0 }, { 0.1, 0.1 }, { NAN, 2.0 }, { INFINITY, -INFINITY }, { 1e308, -1e308 } };
+    const unsigned long counts[] = { 1, 2, 7, 50 };
+    const double T = 0.01;
+    for (size_t r = 0; r < 4; r++)
+    for (size_t d = 0; d < 3; d++)
+    for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
+    for (int init = RL_INIT_VALUE; init <= RL_INIT_INPUT_DELAYED; init++)
+    for (int flags = 0; flags < 4; flags++)
+    for (size_t y0 = 0; y0 < 3; y0++)
+    for (size_t in = 0; in < 5; in++)
+    for (size_t n = 0; n < 4; n++) {
+        RlConfig c = defaults();
+        c.rateUp.value = rates[r];
+        c.rateDown.value = rates[(r + 1) % 4];
+        c.duration.value = durations[d];
+        c.zeroRate = zero;
+        c.initMode = init;
+        c.initValue = starts[y0];
+        c.initDelay = 0.02;
+        c.bypass = flags & 1;
+        c.passNonFinite = flags & 2;
+        RlPrepared p;
+        rl_prepare(&p, &c, T);
+        RlState run, cycles, rules;
+        rl_init(&run, &c, 1.0);
+        cycles = rules = run;
+        uint64_t first = 1;
+        for (int k = 0; k < 2; k++) { /* two inputs in turn: resets too */
+            const double u = inputs[in][k];
+            const uint64_t last = first + counts[n] - 1;
+            rl_run(&run, &p, u, first, last, T);
+            for (uint64_t m = first; m <= last; m++) {
+                rl_cycle(&cycles, &p, u, (double)m * T);
+                rl_cycle_rules(&rules, &p, u, (double)m * T);
+            }
+            check_same_state(&run, &cycles);
+            check_same_state(&cycles, &rules);
+            first = last + 1;
+        }
+    }
+}
+
 int main(void) {
     test_rule0_resolve();
     test_rule0_limits();
@@ -402,6 +460,7 @@ int main(void) {
     test_rule6_ramp();
     test_rule6_duration();
     test_running_time_period_change();
+    test_fast_paths_equal_rules();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }
