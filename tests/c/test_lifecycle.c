@@ -1,0 +1,337 @@
+/* An FMU binary's lifecycle as an importer drives it (dlopen), FMI 2 and 3:
+ *
+ *   test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances>
+ *
+ * 1. a full simulation using every kind of call (set, step, get, FMU states,
+ *    serialize and deserialize, reset, terminate, free), so that valgrind
+ *    memcheck can watch all of it;
+ * 2. <instantiations> instantiate/free cycles: afterwards as many blocks
+ *    are live as before (FMI 2 memory callbacks and an interposed malloc);
+ * 3. <instances> instances alive at once, each stepped with its own input,
+ *    each output checked against a run of one instance alone.
+ * Exit 0 when every check passes. */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2FunctionTypes.h"
+#include "fmi3FunctionTypes.h"
+
+/* ---- live allocations: interposed malloc and FMI 2 callbacks ------------ */
+
+extern void *__libc_malloc(size_t size);
+extern void *__libc_calloc(size_t count, size_t size);
+extern void *__libc_realloc(void *pointer, size_t size);
+extern void __libc_free(void *pointer);
+
+static long liveBlocks; /* allocated minus freed, from the FMU's side */
+static int counting;
+
+void *malloc(size_t size) {
+    void *p = __libc_malloc(size);
+    if (counting && p) liveBlocks++;
+    return p;
+}
+
+void *calloc(size_t count, size_t size) {
+    void *p = __libc_calloc(count, size);
+    if (counting && p) liveBlocks++;
+    return p;
+}
+
+void *realloc(void *pointer, size_t size) {
+    void *p = __libc_realloc(pointer, size);
+    if (counting && p && !pointer) liveBlocks++;
+    return p;
+}
+
+void free(void *pointer) {
+    if (counting && pointer) liveBlocks--;
+    __libc_free(pointer);
+}
+
+static long callbackBlocks;
+
+static void *allocate(size_t count, size_t size) {
+    void *p = __libc_calloc(count, size);
+    if (p) callbackBlocks++;
+    return p;
+}
+
+static void release_memory(void *p) {
+    if (p) callbackBlocks--;
+    __libc_free(p);
+}
+
+static int messages;
+
+static void log2_message(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                         fmi2String message, ...) {
+    (void)env; (void)name; (void)category; (void)status; (void)message;
+    messages++;
+}
+
+static void log3_message(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
+    (void)env; (void)status; (void)category; (void)message;
+    messages++;
+}
+
+/* ---- checks ---------------------------------------------------------- */
+
+static int failures;
+
+#define CHECK(condition)                                                      \
+    do {                                                                      \
+        if (!(condition)) {                                                   \
+            failures++;                                                       \
+            fprintf(stderr, "%s:%d: %s\n", __FILE__, __LINE__, #condition);  \
+        }                                                                     \
+    } while (0)
+
+/* ---- the FMU --------------------------------------------------------- */
+
+static int version;
+static void *library;
+static char token[128];
+static unsigned uVr, yVr;
+
+static void *symbol(const char *name) {
+    void *s = dlsym(library, name);
+    if (!s) {
+        fprintf(stderr, "%s not exported\n", name);
+        exit(2);
+    }
+    return s;
+}
+
+typedef void (*AnyFunction)(void);
+
+static AnyFunction function(const char *name) {
+    void *s = symbol(name);
+    AnyFunction f;
+    memcpy(&f, &s, sizeof f); /* dlsym's object pointer as a function pointer */
+    return f;
+}
+
+#define F2(name) ((name##TYPE *)function(#name))
+#define F3(name) ((name##TYPE *)function(#name))
+
+static const fmi2CallbackFunctions callbacks = { log2_message, allocate, release_memory, NULL, NULL };
+
+static void *instantiate(const char *name) {
+    if (version == 2) {
+        return F2(fmi2Instantiate)(name, fmi2CoSimulation, token, "", &callbacks, fmi2False, fmi2False);
+    }
+    return F3(fmi3InstantiateCoSimulation)(name, token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
+                                           NULL, log3_message, NULL);
+}
+
+static void release(void *c) {
+    if (version == 2) F2(fmi2FreeInstance)(c); else F3(fmi3FreeInstance)(c);
+}
+
+static int start(void *c) {
+    if (version == 2) {
+        return F2(fmi2SetupExperiment)(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK &&
+               F2(fmi2EnterInitializationMode)(c) == fmi2OK && F2(fmi2ExitInitializationMode)(c) == fmi2OK;
+    }
+    return F3(fmi3EnterInitializationMode)(c, fmi3False, 0.0, 0.0, fmi3False, 0.0) == fmi3OK &&
+           F3(fmi3ExitInitializationMode)(c) == fmi3OK;
+}
+
+static int set_u(void *c, double u) {
+    return version == 2 ? F2(fmi2SetReal)(c, &uVr, 1, &u) : F3(fmi3SetFloat64)(c, &uVr, 1, &u, 1);
+}
+
+static double get_y(void *c) {
+    double y = NAN;
+    int status = version == 2 ? F2(fmi2GetReal)(c, &yVr, 1, &y) : F3(fmi3GetFloat64)(c, &yVr, 1, &y, 1);
+    CHECK(status == 0);
+    return y;
+}
+
+static int step(void *c, double t, double h) {
+    if (version == 2) return F2(fmi2DoStep)(c, t, h, fmi2True);
+    fmi3Boolean a, b, e;
+    fmi3Float64 last;
+    return F3(fmi3DoStep)(c, t, h, fmi3True, &a, &b, &e, &last);
+}
+
+static double input(int k, int i) { return ((k + i) % 7) * 1.5 - 4.0; }
+
+/* ---- 1. a full simulation, every kind of call ------------------------- */
+
+static void full_simulation(void) {
+    void *c = instantiate("full");
+    CHECK(c != NULL);
+    if (!c) return;
+    CHECK(start(c));
+    double t = 0.0;
+    for (int k = 0; k < 200; k++, t += 0.01) {
+        CHECK(set_u(c, input(k, 0)) == 0);
+        CHECK(step(c, t, 0.01) == 0);
+        get_y(c);
+    }
+    /* FMU state: get, serialize, deserialize, set, free */
+    void *state = NULL, *copy = NULL;
+    size_t size = 0;
+    if (version == 2) {
+        CHECK(F2(fmi2GetFMUstate)(c, &state) == fmi2OK);
+        CHECK(F2(fmi2SerializedFMUstateSize)(c, state, &size) == fmi2OK);
+        fmi2Byte *bytes = __libc_malloc(size);
+        CHECK(F2(fmi2SerializeFMUstate)(c, state, bytes, size) == fmi2OK);
+        CHECK(F2(fmi2DeSerializeFMUstate)(c, bytes, size, &copy) == fmi2OK);
+        bytes[size / 2] ^= 0x40; /* corrupted bytes: refused, then recovered */
+        void *bad = NULL;
+        CHECK(F2(fmi2DeSerializeFMUstate)(c, bytes, size, &bad) == fmi2Error && bad == NULL);
+        __libc_free(bytes);
+        CHECK(F2(fmi2SetFMUstate)(c, copy) == fmi2OK);
+        CHECK(F2(fmi2FreeFMUstate)(c, &copy) == fmi2OK);
+        CHECK(F2(fmi2FreeFMUstate)(c, &state) == fmi2OK);
+    } else {
+        CHECK(F3(fmi3GetFMUState)(c, &state) == fmi3OK);
+        CHECK(F3(fmi3SerializedFMUStateSize)(c, state, &size) == fmi3OK);
+        fmi3Byte *bytes = __libc_malloc(size);
+        CHECK(F3(fmi3SerializeFMUState)(c, state, bytes, size) == fmi3OK);
+        CHECK(F3(fmi3DeserializeFMUState)(c, bytes, size, &copy) == fmi3OK);
+        bytes[size / 2] ^= 0x40;
+        void *bad = NULL;
+        CHECK(F3(fmi3DeserializeFMUState)(c, bytes, size, &bad) == fmi3Error && bad == NULL);
+        __libc_free(bytes);
+        CHECK(F3(fmi3SetFMUState)(c, copy) == fmi3OK);
+        CHECK(F3(fmi3FreeFMUState)(c, &copy) == fmi3OK);
+        CHECK(F3(fmi3FreeFMUState)(c, &state) == fmi3OK);
+    }
+    for (int k = 0; k < 100; k++, t += 0.01) {
+        set_u(c, input(k, 1));
+        CHECK(step(c, t, 0.01) == 0);
+    }
+    /* reset and run again, then terminate */
+    CHECK((version == 2 ? F2(fmi2Reset)(c) : F3(fmi3Reset)(c)) == 0);
+    CHECK(start(c));
+    CHECK(step(c, 0.0, 0.5) == 0);
+    CHECK((version == 2 ? F2(fmi2Terminate)(c) : F3(fmi3Terminate)(c)) == 0);
+    get_y(c);
+    release(c);
+}
+
+/* ---- 2. instantiate/free cycles leave nothing behind ------------------- */
+
+static void instantiate_free(long cycles) {
+    const long blocks = liveBlocks, callbackLive = callbackBlocks;
+    for (long i = 0; i < cycles; i++) {
+        void *c = instantiate("cycle");
+        CHECK(c != NULL);
+        if (i % 1000 == 0 && c) { /* now and then a used instance */
+            CHECK(start(c));
+            CHECK(step(c, 0.0, 0.1) == 0);
+        }
+        release(c);
+    }
+    CHECK(liveBlocks == blocks);
+    CHECK(callbackBlocks == callbackLive);
+    printf("instantiate/free cycles %ld, live blocks after %ld (before %ld)\n", cycles,
+           liveBlocks + callbackBlocks, blocks + callbackLive);
+}
+
+/* ---- 3. many instances alive at once ----------------------------------- */
+
+static void many_instances(int n) {
+    void **all = __libc_calloc((size_t)n, sizeof *all);
+    char name[32];
+    for (int i = 0; i < n; i++) {
+        snprintf(name, sizeof name, "i%d", i);
+        all[i] = instantiate(name);
+        CHECK(all[i] != NULL);
+        if (!all[i]) return;
+        CHECK(start(all[i]));
+    }
+    for (int k = 0; k < 20; k++) {
+        for (int i = 0; i < n; i++) {
+            set_u(all[i], input(k, i));
+            CHECK(step(all[i], k * 0.1, 0.1) == 0);
+        }
+    }
+    /* each output equals that of one instance run alone with its input */
+    double expected[7];
+    for (int phase = 0; phase < 7; phase++) {
+        void *alone = instantiate("alone");
+        CHECK(start(alone));
+        for (int k = 0; k < 20; k++) {
+            set_u(alone, input(k, phase));
+            step(alone, k * 0.1, 0.1);
+        }
+        expected[phase] = get_y(alone);
+        release(alone);
+    }
+    int mismatches = 0;
+    for (int i = 0; i < n; i++) {
+        if (get_y(all[i]) != expected[i % 7]) mismatches++;
+        release(all[i]);
+    }
+    CHECK(mismatches == 0);
+    __libc_free(all);
+    printf("instances alive at once %d, mismatches %d\n", n, mismatches);
+}
+
+/* The attribute value after `after` in the model description, from `from`. */
+static const char *attribute(const char *text, const char *from, const char *after, char *out, size_t size) {
+    const char *p = from ? strstr(text, from) : text;
+    if (p) p = strstr(p, after);
+    if (!p) {
+        fprintf(stderr, "modelDescription.xml: no %s %s\n", from ? from : "", after);
+        exit(2);
+    }
+    p += strlen(after);
+    size_t n = strcspn(p, "\"");
+    if (n >= size) exit(2);
+    memcpy(out, p, n);
+    out[n] = 0;
+    return out;
+}
+
+static void read_description(const char *stage, char *identifier, size_t size) {
+    char path[4096], number[32];
+    snprintf(path, sizeof path, "%s/modelDescription.xml", stage);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "cannot read %s\n", path);
+        exit(2);
+    }
+    static char text[1 << 16];
+    const size_t n = fread(text, 1, sizeof text - 1, f);
+    text[n] = 0;
+    fclose(f);
+    attribute(text, NULL, version == 2 ? "guid=\"" : "instantiationToken=\"", token, sizeof token);
+    attribute(text, "<CoSimulation", "modelIdentifier=\"", identifier, size);
+    uVr = (unsigned)atoi(attribute(text, "name=\"u\"", "valueReference=\"", number, sizeof number));
+    yVr = (unsigned)atoi(attribute(text, "name=\"y\"", "valueReference=\"", number, sizeof number));
+}
+
+int main(int argc, char **argv) {
+    if (argc != 5) {
+        fprintf(stderr, "usage: test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances>\n");
+        return 2;
+    }
+    version = atoi(argv[1]);
+    char identifier[128], binary[4096];
+    read_description(argv[2], identifier, sizeof identifier);
+    snprintf(binary, sizeof binary, "%s/binaries/%s/%s.so", argv[2], version == 2 ? "linux64" : "x86_64-linux",
+             identifier);
+    library = dlopen(binary, RTLD_NOW | RTLD_LOCAL);
+    if (!library) {
+        fprintf(stderr, "%s\n", dlerror());
+        return 2;
+    }
+    counting = 1;
+    full_simulation();
+    instantiate_free(atol(argv[3]));
+    many_instances(atoi(argv[4]));
+    counting = 0;
+    dlclose(library); /* so that memcheck sees every block freed */
+    printf("FMI %d: %s (%d log messages)\n", version, failures ? "FAILED" : "passed", messages);
+    return failures ? 1 : 0;
+}
