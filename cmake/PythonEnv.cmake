@@ -3,7 +3,9 @@
 # the pinned fmpy are there before anything compiles.
 find_package(Python3 3.11 REQUIRED COMPONENTS Interpreter)  # 3.11: tomllib
 
-set(VENV_DIR ${CMAKE_BINARY_DIR}/venv)
+# RL_VENV_DIR lets a second build tree (the sanitizer build) share one venv.
+set(RL_VENV_DIR ${CMAKE_BINARY_DIR}/venv CACHE PATH "Python virtual environment with the pinned packages")
+set(VENV_DIR ${RL_VENV_DIR})
 set(VENV_PYTHON ${VENV_DIR}/bin/python)
 set(REQUIREMENTS ${CMAKE_SOURCE_DIR}/tests/requirements.txt)
 set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${REQUIREMENTS})
