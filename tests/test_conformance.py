@@ -1,0 +1,258 @@
+"""FMI state-machine conformance: every exported function of the FMI API,
+called in every state (Instantiated, Initialization Mode, Step Mode,
+Terminated, and after an error) with valid arguments, returns what the
+standard's state table requires. A refusal is fmiError with exactly one
+log message naming the function; functions of capabilities this FMU does
+not declare (Model Exchange, derivatives, event mode, clocks, ...) refuse
+in every state.
+
+The allowed states below are written from the standards' tables (FMI
+2.0.4 section 4.2.4; FMI 3.0 sections 2.2.3 and 4.2), not read from the
+FMU's own tables."""
+import ctypes
+import re
+from ctypes import POINTER, c_bool, c_double, c_int, c_size_t, c_uint, c_void_p
+from pathlib import Path
+
+import pytest
+from fmpy import __file__ as fmpy_file
+
+from fmu_driver import Instance, call_status
+
+STATES = ["Instantiated", "Initialization Mode", "Step Mode", "Terminated", "Error"]
+ALL = set(STATES)
+I, N, S, T, E = STATES
+
+# FMI 2.0.4, Co-Simulation: function -> states in which it may be called.
+# (stepComplete, stepFailed and stepCanceled are Step Mode here: this FMU
+# never returns fmi2Pending, so there is no stepInProgress.)
+FMI2_ALLOWED = {
+    "fmi2SetDebugLogging": ALL,
+    "fmi2SetupExperiment": {I},
+    "fmi2EnterInitializationMode": {I},
+    "fmi2ExitInitializationMode": {N},
+    "fmi2Terminate": {S},
+    "fmi2Reset": ALL,
+    "fmi2GetReal": {N, S, T, E}, "fmi2GetInteger": {N, S, T, E},
+    "fmi2GetBoolean": {N, S, T, E}, "fmi2GetString": {N, S, T, E},
+    "fmi2SetReal": {I, N, S}, "fmi2SetInteger": {I, N, S},
+    "fmi2SetBoolean": {I, N, S}, "fmi2SetString": {I, N, S},
+    "fmi2GetFMUstate": ALL, "fmi2SetFMUstate": ALL, "fmi2FreeFMUstate": ALL,
+    "fmi2SerializedFMUstateSize": ALL, "fmi2SerializeFMUstate": ALL, "fmi2DeSerializeFMUstate": ALL,
+    "fmi2DoStep": {S},
+    "fmi2GetStatus": {S, T}, "fmi2GetRealStatus": {S, T}, "fmi2GetIntegerStatus": {S, T},
+    "fmi2GetBooleanStatus": {S, T}, "fmi2GetStringStatus": {S, T},
+}
+
+# FMI 3.0, Co-Simulation without Event Mode. After fmi3Error only the
+# recovery may follow: set a previously taken FMU state (with the helpers
+# that hold and (de)serialize it), reset, free; logging may be changed.
+FMI3_ALLOWED = {
+    "fmi3SetDebugLogging": ALL,
+    "fmi3EnterInitializationMode": {I},
+    "fmi3ExitInitializationMode": {N},
+    "fmi3Terminate": {S},
+    "fmi3Reset": ALL,
+    "fmi3GetFloat64": {N, S, T}, "fmi3GetInt32": {N, S, T}, "fmi3GetInt64": {N, S, T},
+    "fmi3GetBoolean": {N, S, T}, "fmi3GetString": {N, S, T}, "fmi3GetBinary": {N, S, T},
+    "fmi3GetFloat32": {N, S, T}, "fmi3GetInt8": {N, S, T}, "fmi3GetUInt8": {N, S, T},
+    "fmi3GetInt16": {N, S, T}, "fmi3GetUInt16": {N, S, T}, "fmi3GetUInt32": {N, S, T},
+    "fmi3GetUInt64": {N, S, T},
+    "fmi3SetFloat64": {I, N, S}, "fmi3SetInt32": {I, N, S}, "fmi3SetInt64": {I, N, S},
+    "fmi3SetBoolean": {I, N, S}, "fmi3SetString": {I, N, S}, "fmi3SetBinary": {I, N, S},
+    "fmi3SetFloat32": {I, N, S}, "fmi3SetInt8": {I, N, S}, "fmi3SetUInt8": {I, N, S},
+    "fmi3SetInt16": {I, N, S}, "fmi3SetUInt16": {I, N, S}, "fmi3SetUInt32": {I, N, S},
+    "fmi3SetUInt64": {I, N, S},
+    "fmi3GetFMUState": {I, N, S, T}, "fmi3SetFMUState": ALL, "fmi3FreeFMUState": ALL,
+    "fmi3SerializedFMUStateSize": ALL, "fmi3SerializeFMUState": ALL, "fmi3DeserializeFMUState": ALL,
+    "fmi3DoStep": {S},
+}
+
+# not called on an instance, or ending it
+NOT_INSTANCE_CALLS = {"fmi2GetTypesPlatform", "fmi2GetVersion", "fmi2Instantiate", "fmi2FreeInstance",
+                      "fmi3GetVersion", "fmi3InstantiateCoSimulation", "fmi3InstantiateModelExchange",
+                      "fmi3InstantiateScheduledExecution", "fmi3FreeInstance"}
+
+
+def exported_functions(version):
+    """Every function of the FMI API, from the function types header that
+    the pinned fmpy ships."""
+    header = Path(fmpy_file).parent / "c-code" / f"fmi{version}FunctionTypes.h"
+    text = re.sub(r"/\*.*?\*/", "", header.read_text(), flags=re.S)
+    found = re.findall(r"typedef\s+[\w\s\*]+?\b(fmi%d\w+)TYPE\s*\((.*?)\)\s*;" % version, text, flags=re.S)
+    return {name: (0 if params.strip() in ("", "void") else params.count(",") + 1)
+            for name, params in found if not name.startswith(f"fmi{version}Callback")}
+
+
+def raw(fmu, name, argtypes, *args):
+    function = getattr(fmu.fmu.dll, name)
+    function.argtypes, function.restype = argtypes, c_int
+    return function(*args)
+
+
+def valid_call(fmu, name):
+    """The function called with valid arguments; returns its status."""
+    c, v = fmu.fmu.component, fmu.version
+    vr = (c_uint * 1)(fmu.vr("u"))
+    out = (c_uint * 1)(fmu.vr("y"))
+    boolean_vr = (c_uint * 1)(fmu.vr("bypass"))
+    integer_vr = (c_uint * 1)(fmu.vr("status"))
+    real = (c_double * 1)(1.0)
+    integer = (ctypes.c_int32 * 1)(0)
+    int64 = (ctypes.c_int64 * 1)(0)
+    flag = (c_int * 1)(0) if v == 2 else (c_bool * 1)(False)
+    state = c_void_p()
+    take_state = "fmi2GetFMUstate" if v == 2 else "fmi3GetFMUState"
+
+    def with_state(call):
+        # a state taken in Initialization Mode on a second instance of the
+        # same FMU: valid whatever state this instance is in
+        helper = Instance("RateLimiter", v, name="helper")
+        try:
+            helper.start()
+            assert raw(helper, take_state, [c_void_p, POINTER(c_void_p)], helper.fmu.component, ctypes.byref(state)) == 0
+            return call()
+        finally:
+            helper.release()
+
+    size = c_size_t()
+    buffer = ctypes.create_string_buffer(4096)
+    if v == 2:
+        calls = {
+            "fmi2SetDebugLogging": lambda: raw(fmu, name, [c_void_p, c_int, c_size_t, c_void_p], c, 1, 0, None),
+            "fmi2SetupExperiment": lambda: raw(fmu, name, [c_void_p, c_int, c_double, c_double, c_int, c_double], c, 0, 0.0, 0.0, 0, 0.0),
+            "fmi2EnterInitializationMode": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi2ExitInitializationMode": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi2Terminate": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi2Reset": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi2GetReal": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, out, 1, real),
+            "fmi2GetInteger": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, integer_vr, 1, integer),
+            "fmi2GetBoolean": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, boolean_vr, 1, flag),
+            "fmi2GetString": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, vr, 0, buffer),
+            "fmi2SetReal": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, vr, 1, real),
+            "fmi2SetInteger": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, vr, 0, integer),
+            "fmi2SetBoolean": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, boolean_vr, 1, flag),
+            "fmi2SetString": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, vr, 0, buffer),
+            "fmi2GetFMUstate": lambda: raw(fmu, name, [c_void_p, POINTER(c_void_p)], c, ctypes.byref(c_void_p())),
+            "fmi2DoStep": lambda: raw(fmu, name, [c_void_p, c_double, c_double, c_int], c, fmu.t, 0.1, 1),
+            "fmi2GetStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 0, integer),
+            "fmi2GetRealStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 2, real),
+            "fmi2GetIntegerStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 0, integer),
+            "fmi2GetBooleanStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 4, flag),
+            "fmi2GetStringStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 1, buffer),
+        }
+    else:
+        calls = {
+            "fmi3SetDebugLogging": lambda: raw(fmu, name, [c_void_p, c_bool, c_size_t, c_void_p], c, True, 0, None),
+            "fmi3EnterInitializationMode": lambda: raw(fmu, name, [c_void_p, c_bool, c_double, c_double, c_bool, c_double], c, False, 0.0, 0.0, False, 0.0),
+            "fmi3ExitInitializationMode": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi3Terminate": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi3Reset": lambda: raw(fmu, name, [c_void_p], c),
+            "fmi3GetFloat64": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, out, 1, real, 1),
+            "fmi3GetInt32": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, integer_vr, 1, integer, 1),
+            "fmi3GetInt64": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, (c_uint * 1)(fmu.vr("zeroRate")), 1, int64, 1),
+            "fmi3GetBoolean": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, boolean_vr, 1, flag, 1),
+            "fmi3SetFloat64": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, vr, 1, real, 1),
+            "fmi3SetInt64": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, (c_uint * 1)(fmu.vr("zeroRate")), 1, (ctypes.c_int64 * 1)(1), 1),
+            "fmi3SetBoolean": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, boolean_vr, 1, flag, 1),
+            "fmi3GetFMUState": lambda: raw(fmu, name, [c_void_p, POINTER(c_void_p)], c, ctypes.byref(c_void_p())),
+            "fmi3DoStep": lambda: raw(fmu, name, [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4, c, fmu.t, 0.1,
+                                      True, flag, flag, flag, real),
+            "fmi3GetBinary": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], c, vr, 0, buffer, buffer, 0),
+            "fmi3SetBinary": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], c, vr, 0, buffer, buffer, 0),
+        }
+        for kind in ("Float32", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "UInt64", "String"):
+            # no variables of these types (Int32: status is one, read above): none asked for
+            for access in ("Get", "Set"):
+                key = f"fmi3{access}{kind}"
+                if key not in calls:
+                    calls[key] = (lambda k=key: raw(fmu, k, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, vr, 0, buffer, 0))
+    prefix = "fmi2" if v == 2 else "fmi3"
+    calls[f"{prefix}SetFMUstate" if v == 2 else "fmi3SetFMUState"] = lambda: with_state(
+        lambda: raw(fmu, f"{prefix}SetFMUstate" if v == 2 else "fmi3SetFMUState", [c_void_p, c_void_p], c, state))
+    free_name = "fmi2FreeFMUstate" if v == 2 else "fmi3FreeFMUState"
+    calls[free_name] = lambda: raw(fmu, free_name, [c_void_p, POINTER(c_void_p)], c, ctypes.byref(c_void_p()))
+    size_name = "fmi2SerializedFMUstateSize" if v == 2 else "fmi3SerializedFMUStateSize"
+    calls[size_name] = lambda: with_state(lambda: raw(fmu, size_name, [c_void_p, c_void_p, POINTER(c_size_t)], c, state, ctypes.byref(size)))
+    ser_name = "fmi2SerializeFMUstate" if v == 2 else "fmi3SerializeFMUState"
+    calls[ser_name] = lambda: with_state(lambda: raw(fmu, ser_name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, buffer, 4096))
+
+    def deserialize():
+        des_name = "fmi2DeSerializeFMUstate" if v == 2 else "fmi3DeserializeFMUState"
+
+        def serialize_then_deserialize():
+            assert raw(fmu, ser_name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, buffer, 4096) in (0, 3)
+            helper = Instance("RateLimiter", v, name="serializer")
+            try:  # serialized by a healthy instance of the same FMU
+                helper.start()
+                h = helper.fmu.component
+                assert raw(helper, size_name, [c_void_p, c_void_p, POINTER(c_size_t)], h, state, ctypes.byref(size)) == 0
+                assert raw(helper, ser_name, [c_void_p, c_void_p, c_void_p, c_size_t], h, state, buffer, size.value) == 0
+            finally:
+                helper.release()
+            return raw(fmu, des_name, [c_void_p, c_void_p, c_size_t, POINTER(c_void_p)], c, buffer, size.value,
+                       ctypes.byref(c_void_p()))
+        return with_state(serialize_then_deserialize)
+
+    calls["fmi2DeSerializeFMUstate" if v == 2 else "fmi3DeserializeFMUState"] = deserialize
+    if name in calls:
+        return calls[name]()
+    # a function of a capability this FMU lacks: every argument but the instance NULL or 0
+    n = exported_functions(v)[name]
+    return raw(fmu, name, [c_void_p] * n, c, *([None] * (n - 1)))
+
+
+def enter(fmu, state):
+    if state in (N, S, T):
+        if fmu.version == 2:
+            fmu.fmu.setupExperiment(startTime=0.0)
+            fmu.fmu.enterInitializationMode()
+        else:
+            fmu.fmu.enterInitializationMode(startTime=0.0)
+    if state in (S, T):
+        fmu.fmu.exitInitializationMode()
+    if state == T:
+        fmu.fmu.terminate()
+    if state == E:
+        fmu.start()
+        assert call_status(fmu.fmu.doStep, fmu.t, 0.0) == 3  # h = 0: error
+
+
+CASES = [(v, name, state) for v in (2, 3) for name in sorted(exported_functions(v)) if name not in NOT_INSTANCE_CALLS
+         for state in STATES]
+
+
+@pytest.mark.parametrize("version,function,state", CASES)
+def test_every_function_in_every_state(version, function, state):
+    allowed = (FMI2_ALLOWED if version == 2 else FMI3_ALLOWED).get(function, set())
+    fmu = Instance("RateLimiter", version)
+    try:
+        enter(fmu, state)
+        before = len(fmu.errors())
+        status = valid_call(fmu, function)
+        new_errors = fmu.errors()[before:]
+        if state in allowed:
+            assert status in (0, 1, 2), (function, state, status, fmu.messages)  # OK, Warning or Discard
+            assert not new_errors, (function, state, new_errors)
+        else:
+            assert status == 3, (function, state, status)
+            assert len(new_errors) == 1, (function, state, fmu.messages)
+            assert function in new_errors[0][2], new_errors
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_calls_after_an_error_are_refused_until_reset(version):
+    fmu = Instance("RateLimiter", version)
+    try:
+        enter(fmu, E)
+        assert call_status(fmu.fmu.doStep, fmu.t, 0.1) == 3
+        assert call_status(fmu.set, u=1.0) == 3
+        fmu.fmu.reset()
+        fmu.start()
+        fmu.set(u=1.0)
+        fmu.step(0.1)
+        assert fmu.get("y") == pytest.approx(0.1)
+    finally:
+        fmu.free()
