@@ -403,6 +403,23 @@ void fmu_serialize(const FmuInstance *instance, const FmuCore *s, unsigned char 
     put_u32(p, crc32(out, (size_t)(p - out)));
 }
 
+/* Cycle counts stay exact in a double (2^53). */
+#define MAX_EXACT_CYCLES ((uint64_t)1 << 53)
+
+/* A value of the variable's type and declared range (NaN only for an
+ * unranged Real), as fmu_check_set would accept it. */
+static bool value_possible(const FmuVariable *v, double value) {
+    switch (v->type) {
+    case FMU_REAL:
+        return fmu_in_range(v, value);
+    case FMU_BOOLEAN:
+        return value == 0.0 || value == 1.0;
+    default: /* Integer, Enumeration: an int32 in range */
+        return value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0 &&
+               value >= v->min && value <= v->max;
+    }
+}
+
 FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const unsigned char *in, size_t size, FmuCore *out) {
     const ModelDefinition *model = instance->model;
     const size_t expected = fmu_serialized_size(instance);
@@ -451,6 +468,18 @@ FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const uns
     if (s.mode != MODE_INSTANTIATED && s.mode != MODE_INITIALIZATION && s.mode != MODE_STEP &&
         s.mode != MODE_TERMINATED && s.mode != MODE_ERROR) {
         return fmu_error(instance, function, "serialized state has an invalid mode %d", s.mode);
+    }
+    /* a checksum only proves the bytes arrived as written: every value must
+     * also be one that this FMU could have made */
+    for (unsigned i = 0; i < model->count; i++) {
+        if (!value_possible(&model->variables[i], s.values[i])) {
+            return fmu_error(instance, function, "serialized state has an impossible value %g for %s", s.values[i],
+                             model->variables[i].name);
+        }
+    }
+    if (!isfinite(s.startTime) || !isfinite(s.time) || s.cycles > MAX_EXACT_CYCLES ||
+        s.block.runCycles > MAX_EXACT_CYCLES) {
+        return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
     }
     *out = s;
     return FMU_OK;

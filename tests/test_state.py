@@ -76,6 +76,17 @@ def reseal(data):
     return data[:-4] + struct.pack("<I", zlib.crc32(data[:-4]))
 
 
+def value_at(d, offset, packed):
+    return reseal(d[:offset] + packed + d[offset + len(packed):])
+
+
+def values_end(d):
+    """Offset after the values: header 16, count 4, 8 bytes per value."""
+    return 20 + 8 * struct.unpack_from("<I", d, 16)[0]
+
+
+BLOCK = 8 + 8 + 1 + 8 + 8 + 8  # y, uPrevious, rampActive, runCycles, runPeriod, runBase
+
 BAD_BYTES = {
     "truncated": lambda d: d[: len(d) // 2],
     "empty": lambda d: b"",
@@ -85,6 +96,11 @@ BAD_BYTES = {
     "future version": lambda d: reseal(d[:4] + struct.pack("<I", 99) + d[8:]),
     "another model": lambda d: reseal(d[:8] + struct.pack("<I", 0x12345678) + d[12:]),
     "invalid mode": lambda d: reseal(d[:-12] + struct.pack("<I", 12345) + d[-8:]),
+    # checksums right, values impossible (found by the fuzzer: a NaN enumeration)
+    "enumeration NaN": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", float("nan"))),  # zeroRate
+    "boolean 2": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", 2.0)),  # bypass
+    "start time infinite": lambda d: value_at(d, values_end(d) + BLOCK, struct.pack("<d", float("inf"))),
+    "cycle count 2^60": lambda d: value_at(d, values_end(d) + BLOCK + 16, struct.pack("<Q", 1 << 60)),
 }
 
 

@@ -1,0 +1,67 @@
+# Coverage-guided fuzzers (libFuzzer, with ASan and UBSan): tests/fuzz/*.c
+# on the FMI 2 and FMI 3 glue of RateLimiter. libFuzzer comes with clang;
+# when no clang here can build a fuzzer, Debian's clang-14 and
+# libclang-rt-14-dev are installed with apt-get (as the CI machine needs).
+# Without them the ctest test 'fuzz' fails and says why: no silent skip.
+
+set(FUZZ_PROBE ${CMAKE_BINARY_DIR}/fuzz/probe.c)
+file(WRITE ${FUZZ_PROBE} "#include <stddef.h>\n#include <stdint.h>\nint LLVMFuzzerTestOneInput(const uint8_t *d, size_t n);\nint LLVMFuzzerTestOneInput(const uint8_t *d, size_t n) { (void)d; (void)n; return 0; }\n")
+
+function(find_fuzzing_clang out)
+  find_program(clang_found NAMES clang-14 clang NO_CACHE)
+  if(clang_found)
+    execute_process(COMMAND ${clang_found} -fsanitize=fuzzer,address,undefined ${FUZZ_PROBE}
+                            -o ${CMAKE_BINARY_DIR}/fuzz/probe
+                    RESULT_VARIABLE failed OUTPUT_QUIET ERROR_QUIET)
+    if(NOT failed)
+      set(${out} ${clang_found} PARENT_SCOPE)
+      return()
+    endif()
+  endif()
+  set(${out} "" PARENT_SCOPE)
+endfunction()
+
+find_fuzzing_clang(FUZZ_CLANG)
+if(NOT FUZZ_CLANG)
+  find_program(APT_GET apt-get)
+  if(APT_GET)
+    message(STATUS "No clang with libFuzzer: installing Debian's clang-14 and libclang-rt-14-dev")
+    execute_process(COMMAND sh -c "${APT_GET} update -qq && DEBIAN_FRONTEND=noninteractive ${APT_GET} install -y -qq --no-install-recommends clang-14 libclang-rt-14-dev"
+                    OUTPUT_QUIET)
+    find_fuzzing_clang(FUZZ_CLANG)
+  endif()
+endif()
+
+set(FUZZ_TARGETS deserialize calls)
+# fixed budget per target: 30 s with a fixed seed; inputs up to a few
+# serialized states long
+set(FUZZ_SECONDS 30)
+set(FUZZ_MAX_LEN_deserialize 600)
+set(FUZZ_MAX_LEN_calls 1024)
+if(FUZZ_CLANG)
+  message(STATUS "Fuzzers built with ${FUZZ_CLANG}")
+  set(fuzz_sources ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c ${CMAKE_SOURCE_DIR}/fmu_src/fmu_core.c
+                   ${CMAKE_SOURCE_DIR}/fmu_src/fmi2_glue.c ${CMAKE_SOURCE_DIR}/fmu_src/fmi3_glue.c
+                   ${CMAKE_SOURCE_DIR}/fmu_src/models/RateLimiter.c)
+  set(fuzz_binaries)
+  foreach(target IN LISTS FUZZ_TARGETS)
+    set(binary ${CMAKE_BINARY_DIR}/fuzz/fuzz_${target})
+    add_custom_command(
+      OUTPUT ${binary}
+      COMMAND ${FUZZ_CLANG} -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+              -ffp-contract=off -I${CMAKE_SOURCE_DIR}/fmu_src -I${CMAKE_BINARY_DIR}/gen/RateLimiter
+              -I${FMI_HEADERS_DIR} ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} -lm -o ${binary}
+      DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} ${CORE_HEADERS}
+              ${CMAKE_BINARY_DIR}/gen/RateLimiter/RateLimiter_variables.h
+      COMMENT "Building the fuzzer fuzz_${target}")
+    list(APPEND fuzz_binaries ${binary})
+    # new inputs go to build/fuzz/corpus_<target>; the repository's corpus is read
+    add_test(NAME fuzz_${target}
+             COMMAND sh -c "mkdir -p '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}' && '${binary}' -max_total_time=${FUZZ_SECONDS} -max_len=${FUZZ_MAX_LEN_${target}} -seed=1 -print_final_stats=1 '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}' '${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/${target}'")
+    set_tests_properties(fuzz_${target} PROPERTIES TIMEOUT 300)
+  endforeach()
+  add_custom_target(fuzzers ALL DEPENDS ${fuzz_binaries})
+  add_dependencies(fuzzers RateLimiter_description)
+else()
+  add_test(NAME fuzz COMMAND sh -c "echo 'no clang with libFuzzer (Debian: apt-get install clang-14 libclang-rt-14-dev)'; exit 1")
+endif()
