@@ -327,6 +327,23 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
 
 /* ---- Co-Simulation -------------------------------------------------------- */
 
+/* The outputs of fmi3DoStep: no events, no early return. */
+static inline void step_outputs(const FmuInstance *I, fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
+                                fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
+    *eventHandlingNeeded = fmi3False;
+    *terminateSimulation = fmi3False;
+    *earlyReturn = fmi3False;
+    *lastSuccessfulTime = I->core.time;
+}
+
+__attribute__((noinline)) static fmi3Status general_step(FmuInstance *I, const char *function, fmi3Float64 t, fmi3Float64 h,
+                                                          fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
+                                                          fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
+    const FmuStatus status = fmu_do_step_general(I, function, t, h);
+    step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
+    return (fmi3Status)status;
+}
+
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
@@ -335,12 +352,12 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
         return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
     }
-    const FmuStatus status = fmu_do_step(I, FN, currentCommunicationPoint, communicationStepSize);
-    *eventHandlingNeeded = fmi3False;
-    *terminateSimulation = fmi3False;
-    *earlyReturn = fmi3False;
-    *lastSuccessfulTime = I->core.time;
-    return (fmi3Status)status;
+    if (fmu_step_fast(I, currentCommunicationPoint, communicationStepSize)) {
+        step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
+        return fmi3OK;
+    }
+    return general_step(I, FN, currentCommunicationPoint, communicationStepSize, eventHandlingNeeded,
+                        terminateSimulation, earlyReturn, lastSuccessfulTime);
 }
 
 /* ---- not provided --------------------------------------------------------- */

@@ -220,19 +220,19 @@ static inline bool fmu_time_matches(double t, double time, double h) {
 }
 
 /* The common step, inline in the glue: the same step size as the step
- * before (so h is valid), no sub-cycling, nothing changed but u. False:
- * nothing done, take fmu_do_step. */
+ * before (so h is valid), no sub-cycling, nothing changed but u, and a cycle
+ * in which only rule 6 applies. False: nothing done, take the general step. */
 static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     FmuCore *core = &instance->core;
-    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance)) {
+    const double u = core->values[instance->inputVr];
+    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance &&
+          rl_only_ramps(&core->block, &instance->prepared, u))) {
         return false;
     }
-    const double end = t + h;
-    /* stores first: the kernel call is then the last thing done */
+    rl_ramp(&core->block, &instance->prepared, u);
     instance->outputsStale = true;
-    core->time = end;
-    core->values[0] = end;
-    rl_cycle(&core->block, &instance->prepared, core->values[instance->inputVr], end - core->startTime);
+    core->time = t + h;
+    core->values[0] = core->time;
     return true; /* no status change: that needs a new configuration */
 }
 

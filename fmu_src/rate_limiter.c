@@ -61,12 +61,6 @@ void rl_prepare(RlPrepared *p, const RlConfig *c, double period) {
     p->durationLimited = c->duration.value > 0;
 }
 
-void rl_period_changed(RlState *s, double period) {
-    s->runBase += (double)s->runCycles * s->runPeriod;
-    s->runCycles = 0;
-    s->runPeriod = period;
-}
-
 static void running_reset(RlState *s) {
     s->runCycles = 0;
     s->runBase = 0.0;
@@ -113,7 +107,7 @@ void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t 
         return;
     }
     rl_cycle(s, p, u, (double)first * cycleTime);
-    if (!(p->plain && fabs(u - s->y) <= DBL_MAX)) {
+    if (!rl_only_ramps(s, p, u)) {
         for (uint64_t n = first + 1; n <= last; n++) {
             rl_cycle(s, p, u, (double)n * cycleTime);
         }

@@ -94,7 +94,11 @@ static inline double rl_running_time(const RlState *state) {
 }
 
 /* runningTime goes on in cycles of a new length. */
-void rl_period_changed(RlState *state, double period);
+static inline void rl_period_changed(RlState *s, double period) {
+    s->runBase += (double)s->runCycles * s->runPeriod;
+    s->runCycles = 0;
+    s->runPeriod = period;
+}
 
 /* Rule 6: ramp towards u, or jump once the duration has run out. */
 static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
@@ -124,11 +128,17 @@ static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
 /* Rules 1-6 in their order. */
 void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
 
+/* The common case: finite u and y, no bypass, delay or error, so that of
+ * the rules only rule 6 (rl_ramp) applies. */
+static inline bool rl_only_ramps(const RlState *state, const RlPrepared *prepared, double u) {
+    return prepared->plain && fabs(u - state->y) <= DBL_MAX;
+}
+
 /* One cycle of length prepared->period; elapsed is the time from the start
- * to the end of this cycle. Inline, as the common case (finite u and y, no
- * bypass, delay or error: only rule 6 applies) is a few instructions. */
+ * to the end of this cycle. Inline, as the common case is a few
+ * instructions. */
 static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed) {
-    if (prepared->plain && fabs(u - state->y) <= DBL_MAX) {
+    if (rl_only_ramps(state, prepared, u)) {
         rl_ramp(state, prepared, u);
     } else {
         rl_cycle_rules(state, prepared, u, elapsed);
