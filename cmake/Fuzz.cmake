@@ -23,13 +23,8 @@ endfunction()
 
 find_fuzzing_clang(FUZZ_CLANG)
 if(NOT FUZZ_CLANG)
-  find_program(APT_GET apt-get)
-  if(APT_GET)
-    message(STATUS "No clang with libFuzzer: installing Debian's clang-14 and libclang-rt-14-dev")
-    execute_process(COMMAND sh -c "${APT_GET} update -qq && DEBIAN_FRONTEND=noninteractive ${APT_GET} install -y -qq --no-install-recommends clang-14 libclang-rt-14-dev"
-                    OUTPUT_QUIET)
-    find_fuzzing_clang(FUZZ_CLANG)
-  endif()
+  apt_install("No clang with libFuzzer" clang-14 libclang-rt-14-dev)
+  find_fuzzing_clang(FUZZ_CLANG)
 endif()
 
 set(FUZZ_TARGETS deserialize calls)

@@ -45,6 +45,13 @@ if(NOT EXISTS ${venv_stamp})
   file(TOUCH ${venv_stamp})
 endif()
 
+# ecospy's native library needs Debian's libtbb12 (and unzip for FMUs)
+execute_process(COMMAND ${VENV_PYTHON} -c "import ecospy" RESULT_VARIABLE ecospy_failed OUTPUT_QUIET ERROR_QUIET)
+find_program(UNZIP unzip)
+if(ecospy_failed OR NOT UNZIP)
+  apt_install("ecospy cannot load" libtbb12 unzip)
+endif()
+
 execute_process(
   COMMAND ${VENV_PYTHON} -c "import fmpy, os; print(os.path.join(os.path.dirname(fmpy.__file__), 'c-code'))"
   OUTPUT_VARIABLE FMI_HEADERS_DIR OUTPUT_STRIP_TRAILING_WHITESPACE COMMAND_ERROR_IS_FATAL ANY)
