@@ -76,6 +76,28 @@ function(add_fmu model version)
     list(APPEND copies COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi3/buildDescription.xml ${stage}/sources/)
     list(APPEND entries sources/buildDescription.xml)
   endif()
+
+  # the product models carry their documentation and icon, made from the
+  # TOML file and a simulation of the staged FMU
+  set(docs)
+  if(NOT ARG_TOML)
+    if(version EQUAL 2)
+      set(icon model.png)
+    else()
+      set(icon terminalsAndIcons/icon.png)
+    endif()
+    set(doc_files documentation/index.html documentation/ramp.png ${icon})
+    list(TRANSFORM doc_files PREPEND ${stage}/ OUTPUT_VARIABLE docs)
+    add_custom_command(
+      OUTPUT ${docs}
+      COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
+      COMMAND ${RUN_FMU_TOOL} ${VENV_PYTHON} ${CMAKE_SOURCE_DIR}/modelDescription/document.py
+              ${toml} ${stage} ${version} ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c
+      DEPENDS ${lib} ${toml} ${CMAKE_SOURCE_DIR}/modelDescription/document.py ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c
+              ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.h ${gen}/fmi${version}/modelDescription.xml
+      COMMENT "Documenting fmi${version}/${model}")
+    list(APPEND entries ${doc_files})
+  endif()
   list(SORT entries)
 
   set(fmu ${out_dir}/${model}.fmu)
@@ -85,7 +107,7 @@ function(add_fmu model version)
     COMMAND ${CMAKE_COMMAND} -E make_directory ${out_dir}
     COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" -- ${entries}
     WORKING_DIRECTORY ${stage}
-    DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml
+    DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})
   add_dependencies(fmus ${lib}_fmu)

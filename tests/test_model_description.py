@@ -3,6 +3,7 @@ capabilities, the TOML single source of truth against both model
 descriptions and the compiled-in C table, exported symbols, sources."""
 import math
 import os
+import struct
 import subprocess
 import tomllib
 import zipfile
@@ -114,3 +115,29 @@ def test_sources_are_shipped(model, version):
     assert f"sources/{model}_variables.h" in names
     if version == 3:
         assert "sources/buildDescription.xml" in names
+
+
+def png_size(data):
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    return struct.unpack(">II", data[16:24])
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_documentation_and_icon_are_inside(model, version):
+    """documentation/index.html (every variable, the status codes where the
+    block has a status), the ramp plot it shows, and the model icon."""
+    with zipfile.ZipFile(fmu_file(model, version)) as z:
+        page = z.read("documentation/index.html").decode()
+        ramp = z.read("documentation/ramp.png")
+        icon = z.read("model.png" if version == 2 else "terminalsAndIcons/icon.png")
+    md = read_model_description(str(fmu_file(model, version)))
+    for v in md.modelVariables:
+        assert f"<code>{v.name}</code>" in page, v.name
+    if any(v.name == "status" for v in md.modelVariables):
+        for code in ("16#8200", "16#8201", "16#8202", "16#8203", "16#8601"):
+            assert code in page, code
+    assert 'src="ramp.png"' in page
+    width, height = png_size(ramp)
+    assert width >= 400 and height >= 200
+    assert png_size(icon) == (128, 128)
