@@ -15,15 +15,24 @@ StepSize is the communication step. A sample is a match when
 |fmu - ref| <= RelTol * max(1, |ref|); NaN matches NaN, inf matches inf.
 
 Main job:  reference.py --build-dir build --report build/report
+On a cluster:  reference.py ... --scheduler tcp://host:8786
+
+Runs are Dask tasks: on a local cluster of processes (one per core) by
+default, on a Dask distributed scheduler with --scheduler, in this process
+with --serial. A task carries the scenario and the FMU's bytes and returns
+the result, its comparison and its plot, so workers need the same Python
+packages but no shared file system; the report is written here.
 """
 import argparse
 import contextlib
+import hashlib
+import html
 import io
 import math
 import os
 import sys
+import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -165,6 +174,7 @@ class Outcome:
 
 
 def plot(scenario, result, path, version):
+    """The plot as PNG into path (a file name or a binary stream)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -192,51 +202,121 @@ def plot(scenario, result, path, version):
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(f"{scenario.id}: {scenario.description}", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=80)
+    fig.savefig(path, dpi=80, format="png", metadata={"Software": None})
     plt.close(fig)
 
 
-def run_one(folder, build_dir, version, report_dir=None):
-    scenario = load(folder)
+def fmu_on_this_host(fmu_bytes):
+    """The FMU written once per worker process, named by its content."""
+    path = Path(tempfile.gettempdir()) / f"rl-campaign-{hashlib.sha256(fmu_bytes).hexdigest()[:16]}.fmu"
+    if not path.exists():
+        partial = path.with_suffix(f".{os.getpid()}.part")
+        partial.write_bytes(fmu_bytes)
+        partial.replace(path)
+    return path
+
+
+def run_one(scenario, fmu_bytes, version, with_plot=True):
+    """One scenario on one FMU: where the work happens (any worker)."""
     started = time.perf_counter()
     outcome = Outcome(scenario.id, version)
+    result = None
     try:
-        result = simulate(scenario, fmu_path(build_dir, scenario.model, version))
+        result = simulate(scenario, fmu_on_this_host(fmu_bytes))
         outcome.problems = compare(scenario, result)
     except Exception as exception:  # a failed simulation is a failed scenario
         outcome.problems = [f"simulation failed: {exception}"]
-        result = None
     outcome.seconds = time.perf_counter() - started
-    if report_dir is not None and result is not None:
-        stem = Path(report_dir) / f"fmi{version}" / scenario.model / scenario.name
-        stem.parent.mkdir(parents=True, exist_ok=True)
+    png = b""
+    if with_plot and result is not None:
+        stream = io.BytesIO()
+        plot(scenario, result, stream, version)
+        png = stream.getvalue()
+    return outcome, result, png
+
+
+def write_outputs(outcome, scenario, result, png, report_dir):
+    stem = Path(report_dir) / f"fmi{outcome.version}" / scenario.model / scenario.name
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    if result is not None:
         write_csv(f"{stem}_out.csv", result)
-        plot(scenario, result, f"{stem}.png", version)
-        outcome.csv, outcome.plot = f"{stem}_out.csv", f"{stem}.png"
-    return outcome
+        outcome.csv = f"{stem}_out.csv"
+    if png:
+        Path(f"{stem}.png").write_bytes(png)
+        outcome.plot = f"{stem}.png"
 
 
-def write_report(outcomes, report_dir, wall):
+def write_report(outcomes, report_dir, wall, where):
+    """summary.md and index.html: the pass/fail table and the plots."""
     report_dir = Path(report_dir)
     passed = sum(o.passed for o in outcomes)
-    lines = ["# Reference scenarios", "",
-             f"{passed} of {len(outcomes)} runs match their reference; wall time {wall:.1f} s.", "",
+    headline = f"{passed} of {len(outcomes)} runs match their reference; wall time {wall:.1f} s on {where}."
+    lines = ["# Reference scenarios", "", headline, "",
              "| scenario | FMI | result | seconds | plot |", "|---|---|---|---|---|"]
+    rows = []
     for o in outcomes:
         plot_link = os.path.relpath(o.plot, report_dir) if o.plot else ""
         verdict = "pass" if o.passed else "FAIL: " + "; ".join(o.problems[:3])
         lines.append(f"| {o.scenario} | {o.version} | {verdict} | {o.seconds:.2f} | "
                      + (f"[png]({plot_link})" if plot_link else "") + " |")
+        cls = "pass" if o.passed else "fail"
+        image = f'<a href="{plot_link}"><img src="{plot_link}" loading="lazy"></a>' if plot_link else ""
+        rows.append(f'<tr class="{cls}"><td>{html.escape(o.scenario)}</td><td>{o.version}</td>'
+                    f'<td>{html.escape(verdict)}</td><td>{o.seconds:.2f}</td><td>{image}</td></tr>')
     (report_dir / "summary.md").write_text("\n".join(lines) + "\n")
+    (report_dir / "index.html").write_text(f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Reference scenarios</title>
+<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}
+td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}}tr.pass td:nth-child(3){{color:#176617}}
+tr.fail td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</style></head><body>
+<h1>Reference scenarios</h1><p>{html.escape(headline)}</p>
+<table><tr><th>scenario</th><th>FMI</th><th>result</th><th>seconds</th><th>plot</th></tr>
+{chr(10).join(rows)}
+</table></body></html>
+""")
     return passed
+
+
+def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial=False, jobs=None, with_plot=True):
+    """Every scenario on every FMI version; returns [(outcome, scenario,
+    result, png)] in scenario order, and where it ran."""
+    fmus = {(s.model, v): fmu_path(build_dir, s.model, v).read_bytes() for s in scenarios for v in versions}
+    work = [(s, v) for s in scenarios for v in versions]
+    if serial:
+        done = [run_one(s, fmus[(s.model, v)], v, with_plot) for s, v in work]
+        where = "1 process (serial)"
+    else:
+        from dask.distributed import Client, LocalCluster
+
+        cluster = None
+        if scheduler:
+            client = Client(scheduler)
+        else:
+            cluster = LocalCluster(n_workers=jobs or os.cpu_count(), threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            client = Client(cluster)
+        try:
+            client.upload_file(__file__)  # this module, to every worker: nothing to install there but packages
+            workers = len(client.scheduler_info()["workers"])
+            shared = {key: client.scatter(data, broadcast=True) for key, data in fmus.items()}
+            futures = [client.submit(run_one, s, shared[(s.model, v)], v, with_plot, pure=False) for s, v in work]
+            done = client.gather(futures)
+            where = f"Dask, {workers} workers" + (f" at {scheduler}" if scheduler else " (local processes)")
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return [(o, s, r, png) for (o, r, png), (s, _) in zip(done, work)], where
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--build-dir", default="build")
-    parser.add_argument("--report", default=None, help="folder for result CSVs, plots and summary.md")
+    parser.add_argument("--report", default=None, help="folder for result CSVs, plots, summary.md and index.html")
     parser.add_argument("--model", action="append", help="only these models (repeatable)")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count())
+    parser.add_argument("--jobs", type=int, default=os.cpu_count(), help="local Dask workers (default: every core)")
+    parser.add_argument("--scheduler", default=None, help="address of a Dask distributed scheduler to run on")
+    parser.add_argument("--serial", action="store_true", help="run in this process, without Dask")
     args = parser.parse_args(argv)
 
     scenarios = discover(args.model)
@@ -244,22 +324,24 @@ def main(argv=None):
         print("no scenarios found")
         return 1
     report = Path(args.report) if args.report else None
-    if report:
-        report.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    work = [(s.folder, args.build_dir, v, report) for s in scenarios for v in FMI_VERSIONS]
-    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-        outcomes = list(pool.map(run_one, *zip(*work)))
+    runs, where = campaign(scenarios, args.build_dir, scheduler=args.scheduler, serial=args.serial, jobs=args.jobs,
+                           with_plot=report is not None)
     wall = time.perf_counter() - started
-    for o in outcomes:
-        print(f"{'pass' if o.passed else 'FAIL'}  FMI {o.version}  {o.scenario}")
-        for problem in o.problems[:10]:
+    outcomes = []
+    for outcome, scenario, result, png in runs:
+        if report:
+            write_outputs(outcome, scenario, result, png, report)
+        outcomes.append(outcome)
+        print(f"{'pass' if outcome.passed else 'FAIL'}  FMI {outcome.version}  {outcome.scenario}")
+        for problem in outcome.problems[:10]:
             print(f"      {problem}")
     passed = sum(o.passed for o in outcomes)
     if report:
-        write_report(outcomes, report, wall)
-        print(f"report: {report / 'summary.md'}")
-    print(f"{passed} passed, {len(outcomes) - passed} failed (wall time {wall:.1f} s on {args.jobs} processes)")
+        report.mkdir(parents=True, exist_ok=True)
+        write_report(outcomes, report, wall, where)
+        print(f"report: {report / 'index.html'}")
+    print(f"{passed} passed, {len(outcomes) - passed} failed (wall time {wall:.1f} s on {where})")
     return 0 if passed == len(outcomes) else 1
 
 
