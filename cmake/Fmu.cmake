@@ -98,6 +98,21 @@ function(add_fmu model version)
       COMMENT "Documenting fmi${version}/${model}")
     list(APPEND entries ${doc_files})
   endif()
+
+  # the product models also carry Windows x86_64 binaries (cmake/Windows.cmake)
+  set(windows_dll)
+  if(NOT ARG_TOML AND WINDOWS_BUILD_DIR)
+    if(version EQUAL 2)
+      set(windows_platform win64)
+    else()
+      set(windows_platform x86_64-windows)
+    endif()
+    set(windows_dll ${WINDOWS_BUILD_DIR}/fmi${version}/${model}.dll)
+    list(APPEND copies
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/binaries/${windows_platform}
+      COMMAND ${CMAKE_COMMAND} -E copy ${windows_dll} ${stage}/binaries/${windows_platform}/)
+    list(APPEND entries binaries/${windows_platform}/${model}.dll)
+  endif()
   list(SORT entries)
 
   set(fmu ${out_dir}/${model}.fmu)
@@ -107,7 +122,7 @@ function(add_fmu model version)
     COMMAND ${CMAKE_COMMAND} -E make_directory ${out_dir}
     COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" -- ${entries}
     WORKING_DIRECTORY ${stage}
-    DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs}
+    DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs} ${windows_dll}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})
   add_dependencies(fmus ${lib}_fmu)

@@ -161,7 +161,8 @@ def run_fmpy_fixed(scenario, fmu, drop_enumerations=False):
     md = read_model_description(str(fmu))
     model = md.coSimulation.modelIdentifier
     version = 2 if md.fmiVersion.startswith("2") else 3
-    fmu_instance = Instance(model, version, unzipdir=extract(str(fmu)))
+    unzipdir = str(fmu) if Path(fmu).is_dir() else extract(str(fmu))
+    fmu_instance = Instance(model, version, unzipdir=unzipdir)
     variables = fmu_instance.variables
     times = steps(scenario)
     initial = dict(scenario.start_values)
