@@ -125,5 +125,8 @@ function(add_fmu model version)
     DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs} ${windows_dll}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})
+  if(windows_dll)
+    add_dependencies(${lib}_fmu windows_binaries)
+  endif()
   add_dependencies(fmus ${lib}_fmu)
 endfunction()
