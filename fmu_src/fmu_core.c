@@ -54,7 +54,6 @@ void fmu_reset(FmuInstance *instance) {
     instance->fastPeriod = NAN;
     instance->outputsStale = false;
     instance->cycleTime = 0.0;
-    instance->subCycling = false;
     instance->inputVr = model->inputVr;
     const FmuVariable *u = &model->variables[model->inputVr], *y = &model->variables[model->outputVr];
     instance->fastInputVr = u->type == FMU_REAL && u->causality == FMU_INPUT && u->variability != FMU_FIXED &&
@@ -157,7 +156,6 @@ __attribute__((noinline)) static void configure(FmuInstance *instance) {
     instance->model->configure(instance->core.values, &instance->prepared.config);
     const double c = instance->prepared.config.cycleTime.value;
     instance->cycleTime = c > 0 && isfinite(c) ? c : 0.0;
-    instance->subCycling = instance->cycleTime > 0;
     instance->prepared.period = NAN;
     instance->configDirty = false;
 }
@@ -295,7 +293,7 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     }
     core->time = end;
     core->values[0] = end;
-    if (!instance->subCycling) {
+    if (instance->cycleTime == 0) {
         instance->fastPeriod = h; /* prepared for h, configuration current */
         instance->fastTolerance = RL_TIME_TOLERANCE * h;
     }

@@ -85,7 +85,6 @@ struct FmuInstance {
     RlPrepared prepared;
     bool configDirty;       /* a parameter or input other than u changed */
     bool outputsStale;      /* cycles ran since the outputs were published */
-    bool subCycling;        /* cycleTime > 0 */
     /* Step size of the common step (fmu_step_fast), NaN until a step has
      * prepared it and whenever anything it relies on changes; and its
      * time tolerance, RL_TIME_TOLERANCE * h, never more than the general
@@ -122,16 +121,12 @@ FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt
  * few compares. */
 
 /* Out-of-line error paths of the inline checks below. */
+/* A call in a mode its function's state table does not allow. */
 __attribute__((cold)) FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
 FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr);
 __attribute__((cold)) FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set);
 /* Publish the outputs (Initialization Mode: initialize the block first). */
 void fmu_refresh_outputs(FmuInstance *instance);
-
-/* State table check: FMU_OK, or logs and returns FMU_ERROR. */
-static inline FmuStatus fmu_check_mode(FmuInstance *instance, const char *function, int allowedModes) {
-    return (instance->core.mode & allowedModes) ? FMU_OK : fmu_mode_error(instance, function);
-}
 
 static inline FmuStatus fmu_check_array(FmuInstance *instance, const char *function, size_t n, const void *vr,
                                         const void *values) {
