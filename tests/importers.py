@@ -7,7 +7,6 @@ fails one test, not the suite.
 
     importers.py <ecospy|libcosimpy|fmpy-fixed[-no-enumerations]> <scenario folder> <fmu> <result.csv>
 """
-import math
 import sys
 from pathlib import Path
 
@@ -25,10 +24,10 @@ def input_values(scenario, t):
     if rows is None:
         return {}
     tolerance = 1e-9 * max(1.0, abs(t))
-    index = max(i for i in range(len(rows)) if rows["time"][i] <= t + tolerance) if rows["time"][0] <= t + tolerance else None
-    if index is None:
+    started = [i for i in range(len(rows)) if rows["time"][i] <= t + tolerance]
+    if not started:
         return {}
-    return {name: rows[name][index] for name in rows.dtype.names if name != "time"}
+    return {name: rows[name][started[-1]] for name in rows.dtype.names if name != "time"}
 
 
 def steps(scenario):

@@ -142,9 +142,10 @@ def same(value, expected, tolerance):
     return abs(value - expected) <= tolerance * max(1.0, abs(expected))
 
 
-def compare(scenario, result):
-    """Differences between a result and the reference, as readable lines."""
-    ref = scenario.reference
+def compare(scenario, result, reference=None):
+    """Differences between a result and the reference (or the rows of it
+    given), as readable lines."""
+    ref = scenario.reference if reference is None else reference
     tol = scenario.options["RelTol"]
     problems = []
     if len(result) != len(ref):

@@ -2,7 +2,6 @@
 exported function, nValues 0 and mismatched, duplicate value references,
 stop time before start time. Each gets the right status, and the instance
 stays usable where the standard allows."""
-import ctypes
 from ctypes import c_bool, c_double, c_int, c_size_t, c_uint, c_void_p
 
 import pytest
