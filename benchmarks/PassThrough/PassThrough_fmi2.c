@@ -1,5 +1,5 @@
 /* PassThrough, FMI 2: the least a Co-Simulation FMU can do per step
- * (y = u). The functions it does not need are stubs (stubs.py). */
+ * (y = u). The functions it does not need are stubs (tests/fixtures/stubs.py). */
 #include <stdlib.h>
 #include <string.h>
 
