@@ -336,34 +336,41 @@ static inline void step_outputs(const FmuInstance *I, fmi3Boolean *eventHandling
     *lastSuccessfulTime = I->core.time;
 }
 
-__attribute__((noinline)) static fmi3Status general_step(FmuInstance *I, const char *function, fmi3Float64 t, fmi3Float64 h,
+/* Every step but the common one. Its parameters are fmi3DoStep's, so that
+ * the common step's way out to it is a jump with every argument in place;
+ * noipa keeps GCC from cloning it with fewer (clang keeps them anyway). */
+#if defined(__GNUC__) && !defined(__clang__)
+#define KEEP_SIGNATURE __attribute__((noipa))
+#else
+#define KEEP_SIGNATURE __attribute__((noinline))
+#endif
+
+KEEP_SIGNATURE static fmi3Status general_step(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h,
+                                                          fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                                           fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
                                                           fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    const FmuStatus status = fmu_do_step_general(I, function, t, h);
+    (void)noSetFMUStatePriorToCurrentPoint;
+    FmuInstance *I = (FmuInstance *)instance;
+    if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
+        return (fmi3Status)fmu_error(I, "fmi3DoStep", "an output argument pointer is NULL");
+    }
+    const FmuStatus status = fmu_do_step_general(I, "fmi3DoStep", t, h);
     step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
     return (fmi3Status)status;
-}
-
-/* Out of line, taking the instance alone: the step's arguments stay where
- * they are on the way to the common step. */
-__attribute__((cold, noinline)) static fmi3Status null_output_argument(FmuInstance *I) {
-    return (fmi3Status)fmu_error(I, "fmi3DoStep", "an output argument pointer is NULL");
 }
 
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    (void)noSetFMUStatePriorToCurrentPoint;
     BEGIN("fmi3DoStep", MODES_DoStep);
-    if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
-        return null_output_argument(I);
-    }
-    if (fmu_step_fast(I, currentCommunicationPoint, communicationStepSize)) {
+    (void)FN;
+    if (eventHandlingNeeded && terminateSimulation && earlyReturn && lastSuccessfulTime &&
+        fmu_step_fast(I, currentCommunicationPoint, communicationStepSize)) {
         step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
         return fmi3OK;
     }
-    return general_step(I, FN, currentCommunicationPoint, communicationStepSize, eventHandlingNeeded,
-                        terminateSimulation, earlyReturn, lastSuccessfulTime);
+    return general_step(instance, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint,
+                        eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
 }
 
 /* ---- not provided --------------------------------------------------------- */

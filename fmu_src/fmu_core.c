@@ -172,6 +172,7 @@ __attribute__((noinline)) static void prepare(FmuInstance *instance, double peri
 }
 
 static void publish(FmuInstance *instance) {
+    instance->core.values[0] = instance->core.time; /* the independent variable */
     instance->model->publish(&instance->core.block, instance->core.values);
     instance->outputsStale = false;
 }
@@ -260,7 +261,6 @@ __attribute__((noinline)) static FmuStatus run_cycles(FmuInstance *instance, con
         }
         rl_run(&core->block, &instance->prepared, u, core->cycles + 1, (uint64_t)last, cycle);
         core->cycles = (uint64_t)last;
-        instance->outputsStale = true;
     }
     return FMU_OK;
 }
@@ -289,13 +289,18 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
             prepare(instance, h);
         }
         rl_cycle(&core->block, &instance->prepared, u, end - core->startTime);
-        instance->outputsStale = true;
     }
     core->time = end;
-    core->values[0] = end;
-    if (instance->cycleTime == 0) {
-        instance->fastPeriod = h; /* prepared for h, configuration current */
+    instance->outputsStale = true;
+    /* The next step may be the common one (fmu_step_fast) if it has this h,
+     * the configuration stays, one cycle per step, only rule 6 applies to
+     * any finite u (plain) and y is finite: then it stays so. */
+    if (instance->cycleTime == 0 && instance->prepared.plain && isfinite(core->block.y)) {
+        rl_hold_period(&core->block, h);
+        instance->fastPeriod = h;
         instance->fastTolerance = RL_TIME_TOLERANCE * h;
+    } else {
+        instance->fastPeriod = NAN;
     }
     return report_status(instance);
 }

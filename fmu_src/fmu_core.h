@@ -5,6 +5,7 @@
 #ifndef FMU_CORE_H
 #define FMU_CORE_H
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -84,7 +85,7 @@ struct FmuInstance {
     FmuCore core;
     RlPrepared prepared;
     bool configDirty;       /* a parameter or input other than u changed */
-    bool outputsStale;      /* cycles ran since the outputs were published */
+    bool outputsStale;      /* a step ran since outputs and time were published */
     /* Step size of the common step (fmu_step_fast), NaN until a step has
      * prepared it and whenever anything it relies on changes; and its
      * time tolerance, RL_TIME_TOLERANCE * h, never more than the general
@@ -148,16 +149,17 @@ static inline FmuStatus fmu_check_get(FmuInstance *instance, const char *functio
     return fmu_readable(instance, typeMask, vr) ? FMU_OK : fmu_access_error(instance, function, typeMask, vr, 0.0, false);
 }
 
-/* Outputs are published when read, not after every step: a step costs no
- * stores that nobody reads. The block's output is its state y; the others
- * are published together. In Initialization Mode they follow the inputs
- * and parameters set so far. */
+/* Outputs and time are published when read, not after every step: a step
+ * costs no stores that nobody reads. The block's output is its state y; the
+ * rest is published together. In Initialization Mode the outputs follow
+ * the inputs and parameters set so far. */
 static inline double fmu_get(FmuInstance *instance, unsigned vr) {
     if (instance->outputsStale) {
         if (vr == instance->model->outputVr && instance->core.mode != MODE_INITIALIZATION) {
             return instance->core.block.y;
         }
-        if (instance->model->variables[vr].causality == FMU_OUTPUT) {
+        const FmuCausality causality = instance->model->variables[vr].causality;
+        if (causality == FMU_OUTPUT || causality == FMU_INDEPENDENT) {
             fmu_refresh_outputs(instance);
         }
     }
@@ -215,19 +217,19 @@ static inline bool fmu_time_matches(double t, double time, double h) {
 }
 
 /* The common step, inline in the glue: the same step size as the step
- * before (so h is valid), no sub-cycling, nothing changed but u, and a cycle
- * in which only rule 6 applies. False: nothing done, take the general step. */
+ * before, no sub-cycling, nothing changed but u, and a cycle in which only
+ * rule 6 applies. What does not change from step to step is checked once,
+ * by the general step that sets fastPeriod (see there); what is left is h,
+ * t and a finite u. False: nothing done, take the general step. */
 static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     FmuCore *core = &instance->core;
     const double u = core->values[instance->inputVr];
-    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance &&
-          rl_only_ramps(&core->block, &instance->prepared, u))) {
+    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance && fabs(u) <= DBL_MAX)) {
         return false;
     }
-    rl_ramp(&core->block, &instance->prepared, u);
+    rl_ramp_steady(&core->block, &instance->prepared, u); /* y stays finite */
     instance->outputsStale = true;
     core->time = t + h;
-    core->values[0] = core->time;
     return true; /* no status change: that needs a new configuration */
 }
 

@@ -100,15 +100,25 @@ static inline void rl_period_changed(RlState *s, double period) {
     s->runPeriod = period;
 }
 
-/* Rule 6: ramp towards u, or jump once the duration has run out. */
-static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
+/* runningTime counts in cycles of period from now on. rl_ramp does this
+ * itself on its first ramping cycle after T changed; done ahead, it spares
+ * the steps that follow the check (rl_ramp_steady). runningTime keeps its
+ * value bit for bit: runBase takes runCycles * runPeriod, cycles restart. */
+static inline void rl_hold_period(RlState *s, double period) {
+    if (s->runPeriod != period) rl_period_changed(s, period);
+}
+
+/* Rule 6: ramp towards u, or jump once the duration has run out. steady:
+ * u and y are finite and runPeriod is already p->period (rl_hold_period),
+ * which spares two checks; a constant, so each caller gets its own copy. */
+static inline void rl_ramp_cycle(RlState *s, const RlPrepared *p, double u, bool steady) {
     double y = s->y;
     if (u != s->uPrevious) {
         s->runCycles = 0;
         s->runBase = 0.0;
     }
     if (y != u) {
-        if (p->period != s->runPeriod) rl_period_changed(s, p->period);
+        if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
         s->runCycles++;
     }
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
@@ -120,9 +130,20 @@ static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
         const double limited = y - p->maxDown;
         y = limited > u ? limited : u;
     }
-    s->rampActive = y != u;
+    /* the same for finite u and y; != is also true when one is NaN */
+    s->rampActive = steady ? islessgreater(y, u) : y != u;
     s->y = y;
     s->uPrevious = u;
+}
+
+static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
+    rl_ramp_cycle(s, p, u, false);
+}
+
+/* rl_ramp for finite u and y after rl_hold_period(s, p->period): the same
+ * y, uPrevious, rampActive and runningTime. */
+static inline void rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
+    rl_ramp_cycle(s, p, u, true);
 }
 
 /* Rules 1-6 in their order. */

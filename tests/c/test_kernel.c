@@ -1,6 +1,7 @@
 /* Unit tests of the rate limiter kernel: every rule (0 to 6) and every
  * status code of SPEC section 3. Expected values are worked by hand. */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -446,6 +447,60 @@ static void test_fast_paths_equal_rules(void) {
     }
 }
 
+/* The common step of the FMUs against the rules: once a cycle has run,
+ * the FMU moves runningTime to the new period ahead (rl_hold_period) and
+ * then runs rl_ramp_steady while u and y are finite and the configuration
+ * is plain. Over period changes, input steps, durations and huge values,
+ * y, uPrevious, rampActive and runningTime must equal rl_cycle_rules'. */
+static void test_steady_ramp_equals_rules(void) {
+    const double rates[] = { 0.0, 0.3, 1e308 };
+    const double durations[] = { 0.0, 0.05, 0.3 };
+    const double periods[] = { 0.01, 0.01, 0.02, 0.02, 0.02, 0.005, 0.01, 0.01 };
+    const double inputs[][8] = { { 5.0, 5.0, 5.0, -5.0, -5.0, 5.0, 5.0, 5.0 },
+                                 { 0.1, 0.1, 0.2, 0.2, 0.2, 0.2, -0.1, -0.1 },
+                                 { 1e308, -1e308, 1e308, 1e308, 0.0, 0.0, -1e308, -1e308 },
+                                 { 1.0, NAN, 1.0, 1.0, 2.0, INFINITY, 3.0, 3.0 } };
+    for (size_t r = 0; r < 3; r++)
+    for (size_t d = 0; d < 3; d++)
+    for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
+    for (size_t in = 0; in < 4; in++)
+    for (int repeat = 1; repeat <= 12; repeat += 11) {
+        RlConfig c = defaults();
+        c.rateUp.value = rates[r];
+        c.rateDown.value = rates[(r + 2) % 3];
+        c.duration.value = durations[d];
+        c.zeroRate = zero;
+        RlPrepared p;
+        RlState steady, rules;
+        rl_init(&steady, &c, 1.0);
+        rules = steady;
+        bool held = false; /* the FMU's fastPeriod: steady steps allowed */
+        double elapsed = 0.0;
+        for (size_t k = 0; k < 8; k++) {
+            if (k == 0 || periods[k] != periods[k - 1]) {
+                rl_prepare(&p, &c, periods[k]);
+                held = false;
+            }
+            for (int n = 0; n < repeat; n++) {
+                const double u = inputs[in][k];
+                elapsed += periods[k];
+                if (held && isfinite(u)) {
+                    rl_ramp_steady(&steady, &p, u);
+                } else {
+                    rl_cycle(&steady, &p, u, elapsed);
+                }
+                held = p.plain && isfinite(steady.y);
+                if (held) rl_hold_period(&steady, periods[k]);
+                rl_cycle_rules(&rules, &p, u, elapsed);
+                CHECK_EQ(steady.y, rules.y);
+                CHECK_EQ(steady.uPrevious, rules.uPrevious);
+                CHECK_EQ(steady.rampActive, rules.rampActive);
+                CHECK_EQ(rl_running_time(&steady), rl_running_time(&rules));
+            }
+        }
+    }
+}
+
 int main(void) {
     test_rule0_resolve();
     test_rule0_limits();
@@ -461,6 +516,7 @@ int main(void) {
     test_rule6_duration();
     test_running_time_period_change();
     test_fast_paths_equal_rules();
+    test_steady_ramp_equals_rules();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }
