@@ -480,8 +480,10 @@ FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const uns
                              model->variables[i].name);
         }
     }
+    /* runningTime is a sum of whole cycles: no NaN, infinity or negative */
     if (!isfinite(s.startTime) || !isfinite(s.time) || s.cycles > MAX_EXACT_CYCLES ||
-        s.block.runCycles > MAX_EXACT_CYCLES) {
+        s.block.runCycles > MAX_EXACT_CYCLES || !(s.block.runPeriod >= 0 && s.block.runPeriod <= DBL_MAX) ||
+        !(s.block.runBase >= 0 && s.block.runBase <= DBL_MAX)) {
         return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
     }
     *out = s;

@@ -101,6 +101,8 @@ BAD_BYTES = {
     "boolean 2": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", 2.0)),  # bypass
     "start time infinite": lambda d: value_at(d, values_end(d) + BLOCK, struct.pack("<d", float("inf"))),
     "cycle count 2^60": lambda d: value_at(d, values_end(d) + BLOCK + 16, struct.pack("<Q", 1 << 60)),
+    "running time period NaN": lambda d: value_at(d, values_end(d) + 25, struct.pack("<d", float("nan"))),
+    "running time base negative": lambda d: value_at(d, values_end(d) + 33, struct.pack("<d", -1.0)),
 }
 
 
