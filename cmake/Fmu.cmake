@@ -1,6 +1,9 @@
 # add_fmu(<Model> <2|3>): build/fmi<2|3>/<Model>.fmu from the model's TOML
 # file, its mapping fmu_src/models/<Model>.c, the kernel and the shared glue.
-# The .fmu is a zip made by CMake alone, with fixed time stamps.
+# The .fmu is a zip made by CMake alone, with fixed time stamps; the host
+# tool zip_normalize (cmake/zip_normalize.c) then fixes what libarchive takes
+# from the file system (access/change times, owner, umask), so that the same
+# sources give the same bytes on any machine and for any user.
 # A fixture passes its own TOML, C sources (relative to the source tree) and
 # output folder: add_fmu(<Model> <2|3> TOML t SOURCES a.c ... OUTPUT_DIR d).
 
@@ -11,6 +14,9 @@ set(GENERATOR ${CMAKE_SOURCE_DIR}/modelDescription/generate.py)
 
 function(add_fmu model version)
   cmake_parse_arguments(PARSE_ARGV 2 ARG "" "TOML;OUTPUT_DIR" "SOURCES")
+  if(NOT TARGET zip_normalize)
+    add_executable(zip_normalize ${CMAKE_SOURCE_DIR}/cmake/zip_normalize.c)
+  endif()
   set(gen ${CMAKE_BINARY_DIR}/gen/${model})
   set(stage ${CMAKE_BINARY_DIR}/stage/fmi${version}/${model})
   set(toml ${CMAKE_SOURCE_DIR}/modelDescription/${model}.toml)
@@ -121,8 +127,9 @@ function(add_fmu model version)
     ${copies}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${out_dir}
     COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" -- ${entries}
+    COMMAND zip_normalize ${fmu}
     WORKING_DIRECTORY ${stage}
-    DEPENDS ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs} ${windows_dll}
+    DEPENDS zip_normalize ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs} ${windows_dll}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})
   if(windows_dll)
