@@ -48,10 +48,13 @@ def repackage(model, version, tmp_path, normalize):
         if os.geteuid() == 0:
             os.chown(path, 1234, 5678)
     out = tmp_path / f"{model}.fmu"
+    # as the build runs them: without the sanitizer tree's preloaded runtime
+    # (under it cmake -E tar hangs), which an instrumented tool links anyway
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
     subprocess.run([cmake_command(), "-E", "tar", "cf", str(out), "--format=zip", f"--mtime={zip_mtime()}", "--",
-                    *names], cwd=stage, check=True)
+                    *names], cwd=stage, env=env, check=True, timeout=120)
     if normalize:
-        subprocess.run([str(BUILD_DIR / "zip_normalize"), str(out)], check=True)
+        subprocess.run([str(BUILD_DIR / "zip_normalize"), str(out)], env=env, check=True, timeout=120)
     return built.read_bytes(), out.read_bytes()
 
 
