@@ -38,3 +38,22 @@ def test_duration_of_48_hours_jumps_at_its_cycle(version):
     assert fmu.get("y") == 1e9                                # cycle 25,920,000 ends at 259200 s
     assert fmu.get("runningTime") == 259200.0
     fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_time_variable_follows_every_step(version):
+    """time is published when read: after the common step (same h, only u
+    changing) and after general ones (h changes, a parameter set), it is the
+    end of the last step, t + h as the importer passed them."""
+    fmu = Instance("RateLimiter", version)
+    fmu.start(start_time=5.0, rateUpPar=1.0, rateDownPar=1.0)
+    steps = [0.001] * 20 + [0.002] * 5 + [0.001] * 5
+    for n, h in enumerate(steps):
+        if n == 27:
+            fmu.set(rateUpPar=2.0)  # a configuration change: a general step next
+        fmu.set(u=float(n % 3))
+        t = fmu.t
+        fmu.step(h)
+        assert fmu.get("time") == t + h, n
+    assert fmu.get("time") == fmu.t
+    fmu.free()
