@@ -346,9 +346,9 @@ static inline void step_outputs(const FmuInstance *I, fmi3Boolean *eventHandling
 #endif
 
 KEEP_SIGNATURE static fmi3Status general_step(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h,
-                                                          fmi3Boolean noSetFMUStatePriorToCurrentPoint,
-                                                          fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
-                                                          fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
+                                             fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                                             fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
+                                             fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     (void)noSetFMUStatePriorToCurrentPoint;
     FmuInstance *I = (FmuInstance *)instance;
     if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
@@ -363,7 +363,6 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     BEGIN("fmi3DoStep", MODES_DoStep);
-    (void)FN;
     if (eventHandlingNeeded && terminateSimulation && earlyReturn && lastSuccessfulTime &&
         fmu_step_fast(I, currentCommunicationPoint, communicationStepSize)) {
         step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);

@@ -86,8 +86,9 @@ struct FmuInstance {
     RlPrepared prepared;
     bool configDirty;       /* a parameter or input other than u changed */
     bool outputsStale;      /* a step ran since outputs and time were published */
-    /* Step size of the common step (fmu_step_fast), NaN until a step has
-     * prepared it and whenever anything it relies on changes; and its
+    /* Step size of the common step (fmu_step_fast): set by a general step
+     * that found the common one possible (fmu_do_step_general), NaN
+     * whenever anything it relies on changes; and its
      * time tolerance, RL_TIME_TOLERANCE * h, never more than the general
      * step's (which adds |time|), so the fast step accepts less, not more. */
     double fastPeriod, fastTolerance;
