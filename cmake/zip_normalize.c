@@ -6,6 +6,7 @@
  * access and change time = modification time, owner = 0/0, permissions
  * 0644 or 0755 (any execute bit). Data and CRCs are not touched.
  * Exit status 0: done; 1: not a zip this tool understands (left as is). */
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -123,7 +124,8 @@ int main(int argc, char **argv) {
     }
     if (!status) {
         f = fopen(path, "r+b");
-        if (!f || fwrite(zip, 1, size, f) != size || fclose(f) != 0) status = fail(path, "cannot write");
+        const bool written = f && fwrite(zip, 1, size, f) == size;
+        if ((f && fclose(f) != 0) || !written) status = fail(path, "cannot write");
     }
     free(zip);
     return status;
