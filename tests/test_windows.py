@@ -1,25 +1,23 @@
 """The Windows x86_64 binaries in the FMUs (cross-compiled with mingw-w64)
 run reference scenarios through fmpy's wine remoting (Debian's wine64):
 the FMU with only its win64 binary, fmpy's TCP client in its place on
-linux64 and the server under wine; the numbers equal the linux64 binary's
-bit for bit, and the reference."""
-import contextlib
+linux64 and the server under wine (support/wine.py says why we start the
+server ourselves); the numbers equal the linux64 binary's bit for bit, and
+the reference."""
 import os
-import shutil
-import signal
-import subprocess
 import sys
-import time
 import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import extract
-from fmpy.util import add_remoting, read_csv
+from fmpy.util import read_csv
 
 from fmu_driver import BUILD_DIR, fmu_file
 from reference import SCENARIO_ROOT, compare, load
+from support.process import run
+from support.wine import RemotingServer, environment, make_prefix, remoting_copy
 
 HERE = Path(__file__).resolve().parent
 pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
@@ -27,75 +25,69 @@ pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
 WINE_DIR = os.environ.get("RL_WINE_DIR", "/usr/lib/wine")
 SCENARIOS = ["RateLimiter/step_up", "RateLimiter/cycle_steps_of_10", "RateLimiter/status_errors",
              "LGF_LimRateOfChangeCI/rate_100ms", "RateLimit/duration_jump", "Ramp/ttime_10s_both_ways"]
+CLIENT_SECONDS = 120  # a run takes under 1 s idle, a few on a busy machine
 
 
 @pytest.fixture(scope="module")
 def wine():
-    """The wine prefix made once (wineboot), before any run."""
-    env = dict(os.environ, PATH=f"{WINE_DIR}:{os.environ['PATH']}",
-               WINEPREFIX=str((Path(BUILD_DIR) / "wineprefix").resolve()), WINEDEBUG="-all")
-    subprocess.run([str(Path(WINE_DIR) / "wine64"), "wineboot", "--init"], env=env, capture_output=True, timeout=300)
-    stop_wine(env)
-    yield env
-    stop_wine(env)
+    """The wine prefix, made once (wineboot) before any run."""
+    assert (Path(WINE_DIR) / "wine64").exists(), "wine64 is installed by the test set-up (command 2)"
+    env = environment(WINE_DIR, (Path(BUILD_DIR) / "wineprefix").resolve())
+    make_prefix(env, WINE_DIR)
+    return env
 
 
-def stop_wine(env):
-    """Stop the wineserver and wait until it is gone: a wine started while
-    the old server is still exiting dies on arrival, and fmpy's client
-    then waits for its remoting server for ever."""
-    wineserver = str(Path(WINE_DIR) / "wineserver")
-    subprocess.run([wineserver, "--kill"], env=env, capture_output=True, timeout=60)
-    subprocess.run([wineserver, "--wait"], env=env, capture_output=True, timeout=60)
+def simulate(env, fmu_dir, scenario, out, what):
+    """importers.py fmpy-fixed on an extracted FMU, bounded."""
+    done = run([sys.executable, str(HERE / "importers.py"), "fmpy-fixed", str(scenario.folder), str(fmu_dir), str(out)],
+               timeout=CLIENT_SECONDS, what=what, env=env)
+    return done
 
 
-def remoting_servers():
-    """Process ids of fmpy's remoting servers (from /proc: no procps needed)."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                if b"server_tcp.exe" in (entry / "cmdline").read_bytes():
-                    found.append(int(entry.name))
-            except OSError:
-                pass
-    return found
-
-
-def run(env, fmu, scenario, out):
-    stop_wine(env)
-    try:
-        process = subprocess.run([sys.executable, str(HERE / "importers.py"), "fmpy-fixed", str(scenario.folder),
-                                  str(fmu), str(out)], capture_output=True, text=True, timeout=180, env=env)
-    finally:
-        # fmpy's remoting server listens on a fixed port: one left running
-        # would answer the next FMU's client
-        for _ in range(100):
-            servers = remoting_servers()
-            if not servers:
-                break
-            for pid in servers:
-                with contextlib.suppress(OSError):
-                    os.kill(pid, signal.SIGTERM)
-            time.sleep(0.1)
-        stop_wine(env)
-    assert process.returncode == 0, (process.stdout + process.stderr)[-3000:]
-    return np.atleast_1d(read_csv(str(out)))
+def windows_and_linux(wine, scenario, tmp_path):
+    """The scenario on the win64 binary under wine and on the linux64 one."""
+    fmu = fmu_file(scenario.model, 2)
+    with zipfile.ZipFile(fmu) as z:
+        assert f"binaries/win64/{scenario.model}.dll" in z.namelist()
+    extracted = Path(extract(str(fmu), str(tmp_path / "fmu")))
+    windows_only = tmp_path / "win64"
+    dll = remoting_copy(extracted, windows_only)
+    server_exe = windows_only / "binaries" / "win64" / "server_tcp.exe"
+    with RemotingServer(wine, WINE_DIR, server_exe, dll, tmp_path / "server.log") as server:
+        try:
+            done = simulate(wine, windows_only, scenario, tmp_path / "win64.csv",
+                            "fmpy's remoting client on the win64 binary")
+        except AssertionError as failure:
+            raise AssertionError(f"{failure}\nthe server under wine printed:\n{server.output()}") from None
+        assert done.returncode == 0, f"{done.stdout}{done.stderr}\nthe server printed:\n{server.output()}"
+    done = simulate(wine, extracted, scenario, tmp_path / "linux64.csv", "fmpy on the linux64 binary")
+    assert done.returncode == 0, done.stdout + done.stderr
+    on_windows = np.atleast_1d(read_csv(str(tmp_path / "win64.csv")))
+    on_linux = np.atleast_1d(read_csv(str(tmp_path / "linux64.csv")))
+    assert len(on_windows) == len(on_linux) > 1
+    for column in on_linux.dtype.names:
+        assert np.array_equal(on_windows[column], on_linux[column], equal_nan=True), column
+    return on_windows
 
 
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_win64_binary_under_wine_equals_linux64(name, wine, tmp_path):
-    assert (Path(WINE_DIR) / "wine64").exists(), "wine64 is installed by the configure step"
     scenario = load(SCENARIO_ROOT / name)
-    fmu = fmu_file(scenario.model, 2)
-    with zipfile.ZipFile(fmu) as z:
-        assert f"binaries/win64/{scenario.model}.dll" in z.namelist()
-    windows_only = Path(extract(str(fmu), str(tmp_path / "fmu")))
-    shutil.rmtree(windows_only / "binaries" / "linux64")
-    add_remoting(str(windows_only), host_platform="linux64", remote_platform="win64")
-    on_windows = run(wine, windows_only, scenario, tmp_path / "win64.csv")
-    on_linux = run(wine, fmu, scenario, tmp_path / "linux64.csv")
-    assert len(on_windows) == len(on_linux) > 1
-    for column in on_linux.dtype.names:
-        assert np.array_equal(on_windows[column], on_linux[column], equal_nan=True), column
-    assert not compare(scenario, on_windows)
+    assert not compare(scenario, windows_and_linux(wine, scenario, tmp_path))
+
+
+def test_a_run_longer_than_the_servers_lock_file_poll(wine, tmp_path):
+    """400 steps of step_up: longer than the 0.5 s after which fmpy's own
+    server start loses its server (support/wine.py); the ramp of the
+    reference ends at u = 10 and stays."""
+    folder = tmp_path / "RateLimiter" / "long"
+    folder.mkdir(parents=True)
+    for f in (SCENARIO_ROOT / "RateLimiter/step_up").iterdir():
+        text = f.read_text()
+        if f.name.endswith("_ref.opt"):
+            text = "".join("StopTime,200.0\n" if line.startswith("StopTime") else line
+                           for line in text.splitlines(keepends=True))
+        (folder / f.name).write_text(text)
+    result = windows_and_linux(wine, load(folder), tmp_path)
+    assert len(result) == 401 and result["time"][-1] == 200.0
+    assert np.all(result["y"][result["time"] >= 6.0] == 10.0)

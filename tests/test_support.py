@@ -1,0 +1,84 @@
+"""The bounded waits of the test support: a child that hangs, or leaves a
+grandchild holding its output, ends the wait within its bound with a
+message saying what was waited for; a remoting server that dies, never
+listens, or finds its port taken is reported with what it printed."""
+import os
+import socket
+import stat
+import time
+
+import pytest
+
+from support.process import Timeout, run
+from support.wine import PORT, RemotingServer, listeners
+
+
+def test_a_hanging_child_and_its_grandchild_are_stopped_at_the_bound(tmp_path):
+    marker = tmp_path / "grandchild.pid"
+    started = time.monotonic()
+    with pytest.raises(Timeout, match="waiting for sleepers: no end within 1 s"):
+        # the grandchild inherits stdout: subprocess.run would wait for it
+        run(["sh", "-c", f"sleep 300 & echo $! > {marker}; echo started; wait"], timeout=1,
+            what="waiting for sleepers")
+    assert time.monotonic() - started < 30
+    grandchild = int(marker.read_text())
+    time.sleep(0.2)
+    assert not os.path.exists(f"/proc/{grandchild}") or \
+        open(f"/proc/{grandchild}/stat").read().split(")")[1].split()[0] == "Z"
+
+
+def test_output_and_exit_status_of_a_child_that_ends():
+    done = run(["sh", "-c", "echo out; echo err >&2; exit 3"], timeout=30, what="sh")
+    assert (done.returncode, done.stdout, done.stderr) == (3, "out\n", "err\n")
+    with pytest.raises(AssertionError, match="sh: exit status 3"):
+        run(["sh", "-c", "exit 3"], timeout=30, what="sh", check=True)
+
+
+def fake_wine(folder, server_script):
+    """A wine64 that runs server_script instead of the server, and a
+    wineserver that does nothing."""
+    folder.mkdir()
+    for name, body in (("wine64", server_script), ("wineserver", "exit 0")):
+        path = folder / name
+        path.write_text(f"#!/bin/sh\n{body}\n")
+        path.chmod(path.stat().st_mode | stat.S_IEXEC)
+    return folder
+
+
+def server(tmp_path, script, seconds=60):
+    assert not listeners(PORT), f"port {PORT} is taken on this machine: the Windows test cannot run either"
+    wine_dir = fake_wine(tmp_path / "wine", script)
+    prefix = tmp_path / "prefix"
+    prefix.mkdir()
+    env = dict(os.environ, WINEPREFIX=str(prefix))
+    return RemotingServer(env, str(wine_dir), "server_tcp.exe", "Model.dll", tmp_path / "server.log", seconds)
+
+
+def test_a_server_that_dies_at_start_is_reported_with_what_it_printed(tmp_path):
+    started = time.monotonic()
+    with pytest.raises(AssertionError, match="(?s)attempt 1: .*exited with status 7 .*wine: could not load"):
+        with server(tmp_path, "echo 'wine: could not load Model.dll'; exit 7"):
+            pass
+    assert time.monotonic() - started < 30
+
+
+def test_a_server_that_never_listens_is_reported_at_the_bound(tmp_path):
+    started = time.monotonic()
+    with pytest.raises(AssertionError, match="(?s)did not listen on port 8080 within 1 s.*still starting"):
+        with server(tmp_path, "echo 'still starting'; sleep 300", seconds=1):
+            pass
+    assert time.monotonic() - started < 30
+
+
+def test_a_port_taken_by_another_process_is_refused(tmp_path):
+    never_started = server(tmp_path, "sleep 300")
+    with socket.socket() as taken:
+        taken.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            taken.bind(("127.0.0.1", PORT))
+        except OSError:
+            pytest.fail(f"port {PORT} is taken on this machine: the Windows test cannot run either")
+        taken.listen()
+        with pytest.raises(AssertionError, match=f"port {PORT} .* is already listened on by"):
+            with never_started:
+                pass
