@@ -278,9 +278,11 @@ tr.fail td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</st
     return passed
 
 
-def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial=False, jobs=None, with_plot=True):
+def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial=False, jobs=None, with_plot=True,
+             timeout=None):
     """Every scenario on every FMI version; returns [(outcome, scenario,
-    result, png)] in scenario order, and where it ran."""
+    result, png)] in scenario order, and where it ran. timeout: seconds
+    to wait for the cluster's results (None: no bound)."""
     fmus = {(s.model, v): fmu_path(build_dir, s.model, v).read_bytes() for s in scenarios for v in versions}
     work = [(s, v) for s in scenarios for v in versions]
     if serial:
@@ -301,6 +303,8 @@ def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial
             workers = len(client.scheduler_info()["workers"])
             shared = {key: client.scatter(data, broadcast=True) for key, data in fmus.items()}
             futures = [client.submit(run_one, s, shared[(s.model, v)], v, with_plot, pure=False) for s, v in work]
+            from dask.distributed import wait
+            wait(futures, timeout=timeout)  # TimeoutError names the bound
             done = client.gather(futures)
             where = f"Dask, {workers} workers" + (f" at {scheduler}" if scheduler else " (local processes)")
         finally:

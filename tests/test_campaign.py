@@ -18,33 +18,57 @@ from reference import campaign, discover, write_outputs, write_report
 BIN = Path(sys.executable).parent
 
 
+START_SECONDS = 60
+
+
+def log_tail(path):
+    return path.read_text(errors="replace")[-2000:] if path.exists() else "(nothing)"
+
+
 @pytest.fixture
 def cluster(tmp_path):
+    """A scheduler and two workers on loopback; every wait bounded, and a
+    failure shows what they printed."""
     scheduler_file = tmp_path / "scheduler.json"
+    logs = [tmp_path / "scheduler.log", tmp_path / "worker-a.log", tmp_path / "worker-b.log"]
     common = ["--no-dashboard"]
-    processes = [subprocess.Popen([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0",
-                                   "--scheduler-file", str(scheduler_file)] + common,
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+
+    def start(args, log):
+        with open(log, "wb") as out:
+            return subprocess.Popen([str(BIN / "dask")] + args + common, stdin=subprocess.DEVNULL, stdout=out,
+                                    stderr=subprocess.STDOUT)
+
+    processes = [start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(scheduler_file)],
+                       logs[0])]
     try:
-        for _ in range(200):
-            if scheduler_file.exists() and scheduler_file.stat().st_size:
-                break
+        deadline = time.monotonic() + START_SECONDS
+        while not (scheduler_file.exists() and scheduler_file.stat().st_size):
+            assert processes[0].poll() is None, f"the Dask scheduler exited: {log_tail(logs[0])}"
+            assert time.monotonic() < deadline, \
+                f"the Dask scheduler wrote no address within {START_SECONDS} s: {log_tail(logs[0])}"
             time.sleep(0.1)
         address = json.loads(scheduler_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
-        for name in ("worker-a", "worker-b"):
-            processes.append(subprocess.Popen([str(BIN / "dask"), "worker", address, "--nworkers", "1",
-                                               "--nthreads", "1", "--name", name, "--host", "127.0.0.1"] + common,
-                                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        for name, log in zip(("worker-a", "worker-b"), logs[1:]):
+            processes.append(start(["worker", address, "--nworkers", "1", "--nthreads", "1", "--name", name,
+                                    "--host", "127.0.0.1"], log))
         from dask.distributed import Client
-        with Client(address) as client:
-            client.wait_for_workers(2, timeout=60)
+        with Client(address, timeout=START_SECONDS) as client:
+            try:
+                client.wait_for_workers(2, timeout=START_SECONDS)
+            except TimeoutError:
+                raise AssertionError(f"two Dask workers did not join within {START_SECONDS} s: "
+                                     + " | ".join(log_tail(log) for log in logs)) from None
         yield address
     finally:
         for p in reversed(processes):
             p.terminate()
         for p in processes:
-            p.wait(timeout=30)
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait(timeout=30)
 
 
 def report(runs, where, folder):
@@ -63,7 +87,7 @@ def without_timings(text):
 
 def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_path):
     scenarios = discover(["RateLimiter", "Ramp"])
-    distributed, where = campaign(scenarios, BUILD_DIR, scheduler=cluster)
+    distributed, where = campaign(scenarios, BUILD_DIR, scheduler=cluster, timeout=600)
     assert where == f"Dask, 2 workers at {cluster}"
     serial, _ = campaign(scenarios, BUILD_DIR, serial=True)
     a = report(distributed, where, tmp_path / "distributed")

@@ -6,7 +6,6 @@ contract's rate limiter (tests/oracle.py) and the plant's exact step
 response, coupled the same way (at each communication point the outputs
 go to the inputs, then both step)."""
 import math
-import subprocess
 import sys
 from pathlib import Path
 
@@ -17,6 +16,7 @@ from fmpy.util import read_csv
 
 from closed_loop import H, LIMITER, N, PLANT
 from fmu_driver import BUILD_DIR, fmu_file
+from support.process import run as run_bounded
 from oracle import oracle_for
 
 HERE = Path(__file__).resolve().parent
@@ -42,8 +42,8 @@ def oracle_loop():
 @pytest.mark.parametrize("importer,version", RUNS, ids=[f"{i}-fmi{v}" for i, v in RUNS])
 def test_closed_loop_agrees_with_the_oracle(importer, version, tmp_path):
     out = tmp_path / "loop.csv"
-    process = subprocess.run([sys.executable, str(HERE / "closed_loop.py"), importer, str(version), str(BUILD_DIR),
-                              str(out)], capture_output=True, text=True, timeout=300)
+    process = run_bounded([sys.executable, str(HERE / "closed_loop.py"), importer, str(version), str(BUILD_DIR),
+                           str(out)], timeout=300, what=f"the closed loop in {importer} (FMI {version})")
     assert process.returncode == 0, (process.stdout + process.stderr)[-3000:]
     result = np.atleast_1d(read_csv(str(out)))
     expected = oracle_loop()

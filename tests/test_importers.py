@@ -12,8 +12,6 @@ What an importer cannot do is asserted, not skipped:
 - both step on a fixed grid: a scenario whose inputs change between grid
   points (fmpy adds communication points there) is compared, bit for bit,
   with fmpy's low-level API making the same calls on the same grid."""
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -23,6 +21,7 @@ from fmpy import read_model_description
 from fmpy.util import read_csv
 
 from fmu_driver import BUILD_DIR
+from support.process import run as run_bounded
 from reference import compare, discover, fmu_path
 
 HERE = Path(__file__).resolve().parent
@@ -41,9 +40,9 @@ def enumerations_set(scenario, version):
 
 def run(importer, scenario, version, tmp_path):
     out = tmp_path / "result.csv"
-    process = subprocess.run([sys.executable, str(HERE / "importers.py"), importer, str(scenario.folder),
-                              str(fmu_path(BUILD_DIR, scenario.model, version)), str(out)],
-                             capture_output=True, text=True, timeout=300, env=dict(os.environ))
+    process = run_bounded([sys.executable, str(HERE / "importers.py"), importer, str(scenario.folder),
+                           str(fmu_path(BUILD_DIR, scenario.model, version)), str(out)],
+                          timeout=300, what=f"{scenario.id} through {importer} (FMI {version})")
     assert process.returncode == 0, process.stderr[-3000:]
     return np.atleast_1d(read_csv(str(out))), process.stdout + process.stderr
 

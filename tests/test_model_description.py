@@ -4,7 +4,6 @@ descriptions and the compiled-in C table, exported symbols, sources."""
 import math
 import os
 import struct
-import subprocess
 import tomllib
 import zipfile
 
@@ -13,6 +12,7 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 from fmu_driver import REPO, Instance, fmu_file, unzipped
+from support.process import run as run_bounded
 
 MODELS = sorted(p.stem for p in (REPO / "modelDescription").glob("*.toml"))
 FMI3_TYPE = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enumeration": "Enumeration"}
@@ -95,10 +95,10 @@ def test_compiled_variable_table_is_the_toml(model, version):
                     reason="sanitizer build: its binaries need libasan by design; the release build is checked")
 def test_binary_exports_fmi_only_and_needs_libc_only(model, version):
     binary = f"{unzipped(model, version)}/binaries/{PLATFORM[version]}/{model}.so"
-    symbols = subprocess.run(["nm", "-D", "--defined-only", binary], capture_output=True, text=True, check=True)
+    symbols = run_bounded(["nm", "-D", "--defined-only", binary], timeout=60, what="nm", check=True)
     names = [line.split()[-1] for line in symbols.stdout.splitlines()]
     assert names and all(n.startswith(f"fmi{version}") for n in names), [n for n in names if not n.startswith("fmi")]
-    dynamic = subprocess.run(["readelf", "-d", binary], capture_output=True, text=True, check=True).stdout
+    dynamic = run_bounded(["readelf", "-d", binary], timeout=60, what="readelf", check=True).stdout
     needed = sorted(line.split("[")[1].rstrip("]") for line in dynamic.splitlines() if "(NEEDED)" in line)
     assert set(needed) <= {"libc.so.6", "libm.so.6"}
 

@@ -5,12 +5,12 @@ same bytes. Without zip_normalize they differ (the control)."""
 import os
 import re
 import shutil
-import subprocess
 import zipfile
 
 import pytest
 
 from fmu_driver import BUILD_DIR, REPO, fmu_file
+from support.process import run as run_bounded
 
 MODELS = ["RateLimiter", "LGF_LimRateOfChangeCI", "RateLimit", "Ramp", "PassThrough"]
 
@@ -51,10 +51,10 @@ def repackage(model, version, tmp_path, normalize):
     # as the build runs them: without the sanitizer tree's preloaded runtime
     # (under it cmake -E tar hangs), which an instrumented tool links anyway
     env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
-    subprocess.run([cmake_command(), "-E", "tar", "cf", str(out), "--format=zip", f"--mtime={zip_mtime()}", "--",
-                    *names], cwd=stage, env=env, check=True, timeout=120)
+    run_bounded([cmake_command(), "-E", "tar", "cf", str(out), "--format=zip", f"--mtime={zip_mtime()}", "--",
+                 *names], cwd=stage, env=env, check=True, timeout=120, what="cmake -E tar (packaging)")
     if normalize:
-        subprocess.run([str(BUILD_DIR / "zip_normalize"), str(out)], env=env, check=True, timeout=120)
+        run_bounded([str(BUILD_DIR / "zip_normalize"), str(out)], env=env, check=True, timeout=120, what="zip_normalize")
     return built.read_bytes(), out.read_bytes()
 
 

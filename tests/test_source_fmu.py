@@ -1,7 +1,6 @@
 """The source FMU: binaries removed, compiled by `fmpy compile` as an
 importer on another platform would, gives the same bits as the shipped
 binary."""
-import subprocess
 import sys
 import zipfile
 
@@ -9,6 +8,7 @@ import numpy as np
 import pytest
 
 from fmu_driver import fmu_file
+from support.process import run as run_bounded
 from reference import discover, simulate
 
 SCENARIOS = discover()
@@ -30,8 +30,8 @@ def test_compiled_source_fmu_matches_shipped_binary(model, version, tmp_path):
     strip_binaries(shipped, source_only)
     with zipfile.ZipFile(source_only) as z:
         assert not any(n.startswith("binaries/") for n in z.namelist())
-    subprocess.run([sys.executable, "-m", "fmpy", "compile", str(source_only)], check=True,
-                   capture_output=True, cwd=tmp_path)
+    run_bounded([sys.executable, "-m", "fmpy", "compile", str(source_only)], check=True, cwd=tmp_path,
+                timeout=300, what="fmpy compile (the source FMU)")
     with zipfile.ZipFile(source_only) as z:
         assert any(n.startswith("binaries/") and n.endswith(".so") for n in z.namelist())
     scenarios = [s for s in SCENARIOS if s.model == model]

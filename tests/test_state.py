@@ -2,7 +2,6 @@
 process, continue bit-identically; bad serialized bytes are refused."""
 import json
 import struct
-import subprocess
 import sys
 import zlib
 from pathlib import Path
@@ -10,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from fmu_driver import Instance, call_status
+from support.process import run as run_bounded
 
 OUTPUT_NAMES = ("y", "runningTime", "status", "rampActive")
 # inputs and step sizes of a run: ramps, a change, NaN, sub-cycling steps
@@ -65,9 +65,9 @@ def test_serialized_state_continues_bit_identically_in_a_new_process(version, tm
     (tmp_path / "state.bin").write_bytes(bytes(api["serialize"](state)))
     uninterrupted = run_steps(fmu, STEPS[12:])
     fmu.free()
-    out = subprocess.run([sys.executable, str(Path(__file__).parent / "continue_from_state.py"), str(version),
-                          str(tmp_path / "state.bin"), json.dumps(STEPS[12:])],
-                         capture_output=True, text=True, check=True, cwd=Path(__file__).parent)
+    out = run_bounded([sys.executable, str(Path(__file__).parent / "continue_from_state.py"), str(version),
+                       str(tmp_path / "state.bin"), json.dumps(STEPS[12:])],
+                      check=True, cwd=Path(__file__).parent, timeout=120, what="the run continued in a new process")
     assert json.loads(out.stdout.strip().splitlines()[-1]) == uninterrupted
 
 
