@@ -18,12 +18,13 @@ for _ in 1 2; do
   sh -c 'while :; do :; done' &
   busy+=($!)
 done
-echo "commit $(git -C "$repo" rev-parse --short HEAD), $(nproc) cores, 2 busy loops; logs in $work"
+commit=$(git -C "$repo" rev-parse HEAD)  # every run tests this commit
+echo "commit ${commit:0:7}, $(nproc) cores, 2 busy loops; logs in $work"
 
 failed=0
 one_run() {  # one_run NAME CTEST_JOBS
   local name=$1 ctest_jobs=$2 clone="$work/$1" started=$SECONDS status
-  git clone -q "$repo" "$clone"
+  git clone -q "$repo" "$clone" && git -C "$clone" checkout -q "$commit"
   if [ "$ctest_jobs" = 2 ]; then  # exactly what CI runs
     (cd "$clone" && CI=true bash .ci/run) </dev/null >"$work/$name.log" 2>&1
   else                            # the same command with more ctest jobs
