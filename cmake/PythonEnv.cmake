@@ -1,16 +1,25 @@
-# A virtual environment under build/ with the pinned Python packages of
-# tests/requirements.txt, made at configure time so that the FMI headers of
-# the pinned fmpy are there before anything compiles.
+# A virtual environment under build/ with the pinned Python packages, made
+# at configure time so that the FMI headers of the pinned fmpy are there
+# before anything compiles: fmutrace/requirements.txt (the main job) always,
+# tests/requirements.txt only for the tests (RL_TESTS).
 find_package(Python3 3.11 REQUIRED COMPONENTS Interpreter)  # 3.11: tomllib
 
 # RL_VENV_DIR lets a second build tree (the sanitizer build) share one venv.
 set(RL_VENV_DIR ${CMAKE_BINARY_DIR}/venv CACHE PATH "Python virtual environment with the pinned packages")
 set(VENV_DIR ${RL_VENV_DIR})
 set(VENV_PYTHON ${VENV_DIR}/bin/python)
-set(REQUIREMENTS ${CMAKE_SOURCE_DIR}/tests/requirements.txt)
-set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${REQUIREMENTS})
+set(REQUIREMENTS ${CMAKE_SOURCE_DIR}/fmutrace/requirements.txt)
+if(RL_TESTS)
+  list(APPEND REQUIREMENTS ${CMAKE_SOURCE_DIR}/tests/requirements.txt)
+endif()
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${REQUIREMENTS} ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml)
 
-file(SHA256 ${REQUIREMENTS} requirements_hash)
+file(READ ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml requirements_text)
+foreach(file IN LISTS REQUIREMENTS)
+  file(READ ${file} text)
+  string(APPEND requirements_text "${text}")
+endforeach()
+string(SHA256 requirements_hash "${requirements_text}")
 set(venv_stamp ${VENV_DIR}/requirements-${requirements_hash}.stamp)
 
 if(NOT EXISTS ${venv_stamp})
@@ -19,37 +28,36 @@ if(NOT EXISTS ${venv_stamp})
     execute_process(COMMAND ${Python3_EXECUTABLE} -m venv ${VENV_DIR} RESULT_VARIABLE venv_failed)
     if(venv_failed)
       # Debian ships venv's pip bootstrap separately (python3-venv)
-      find_program(APT_GET apt-get)
-      if(APT_GET)
-        message(STATUS "python3 -m venv failed: installing Debian's python3-venv")
-        execute_process(COMMAND sh -c "${APT_GET} update -qq && DEBIAN_FRONTEND=noninteractive ${APT_GET} install -y -qq python3-venv"
-                        RESULT_VARIABLE apt_failed)
-        file(REMOVE_RECURSE ${VENV_DIR})
-        execute_process(COMMAND ${Python3_EXECUTABLE} -m venv ${VENV_DIR} RESULT_VARIABLE venv_failed)
-      endif()
+      file(REMOVE_RECURSE ${VENV_DIR})
+      apt_install("python3 -m venv failed" python3-venv)
+      execute_process(COMMAND ${Python3_EXECUTABLE} -m venv ${VENV_DIR} RESULT_VARIABLE venv_failed)
       if(venv_failed)
         message(FATAL_ERROR "Cannot create a Python virtual environment (on Debian: apt-get install python3-venv)")
       endif()
     endif()
   endif()
+  set(pip_args)
+  foreach(file IN LISTS REQUIREMENTS)
+    list(APPEND pip_args -r ${file})
+  endforeach()
   message(STATUS "Installing the pinned Python packages of ${REQUIREMENTS}")
-  execute_process(COMMAND ${VENV_PYTHON} -m pip install --disable-pip-version-check -q -r ${REQUIREMENTS}
+  execute_process(COMMAND ${VENV_PYTHON} -m pip install --disable-pip-version-check -q ${pip_args}
                   RESULT_VARIABLE pip_failed)
   if(pip_failed)
-    message(FATAL_ERROR "pip install -r ${REQUIREMENTS} failed")
+    message(FATAL_ERROR "pip install ${pip_args} failed")
+  endif()
+  # the trace tool, editable: the venv runs the source tree's fmutrace
+  execute_process(COMMAND ${VENV_PYTHON} -m pip install --disable-pip-version-check -q --no-deps
+                          --no-build-isolation -e ${CMAKE_SOURCE_DIR}/fmutrace
+                  RESULT_VARIABLE pip_failed)
+  if(pip_failed)
+    message(FATAL_ERROR "pip install -e fmutrace failed")
   endif()
   file(GLOB old_stamps ${VENV_DIR}/requirements-*.stamp)
   if(old_stamps)
     file(REMOVE ${old_stamps})
   endif()
   file(TOUCH ${venv_stamp})
-endif()
-
-# ecospy's native library needs Debian's libtbb12 (and unzip for FMUs)
-execute_process(COMMAND ${VENV_PYTHON} -c "import ecospy" RESULT_VARIABLE ecospy_failed OUTPUT_QUIET ERROR_QUIET)
-find_program(UNZIP unzip)
-if(ecospy_failed OR NOT UNZIP)
-  apt_install("ecospy cannot load" libtbb12 unzip)
 endif()
 
 execute_process(

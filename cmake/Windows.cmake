@@ -1,7 +1,8 @@
 # Windows x86_64 FMU binaries (FMI 2 binaries/win64, FMI 3
 # binaries/x86_64-windows), cross-compiled by the sub-build in
-# cmake/windows with Debian's mingw-w64 (installed when missing). Sets
-# WINDOWS_BUILD_DIR, or leaves it empty when no cross compiler is there.
+# cmake/windows with Debian's mingw-w64 (installed when missing: the FMUs
+# carry these binaries). Sets WINDOWS_BUILD_DIR, or leaves it empty when no
+# cross compiler is there.
 include(ExternalProject)
 
 set(WINDOWS_BUILD_DIR "")
@@ -29,16 +30,4 @@ if(MINGW_GCC)
     BUILD_BYPRODUCTS ${byproducts})
 else()
   message(WARNING "No x86_64-w64-mingw32-gcc: the FMUs carry no Windows binaries")
-endif()
-
-# wine64 runs the Windows binaries in the tests (fmpy's wine remoting);
-# Debian keeps it in /usr/lib/wine
-find_program(WINE64 wine64 PATHS /usr/lib/wine NO_CACHE)
-if(NOT WINE64)
-  apt_install("No wine64 for the Windows test" wine64)
-  find_program(WINE64 wine64 PATHS /usr/lib/wine NO_CACHE)
-endif()
-set(WINE_DIR "")
-if(WINE64)
-  get_filename_component(WINE_DIR ${WINE64} DIRECTORY)
 endif()

@@ -6,7 +6,7 @@ from ctypes import c_bool, c_double, c_int, c_size_t, c_uint, c_void_p
 
 import pytest
 
-from fmu_driver import Instance
+from support.fmu_driver import Instance
 from test_conformance import NOT_INSTANCE_CALLS, exported_functions
 
 

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fmu_driver import BUILD_DIR
-from reference import campaign, discover, write_outputs, write_report
+from support.fmu_driver import BUILD_DIR
+from support.scenarios import campaign, discover, write_outputs, write_report
 
 BIN = Path(sys.executable).parent
 

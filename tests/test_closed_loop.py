@@ -7,19 +7,17 @@ response, coupled the same way (at each communication point the outputs
 go to the inputs, then both step)."""
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import read_model_description
 from fmpy.util import read_csv
 
-from closed_loop import H, LIMITER, N, PLANT
-from fmu_driver import BUILD_DIR, fmu_file
+from support.closed_loop import H, LIMITER, N, PLANT
+from support.fmu_driver import BUILD_DIR, TESTS, fmu_file
 from support.process import run as run_bounded
-from oracle import oracle_for
+from support.oracle import oracle_for
 
-HERE = Path(__file__).resolve().parent
 RUNS = [("fmpy", 2), ("fmpy", 3), ("ecospy", 2), ("ecospy", 3), ("libcosimpy", 2)]
 
 
@@ -42,8 +40,8 @@ def oracle_loop():
 @pytest.mark.parametrize("importer,version", RUNS, ids=[f"{i}-fmi{v}" for i, v in RUNS])
 def test_closed_loop_agrees_with_the_oracle(importer, version, tmp_path):
     out = tmp_path / "loop.csv"
-    process = run_bounded([sys.executable, str(HERE / "closed_loop.py"), importer, str(version), str(BUILD_DIR),
-                           str(out)], timeout=300, what=f"the closed loop in {importer} (FMI {version})")
+    process = run_bounded([sys.executable, "-m", "support.closed_loop", importer, str(version), str(BUILD_DIR),
+                           str(out)], timeout=300, what=f"the closed loop in {importer} (FMI {version})", cwd=TESTS)
     assert process.returncode == 0, (process.stdout + process.stderr)[-3000:]
     result = np.atleast_1d(read_csv(str(out)))
     expected = oracle_loop()

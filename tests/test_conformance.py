@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from fmpy import __file__ as fmpy_file
 
-from fmu_driver import Instance, call_status
+from support.fmu_driver import Instance, call_status
 
 STATES = ["Instantiated", "Initialization Mode", "Step Mode", "Terminated", "Error"]
 ALL = set(STATES)

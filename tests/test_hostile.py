@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from fmu_driver import Instance, call_status
-from oracle import oracle_for, output_names
+from support.fmu_driver import Instance, call_status
+from support.oracle import oracle_for, output_names
 from test_random import agree
 
 HOSTILE = [math.nan, math.inf, -math.inf, -0.0, 5e-324, 2.2250738585072014e-308, 1e-300, 1e308, -1e308, 1e300]

@@ -1,6 +1,6 @@
 """Every reference scenario of every model through other importers than
 fmpy: ecospy (Ecos on fmi4c; FMI 2 and FMI 3) and libcosimpy (libcosim on
-FMI Library; FMI 2). Each run is a subprocess (tests/importers.py), so that
+FMI Library; FMI 2). Each run is a subprocess (tests/support/importers.py), so that
 an importer crash fails one test. Results must match the reference trace
 as the fmpy runs do.
 
@@ -13,18 +13,16 @@ What an importer cannot do is asserted, not skipped:
   points (fmpy adds communication points there) is compared, bit for bit,
   with fmpy's low-level API making the same calls on the same grid."""
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import read_model_description
 from fmpy.util import read_csv
 
-from fmu_driver import BUILD_DIR
+from support.fmu_driver import BUILD_DIR, TESTS
 from support.process import run as run_bounded
-from reference import compare, discover, fmu_path
+from support.scenarios import compare, discover, fmu_path
 
-HERE = Path(__file__).resolve().parent
 SCENARIOS = discover()
 IMPORTERS = [("ecospy", 2), ("ecospy", 3), ("libcosimpy", 2)]
 
@@ -40,9 +38,9 @@ def enumerations_set(scenario, version):
 
 def run(importer, scenario, version, tmp_path):
     out = tmp_path / "result.csv"
-    process = run_bounded([sys.executable, str(HERE / "importers.py"), importer, str(scenario.folder),
+    process = run_bounded([sys.executable, "-m", "support.importers", importer, str(scenario.folder),
                            str(fmu_path(BUILD_DIR, scenario.model, version)), str(out)],
-                          timeout=300, what=f"{scenario.id} through {importer} (FMI {version})")
+                          timeout=300, what=f"{scenario.id} through {importer} (FMI {version})", cwd=TESTS)
     assert process.returncode == 0, process.stderr[-3000:]
     return np.atleast_1d(read_csv(str(out))), process.stdout + process.stderr
 

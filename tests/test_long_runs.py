@@ -3,7 +3,7 @@ steps end with the exact cycle count and the closed-form ramp value, and a
 259,200 s duration jumps at exactly its cycle (no drift)."""
 import pytest
 
-from fmu_driver import Instance
+from support.fmu_driver import Instance
 
 STEP = 100.0                 # 10,000 cycles of 10 ms per communication step
 PER_CYCLE = 2.0 ** -7        # binary-exact, so the closed form is exact too

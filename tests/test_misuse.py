@@ -7,8 +7,7 @@ import math
 import pytest
 from fmpy.fmi2 import FMU2Slave
 
-from fmu_driver import Instance, call_status, unzipped
-from test_state import state_api
+from support.fmu_driver import Instance, call_status, state_api, unzipped
 
 
 def set_raw(fmu, vr, value, kind="Real"):

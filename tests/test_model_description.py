@@ -11,7 +11,7 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from fmu_driver import REPO, Instance, fmu_file, unzipped
+from support.fmu_driver import REPO, Instance, fmu_file, unzipped
 from support.process import run as run_bounded
 
 MODELS = sorted(p.stem for p in (REPO / "modelDescription").glob("*.toml"))

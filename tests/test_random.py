@@ -7,8 +7,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fmu_driver import Instance
-from oracle import oracle_for, output_names
+from support.fmu_driver import Instance
+from support.oracle import oracle_for, output_names
 
 nan, inf = math.nan, math.inf
 SPECIAL = [0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 10.0, nan, inf, -inf]

@@ -5,10 +5,10 @@ import math
 
 import pytest
 
-from fmu_driver import fmu_file, unzipped
+from support.fmu_driver import fmu_file, unzipped
 from fmpy import read_model_description
-from oracle import oracle_for
-from reference import compare, discover, same, simulate
+from support.oracle import oracle_for
+from support.scenarios import compare, discover, same, simulate
 
 SCENARIOS = discover()
 

@@ -9,7 +9,7 @@ import zipfile
 
 import pytest
 
-from fmu_driver import BUILD_DIR, REPO, fmu_file
+from support.fmu_driver import BUILD_DIR, REPO, fmu_file
 from support.process import run as run_bounded
 
 MODELS = ["RateLimiter", "LGF_LimRateOfChangeCI", "RateLimit", "Ramp", "PassThrough"]

@@ -7,9 +7,9 @@ import zipfile
 import numpy as np
 import pytest
 
-from fmu_driver import fmu_file
+from support.fmu_driver import fmu_file
 from support.process import run as run_bounded
-from reference import discover, simulate
+from support.scenarios import discover, simulate
 
 SCENARIOS = discover()
 MODELS = sorted({s.model for s in SCENARIOS})

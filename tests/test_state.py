@@ -4,36 +4,16 @@ import json
 import struct
 import sys
 import zlib
-from pathlib import Path
 
 import pytest
 
-from fmu_driver import Instance, call_status
+from support.fmu_driver import TESTS, Instance, call_status, run_steps, state_api
 from support.process import run as run_bounded
 
-OUTPUT_NAMES = ("y", "runningTime", "status", "rampActive")
 # inputs and step sizes of a run: ramps, a change, NaN, sub-cycling steps
 STEPS = [(0.25, {"u": 10.0}), (0.25, {}), (0.5, {"u": -3.0}), (0.3, {}), (0.25, {"u": float("nan")}),
          (0.5, {"u": 4.0}), (0.1, {}), (0.75, {"rateUp": 0.5}), (0.25, {}), (1.0, {"u": 100.0})] * 3
 START = {"rateUpPar": 3.0, "rateDownPar": 1.5, "cycleTime": 0.05, "durationPar": 2.0}
-
-
-def state_api(fmu):
-    f = fmu.fmu
-    if fmu.version == 2:
-        return {"get": f.getFMUstate, "set": f.setFMUstate, "free": f.freeFMUstate,
-                "serialize": f.serializeFMUstate, "deserialize": f.deSerializeFMUstate}
-    return {"get": f.getFMUState, "set": f.setFMUState, "free": f.freeFMUState,
-            "serialize": f.serializeFMUState, "deserialize": f.deserializeFMUState}
-
-
-def run_steps(fmu, steps):
-    trace = []
-    for h, inputs in steps:
-        fmu.set(**inputs)
-        fmu.step(h)
-        trace.append([float(fmu.get(n)).hex() for n in OUTPUT_NAMES])
-    return trace
 
 
 def started(version):
@@ -65,9 +45,9 @@ def test_serialized_state_continues_bit_identically_in_a_new_process(version, tm
     (tmp_path / "state.bin").write_bytes(bytes(api["serialize"](state)))
     uninterrupted = run_steps(fmu, STEPS[12:])
     fmu.free()
-    out = run_bounded([sys.executable, str(Path(__file__).parent / "continue_from_state.py"), str(version),
+    out = run_bounded([sys.executable, "-m", "support.continue_from_state", str(version),
                        str(tmp_path / "state.bin"), json.dumps(STEPS[12:])],
-                      check=True, cwd=Path(__file__).parent, timeout=120, what="the run continued in a new process")
+                      check=True, cwd=TESTS, timeout=120, what="the run continued in a new process")
     assert json.loads(out.stdout.strip().splitlines()[-1]) == uninterrupted
 
 

@@ -5,7 +5,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
-from fmu_driver import Instance, unzipped
+from support.fmu_driver import Instance, unzipped
 
 THREADS = 8
 

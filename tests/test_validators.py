@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from fmu_driver import fmu_file
+from support.fmu_driver import fmu_file
 from support.process import run as run_bounded
 
 MODELS = ["RateLimiter", "LGF_LimRateOfChangeCI", "RateLimit", "Ramp"]

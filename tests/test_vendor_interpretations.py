@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from fmu_driver import Instance, call_status
+from support.fmu_driver import Instance, call_status
 
 
 @pytest.fixture(params=[2, 3])

@@ -14,12 +14,11 @@ import pytest
 from fmpy import extract
 from fmpy.util import read_csv
 
-from fmu_driver import BUILD_DIR, fmu_file
-from reference import SCENARIO_ROOT, compare, load
+from support.fmu_driver import BUILD_DIR, TESTS, fmu_file
+from support.scenarios import SCENARIO_ROOT, compare, load
 from support.process import run
 from support.wine import RemotingServer, environment, make_prefix, remoting_copy
 
-HERE = Path(__file__).resolve().parent
 pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
                                 reason="the sanitizer build makes Linux binaries only; the release build runs this")
 WINE_DIR = os.environ.get("RL_WINE_DIR", "/usr/lib/wine")
@@ -39,8 +38,8 @@ def wine():
 
 def simulate(env, fmu_dir, scenario, out, what):
     """importers.py fmpy-fixed on an extracted FMU, bounded."""
-    done = run([sys.executable, str(HERE / "importers.py"), "fmpy-fixed", str(scenario.folder), str(fmu_dir), str(out)],
-               timeout=CLIENT_SECONDS, what=what, env=env)
+    done = run([sys.executable, "-m", "support.importers", "fmpy-fixed", str(scenario.folder), str(fmu_dir), str(out)],
+               timeout=CLIENT_SECONDS, what=what, env=env, cwd=TESTS)
     return done
 
 

@@ -2,8 +2,8 @@
 """Reference scenarios: run each through fmpy.simulate_fmu on the FMI 2 and
 FMI 3 FMUs, compare with the reference trace, and write a report.
 
-A scenario is a folder tests/scenarios/<Model>/<name>/ in the FMI
-cross-check layout:
+A scenario is a folder <root>/<Model>/<name>/ in the FMI cross-check
+layout:
 
   <Model>_ref.opt    StartTime, StopTime, StepSize, RelTol (fmpy reads it)
   <Model>_in.csv     input signals (optional); a row holds from its time on
@@ -14,14 +14,15 @@ cross-check layout:
 StepSize is the communication step. A sample is a match when
 |fmu - ref| <= RelTol * max(1, |ref|); NaN matches NaN, inf matches inf.
 
-Main job:  reference.py --build-dir build --report build/report
-On a cluster:  reference.py ... --scheduler tcp://host:8786
+Main job:  python -m fmutrace.campaign tests/scenarios --build-dir build --report build/report
+On a cluster:  python -m fmutrace.campaign ... --scheduler tcp://host:8786
 
 Runs are Dask tasks: on a local cluster of processes (one per core) by
 default, on a Dask distributed scheduler with --scheduler, in this process
 with --serial. A task carries the scenario and the FMU's bytes and returns
 the result, its comparison and its plot, so workers need the same Python
-packages but no shared file system; the report is written here.
+packages (fmutrace itself is uploaded to them) but no shared file system;
+the report is written here.
 """
 import argparse
 import contextlib
@@ -40,7 +41,6 @@ import numpy as np
 from fmpy import simulate_fmu
 from fmpy.util import read_csv, read_ref_opt_file, write_csv
 
-SCENARIO_ROOT = Path(__file__).resolve().parent / "scenarios"
 FMI_VERSIONS = (2, 3)
 
 
@@ -111,8 +111,10 @@ def load(folder):
     )
 
 
-def discover(models=None):
-    folders = sorted(p.parent for p in SCENARIO_ROOT.glob("*/*/*_ref.opt"))
+def discover(root, models=None):
+    """The scenarios under root (<root>/<Model>/<name>/), optionally of
+    some models only."""
+    folders = sorted(p.parent for p in Path(root).glob("*/*/*_ref.opt"))
     return [load(f) for f in folders if models is None or f.parent.name in models]
 
 
@@ -278,6 +280,19 @@ tr.fail td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</st
     return passed
 
 
+def package_zip():
+    """fmutrace as a zip (for Dask's upload_file), made once per process."""
+    import zipfile
+
+    target = Path(tempfile.gettempdir()) / f"fmutrace-{os.getpid()}.zip"
+    if not target.exists():
+        package = Path(__file__).resolve().parent
+        with zipfile.ZipFile(target, "w") as z:
+            for source in sorted(package.glob("*.py")):
+                z.write(source, f"fmutrace/{source.name}")
+    return target
+
+
 def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial=False, jobs=None, with_plot=True,
              timeout=None):
     """Every scenario on every FMI version; returns [(outcome, scenario,
@@ -299,7 +314,7 @@ def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial
                                    dashboard_address=None)
             client = Client(cluster)
         try:
-            client.upload_file(__file__)  # this module, to every worker: nothing to install there but packages
+            client.upload_file(str(package_zip()))  # fmutrace, to every worker: nothing to install there but packages
             workers = len(client.scheduler_info()["workers"])
             shared = {key: client.scatter(data, broadcast=True) for key, data in fmus.items()}
             futures = [client.submit(run_one, s, shared[(s.model, v)], v, with_plot, pure=False) for s, v in work]
@@ -316,6 +331,7 @@ def campaign(scenarios, build_dir, versions=FMI_VERSIONS, scheduler=None, serial
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenarios", help="folder of scenarios: <Model>/<name>/ in the cross-check layout")
     parser.add_argument("--build-dir", default="build")
     parser.add_argument("--report", default=None, help="folder for result CSVs, plots, summary.md and index.html")
     parser.add_argument("--model", action="append", help="only these models (repeatable)")
@@ -324,7 +340,7 @@ def main(argv=None):
     parser.add_argument("--serial", action="store_true", help="run in this process, without Dask")
     args = parser.parse_args(argv)
 
-    scenarios = discover(args.model)
+    scenarios = discover(args.scenarios, args.model)
     if not scenarios:
         print("no scenarios found")
         return 1

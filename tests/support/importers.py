@@ -5,7 +5,7 @@ each step: inputs at t, step, outputs recorded at t + h), and write the
 result CSV. One scenario per process, so that an importer that crashes
 fails one test, not the suite.
 
-    importers.py <ecospy|libcosimpy|fmpy-fixed[-no-enumerations]> <scenario folder> <fmu> <result.csv>
+    python -m support.importers <ecospy|libcosimpy|fmpy-fixed[-no-enumerations]> <scenario folder> <fmu> <result.csv>
 """
 import sys
 from pathlib import Path
@@ -14,8 +14,7 @@ import numpy as np
 from fmpy import read_model_description
 from fmpy.util import write_csv
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from reference import load  # noqa: E402
+from support.scenarios import load
 
 
 def input_values(scenario, t):
@@ -155,7 +154,7 @@ def run_fmpy_fixed(scenario, fmu, drop_enumerations=False):
     as importers that cannot set them do."""
     from fmpy import extract
 
-    from fmu_driver import Instance
+    from support.fmu_driver import Instance
 
     md = read_model_description(str(fmu))
     model = md.coSimulation.modelIdentifier

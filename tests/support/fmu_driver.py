@@ -11,7 +11,8 @@ from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFr
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
 from fmpy.fmi3 import FMU3Slave
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
+TESTS = REPO / "tests"  # the working directory of the helper scripts (python -m support.x)
 BUILD_DIR = Path(os.environ.get("RL_BUILD_DIR", REPO / "build"))
 
 _unzipped = {}
@@ -143,3 +144,27 @@ def call_status(function, *args, **kwargs):
         return 0
     except FMICallException as exception:
         return exception.status
+
+
+# outputs recorded by run_steps
+STATE_OUTPUTS = ("y", "runningTime", "status", "rampActive")
+
+
+def state_api(fmu):
+    """The FMU-state functions of fmpy's slave, by one name for both versions."""
+    f = fmu.fmu
+    if fmu.version == 2:
+        return {"get": f.getFMUstate, "set": f.setFMUstate, "free": f.freeFMUstate,
+                "serialize": f.serializeFMUstate, "deserialize": f.deSerializeFMUstate}
+    return {"get": f.getFMUState, "set": f.setFMUState, "free": f.freeFMUState,
+            "serialize": f.serializeFMUState, "deserialize": f.deserializeFMUState}
+
+
+def run_steps(fmu, steps, names=STATE_OUTPUTS):
+    """Set inputs, step, and record the outputs as exact hex floats."""
+    trace = []
+    for h, inputs in steps:
+        fmu.set(**inputs)
+        fmu.step(h)
+        trace.append([float(fmu.get(n)).hex() for n in names])
+    return trace

@@ -4,7 +4,7 @@ RateLimiter, whose output is the plant's actuator command. Run by one
 importer (one process each), communication step H, N steps; writes time,
 RateLimiter y and plant x after every step.
 
-    closed_loop.py <fmpy|ecospy|libcosimpy> <FMI version> <build dir> <result.csv>
+    python -m support.closed_loop <fmpy|ecospy|libcosimpy> <FMI version> <build dir> <result.csv>
 """
 import sys
 from pathlib import Path
@@ -13,7 +13,6 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.util import write_csv
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 H, N = 0.1, 100
 PLANT = {"tau": 2.0, "Kp": 0.8, "setpoint": 10.0, "x0": 0.0}
@@ -32,7 +31,7 @@ def paths(build, version):
 def run_fmpy(build, version):
     """Jacobi coupling by hand with fmpy's low-level API: at each
     communication point the outputs go to the inputs, then both step."""
-    from fmu_driver import Instance
+    from support.fmu_driver import Instance
 
     rl_path, plant_path = paths(build, version)
     rl = Instance("RateLimiter", version, unzipdir=extract(str(rl_path)))

@@ -3,7 +3,7 @@ instance, continue a run, print the outputs as exact hex floats (JSON)."""
 import json
 import sys
 
-from fmu_driver import Instance
+from support.fmu_driver import Instance
 from test_state import run_steps, state_api
 
 version, state_file, steps = int(sys.argv[1]), sys.argv[2], json.loads(sys.argv[3])

@@ -1,0 +1,47 @@
+# The tools the tests need and the product does not (RL_TESTS only, the
+# test command): each installed here when missing, with what it is for.
+# Debian's packages:
+#   wine64                          the win64 binaries run under fmpy's remoting (test_windows)
+#   default-jre-headless, maven     VDMCheck2, the FMI 2 validator (test_validators)
+#   clang-14, libclang-rt-14-dev    libFuzzer with ASan/UBSan (ctest fuzz_*; cmake/Fuzz.cmake)
+#   valgrind                        memcheck (ctest memcheck_*) and callgrind (benchmarks)
+#   libtbb12, unzip                 ecospy, another importer (test_importers, test_closed_loop)
+# Python packages: tests/requirements.txt (cmake/PythonEnv.cmake).
+# A tool that still cannot be had makes its tests fail and say why.
+
+# wine64 (Debian keeps it in /usr/lib/wine)
+find_program(WINE64 wine64 PATHS /usr/lib/wine NO_CACHE)
+if(NOT WINE64)
+  apt_install("No wine64 for the Windows test" wine64)
+  find_program(WINE64 wine64 PATHS /usr/lib/wine NO_CACHE)
+endif()
+set(WINE_DIR "")
+if(WINE64)
+  get_filename_component(WINE_DIR ${WINE64} DIRECTORY)
+endif()
+
+# Java and Maven for VDMCheck2
+find_program(JAVA java)
+find_program(MAVEN mvn)
+if(NOT JAVA OR NOT MAVEN)
+  apt_install("VDMCheck2 needs Java and Maven" default-jre-headless maven)
+  find_program(JAVA java)
+  find_program(MAVEN mvn)
+endif()
+include(cmake/VDMCheck.cmake)
+
+# valgrind
+find_program(VALGRIND valgrind)
+if(NOT VALGRIND)
+  apt_install("No valgrind for the memcheck tests" valgrind)
+  find_program(VALGRIND valgrind)
+endif()
+
+# ecospy's native library needs libtbb12, and unzip for FMUs
+execute_process(COMMAND ${VENV_PYTHON} -c "import ecospy" RESULT_VARIABLE ecospy_failed OUTPUT_QUIET ERROR_QUIET)
+find_program(UNZIP unzip)
+if(ecospy_failed OR NOT UNZIP)
+  apt_install("ecospy cannot load" libtbb12 unzip)
+endif()
+
+# clang with libFuzzer: cmake/Fuzz.cmake
