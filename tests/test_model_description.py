@@ -4,6 +4,7 @@ descriptions and the compiled-in C table, exported symbols, sources."""
 import math
 import os
 import struct
+import sys
 import tomllib
 import zipfile
 
@@ -141,3 +142,15 @@ def test_documentation_and_icon_are_inside(model, version):
     width, height = png_size(ramp)
     assert width >= 400 and height >= 200
     assert png_size(icon) == (128, 128)
+
+
+def test_docs_tables_are_generated_from_the_toml_files():
+    """docs/models.md restates each model's variables: its tables must be
+    what modelDescription/tables.py makes from the TOML files today."""
+    tomls = [str(REPO / "modelDescription" / f"{m}.toml") for m in MODELS]
+    done = run_bounded([sys.executable, str(REPO / "modelDescription" / "tables.py"), str(REPO / "docs" / "models.md"),
+                        *tomls], timeout=60, what="tables.py (docs/models.md)")
+    assert done.returncode == 0, done.stdout + done.stderr
+    text = (REPO / "docs" / "models.md").read_text()
+    for model in MODELS:
+        assert f"<!-- generated: variables {model} -->" in text
