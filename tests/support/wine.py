@@ -15,14 +15,16 @@ Here the server is started by us, without a lock file (the client's
 lives until we stop it, its start is awaited with a bound (the port must be
 listened on by it or its wineserver), and what wine printed is in every
 failure.
-The server's port is fixed (rpclib's 8080), so the runs are serialised by
-a lock file and the port must be free before a start."""
+The server's port is fixed (rpclib's 8080) and machine-wide, so the runs of
+every test process on the machine are serialised by one lock file
+(port_lock) and the port must be free before a start."""
 import contextlib
 import fcntl
 import os
 import re
 import shutil
 import subprocess
+import tempfile
 import time
 from pathlib import Path
 
@@ -34,6 +36,15 @@ PORT = 8080                 # rpc::constants::DEFAULT_PORT in fmpy's server and 
 START_SECONDS = 60          # wine's start on a busy machine, measured at 1 to 15 s
 ATTEMPTS = 2
 CLIENT = "client_tcp"       # fmpy's client in "server started externally" mode
+
+
+@contextlib.contextmanager
+def port_lock():
+    """The machine-wide lock on PORT, held while a server runs or a test
+    uses the port (a sanitizer tree's tests run beside the release tree's)."""
+    with open(Path(tempfile.gettempdir()) / f"fmpy-remoting-port-{PORT}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
 
 
 def environment(wine_dir, prefix):
@@ -145,32 +156,30 @@ class RemotingServer:
             self.process = None
         stop_wineserver(self.env, self.wine_dir)
 
-    def __enter__(self):
-        self._lock = open(Path(self.env["WINEPREFIX"]) / ".remoting.lock", "w")
-        fcntl.flock(self._lock, fcntl.LOCK_EX)  # one server at a time: the port is fixed
+    def start(self):
+        """Start the server (ATTEMPTS tries); the caller holds port_lock."""
         failures = []
-        try:
-            for attempt in range(ATTEMPTS):
-                stop_wineserver(self.env, self.wine_dir)
-                try:
-                    self._start_once()
-                    return self
-                except AssertionError as failure:
-                    failures.append(f"attempt {attempt + 1}: {failure}")
-                    self.stop()
-            raise AssertionError("\n".join(failures))
-        except BaseException:
-            self.stop()
-            self._release()
-            raise
+        for attempt in range(ATTEMPTS):
+            stop_wineserver(self.env, self.wine_dir)
+            try:
+                self._start_once()
+                return self
+            except AssertionError as failure:
+                failures.append(f"attempt {attempt + 1}: {failure}")
+                self.stop()
+        raise AssertionError("\n".join(failures))
 
-    def _release(self):
-        if self._lock:
-            self._lock.close()
-            self._lock = None
+    def __enter__(self):
+        self._lock = port_lock()
+        self._lock.__enter__()
+        try:
+            return self.start()
+        except BaseException:
+            self._lock.__exit__(None, None, None)
+            raise
 
     def __exit__(self, *exc):
         try:
             self.stop()
         finally:
-            self._release()
+            self._lock.__exit__(None, None, None)
