@@ -14,7 +14,7 @@
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
 #define ERR  MODE_ERROR
-#define NONE 0
+#define NO_MODE 0
 
 #define MODES_SetDebugLogging           (INST | INIT | STEP | TERM | ERR)
 #define MODES_SetupExperiment           (INST)
@@ -40,7 +40,7 @@
 #define MODES_SetRealInputDerivatives   (INST | INIT | STEP)
 #define MODES_GetRealOutputDerivatives  (STEP | TERM | ERR)
 #define MODES_DoStep                    (STEP)
-#define MODES_CancelStep                NONE
+#define MODES_CancelStep                NO_MODE
 #define MODES_GetStatus                 (STEP | TERM)
 #define MODES_GetRealStatus             MODES_GetStatus
 #define MODES_GetIntegerStatus          MODES_GetStatus
@@ -51,14 +51,6 @@ typedef struct {
     FmuInstance base; /* first: an fmi2Component is an FmuInstance */
     fmi2CallbackFunctions functions;
 } Fmi2Instance;
-
-/* An FMU state: a tagged copy of the core, so that a foreign pointer is
- * refused rather than read. */
-#define STATE_TAG 0x524c5332u
-typedef struct {
-    uint32_t tag;
-    FmuCore core;
-} Fmi2State;
 
 /* Errors and warnings are logged even with loggingOn = false: a failed call
  * must say why. */
@@ -79,6 +71,15 @@ typedef struct {
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
     const Fmi2Instance *g = (const Fmi2Instance *)instance;
     g->functions.logger(g->functions.componentEnvironment, instance->instanceName, (fmi2Status)status, category, message);
+}
+
+/* FMU states live in the importer's memory */
+static void *allocate_state(FmuInstance *instance, size_t size) {
+    return ((Fmi2Instance *)instance)->functions.allocateMemory(1, size);
+}
+
+static void release_state(FmuInstance *instance, void *memory) {
+    ((Fmi2Instance *)instance)->functions.freeMemory(memory);
 }
 
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -120,6 +121,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     g->base.environment = functions->componentEnvironment;
     g->base.logFunction = functions->logger ? log_to_importer : NULL;
     g->base.logCategories = (loggingOn ? LOG_ALL : 0) | ALWAYS_LOGGED;
+    g->base.allocate = allocate_state;
+    g->base.release = release_state;
     fmu_init_instance(&g->base);
     return g;
 }
@@ -181,14 +184,14 @@ fmi2Status fmi2Reset(fmi2Component c) {
 /* One value is the common call: straight-line code without a frame; any
  * other count goes through the loops (all checked before any is set). */
 #define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI, FROM_FMI)                    \
-    __attribute__((noinline)) static fmi2Status get_##NAME(FmuInstance *I, const char *FN, \
+    FMU_NOINLINE static fmi2Status get_##NAME(FmuInstance *I, const char *FN, \
         const fmi2ValueReference vr[], size_t nvr, TYPE value[]) {            \
         CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) value[i] = TO_FMI(fmu_get(I, vr[i])); \
         return fmi2OK;                                                        \
     }                                                                         \
-    __attribute__((noinline)) static fmi2Status set_##NAME(FmuInstance *I, const char *FN, \
+    FMU_NOINLINE static fmi2Status set_##NAME(FmuInstance *I, const char *FN, \
         const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) {      \
         CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], FROM_FMI(value[i]))); \
@@ -197,32 +200,16 @@ fmi2Status fmi2Reset(fmi2Component c) {
     }                                                                         \
     fmi2Status fmi2Get##NAME(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
         BEGIN(Get##NAME);                                                     \
-        if (nvr == 1 && vr && value) {                                        \
-            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastOutputVr) { \
-                value[0] = TO_FMI(fmu_get(I, vr[0]));                         \
-                return fmi2OK;                                                \
-            }                                                                 \
-            if (!fmu_readable(I, TYPE_MASK, vr[0]))                           \
-                return (fmi2Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], 0.0, false); \
-            value[0] = TO_FMI(fmu_get(I, vr[0]));                             \
-            return fmi2OK;                                                    \
-        }                                                                     \
-        return get_##NAME(I, FN, vr, nvr, value);                             \
+        double v_;                                                            \
+        if (nvr != 1 || !vr || !value) return get_##NAME(I, FN, vr, nvr, value); \
+        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi2Error;     \
+        value[0] = TO_FMI(v_);                                                \
+        return fmi2OK;                                                        \
     }                                                                         \
     fmi2Status fmi2Set##NAME(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
         BEGIN(Set##NAME);                                                     \
-        if (nvr == 1 && vr && value) {                                        \
-            const double v_ = FROM_FMI(value[0]);                             \
-            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastInputVr) { \
-                fmu_set_input(I, v_);                                         \
-                return fmi2OK;                                                \
-            }                                                                 \
-            if (!fmu_settable(I, TYPE_MASK, vr[0], v_))                       \
-                return (fmi2Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], v_, true); \
-            fmu_set(I, vr[0], v_);                                            \
-            return fmi2OK;                                                    \
-        }                                                                     \
-        return set_##NAME(I, FN, vr, nvr, value);                             \
+        if (nvr != 1 || !vr || !value) return set_##NAME(I, FN, vr, nvr, value); \
+        return fmu_set_one(I, FN, TYPE_MASK, vr[0], FROM_FMI(value[0])) ? fmi2OK : fmi2Error; \
     }
 
 ACCESSORS(Real, fmi2Real, TYPE_BIT(FMU_REAL), AS_REAL, AS_REAL)
@@ -243,89 +230,36 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     return fmi2OK;
 }
 
-/* ---- FMU states ---------------------------------------------------------- */
-
-static Fmi2State *new_state(FmuInstance *I) {
-    Fmi2Instance *g = (Fmi2Instance *)I;
-    Fmi2State *state = g->functions.allocateMemory(1, sizeof *state);
-    if (state) state->tag = STATE_TAG;
-    return state;
-}
-
-static FmuStatus check_state(FmuInstance *I, const char *function, const Fmi2State *state) {
-    if (!state) {
-        return fmu_error(I, function, "the FMU state is NULL");
-    }
-    if (state->tag != STATE_TAG) {
-        return fmu_error(I, function, "not an FMU state of this FMU");
-    }
-    return FMU_OK;
-}
+/* ---- FMU states (fmu_core.c) ---------------------------------------------- */
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(GetFMUstate);
-    if (!FMUstate) return (fmi2Status)fmu_error(I, FN, "the FMU state pointer is NULL");
-    Fmi2State *state = *FMUstate;
-    if (state) {
-        CHECK(check_state(I, FN, state));
-    } else if (!(state = new_state(I))) {
-        return (fmi2Status)fmu_error(I, FN, "out of memory");
-    }
-    fmu_snapshot(I, &state->core);
-    *FMUstate = state;
-    return fmi2OK;
+    return (fmi2Status)fmu_get_state(I, FN, FMUstate);
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     BEGIN(SetFMUstate);
-    CHECK(check_state(I, FN, FMUstate));
-    fmu_restore(I, &((const Fmi2State *)FMUstate)->core);
-    return fmi2OK;
+    return (fmi2Status)fmu_set_state(I, FN, FMUstate);
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(FreeFMUstate);
-    if (!FMUstate || !*FMUstate) return fmi2OK;
-    CHECK(check_state(I, FN, *FMUstate));
-    ((Fmi2State *)*FMUstate)->tag = 0;
-    ((Fmi2Instance *)I)->functions.freeMemory(*FMUstate);
-    *FMUstate = NULL;
-    return fmi2OK;
+    return (fmi2Status)fmu_free_state(I, FN, FMUstate);
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     BEGIN(SerializedFMUstateSize);
-    CHECK(check_state(I, FN, FMUstate));
-    if (!size) return (fmi2Status)fmu_error(I, FN, "the size pointer is NULL");
-    *size = fmu_serialized_size(I);
-    return fmi2OK;
+    return (fmi2Status)fmu_serialized_state_size(I, FN, FMUstate, size);
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
     BEGIN(SerializeFMUstate);
-    CHECK(check_state(I, FN, FMUstate));
-    if (!serializedState) return (fmi2Status)fmu_error(I, FN, "the byte array is NULL");
-    if (size < fmu_serialized_size(I)) {
-        return (fmi2Status)fmu_error(I, FN, "the byte array has %zu bytes; the state needs %zu", size, fmu_serialized_size(I));
-    }
-    fmu_serialize(I, &((const Fmi2State *)FMUstate)->core, (unsigned char *)serializedState);
-    return fmi2OK;
+    return (fmi2Status)fmu_serialize_state(I, FN, FMUstate, (unsigned char *)serializedState, size);
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate *FMUstate) {
     BEGIN(DeSerializeFMUstate);
-    FmuCore core;
-    if (!FMUstate) return (fmi2Status)fmu_error(I, FN, "the FMU state pointer is NULL");
-    CHECK(fmu_deserialize(I, FN, (const unsigned char *)serializedState, size, &core));
-    Fmi2State *state = *FMUstate;
-    if (state) {
-        CHECK(check_state(I, FN, state));
-    } else if (!(state = new_state(I))) {
-        return (fmi2Status)fmu_error(I, FN, "out of memory");
-    }
-    state->core = core;
-    *FMUstate = state;
-    return fmi2OK;
+    return (fmi2Status)fmu_deserialize_state(I, FN, (const unsigned char *)serializedState, size, FMUstate);
 }
 
 /* ---- Co-Simulation -------------------------------------------------------- */

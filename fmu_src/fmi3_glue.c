@@ -30,6 +30,33 @@
 #define MODES_SerializeFMUState         (INST | INIT | STEP | TERM | ERR)
 #define MODES_DeserializeFMUState       (INST | INIT | STEP | TERM | ERR)
 #define MODES_DoStep                    (STEP)
+/* every fmi3Get<Type> and fmi3Set<Type> */
+#define MODES_GetFloat32                     MODES_Get
+#define MODES_SetFloat32                     MODES_Set
+#define MODES_GetFloat64                     MODES_Get
+#define MODES_SetFloat64                     MODES_Set
+#define MODES_GetInt8                        MODES_Get
+#define MODES_SetInt8                        MODES_Set
+#define MODES_GetUInt8                       MODES_Get
+#define MODES_SetUInt8                       MODES_Set
+#define MODES_GetInt16                       MODES_Get
+#define MODES_SetInt16                       MODES_Set
+#define MODES_GetUInt16                      MODES_Get
+#define MODES_SetUInt16                      MODES_Set
+#define MODES_GetInt32                       MODES_Get
+#define MODES_SetInt32                       MODES_Set
+#define MODES_GetUInt32                      MODES_Get
+#define MODES_SetUInt32                      MODES_Set
+#define MODES_GetInt64                       MODES_Get
+#define MODES_SetInt64                       MODES_Set
+#define MODES_GetUInt64                      MODES_Get
+#define MODES_SetUInt64                      MODES_Set
+#define MODES_GetBoolean                     MODES_Get
+#define MODES_SetBoolean                     MODES_Set
+#define MODES_GetString                      MODES_Get
+#define MODES_SetString                      MODES_Set
+#define MODES_GetBinary                      MODES_Get
+#define MODES_SetBinary                      MODES_Set
 
 typedef struct {
     FmuInstance base; /* first: an fmi3Instance is an FmuInstance */
@@ -37,17 +64,11 @@ typedef struct {
     char name[];
 } Fmi3Instance;
 
-#define STATE_TAG 0x524c5333u
-typedef struct {
-    uint32_t tag;
-    FmuCore core;
-} Fmi3State;
-
-#define BEGIN(function, modes)                                                \
+#define BEGIN(name)                                                           \
     FmuInstance *I = (FmuInstance *)instance;                                 \
-    static const char FN[] = function;                                        \
+    static const char FN[] = "fmi3" #name;                                    \
     if (!I) return fmi3Error;                                                 \
-    if (!(I->core.mode & (modes))) return (fmi3Status)fmu_mode_error(I, FN)
+    if (!(I->core.mode & (MODES_##name))) return (fmi3Status)fmu_mode_error(I, FN)
 
 #define CHECK(expression)                                                     \
     do {                                                                      \
@@ -58,6 +79,17 @@ typedef struct {
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
     const Fmi3Instance *g = (const Fmi3Instance *)instance;
     g->logMessage(instance->environment, (fmi3Status)status, category, message);
+}
+
+/* FMI 3 has no memory callbacks: FMU states use the C heap */
+static void *allocate_state(FmuInstance *instance, size_t size) {
+    (void)instance;
+    return malloc(size);
+}
+
+static void release_state(FmuInstance *instance, void *memory) {
+    (void)instance;
+    free(memory);
 }
 
 const char *fmi3GetVersion(void) { return fmi3Version; }
@@ -94,6 +126,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     g->base.environment = instanceEnvironment;
     g->base.logFunction = logMessage ? log_to_importer : NULL;
     g->base.logCategories = loggingOn ? LOG_ALL : 0;
+    g->base.allocate = allocate_state;
+    g->base.release = release_state;
     fmu_init_instance(&g->base);
     return g;
 }
@@ -103,7 +137,7 @@ void fmi3FreeInstance(fmi3Instance instance) {
 }
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories, const fmi3String categories[]) {
-    BEGIN("fmi3SetDebugLogging", MODES_SetDebugLogging);
+    BEGIN(SetDebugLogging);
     return (fmi3Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, 0);
 }
 
@@ -111,7 +145,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
     (void)toleranceDefined;
     (void)tolerance;
-    BEGIN("fmi3EnterInitializationMode", MODES_EnterInitializationMode);
+    BEGIN(EnterInitializationMode);
     if (stopTimeDefined && !(stopTime >= startTime)) {
         return (fmi3Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
     }
@@ -120,18 +154,18 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
-    BEGIN("fmi3ExitInitializationMode", MODES_ExitInitializationMode);
+    BEGIN(ExitInitializationMode);
     return (fmi3Status)fmu_exit_initialization(I);
 }
 
 fmi3Status fmi3Terminate(fmi3Instance instance) {
-    BEGIN("fmi3Terminate", MODES_Terminate);
+    BEGIN(Terminate);
     I->core.mode = MODE_TERMINATED;
     return fmi3OK;
 }
 
 fmi3Status fmi3Reset(fmi3Instance instance) {
-    BEGIN("fmi3Reset", MODES_Reset);
+    BEGIN(Reset);
     fmu_reset(I);
     return fmi3OK;
 }
@@ -150,14 +184,14 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
 /* One value is the common call: straight-line code without a frame; any
  * other count goes through the loops (all checked before any is set). */
 #define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI)                              \
-    __attribute__((noinline)) static fmi3Status get_##NAME(FmuInstance *I, const char *FN, \
+    FMU_NOINLINE static fmi3Status get_##NAME(FmuInstance *I, const char *FN, \
         const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
         CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) values[i] = TO_FMI(fmu_get(I, vr[i])); \
         return fmi3OK;                                                        \
     }                                                                         \
-    __attribute__((noinline)) static fmi3Status set_##NAME(FmuInstance *I, const char *FN, \
+    FMU_NOINLINE static fmi3Status set_##NAME(FmuInstance *I, const char *FN, \
         const fmi3ValueReference vr[], size_t nvr, const TYPE values[], size_t nValues) { \
         CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], (double)values[i])); \
@@ -166,163 +200,102 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
     }                                                                         \
     fmi3Status fmi3Get##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
                              TYPE values[], size_t nValues) {                 \
-        BEGIN("fmi3Get" #NAME, MODES_Get);                                    \
-        if (nvr == 1 && nValues == 1 && vr && values) {                       \
-            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastOutputVr) { \
-                values[0] = TO_FMI(fmu_get(I, vr[0]));                        \
-                return fmi3OK;                                                \
-            }                                                                 \
-            if (!fmu_readable(I, TYPE_MASK, vr[0]))                           \
-                return (fmi3Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], 0.0, false); \
-            values[0] = TO_FMI(fmu_get(I, vr[0]));                            \
-            return fmi3OK;                                                    \
-        }                                                                     \
-        return get_##NAME(I, FN, vr, nvr, values, nValues);                   \
+        BEGIN(Get##NAME);                                                     \
+        double v_;                                                            \
+        if (nvr != 1 || nValues != 1 || !vr || !values) return get_##NAME(I, FN, vr, nvr, values, nValues); \
+        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi3Error;     \
+        values[0] = TO_FMI(v_);                                               \
+        return fmi3OK;                                                        \
     }                                                                         \
     fmi3Status fmi3Set##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
                              const TYPE values[], size_t nValues) {           \
-        BEGIN("fmi3Set" #NAME, MODES_Set);                                    \
-        if (nvr == 1 && nValues == 1 && vr && values) {                       \
-            const double v_ = (double)values[0];                              \
-            if ((TYPE_MASK) == TYPE_BIT(FMU_REAL) && vr[0] == I->fastInputVr) { \
-                fmu_set_input(I, v_);                                         \
-                return fmi3OK;                                                \
-            }                                                                 \
-            if (!fmu_settable(I, TYPE_MASK, vr[0], v_))                       \
-                return (fmi3Status)fmu_access_error(I, FN, TYPE_MASK, vr[0], v_, true); \
-            fmu_set(I, vr[0], v_);                                            \
-            return fmi3OK;                                                    \
-        }                                                                     \
-        return set_##NAME(I, FN, vr, nvr, values, nValues);                   \
+        BEGIN(Set##NAME);                                                     \
+        if (nvr != 1 || nValues != 1 || !vr || !values) return set_##NAME(I, FN, vr, nvr, values, nValues); \
+        return fmu_set_one(I, FN, TYPE_MASK, vr[0], (double)values[0]) ? fmi3OK : fmi3Error; \
     }
 
 #define AS_FLOAT64(x) (x)
 #define AS_INT(x) (x)
 #define AS_BOOLEAN(x) ((x) != 0)
-#define NONE TYPE_BIT(FMU_UNSUPPORTED_TYPE)
+#define NO_TYPE TYPE_BIT(FMU_UNSUPPORTED_TYPE)
 
 ACCESSORS(Float64, fmi3Float64, TYPE_BIT(FMU_REAL), AS_FLOAT64)
 ACCESSORS(Int32, fmi3Int32, TYPE_BIT(FMU_INTEGER), (fmi3Int32)AS_INT)
 ACCESSORS(Int64, fmi3Int64, TYPE_BIT(FMU_ENUMERATION), (fmi3Int64)AS_INT)
 ACCESSORS(Boolean, fmi3Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN)
 /* no variables of these types: any value reference is refused */
-ACCESSORS(Float32, fmi3Float32, NONE, (fmi3Float32)AS_INT)
-ACCESSORS(Int8, fmi3Int8, NONE, (fmi3Int8)AS_INT)
-ACCESSORS(UInt8, fmi3UInt8, NONE, (fmi3UInt8)AS_INT)
-ACCESSORS(Int16, fmi3Int16, NONE, (fmi3Int16)AS_INT)
-ACCESSORS(UInt16, fmi3UInt16, NONE, (fmi3UInt16)AS_INT)
-ACCESSORS(UInt32, fmi3UInt32, NONE, (fmi3UInt32)AS_INT)
-ACCESSORS(UInt64, fmi3UInt64, NONE, (fmi3UInt64)AS_INT)
+ACCESSORS(Float32, fmi3Float32, NO_TYPE, (fmi3Float32)AS_INT)
+ACCESSORS(Int8, fmi3Int8, NO_TYPE, (fmi3Int8)AS_INT)
+ACCESSORS(UInt8, fmi3UInt8, NO_TYPE, (fmi3UInt8)AS_INT)
+ACCESSORS(Int16, fmi3Int16, NO_TYPE, (fmi3Int16)AS_INT)
+ACCESSORS(UInt16, fmi3UInt16, NO_TYPE, (fmi3UInt16)AS_INT)
+ACCESSORS(UInt32, fmi3UInt32, NO_TYPE, (fmi3UInt32)AS_INT)
+ACCESSORS(UInt64, fmi3UInt64, NO_TYPE, (fmi3UInt64)AS_INT)
 
 fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                          fmi3String values[], size_t nValues) {
-    BEGIN("fmi3GetString", MODES_Get);
+    BEGIN(GetString);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
-    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NONE, vr[i]));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NO_TYPE, vr[i]));
     return fmi3OK;
 }
 
 fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                          const fmi3String values[], size_t nValues) {
-    BEGIN("fmi3SetString", MODES_Set);
+    BEGIN(SetString);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
-    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NONE, vr[i], 0.0));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NO_TYPE, vr[i], 0.0));
     return fmi3OK;
 }
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                          size_t valueSizes[], fmi3Binary values[], size_t nValues) {
-    BEGIN("fmi3GetBinary", MODES_Get);
+    BEGIN(GetBinary);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
-    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NONE, vr[i]));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NO_TYPE, vr[i]));
     return fmi3OK;
 }
 
 fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                          const size_t valueSizes[], const fmi3Binary values[], size_t nValues) {
-    BEGIN("fmi3SetBinary", MODES_Set);
+    BEGIN(SetBinary);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
-    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NONE, vr[i], 0.0));
+    for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NO_TYPE, vr[i], 0.0));
     return fmi3OK;
 }
 
-/* ---- FMU states ---------------------------------------------------------- */
-
-static FmuStatus check_state(FmuInstance *I, const char *function, const Fmi3State *state) {
-    if (!state) {
-        return fmu_error(I, function, "the FMU state is NULL");
-    }
-    if (state->tag != STATE_TAG) {
-        return fmu_error(I, function, "not an FMU state of this FMU");
-    }
-    return FMU_OK;
-}
-
-static FmuStatus store_state(FmuInstance *I, const char *function, fmi3FMUState *FMUState, const FmuCore *core) {
-    Fmi3State *state = *FMUState;
-    if (state) {
-        if (check_state(I, function, state) != FMU_OK) return FMU_ERROR;
-    } else if (!(state = malloc(sizeof *state))) {
-        return fmu_error(I, function, "out of memory");
-    }
-    state->tag = STATE_TAG;
-    state->core = *core;
-    *FMUState = state;
-    return FMU_OK;
-}
+/* ---- FMU states (fmu_core.c) ---------------------------------------------- */
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
-    BEGIN("fmi3GetFMUState", MODES_GetFMUState);
-    if (!FMUState) return (fmi3Status)fmu_error(I, FN, "the FMU state pointer is NULL");
-    FmuCore core;
-    fmu_snapshot(I, &core);
-    return (fmi3Status)store_state(I, FN, FMUState, &core);
+    BEGIN(GetFMUState);
+    return (fmi3Status)fmu_get_state(I, FN, FMUState);
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) {
-    BEGIN("fmi3SetFMUState", MODES_SetFMUState);
-    CHECK(check_state(I, FN, FMUState));
-    fmu_restore(I, &((const Fmi3State *)FMUState)->core);
-    return fmi3OK;
+    BEGIN(SetFMUState);
+    return (fmi3Status)fmu_set_state(I, FN, FMUState);
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
-    BEGIN("fmi3FreeFMUState", MODES_FreeFMUState);
-    if (!FMUState || !*FMUState) return fmi3OK;
-    CHECK(check_state(I, FN, *FMUState));
-    ((Fmi3State *)*FMUState)->tag = 0;
-    free(*FMUState);
-    *FMUState = NULL;
-    return fmi3OK;
+    BEGIN(FreeFMUState);
+    return (fmi3Status)fmu_free_state(I, FN, FMUState);
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size) {
-    BEGIN("fmi3SerializedFMUStateSize", MODES_SerializedFMUStateSize);
-    CHECK(check_state(I, FN, FMUState));
-    if (!size) return (fmi3Status)fmu_error(I, FN, "the size pointer is NULL");
-    *size = fmu_serialized_size(I);
-    return fmi3OK;
+    BEGIN(SerializedFMUStateSize);
+    return (fmi3Status)fmu_serialized_state_size(I, FN, FMUState, size);
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
-    BEGIN("fmi3SerializeFMUState", MODES_SerializeFMUState);
-    CHECK(check_state(I, FN, FMUState));
-    if (!serializedState) return (fmi3Status)fmu_error(I, FN, "the byte array is NULL");
-    if (size < fmu_serialized_size(I)) {
-        return (fmi3Status)fmu_error(I, FN, "the byte array has %zu bytes; the state needs %zu", size, fmu_serialized_size(I));
-    }
-    fmu_serialize(I, &((const Fmi3State *)FMUState)->core, serializedState);
-    return fmi3OK;
+    BEGIN(SerializeFMUState);
+    return (fmi3Status)fmu_serialize_state(I, FN, FMUState, serializedState, size);
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size, fmi3FMUState *FMUState) {
-    BEGIN("fmi3DeserializeFMUState", MODES_DeserializeFMUState);
-    FmuCore core;
-    if (!FMUState) return (fmi3Status)fmu_error(I, FN, "the FMU state pointer is NULL");
-    CHECK(fmu_deserialize(I, FN, serializedState, size, &core));
-    return (fmi3Status)store_state(I, FN, FMUState, &core);
+    BEGIN(DeserializeFMUState);
+    return (fmi3Status)fmu_deserialize_state(I, FN, serializedState, size, FMUState);
 }
 
 /* ---- Co-Simulation -------------------------------------------------------- */
@@ -337,15 +310,8 @@ static inline void step_outputs(const FmuInstance *I, fmi3Boolean *eventHandling
 }
 
 /* Every step but the common one. Its parameters are fmi3DoStep's, so that
- * the common step's way out to it is a jump with every argument in place;
- * noipa keeps GCC from cloning it with fewer (clang keeps them anyway). */
-#if defined(__GNUC__) && !defined(__clang__)
-#define KEEP_SIGNATURE __attribute__((noipa))
-#else
-#define KEEP_SIGNATURE __attribute__((noinline))
-#endif
-
-KEEP_SIGNATURE static fmi3Status general_step(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h,
+ * the common step's way out to it is a jump with every argument in place. */
+FMU_KEEP_SIGNATURE static fmi3Status general_step(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h,
                                              fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                              fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
                                              fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
@@ -362,7 +328,7 @@ KEEP_SIGNATURE static fmi3Status general_step(fmi3Instance instance, fmi3Float64
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    BEGIN("fmi3DoStep", MODES_DoStep);
+    BEGIN(DoStep);
     if (eventHandlingNeeded && terminateSimulation && earlyReturn && lastSuccessfulTime &&
         fmu_step_fast(I, currentCommunicationPoint, communicationStepSize)) {
         step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);

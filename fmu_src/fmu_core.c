@@ -152,7 +152,7 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
 
 /* Kernel configuration from the current values; the cycle length and
  * limits are derived again at the next cycle. */
-__attribute__((noinline)) static void configure(FmuInstance *instance) {
+FMU_NOINLINE static void configure(FmuInstance *instance) {
     instance->model->configure(instance->core.values, &instance->prepared.config);
     const double c = instance->prepared.config.cycleTime.value;
     instance->cycleTime = c > 0 && isfinite(c) ? c : 0.0;
@@ -161,7 +161,7 @@ __attribute__((noinline)) static void configure(FmuInstance *instance) {
 }
 
 /* not inline: keeps the step's frame small */
-__attribute__((noinline)) static void prepare(FmuInstance *instance, double period) {
+FMU_NOINLINE static void prepare(FmuInstance *instance, double period) {
     instance->fastPeriod = NAN;
     RlConfig config = instance->prepared.config;
     rl_prepare(&instance->prepared, &config, period);
@@ -195,7 +195,8 @@ void fmu_refresh_outputs(FmuInstance *instance) {
     }
 }
 
-void fmu_snapshot(FmuInstance *instance, FmuCore *state) {
+/* The current core, outputs published, for an FMU state. */
+static void snapshot(FmuInstance *instance, FmuCore *state) {
     if (instance->outputsStale) fmu_refresh_outputs(instance);
     *state = instance->core;
 }
@@ -219,7 +220,7 @@ FmuStatus fmu_enter_initialization(FmuInstance *instance) {
 }
 
 /* Log a change of the status word once; an error status is a warning. */
-__attribute__((noinline)) static FmuStatus log_status(FmuInstance *instance) {
+FMU_NOINLINE static FmuStatus log_status(FmuInstance *instance) {
     const RlPrepared *p = &instance->prepared;
     instance->core.reportedStatus = p->status;
     if (p->status >= 0x8000) {
@@ -246,7 +247,7 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance) {
 
 /* Sub-cycling (cycleTime > 0): the cycles that end in (t, end], each end
  * t0 + n*cycleTime computed afresh from the whole cycle count n. */
-__attribute__((noinline)) static FmuStatus run_cycles(FmuInstance *instance, const char *function, double end, double h, double u) {
+FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *function, double end, double h, double u) {
     FmuCore *core = &instance->core;
     const double cycle = instance->cycleTime;
     const double last = floor((end - core->startTime) / cycle + RL_TIME_TOLERANCE);
@@ -305,7 +306,8 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     return report_status(instance);
 }
 
-void fmu_restore(FmuInstance *instance, const FmuCore *state) {
+/* Make a restored core the current one. */
+static void restore(FmuInstance *instance, const FmuCore *state) {
     instance->core = *state;
     instance->configDirty = true;
     instance->fastPeriod = NAN;
@@ -378,11 +380,11 @@ static size_t payload_size(const ModelDefinition *model) {
          + 8 + 8 + 8 + 4 + 4;                /* startTime, time, cycles, mode, status */
 }
 
-size_t fmu_serialized_size(const FmuInstance *instance) {
+static size_t serialized_size(const FmuInstance *instance) {
     return SERIAL_HEADER + payload_size(instance->model) + SERIAL_TRAILER;
 }
 
-void fmu_serialize(const FmuInstance *instance, const FmuCore *s, unsigned char *out) {
+static void serialize(const FmuInstance *instance, const FmuCore *s, unsigned char *out) {
     const ModelDefinition *model = instance->model;
     unsigned char *p = out;
     memcpy(p, SERIAL_MAGIC, 4);
@@ -423,9 +425,10 @@ static bool value_possible(const FmuVariable *v, double value) {
     }
 }
 
-FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const unsigned char *in, size_t size, FmuCore *out) {
+static FmuStatus deserialize(FmuInstance *instance, const char *function, const unsigned char *in, size_t size,
+                             FmuCore *out) {
     const ModelDefinition *model = instance->model;
-    const size_t expected = fmu_serialized_size(instance);
+    const size_t expected = serialized_size(instance);
     const unsigned char *p = in;
 
     if (!in) {
@@ -487,5 +490,117 @@ FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const uns
         return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
     }
     *out = s;
+    return FMU_OK;
+}
+
+/* ---- FMU states --------------------------------------------------------- */
+
+#define STATE_TAG 0x524c5354u /* "RLST" */
+typedef struct {
+    uint32_t tag;
+    FmuCore core;
+} FmuState;
+
+static FmuStatus check_state(FmuInstance *instance, const char *function, const FmuState *state) {
+    if (!state) {
+        return fmu_error(instance, function, "the FMU state is NULL");
+    }
+    if (state->tag != STATE_TAG) {
+        return fmu_error(instance, function, "not an FMU state of this FMU");
+    }
+    return FMU_OK;
+}
+
+/* *state, checked, or a new one; NULL after an error */
+static FmuState *state_to_fill(FmuInstance *instance, const char *function, void **state) {
+    FmuState *target = *state;
+    if (target) {
+        return check_state(instance, function, target) == FMU_OK ? target : NULL;
+    }
+    target = instance->allocate(instance, sizeof *target);
+    if (!target) {
+        fmu_error(instance, function, "out of memory");
+    }
+    return target;
+}
+
+FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **state) {
+    if (!state) {
+        return fmu_error(instance, function, "the FMU state pointer is NULL");
+    }
+    FmuState *target = state_to_fill(instance, function, state);
+    if (!target) {
+        return FMU_ERROR;
+    }
+    target->tag = STATE_TAG;
+    snapshot(instance, &target->core);
+    *state = target;
+    return FMU_OK;
+}
+
+FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void *state) {
+    if (check_state(instance, function, state) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    restore(instance, &((const FmuState *)state)->core);
+    return FMU_OK;
+}
+
+FmuStatus fmu_free_state(FmuInstance *instance, const char *function, void **state) {
+    if (!state || !*state) {
+        return FMU_OK;
+    }
+    if (check_state(instance, function, *state) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    ((FmuState *)*state)->tag = 0;
+    instance->release(instance, *state);
+    *state = NULL;
+    return FMU_OK;
+}
+
+FmuStatus fmu_serialized_state_size(FmuInstance *instance, const char *function, const void *state, size_t *size) {
+    if (check_state(instance, function, state) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    if (!size) {
+        return fmu_error(instance, function, "the size pointer is NULL");
+    }
+    *size = serialized_size(instance);
+    return FMU_OK;
+}
+
+FmuStatus fmu_serialize_state(FmuInstance *instance, const char *function, const void *state, unsigned char *out,
+                              size_t size) {
+    if (check_state(instance, function, state) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    if (!out) {
+        return fmu_error(instance, function, "the byte array is NULL");
+    }
+    if (size < serialized_size(instance)) {
+        return fmu_error(instance, function, "the byte array has %zu bytes; the state needs %zu", size,
+                         serialized_size(instance));
+    }
+    serialize(instance, &((const FmuState *)state)->core, out);
+    return FMU_OK;
+}
+
+FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, const unsigned char *in, size_t size,
+                                void **state) {
+    FmuCore core;
+    if (!state) {
+        return fmu_error(instance, function, "the FMU state pointer is NULL");
+    }
+    if (deserialize(instance, function, in, size, &core) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    FmuState *target = state_to_fill(instance, function, state);
+    if (!target) {
+        return FMU_ERROR;
+    }
+    target->tag = STATE_TAG;
+    target->core = core;
+    *state = target;
     return FMU_OK;
 }

@@ -14,6 +14,23 @@
 
 #include "rate_limiter.h"
 
+/* Compiler hints, portable: GCC and clang read them, any other compiler
+ * (MSVC compiling the source FMU) gets nothing; FMU_PORTABLE forces that
+ * (a test compiles the sources so). They change speed, never results. */
+#if defined(__GNUC__) && !defined(FMU_PORTABLE)
+#define FMU_NOINLINE __attribute__((noinline))
+#define FMU_COLD __attribute__((cold))
+#else
+#define FMU_NOINLINE
+#define FMU_COLD
+#endif
+/* keep every parameter of a function (no clone with fewer): GCC's noipa */
+#if defined(__GNUC__) && !defined(__clang__) && !defined(FMU_PORTABLE)
+#define FMU_KEEP_SIGNATURE __attribute__((noipa))
+#else
+#define FMU_KEEP_SIGNATURE FMU_NOINLINE
+#endif
+
 typedef enum { FMU_REAL, FMU_INTEGER, FMU_BOOLEAN, FMU_ENUMERATION, FMU_UNSUPPORTED_TYPE } FmuType;
 typedef enum { FMU_INDEPENDENT, FMU_PARAMETER, FMU_INPUT, FMU_OUTPUT } FmuCausality;
 typedef enum { FMU_CONTINUOUS, FMU_DISCRETE, FMU_FIXED, FMU_TUNABLE } FmuVariability;
@@ -41,6 +58,7 @@ typedef enum {
     MODE_ERROR          = 1 << 4
 } FmuMode;
 
+/* Variables per model, at most (the generated header checks its model). */
 #define FMU_MAX_VARIABLES 32
 
 /* A step that would run more cycles than this is refused (no endless loop
@@ -51,7 +69,8 @@ typedef enum {
 enum { LOG_ERROR = 1, LOG_WARNING = 2, LOG_EVENTS = 4, LOG_ALL = 7 };
 extern const char *const fmu_log_category_names[3];
 
-/* What a model file provides: its variables and the mapping to the kernel. */
+/* What a model file provides: its variables and the mapping to the kernel.
+ * Value reference 0 is the independent variable time (generate.py). */
 typedef struct {
     const char *identifier;
     const char *token;
@@ -101,8 +120,10 @@ struct FmuInstance {
     FmuLogFunction *logFunction;
     int logCategories;      /* enabled categories */
     const char *instanceName;
-    const void *glue;       /* the glue's callbacks */
     void *environment;      /* the importer's instance environment */
+    /* memory for FMU states, as the importer provides it (FMI 2) or not */
+    void *(*allocate)(FmuInstance *instance, size_t size);
+    void (*release)(FmuInstance *instance, void *memory);
 };
 
 void fmu_init_instance(FmuInstance *instance);
@@ -124,9 +145,9 @@ FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt
 
 /* Out-of-line error paths of the inline checks below. */
 /* A call in a mode its function's state table does not allow. */
-__attribute__((cold)) FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
+FMU_COLD FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
 FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr);
-__attribute__((cold)) FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set);
+FMU_COLD FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set);
 /* Publish the outputs (Initialization Mode: initialize the block first). */
 void fmu_refresh_outputs(FmuInstance *instance);
 
@@ -208,6 +229,31 @@ static inline void fmu_set(FmuInstance *instance, unsigned vr, double value) {
     }
 }
 
+/* One value, the common call of every get and set: inline, the error path
+ * out of line. false: refused (logged, error mode). u and y, when they are
+ * plain Real variables, need no table lookup. */
+static inline bool fmu_get_one(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double *value) {
+    if (!(typeMask == TYPE_BIT(FMU_REAL) && vr == instance->fastOutputVr) && !fmu_readable(instance, typeMask, vr)) {
+        fmu_access_error(instance, function, typeMask, vr, 0.0, false);
+        return false;
+    }
+    *value = fmu_get(instance, vr);
+    return true;
+}
+
+static inline bool fmu_set_one(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value) {
+    if (typeMask == TYPE_BIT(FMU_REAL) && vr == instance->fastInputVr) {
+        fmu_set_input(instance, value);
+        return true;
+    }
+    if (!fmu_settable(instance, typeMask, vr, value)) {
+        fmu_access_error(instance, function, typeMask, vr, value, true);
+        return false;
+    }
+    fmu_set(instance, vr, value);
+    return true;
+}
+
 FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime);
 FmuStatus fmu_enter_initialization(FmuInstance *instance);
 FmuStatus fmu_exit_initialization(FmuInstance *instance);
@@ -241,16 +287,18 @@ static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function,
     return fmu_step_fast(instance, t, h) ? FMU_OK : fmu_do_step_general(instance, function, t, h);
 }
 
-/* Serialized FMU state: header, payload, CRC-32. */
-size_t fmu_serialized_size(const FmuInstance *instance);
-void fmu_serialize(const FmuInstance *instance, const FmuCore *state, unsigned char *out);
-FmuStatus fmu_deserialize(FmuInstance *instance, const char *function, const unsigned char *in, size_t size, FmuCore *out);
-
-/* The current core, outputs published, for an FMU state. */
-void fmu_snapshot(FmuInstance *instance, FmuCore *state);
-
-/* Make a restored core the current one. */
-void fmu_restore(FmuInstance *instance, const FmuCore *state);
+/* FMU states, for both FMI versions: the glue converts types only. A state
+ * is a tagged copy of the core (a foreign pointer is refused, not read);
+ * serialized, it is a header, the payload and a CRC-32. *state NULL: a new
+ * state is allocated, else the given one is overwritten. */
+FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **state);
+FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void *state);
+FmuStatus fmu_free_state(FmuInstance *instance, const char *function, void **state);
+FmuStatus fmu_serialized_state_size(FmuInstance *instance, const char *function, const void *state, size_t *size);
+FmuStatus fmu_serialize_state(FmuInstance *instance, const char *function, const void *state, unsigned char *out,
+                              size_t size);
+FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, const unsigned char *in, size_t size,
+                                void **state);
 
 const char *fmu_mode_name(int mode);
 

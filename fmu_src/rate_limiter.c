@@ -57,6 +57,10 @@ void rl_prepare(RlPrepared *p, const RlConfig *c, double period) {
     p->maxDown = cycle_limit(c->rateDown.value, c, period);
     p->durationReached = c->duration.value * (1.0 - RL_TIME_TOLERANCE);
     p->initDelayEnd = c->initDelay + RL_TIME_TOLERANCE * period;
+    /* The fast paths (rl_cycle, rl_run, fmu_step_fast) run rule 6 alone
+     * while plain: every rule before 6 that can decide a cycle with a
+     * finite u and y (2 bypass, 3 delayed init, 5 error hold, and any new
+     * one) must clear it here. */
     p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && p->status < 0x8000;
     p->durationLimited = c->duration.value > 0;
 }
@@ -122,12 +126,8 @@ void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t 
         cycles++;
         if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
             y = u;
-        } else if (u > y) {
-            const double limited = y + p->maxUp;
-            y = limited < u ? limited : u;
         } else {
-            const double limited = y - p->maxDown;
-            y = limited > u ? limited : u;
+            y = rl_step_towards(y, u, p);
         }
     }
     s->y = y;

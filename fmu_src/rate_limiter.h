@@ -59,8 +59,8 @@ typedef struct {
     double initDelayEnd;       /* elapsed time up to which initMode 3 tracks */
     int status;
     int statusSource;          /* id of the variable that caused status */
-    bool plain;                /* no bypass, no delayed init, no error: only
-                                  rule 6 can apply to a finite u and y */
+    bool plain;                /* only rule 6 can decide a cycle with a
+                                  finite u and y (rl_prepare says when) */
     bool durationLimited;      /* duration > 0 */
 } RlPrepared;
 
@@ -108,6 +108,21 @@ static inline void rl_hold_period(RlState *s, double period) {
     if (s->runPeriod != period) rl_period_changed(s, period);
 }
 
+/* Rule 6's step of y towards u at the per-cycle limits, never past u:
+ * every path that ramps (rl_ramp_cycle, rl_run's sub-cycles, and through
+ * them the FMUs' common step) takes it from here. */
+static inline double rl_step_towards(double y, double u, const RlPrepared *p) {
+    if (u > y) {
+        const double limited = y + p->maxUp;
+        return limited < u ? limited : u;
+    }
+    if (u < y) {
+        const double limited = y - p->maxDown;
+        return limited > u ? limited : u;
+    }
+    return y;
+}
+
 /* Rule 6: ramp towards u, or jump once the duration has run out. steady:
  * u and y are finite and runPeriod is already p->period (rl_hold_period),
  * which spares two checks; a constant, so each caller gets its own copy. */
@@ -123,12 +138,8 @@ static inline void rl_ramp_cycle(RlState *s, const RlPrepared *p, double u, bool
     }
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
         y = u;
-    } else if (u > y) {
-        const double limited = y + p->maxUp;
-        y = limited < u ? limited : u;
-    } else if (u < y) {
-        const double limited = y - p->maxDown;
-        y = limited > u ? limited : u;
+    } else {
+        y = rl_step_towards(y, u, p);
     }
     /* the same for finite u and y; != is also true when one is NaN */
     s->rampActive = steady ? islessgreater(y, u) : y != u;

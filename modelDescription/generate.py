@@ -12,6 +12,7 @@ Only the Python standard library is used, so the build needs nothing else.
 import argparse
 import hashlib
 import math
+import re
 import sys
 import tomllib
 import uuid
@@ -19,6 +20,12 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 GENERATION_TOOL = "rate-limiter-fmus modelDescription/generate.py"
+CORE_HEADER = Path(__file__).resolve().parent.parent / "fmu_src" / "fmu_core.h"
+
+
+def max_variables():
+    """The size of the core's variable table (FMU_MAX_VARIABLES)."""
+    return int(re.search(r"#define FMU_MAX_VARIABLES (\d+)", CORE_HEADER.read_text()).group(1))
 
 TYPES = {"Real", "Integer", "Boolean", "Enumeration"}
 CAUSALITIES = {"independent", "parameter", "input", "output"}
@@ -52,6 +59,11 @@ def load(path):
     names = [v["name"] for v in variables]
     if len(set(names)) != len(names):
         sys.exit(f"{path}: variable names must be unique")
+    if not variables or variables[0]["name"] != "time" or variables[0]["causality"] != "independent":
+        sys.exit(f"{path}: value reference 0 must be the independent variable time (the core publishes it there)")
+    if len(variables) > max_variables():
+        sys.exit(f"{path}: {len(variables)} variables; the core's table holds {max_variables()} "
+                 f"(FMU_MAX_VARIABLES in {CORE_HEADER.name})")
     return model
 
 
@@ -220,6 +232,11 @@ enum {{
 {enum}
     MODEL_VARIABLE_COUNT = {len(model["variable"])}
 }};
+
+/* compile-time checks (a negative array size fails): the core's table
+ * holds this model, and time is value reference 0 */
+typedef char modelVariableCountFits[MODEL_VARIABLE_COUNT <= FMU_MAX_VARIABLES ? 1 : -1];
+typedef char modelTimeIsValueReference0[VR_time == 0 ? 1 : -1];
 
 static const FmuVariable modelVariables[MODEL_VARIABLE_COUNT] = {{
 {table}

@@ -3,6 +3,7 @@ capabilities, the TOML single source of truth against both model
 descriptions and the compiled-in C table, exported symbols, sources."""
 import math
 import os
+import re
 import struct
 import sys
 import tomllib
@@ -154,3 +155,30 @@ def test_docs_tables_are_generated_from_the_toml_files():
     text = (REPO / "docs" / "models.md").read_text()
     for model in MODELS:
         assert f"<!-- generated: variables {model} -->" in text
+
+
+def generator_run(tmp_path, variables):
+    """generate.py on a model of the given (name, causality) variables."""
+    lines = ['[model]\nidentifier = "Probe"\ndescription = "probe"\n']
+    for vr, (name, causality) in enumerate(variables):
+        lines.append(f'[[variable]]\nname = "{name}"\nvr = {vr}\ntype = "Real"\ncausality = "{causality}"\n'
+                     f'variability = "{"continuous" if causality == "independent" else "discrete"}"\n'
+                     + ('start = 0.0\n' if causality == "input" else ""))
+    toml = tmp_path / "Probe.toml"
+    toml.write_text("\n".join(lines))
+    return run_bounded([sys.executable, str(REPO / "modelDescription" / "generate.py"), str(toml), str(tmp_path / "gen")],
+                       timeout=60, what="generate.py")
+
+
+def test_generator_refuses_a_model_without_time_at_value_reference_0(tmp_path):
+    done = generator_run(tmp_path, [("u", "input"), ("time", "independent"), ("y", "output")])
+    assert done.returncode != 0 and "value reference 0 must be the independent variable time" in done.stderr
+    assert generator_run(tmp_path, [("time", "independent"), ("u", "input"), ("y", "output")]).returncode == 0
+
+
+def test_generator_refuses_more_variables_than_the_core_holds(tmp_path):
+    limit = int(re.search(r"#define FMU_MAX_VARIABLES (\d+)", (REPO / "fmu_src" / "fmu_core.h").read_text()).group(1))
+    fits = [("time", "independent")] + [(f"u{i}", "input") for i in range(limit - 1)]
+    assert generator_run(tmp_path, fits).returncode == 0
+    done = generator_run(tmp_path, fits + [("y", "output")])
+    assert done.returncode != 0 and f"the core's table holds {limit}" in done.stderr

@@ -34,5 +34,13 @@ static void publish_status(const RlPrepared *p, double *v) {
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_value, VR_delayedValue, configure, publish, publish_status
+    .identifier = MODEL_IDENTIFIER,
+    .token = MODEL_TOKEN,
+    .variables = modelVariables,
+    .count = MODEL_VARIABLE_COUNT,
+    .inputVr = VR_value,
+    .outputVr = VR_delayedValue,
+    .configure = configure,
+    .publish = publish,
+    .publishStatus = publish_status,
 };

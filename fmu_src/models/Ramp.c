@@ -23,5 +23,13 @@ static void publish(const RlState *block, double *v) {
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_rIn, VR_rOut, configure, publish, NULL
+    .identifier = MODEL_IDENTIFIER,
+    .token = MODEL_TOKEN,
+    .variables = modelVariables,
+    .count = MODEL_VARIABLE_COUNT,
+    .inputVr = VR_rIn,
+    .outputVr = VR_rOut,
+    .configure = configure,
+    .publish = publish,
+    .publishStatus = NULL,
 };

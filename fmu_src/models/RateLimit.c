@@ -30,5 +30,13 @@ static void publish(const RlState *block, double *v) {
 }
 
 const ModelDefinition fmuModel = {
-    MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, VR_In, VR_Out, configure, publish, NULL
+    .identifier = MODEL_IDENTIFIER,
+    .token = MODEL_TOKEN,
+    .variables = modelVariables,
+    .count = MODEL_VARIABLE_COUNT,
+    .inputVr = VR_In,
+    .outputVr = VR_Out,
+    .configure = configure,
+    .publish = publish,
+    .publishStatus = NULL,
 };
