@@ -11,26 +11,23 @@ differs from what the TOML files give (the test runs it so); with --write
 it rewrites them (cmake --build build --target docs). Standard library only.
 """
 import argparse
-import math
 import re
 import sys
-import tomllib
 from pathlib import Path
+
+from generate import load, xml_number  # this folder's generator: one reading of the TOML
 
 FMI_TYPE = {"Real": "Real / Float64", "Integer": "Integer / Int32", "Boolean": "Boolean"}
 MARKER = re.compile(r"(<!-- generated: variables (\w+) -->\n)(.*?)(<!-- end generated -->)", re.S)
 
 
 def literal(value):
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "NaN"
-        if math.isinf(value):
-            return "+inf" if value > 0 else "-inf"
-        return f"{value:g}" if value == int(value) and abs(value) < 1e15 else repr(value)
-    return str(value)
+    """A value as the model description writes it, integers without ".0"."""
+    text = xml_number(value)
+    infinite = {"INF": "+inf", "-INF": "-inf"}
+    if text in infinite:
+        return infinite[text]
+    return text.removesuffix(".0") if isinstance(value, float) else text
 
 
 def fmi_type(v, model):
@@ -91,7 +88,7 @@ def main():
     args = parser.parse_args()
     models = {}
     for path in args.models:
-        model = tomllib.loads(path.read_text(encoding="utf-8"))
+        model = load(path)
         models[model["model"]["identifier"]] = model
     text = args.document.read_text(encoding="utf-8")
     fresh = render(text, models)
