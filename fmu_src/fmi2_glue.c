@@ -121,6 +121,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     g->base.environment = functions->componentEnvironment;
     g->base.logFunction = functions->logger ? log_to_importer : NULL;
     g->base.logCategories = (loggingOn ? LOG_ALL : 0) | ALWAYS_LOGGED;
+    g->base.errorMode = MODE_ERROR; /* FMI 2.0.4 section 2.1.3: only reads, reset or an FMU state lead on */
     g->base.allocate = allocate_state;
     g->base.release = release_state;
     fmu_init_instance(&g->base);

@@ -6,29 +6,32 @@
 #include "fmi3Functions.h"
 #include "fmu_core.h"
 
-/* Modes each function may be called in: FMI 3.0.2, section 4.2 (state
- * machine of Co-Simulation without Event Mode). After an fmi3Error only
- * fmi3SetFMUState, fmi3Reset and fmi3FreeInstance lead on (section 2.2.3);
- * the FMU-state helpers that serve that recovery are allowed too. */
+/* Modes each function may be called in: FMI 3.0.2, section 2.3 (common
+ * states) and 4.2 (Co-Simulation without Event Mode). "If any function
+ * called in super state FMU State Settable returns fmi3Error, the FMU
+ * enters state Terminated" (2.3): there is no Error state, a failed call
+ * leaves the instance Terminated (errorMode), where the values can be
+ * read and the FMU-state functions, reset and free are allowed. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
-#define ERR  MODE_ERROR
+/* the super state FMU State Settable: every state of this FMU */
+#define SETTABLE (INST | INIT | STEP | TERM)
 
-#define MODES_SetDebugLogging           (INST | INIT | STEP | TERM | ERR)
+#define MODES_SetDebugLogging           SETTABLE
 #define MODES_EnterInitializationMode   (INST)
 #define MODES_ExitInitializationMode    (INIT)
 #define MODES_Terminate                 (STEP)
-#define MODES_Reset                     (INST | INIT | STEP | TERM | ERR)
+#define MODES_Reset                     SETTABLE
 #define MODES_Get                       (INIT | STEP | TERM)
 #define MODES_Set                       (INST | INIT | STEP)
-#define MODES_GetFMUState               (INST | INIT | STEP | TERM)
-#define MODES_SetFMUState               (INST | INIT | STEP | TERM | ERR)
-#define MODES_FreeFMUState              (INST | INIT | STEP | TERM | ERR)
-#define MODES_SerializedFMUStateSize    (INST | INIT | STEP | TERM | ERR)
-#define MODES_SerializeFMUState         (INST | INIT | STEP | TERM | ERR)
-#define MODES_DeserializeFMUState       (INST | INIT | STEP | TERM | ERR)
+#define MODES_GetFMUState               SETTABLE
+#define MODES_SetFMUState               SETTABLE
+#define MODES_FreeFMUState              SETTABLE
+#define MODES_SerializedFMUStateSize    SETTABLE
+#define MODES_SerializeFMUState         SETTABLE
+#define MODES_DeserializeFMUState       SETTABLE
 #define MODES_DoStep                    (STEP)
 /* every fmi3Get<Type> and fmi3Set<Type> */
 #define MODES_GetFloat32                     MODES_Get
@@ -126,6 +129,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     g->base.environment = instanceEnvironment;
     g->base.logFunction = logMessage ? log_to_importer : NULL;
     g->base.logCategories = loggingOn ? LOG_ALL : 0;
+    g->base.errorMode = MODE_TERMINATED;
     g->base.allocate = allocate_state;
     g->base.release = release_state;
     fmu_init_instance(&g->base);

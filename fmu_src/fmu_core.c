@@ -114,7 +114,7 @@ FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt
     vsnprintf(reason, sizeof reason, fmt, args);
     va_end(args);
     fmu_log(instance, FMU_ERROR, "%s: %s", function, reason);
-    instance->core.mode = MODE_ERROR;
+    instance->core.mode = instance->errorMode;
     return FMU_ERROR;
 }
 
@@ -274,7 +274,7 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     if (!(h > 0 && h <= DBL_MAX)) {
         return fmu_error(instance, function, "communicationStepSize must be finite and > 0, not %g", h);
     }
-    if (!fmu_time_matches(t, core->time, h)) {
+    if (!fmu_time_matches(t, core->time)) {
         return fmu_error(instance, function, "currentCommunicationPoint %.17g is not the FMU's time %.17g", t, core->time);
     }
     if (instance->configDirty) {
@@ -299,7 +299,10 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     if (instance->cycleTime == 0 && instance->prepared.plain && isfinite(core->block.y)) {
         rl_hold_period(&core->block, h);
         instance->fastPeriod = h;
-        instance->fastTolerance = RL_TIME_TOLERANCE * h;
+        /* the general tolerance, RL_TIME_TOLERANCE * |time|, only grows
+         * from here while time >= 0 (steps go forward): taken now, it is
+         * never more than the general one later; before 0, exact times */
+        instance->fastTolerance = core->time >= 0 ? RL_TIME_TOLERANCE * core->time : 0.0;
     } else {
         instance->fastPeriod = NAN;
     }
@@ -472,7 +475,7 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     s.mode = (int)get_u32(&p);
     s.reportedStatus = (int)get_u32(&p);
     if (s.mode != MODE_INSTANTIATED && s.mode != MODE_INITIALIZATION && s.mode != MODE_STEP &&
-        s.mode != MODE_TERMINATED && s.mode != MODE_ERROR) {
+        s.mode != MODE_TERMINATED && s.mode != instance->errorMode) {
         return fmu_error(instance, function, "serialized state has an invalid mode %d", s.mode);
     }
     /* a checksum only proves the bytes arrived as written: every value must

@@ -107,9 +107,8 @@ struct FmuInstance {
     bool outputsStale;      /* a step ran since outputs and time were published */
     /* Step size of the common step (fmu_step_fast): set by a general step
      * that found the common one possible (fmu_do_step_general), NaN
-     * whenever anything it relies on changes; and its
-     * time tolerance, RL_TIME_TOLERANCE * h, never more than the general
-     * step's (which adds |time|), so the fast step accepts less, not more. */
+     * whenever anything it relies on changes; and its time tolerance, set
+     * there too (see there why it never exceeds the general one). */
     double fastPeriod, fastTolerance;
     double cycleTime;       /* sub-cycle length, 0 = one cycle per step */
     unsigned inputVr;       /* model->inputVr, one load nearer */
@@ -119,6 +118,7 @@ struct FmuInstance {
     const ModelDefinition *model;
     FmuLogFunction *logFunction;
     int logCategories;      /* enabled categories */
+    int errorMode;          /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
     const char *instanceName;
     void *environment;      /* the importer's instance environment */
     /* memory for FMU states, as the importer provides it (FMI 2) or not */
@@ -257,10 +257,10 @@ static inline bool fmu_set_one(FmuInstance *instance, const char *function, int 
 FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime);
 FmuStatus fmu_enter_initialization(FmuInstance *instance);
 FmuStatus fmu_exit_initialization(FmuInstance *instance);
-/* currentCommunicationPoint within rounding of the FMU's time (NaN and
- * infinity are not) */
-static inline bool fmu_time_matches(double t, double time, double h) {
-    return fabs(t - time) <= RL_TIME_TOLERANCE * (fabs(time) + h);
+/* currentCommunicationPoint within a relative RL_TIME_TOLERANCE of the
+ * FMU's time, whatever the step size (NaN and infinity are not) */
+static inline bool fmu_time_matches(double t, double time) {
+    return fabs(t - time) <= RL_TIME_TOLERANCE * fabs(time);
 }
 
 /* The common step, inline in the glue: the same step size as the step

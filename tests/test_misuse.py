@@ -75,11 +75,11 @@ def test_misuse_is_an_error_and_the_instance_recovers(version, misuse):
     assert len(errors) == 1, errors
     assert words in errors[0][2] and f"fmi{version}" in errors[0][2], errors[0]
 
-    # the standard's Error state: no further stepping until recovered
+    # FMI 2's Error state, FMI 3's Terminated: no further stepping until
+    # recovered; both allow reading the last good values
     assert call_status(fmu.step, 0.5) == 3
-    assert "not allowed in Error" in fmu.errors()[-1][2]
-    if version == 2:                                # FMI 2 allows get in Error: last good values
-        assert fmu.get("y") == 1.0 and fmu.get("cycleTime") == 0.0 and fmu.get("zeroRate") == 1
+    assert f"not allowed in {'Error' if version == 2 else 'Terminated'}" in fmu.errors()[-1][2]
+    assert fmu.get("y") == 1.0 and fmu.get("cycleTime") == 0.0 and fmu.get("zeroRate") == 1
     api["set"](good)
     fmu.t = t
     fmu.step(0.5)
@@ -160,3 +160,51 @@ def test_many_instances_are_independent(version):
     for fmu in instances:
         fmu.fmu.terminate()
         fmu.release()
+
+
+def test_fmi3_error_leaves_terminated_with_values_states_and_reset():
+    """FMI 3.0 section 2.3: "If any function called in super state FMU State
+    Settable returns fmi3Error, the FMU enters state Terminated", where
+    fmi3Get{VariableType} and the FMU-state functions are allowed."""
+    fmu = Instance("RateLimiter", 3)
+    fmu.start(rateUpPar=2.0)
+    fmu.set(u=5.0)
+    fmu.step(0.5)                                   # y = 1, ramping
+    last_good = {n: fmu.get(n) for n in ("y", "rampActive", "runningTime", "status", "time")}
+    assert call_status(fmu.fmu.doStep, fmu.t, -1.0) == 3
+    assert {n: fmu.get(n) for n in last_good} == last_good
+    api = state_api(fmu)
+    state = api["get"]()                            # allowed in Terminated
+    data = bytes(api["serialize"](state))
+    assert data[:4] == b"RLFS"
+    assert call_status(fmu.fmu.doStep, fmu.t, 0.5) == 3
+    assert "fmi3DoStep: not allowed in Terminated" in fmu.errors()[-1][2]
+    api["free"](state)
+    fmu.fmu.reset()
+    fmu.start(rateUpPar=4.0)
+    fmu.set(u=5.0)
+    fmu.step(0.5)
+    assert fmu.get("y") == 2.0
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_communication_point_within_a_relative_1e_9_of_the_time(version):
+    """Whatever the step size: a huge h does not widen the tolerance."""
+    fmu = Instance("RateLimiter", version)
+    fmu.start(rateUpPar=1.0)
+    fmu.set(u=1e15)
+    fmu.step(0.1)                                   # the FMU's time is 0.1
+    assert call_status(fmu.fmu.doStep, 1000.0, 1e12) == 3
+    assert "currentCommunicationPoint 1000 is not the FMU's time 0.10000000000000001" in fmu.errors()[-1][2]
+    fmu.fmu.reset()
+    fmu.start(rateUpPar=1.0)
+    fmu.set(u=1e15)
+    fmu.step(0.1)
+    inside = 0.1 * (1 + 0.9e-9)                     # the step runs from there
+    assert fmu.raw_step_at(inside, 0.1) == 0
+    assert fmu.get("time") == inside + 0.1
+    outside = fmu.get("time") * (1 + 1.1e-9)
+    assert fmu.raw_step_at(outside, 0.1) == 3
+    assert "is not the FMU's time" in fmu.errors()[-1][2]
+    fmu.free()

@@ -109,18 +109,23 @@ class Instance:
     def raw_step(self, h):
         """doStep through ctypes alone, returning the FMI status (fmpy's
         wrapper hides warnings)."""
+        return self.raw_step_at(self.t, h)
+
+    def raw_step_at(self, t, h):
+        """doStep(t, h) through ctypes alone; the driver's time is t + h
+        after a step that passed."""
         dll, flag, when = self.fmu.dll, ctypes.c_bool(), ctypes.c_double()
         if self.version == 2:
             do_step = dll.fmi2DoStep
             do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_int]
-            status = do_step(self.fmu.component, self.t, h, 1)
+            status = do_step(self.fmu.component, t, h, 1)
         else:
             do_step = dll.fmi3DoStep
             do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [ctypes.c_void_p] * 4
-            status = do_step(self.fmu.component, self.t, h, True, ctypes.byref(flag), ctypes.byref(flag),
+            status = do_step(self.fmu.component, t, h, True, ctypes.byref(flag), ctypes.byref(flag),
                              ctypes.byref(flag), ctypes.byref(when))
         if status <= 1:
-            self.t += h
+            self.t = t + h
         return status
 
     def errors(self):
