@@ -2,7 +2,10 @@
  * loads it, next to a direct call of the kernel's cycle function (the
  * floor). Prints one line per figure: "name value unit".
  *
- *   fmu_bench <2|3> <binary.so> <token> <u_vr> <y_vr> <cycleTime_vr|-1> <steps> <repeats>
+ *   fmu_bench <2|3> <binary.so> <token> <u_vr> <y_vr> <cycleTime_vr|-1> <steps> <repeats> [vr=value ...]
+ *
+ * vr=value: Real start values set before initialisation (the benchmark of
+ * a configuration with the section 6 features in use).
  *
  * Under valgrind --tool=callgrind each measured loop is bracketed by client
  * requests (zero, then dump with the loop's name), so that the caller can
@@ -155,8 +158,14 @@ static void set_real(void *c, unsigned vr, double value) {
     must(F.version == 2 ? F.fmi2SetReal(c, &vr, 1, &value) : F.fmi3SetFloat64(c, &vr, 1, &value, 1), "set");
 }
 
+/* the start values given on the command line */
+static unsigned startVrs[16];
+static double startValues[16];
+static int startCount;
+
 static void start(void *c, double cycleTime) {
     if (cycleTime > 0) set_real(c, (unsigned)F.cycleVr, cycleTime);
+    for (int i = 0; i < startCount; i++) set_real(c, startVrs[i], startValues[i]);
     if (F.version == 2) {
         must(F.fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0), "fmi2SetupExperiment");
         must(F.fmi2EnterInitializationMode(c), "fmi2EnterInitializationMode");
@@ -336,9 +345,19 @@ static void allocations(void) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 9) {
-        fprintf(stderr, "usage: fmu_bench <2|3> <binary.so> <token> <u_vr> <y_vr> <cycleTime_vr|-1> <steps> <repeats>\n");
+    if (argc < 9 || argc > 9 + 16) {
+        fprintf(stderr, "usage: fmu_bench <2|3> <binary.so> <token> <u_vr> <y_vr> <cycleTime_vr|-1> <steps> <repeats>"
+                        " [vr=value ...]\n");
         return 2;
+    }
+    for (int i = 9; i < argc; i++) {
+        char *end = NULL;
+        startVrs[startCount] = (unsigned)strtoul(argv[i], &end, 10);
+        if (!end || *end != '=') {
+            fprintf(stderr, "fmu_bench: not vr=value: %s\n", argv[i]);
+            return 2;
+        }
+        startValues[startCount++] = strtod(end + 1, NULL);
     }
     F.version = atoi(argv[1]);
     F.token = argv[3];

@@ -50,10 +50,16 @@ def model_info(build, model, version):
     return binary, token, vr
 
 
-def bench_args(build, model, version, steps, repeats):
+# The section 6 features in use (second row): output limits far from the
+# ramp and other rates below 0, so that only their cost shows
+FEATURES = {"yMaxPar": 1e300, "yMinPar": -1e300, "rateUpNeg": 2.0, "rateDownNeg": 2.0}
+
+
+def bench_args(build, model, version, steps, repeats, start=None):
     binary, token, vr = model_info(build, model, version)
+    extra = [f"{vr[name]}={value!r}" for name, value in (start or {}).items()]
     return [str(build / "fmu_bench"), str(version), str(binary), token, str(vr["u"]), str(vr["y"]),
-            str(vr.get("cycleTime", -1)), str(steps), str(repeats)]
+            str(vr.get("cycleTime", -1)), str(steps), str(repeats)] + extra
 
 
 def parse(output):
@@ -86,13 +92,13 @@ def inclusive_costs(dump):
     return costs
 
 
-def run_callgrind(build, model, version, steps):
+def run_callgrind(build, model, version, steps, start=None):
     """Instructions per call, from the calls themselves (callees included,
     the benchmark loop not), for each measured loop."""
     with tempfile.TemporaryDirectory() as tmp:
         out_file = Path(tmp) / "callgrind.out"
         subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out_file}"]
-                       + bench_args(build, model, version, steps, 1),
+                       + bench_args(build, model, version, steps, 1, start),
                        check=True, capture_output=True, text=True)
         loops = {}
         for dump in Path(tmp).glob("callgrind.out.*"):
@@ -154,6 +160,9 @@ def table(results, smoke, commands):
     rows = [
         ("instructions, set u + doStep + get y", "step_instructions", "{:.0f}", "<= 150"),
         ("instructions, doStep alone", "doStep_instructions", "{:.0f}", "<= 60"),
+        ("instructions, set u + doStep + get y, limits and Neg rates in use", "features_step_instructions",
+         "{:.0f}", ""),
+        ("instructions, doStep alone, limits and Neg rates in use", "features_doStep_instructions", "{:.0f}", ""),
         ("instructions per extra sub-cycle", "subcycle_instructions", "{:.1f}", "<= 25"),
         ("instructions, set u alone / get y alone", "set_get_instructions", "{}", ""),
         ("instructions, kernel rl_cycle (floor)", "kernel_instructions", "{:.0f}", ""),
@@ -219,6 +228,9 @@ def main():
             r.update(run_callgrind(build, MODEL, version, cg_steps))
             r["set_get_instructions"] = f"{r.pop('set_instructions'):.0f} / {r.pop('get_instructions'):.0f}"
             r["fixture_step_instructions"] = run_callgrind(build, FIXTURE, version, cg_steps)["step_instructions"]
+            features = run_callgrind(build, MODEL, version, cg_steps, FEATURES)
+            r["features_step_instructions"] = features["step_instructions"]
+            r["features_doStep_instructions"] = features["doStep_instructions"]
         r.update(run_fmpy(build, version, fmpy_steps, fmpy_repeats))
         results[version] = r
         print(f"FMI {version}: " + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"

@@ -1,5 +1,6 @@
 # Coverage-guided fuzzers (libFuzzer, with ASan and UBSan): tests/fuzz/*.c
-# on the FMI 2 and FMI 3 glue of RateLimiter. libFuzzer comes with clang;
+# on the FMI 2 and FMI 3 glue of RateLimiter and of
+# LGF_LimRateOfChangeAdvancedCI. libFuzzer comes with clang;
 # when no clang here can build a fuzzer, Debian's clang-14 and
 # libclang-rt-14-dev are installed with apt-get (as the CI machine needs).
 # Without them the ctest test 'fuzz' fails and says why: no silent skip.
@@ -35,28 +36,37 @@ set(FUZZ_MAX_LEN_deserialize 600)
 set(FUZZ_MAX_LEN_calls 1024)
 if(FUZZ_CLANG)
   message(STATUS "Fuzzers built with ${FUZZ_CLANG}")
-  set(fuzz_sources ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c ${CMAKE_SOURCE_DIR}/fmu_src/fmu_core.c
-                   ${CMAKE_SOURCE_DIR}/fmu_src/fmi2_glue.c ${CMAKE_SOURCE_DIR}/fmu_src/fmi3_glue.c
-                   ${CMAKE_SOURCE_DIR}/fmu_src/models/RateLimiter.c)
+  set(fuzz_core ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c ${CMAKE_SOURCE_DIR}/fmu_src/fmu_core.c
+                ${CMAKE_SOURCE_DIR}/fmu_src/fmi2_glue.c ${CMAKE_SOURCE_DIR}/fmu_src/fmi3_glue.c)
   set(fuzz_binaries)
-  foreach(target IN LISTS FUZZ_TARGETS)
-    set(binary ${CMAKE_BINARY_DIR}/fuzz/fuzz_${target})
-    add_custom_command(
-      OUTPUT ${binary}
-      COMMAND ${FUZZ_CLANG} -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
-              -ffp-contract=off -I${CMAKE_SOURCE_DIR}/fmu_src -I${CMAKE_BINARY_DIR}/gen/RateLimiter
-              -I${FMI_HEADERS_DIR} ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} -lm -o ${binary}
-      DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} ${CORE_HEADERS}
-              ${CMAKE_BINARY_DIR}/gen/RateLimiter/RateLimiter_variables.h
-      COMMENT "Building the fuzzer fuzz_${target}")
-    list(APPEND fuzz_binaries ${binary})
-    # new inputs go to build/fuzz/corpus_<target>; the repository's corpus is read
-    add_test(NAME fuzz_${target}
-             COMMAND sh -c "mkdir -p '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}' && '${binary}' -max_total_time=${FUZZ_SECONDS} -max_len=${FUZZ_MAX_LEN_${target}} -seed=1 -print_final_stats=1 '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}' '${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/${target}'")
-    set_tests_properties(fuzz_${target} PROPERTIES TIMEOUT 300)
+  # each target on the unified block and on the Siemens advanced block
+  foreach(model RateLimiter LGF_LimRateOfChangeAdvancedCI)
+    if(model STREQUAL "RateLimiter")
+      set(suffix "")
+    else()
+      set(suffix "_${model}")
+    endif()
+    set(fuzz_sources ${fuzz_core} ${CMAKE_SOURCE_DIR}/fmu_src/models/${model}.c)
+    foreach(target IN LISTS FUZZ_TARGETS)
+      set(binary ${CMAKE_BINARY_DIR}/fuzz/fuzz_${target}${suffix})
+      add_custom_command(
+        OUTPUT ${binary}
+        COMMAND ${FUZZ_CLANG} -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+                -ffp-contract=off -I${CMAKE_SOURCE_DIR}/fmu_src -I${CMAKE_BINARY_DIR}/gen/${model}
+                -DMODEL_VARIABLES=${model}_variables.h
+                -I${FMI_HEADERS_DIR} ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} -lm -o ${binary}
+        DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} ${CORE_HEADERS}
+                ${CMAKE_BINARY_DIR}/gen/${model}/${model}_variables.h
+        COMMENT "Building the fuzzer fuzz_${target}${suffix}")
+      list(APPEND fuzz_binaries ${binary})
+      # new inputs go to build/fuzz/corpus_<target><suffix>; the repository's corpus is read
+      add_test(NAME fuzz_${target}${suffix}
+               COMMAND sh -c "mkdir -p '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}${suffix}' && '${binary}' -max_total_time=${FUZZ_SECONDS} -max_len=${FUZZ_MAX_LEN_${target}} -seed=1 -print_final_stats=1 '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}${suffix}' '${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/${target}'")
+      set_tests_properties(fuzz_${target}${suffix} PROPERTIES TIMEOUT 300)
+    endforeach()
   endforeach()
   add_custom_target(fuzzers ALL DEPENDS ${fuzz_binaries})
-  add_dependencies(fuzzers RateLimiter_description)
+  add_dependencies(fuzzers RateLimiter_description LGF_LimRateOfChangeAdvancedCI_description)
 else()
   add_test(NAME fuzz COMMAND sh -c "echo 'no clang with libFuzzer (Debian: apt-get install clang-14 libclang-rt-14-dev)'; exit 1")
 endif()

@@ -9,7 +9,7 @@
 const char *const fmu_log_category_names[3] = { "logStatusError", "logStatusWarning", "logEvents" };
 
 #define SERIAL_MAGIC "RLFS"
-#define SERIAL_VERSION 1u
+#define SERIAL_VERSION 2u
 /* magic, version, model hash, payload size; CRC-32 after the payload */
 #define SERIAL_HEADER 16u
 #define SERIAL_TRAILER 4u
@@ -50,9 +50,10 @@ void fmu_reset(FmuInstance *instance) {
     core->mode = MODE_INSTANTIATED;
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
+    instance->prepareDue = true;
     instance->configDirty = true;
     instance->fastPeriod = NAN;
-    instance->outputsStale = false;
+    instance->outputsStale = FMU_FRESH;
     instance->cycleTime = 0.0;
     instance->inputVr = model->inputVr;
     const FmuVariable *u = &model->variables[model->inputVr], *y = &model->variables[model->outputVr];
@@ -150,13 +151,19 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
     return fmu_error(instance, function, "%s = %.17g is outside its range [%g, %g]", v->name, value, v->min, v->max);
 }
 
+static void publish(FmuInstance *instance, bool block);
+
 /* Kernel configuration from the current values; the cycle length and
- * limits are derived again at the next cycle. */
+ * limits are derived again before the next cycle. The outputs derived from
+ * the last cycle are published first: they need its configuration. */
 FMU_NOINLINE static void configure(FmuInstance *instance) {
+    if (instance->outputsStale == FMU_STALE_ALL) {
+        publish(instance, true);
+    }
     instance->model->configure(instance->core.values, &instance->prepared.config);
     const double c = instance->prepared.config.cycleTime.value;
     instance->cycleTime = c > 0 && isfinite(c) ? c : 0.0;
-    instance->prepared.period = NAN;
+    instance->prepareDue = true;
     instance->configDirty = false;
 }
 
@@ -165,16 +172,21 @@ FMU_NOINLINE static void prepare(FmuInstance *instance, double period) {
     instance->fastPeriod = NAN;
     RlConfig config = instance->prepared.config;
     rl_prepare(&instance->prepared, &config, period);
+    instance->prepareDue = false;
     /* the status is known from here; the block's outputs after a cycle */
     if (instance->model->publishStatus) {
         instance->model->publishStatus(&instance->prepared, instance->core.values);
     }
 }
 
-static void publish(FmuInstance *instance) {
+/* The time, and the block's outputs when a cycle ran since they were
+ * published (a step that runs no cycle changes no output). */
+static void publish(FmuInstance *instance, bool block) {
     instance->core.values[0] = instance->core.time; /* the independent variable */
-    instance->model->publish(&instance->core.block, instance->core.values);
-    instance->outputsStale = false;
+    if (block) {
+        instance->model->publish(&instance->core.block, &instance->prepared, instance->core.values);
+    }
+    instance->outputsStale = FMU_FRESH;
 }
 
 /* Outputs at the start from the current parameters and inputs. */
@@ -184,14 +196,14 @@ static void initialize_block(FmuInstance *instance) {
     /* with cycleTime 0 the cycle length is only known at the first step */
     prepare(instance, instance->cycleTime > 0 ? instance->cycleTime : NAN);
     rl_init(&core->block, &instance->prepared.config, core->values[instance->model->inputVr]);
-    publish(instance);
+    publish(instance, true);
 }
 
 void fmu_refresh_outputs(FmuInstance *instance) {
     if (instance->core.mode == MODE_INITIALIZATION) {
         initialize_block(instance);
     } else {
-        publish(instance);
+        publish(instance, instance->outputsStale == FMU_STALE_ALL);
     }
 }
 
@@ -215,7 +227,7 @@ FmuStatus fmu_enter_initialization(FmuInstance *instance) {
     instance->core.mode = MODE_INITIALIZATION;
     instance->configDirty = true;
     instance->fastPeriod = NAN;
-    instance->outputsStale = true;
+    instance->outputsStale = FMU_STALE_ALL;
     return FMU_OK;
 }
 
@@ -247,7 +259,9 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance) {
 
 /* Sub-cycling (cycleTime > 0): the cycles that end in (t, end], each end
  * t0 + n*cycleTime computed afresh from the whole cycle count n. */
-FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *function, double end, double h, double u) {
+/* Sets *ran when a cycle ran. */
+FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *function, double end, double h, double u,
+                                         bool *ran) {
     FmuCore *core = &instance->core;
     const double cycle = instance->cycleTime;
     const double last = floor((end - core->startTime) / cycle + RL_TIME_TOLERANCE);
@@ -256,8 +270,9 @@ FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *func
         return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
                          h, pending, cycle, FMU_MAX_CYCLES_PER_STEP);
     }
-    if (pending >= 1) {
-        if (instance->prepared.period != cycle) {
+    *ran = pending >= 1;
+    if (*ran) {
+        if (instance->prepareDue || instance->prepared.period != cycle) {
             prepare(instance, cycle);
         }
         rl_run(&core->block, &instance->prepared, u, core->cycles + 1, (uint64_t)last, cycle);
@@ -282,17 +297,22 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     }
     const double end = t + h;
     const double u = core->values[instance->model->inputVr];
+    bool ran = true;
     if (instance->cycleTime > 0) {
-        if (run_cycles(instance, function, end, h, u) != FMU_OK) return FMU_ERROR;
+        if (run_cycles(instance, function, end, h, u, &ran) != FMU_OK) return FMU_ERROR;
     } else {
         /* one cycle of length h */
-        if (instance->prepared.period != h) {
+        if (instance->prepareDue || instance->prepared.period != h) {
             prepare(instance, h);
         }
         rl_cycle(&core->block, &instance->prepared, u, end - core->startTime);
     }
     core->time = end;
-    instance->outputsStale = true;
+    if (ran) {
+        instance->outputsStale = FMU_STALE_ALL;
+    } else if (instance->outputsStale == FMU_FRESH) {
+        instance->outputsStale = FMU_STALE_TIME;
+    }
     /* The next step may be the common one (fmu_step_fast) if it has this h,
      * the configuration stays, one cycle per step, only rule 6 applies to
      * any finite u (plain) and y is finite: then it stays so. */
@@ -314,9 +334,10 @@ static void restore(FmuInstance *instance, const FmuCore *state) {
     instance->core = *state;
     instance->configDirty = true;
     instance->fastPeriod = NAN;
-    instance->prepared.period = NAN;
-    /* a state taken in Initialization Mode initializes again on a get */
-    instance->outputsStale = state->mode == MODE_INITIALIZATION;
+    instance->prepareDue = true;
+    /* the outputs are the state's; one taken in Initialization Mode
+     * initializes again on a get */
+    instance->outputsStale = state->mode == MODE_INITIALIZATION ? FMU_STALE_ALL : FMU_FRESH;
 }
 
 /* ---- serialization ---------------------------------------------------- */
@@ -379,7 +400,7 @@ static double get_f64(const unsigned char **p) {
 
 static size_t payload_size(const ModelDefinition *model) {
     return 4 + 8 * (size_t)model->count      /* values */
-         + 8 + 8 + 1 + 8 + 8 + 8             /* block */
+         + 8 + 8 + 8 + 1 + 8 + 8 + 8         /* block */
          + 8 + 8 + 8 + 4 + 4;                /* startTime, time, cycles, mode, status */
 }
 
@@ -399,7 +420,8 @@ static void serialize(const FmuInstance *instance, const FmuCore *s, unsigned ch
     for (unsigned i = 0; i < model->count; i++) p = put_f64(p, s->values[i]);
     p = put_f64(p, s->block.y);
     p = put_f64(p, s->block.uPrevious);
-    *p++ = s->block.rampActive ? 1 : 0;
+    p = put_f64(p, s->block.yPrevious);
+    *p++ = s->block.decided;
     p = put_u64(p, s->block.runCycles);
     p = put_f64(p, s->block.runPeriod);
     p = put_f64(p, s->block.runBase);
@@ -465,7 +487,8 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     for (unsigned i = 0; i < model->count; i++) s.values[i] = get_f64(&p);
     s.block.y = get_f64(&p);
     s.block.uPrevious = get_f64(&p);
-    s.block.rampActive = *p++ != 0;
+    s.block.yPrevious = get_f64(&p);
+    s.block.decided = *p++;
     s.block.runCycles = get_u64(&p);
     s.block.runPeriod = get_f64(&p);
     s.block.runBase = get_f64(&p);
@@ -485,6 +508,9 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
             return fmu_error(instance, function, "serialized state has an impossible value %g for %s", s.values[i],
                              model->variables[i].name);
         }
+    }
+    if (s.block.decided > RL_DECIDED_RAMP) {
+        return fmu_error(instance, function, "serialized state has an invalid rule %u", (unsigned)s.block.decided);
     }
     /* runningTime is a sum of whole cycles: no NaN, infinity or negative */
     if (!isfinite(s.startTime) || !isfinite(s.time) || s.cycles > MAX_EXACT_CYCLES ||

@@ -59,7 +59,7 @@ typedef enum {
 } FmuMode;
 
 /* Variables per model, at most (the generated header checks its model). */
-#define FMU_MAX_VARIABLES 32
+#define FMU_MAX_VARIABLES 40
 
 /* A step that would run more cycles than this is refused (no endless loop
  * on a tiny cycleTime or a huge step). */
@@ -79,12 +79,17 @@ typedef struct {
     unsigned inputVr;  /* the cycle input u */
     unsigned outputVr; /* the output y: the block's state y */
     void (*configure)(const double *values, RlConfig *config);
-    /* outputs of the block's state, and (NULL: none) of the status */
-    void (*publish)(const RlState *block, double *values);
+    /* outputs of the block's state (and of what the configuration of its
+     * last cycle derives from it), and (NULL: none) of the status */
+    void (*publish)(const RlState *block, const RlPrepared *prepared, double *values);
     void (*publishStatus)(const RlPrepared *prepared, double *values);
 } ModelDefinition;
 
 extern const ModelDefinition fmuModel;
+
+/* What a step changed since the outputs were last published: the time
+ * only (a step that ran no cycle), or the block too. */
+enum { FMU_FRESH = 0, FMU_STALE_TIME = 1, FMU_STALE_ALL = 2 };
 
 /* Everything an FMU state restores: plain data, copied as a whole. */
 typedef struct {
@@ -102,9 +107,13 @@ typedef void FmuLogFunction(FmuInstance *instance, FmuStatus status, const char 
 
 struct FmuInstance {
     FmuCore core;
+    /* of the last cycle (or initialisation); its configuration is taken
+     * from the values at the next step (configure), prepared before a
+     * cycle runs (prepareDue) */
     RlPrepared prepared;
     bool configDirty;       /* a parameter or input other than u changed */
-    bool outputsStale;      /* a step ran since outputs and time were published */
+    unsigned char outputsStale; /* FMU_STALE_*: what changed since the outputs were published */
+    bool prepareDue;        /* the configuration changed: prepare before the next cycle */
     /* Step size of the common step (fmu_step_fast): set by a general step
      * that found the common one possible (fmu_do_step_general), NaN
      * whenever anything it relies on changes; and its time tolerance, set
@@ -214,7 +223,7 @@ static inline FmuStatus fmu_check_set(FmuInstance *instance, const char *functio
 static inline void fmu_set_input(FmuInstance *instance, double value) {
     instance->core.values[instance->inputVr] = value;
     if (instance->core.mode == MODE_INITIALIZATION) {
-        instance->outputsStale = true;
+        instance->outputsStale = FMU_STALE_ALL;
     }
 }
 
@@ -225,7 +234,7 @@ static inline void fmu_set(FmuInstance *instance, unsigned vr, double value) {
         instance->fastPeriod = NAN;
     }
     if (instance->core.mode == MODE_INITIALIZATION) {
-        instance->outputsStale = true;
+        instance->outputsStale = FMU_STALE_ALL;
     }
 }
 
@@ -275,7 +284,7 @@ static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
         return false;
     }
     rl_ramp_steady(&core->block, &instance->prepared, u); /* y stays finite */
-    instance->outputsStale = true;
+    instance->outputsStale = FMU_STALE_ALL;
     core->time = t + h;
     return true; /* no status change: that needs a new configuration */
 }

@@ -19,18 +19,21 @@ int rl_status(const RlConfig *c, int *source) {
     const RlValue *culprit = 0;
     int status = RL_STATUS_OK;
 
-    if (c->rateUp.value < 0) {
-        status = RL_STATUS_RATE_NEGATIVE; culprit = &c->rateUp;
-    } else if (c->rateDown.value < 0) {
-        status = RL_STATUS_RATE_NEGATIVE; culprit = &c->rateDown;
-    } else if (isnan(c->rateUp.value)) {
-        status = RL_STATUS_RATE_NAN; culprit = &c->rateUp;
-    } else if (isnan(c->rateDown.value)) {
-        status = RL_STATUS_RATE_NAN; culprit = &c->rateDown;
+    const RlValue *rates[4] = { &c->rateUp, &c->rateDown, &c->rateUpNeg, &c->rateDownNeg };
+    for (int i = 0; i < 4 && !culprit; i++) {
+        if (rates[i]->value < 0) { status = RL_STATUS_RATE_NEGATIVE; culprit = rates[i]; }
+    }
+    for (int i = 0; i < 4 && !culprit; i++) {
+        if (isnan(rates[i]->value)) { status = RL_STATUS_RATE_NAN; culprit = rates[i]; }
+    }
+    if (culprit) {
+        /* the first match above */
     } else if (!(c->ratePeriod.value >= 0) || !isfinite(c->ratePeriod.value)) {
         status = RL_STATUS_RATE_PERIOD; culprit = &c->ratePeriod;
     } else if (!(c->duration.value >= 0)) {
         status = RL_STATUS_DURATION; culprit = &c->duration;
+    } else if (c->yMin.value > c->yMax.value) {
+        status = RL_STATUS_LIMITS; culprit = &c->yMin;
     } else if (!(c->cycleTime.value >= 0) || !isfinite(c->cycleTime.value)) {
         status = RL_STATUS_NO_CYCLE; culprit = &c->cycleTime;
     }
@@ -55,13 +58,21 @@ void rl_prepare(RlPrepared *p, const RlConfig *c, double period) {
     p->status = rl_status(c, &p->statusSource);
     p->maxUp = cycle_limit(c->rateUp.value, c, period);
     p->maxDown = cycle_limit(c->rateDown.value, c, period);
+    p->maxUpNeg = cycle_limit(c->rateUpNeg.value, c, period);
+    p->maxDownNeg = cycle_limit(c->rateDownNeg.value, c, period);
+    p->yLow = isnan(c->yMin.value) ? -INFINITY : c->yMin.value;
+    p->yHigh = isnan(c->yMax.value) ? INFINITY : c->yMax.value;
     p->durationReached = c->duration.value * (1.0 - RL_TIME_TOLERANCE);
     p->initDelayEnd = c->initDelay + RL_TIME_TOLERANCE * period;
     /* The fast paths (rl_cycle, rl_run, fmu_step_fast) run rule 6 alone
-     * while plain: every rule before 6 that can decide a cycle with a
-     * finite u and y (2 bypass, 3 delayed init, 5 error hold, and any new
-     * one) must clear it here. */
-    p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && p->status < 0x8000;
+     * while plain, towards u itself at maxUp and maxDown: every rule before
+     * 6 that can decide a cycle with a finite u and y (2 bypass, 3 delayed
+     * init, 5 error hold, 5b hold, and any new one) and everything that
+     * makes rule 6 ramp otherwise (output limits, other limits below 0)
+     * must clear it here. */
+    p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && p->status < 0x8000 && !c->hold &&
+               p->yLow == -INFINITY && p->yHigh == INFINITY && p->maxUpNeg == p->maxUp &&
+               p->maxDownNeg == p->maxDown;
     p->durationLimited = c->duration.value > 0;
 }
 
@@ -71,9 +82,16 @@ static void running_reset(RlState *s) {
 }
 
 void rl_init(RlState *s, const RlConfig *c, double u) {
-    s->y = c->initMode == RL_INIT_VALUE ? c->initValue : u;
+    double y = c->initMode == RL_INIT_VALUE ? c->initValue : u;
+    /* within the limits that are set, unless they are inverted */
+    if (c->limitInitialOutput && isfinite(y) && !(c->yMin.value > c->yMax.value)) {
+        if (y < c->yMin.value) y = c->yMin.value;
+        if (y > c->yMax.value) y = c->yMax.value;
+    }
+    s->y = y;
+    s->yPrevious = y;
+    s->decided = RL_DECIDED_NOTHING;
     s->uPrevious = u;
-    s->rampActive = false;
     s->runCycles = 0;
     s->runPeriod = 0.0;
     s->runBase = 0.0;
@@ -97,11 +115,18 @@ void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
         running_reset(s);
     } else if (p->status >= 0x8000) {
         y = s->y;
+    } else if (c->hold) {
+        /* rule 5b: y and runningTime as they are */
+        s->decided = RL_DECIDED_HOLD;
+        s->yPrevious = s->y;
+        s->uPrevious = u;
+        return;
     } else {
         rl_ramp(s, p, u);
         return;
     }
-    s->rampActive = false;
+    s->decided = RL_DECIDED_OTHER;
+    s->yPrevious = s->y;
     s->y = y;
     s->uPrevious = u;
 }
@@ -117,22 +142,31 @@ void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t 
         }
         return;
     }
-    /* u held and only rule 6 applies: after the first cycle uPrevious is u
-     * and runPeriod is T, so each cycle is rl_ramp without its resets; once
-     * y reaches u nothing changes any more. */
-    double y = s->y;
+    /* u held and only rule 6 applies, towards u at maxUp and maxDown
+     * (plain): after the first cycle uPrevious is u and runPeriod is T, so
+     * each cycle is rl_ramp without its resets; once y reaches u nothing
+     * changes any more (and yPrevious is y too). */
+    double y = s->y, yp = s->yPrevious;
     uint64_t cycles = s->runCycles;
-    for (uint64_t n = first + 1; n <= last && y != u; n++) {
+    uint64_t n = first + 1;
+    for (; n <= last && y != u; n++) {
         cycles++;
+        yp = y;
         if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
             y = u;
         } else {
-            y = rl_step_towards(y, u, p);
+            y = rl_step_towards(y, u, p->maxUp, p->maxDown);
         }
     }
+    if (n <= last) {
+        yp = y; /* cycles that found y at u */
+    }
     s->y = y;
+    s->yPrevious = yp;
     s->runCycles = cycles;
-    s->rampActive = y != u;
+    if (last > first) {
+        s->decided = RL_DECIDED_RAMP; /* cycles first + 1 .. last */
+    }
 }
 
 const char *rl_status_text(int status) {
@@ -142,7 +176,60 @@ const char *rl_status_text(int status) {
     case RL_STATUS_RATE_NAN: return "a rate is NaN after falling back to its parameter";
     case RL_STATUS_RATE_PERIOD: return "ratePeriod is negative or not finite";
     case RL_STATUS_DURATION: return "duration is negative, or NaN after falling back to its parameter";
+    case RL_STATUS_LIMITS: return "yMin is above yMax";
     case RL_STATUS_NO_CYCLE: return "no valid cycle configured";
     default: return "unknown status";
     }
+}
+
+/* One leg of the remaining way: length at rate (change per ratePeriod), in
+ * seconds; a held direction never arrives, an unlimited one at once. */
+static double leg_time(double length, double rate, const RlPrepared *p) {
+    const RlConfig *c = &p->config;
+    if (length == 0) {
+        return 0.0;
+    }
+    if (rate == 0) {
+        return c->zeroRate == RL_ZERO_RATE_NO_LIMIT ? 0.0 : INFINITY;
+    }
+    const double perSecond = c->ratePeriod.value > 0 ? rate / c->ratePeriod.value : rate / p->period;
+    return length / perSecond;
+}
+
+/* The time from y to uc at the current rates (SPEC section 6): the part of
+ * the way below 0 at the Neg rate, the rest at the other. */
+static double remaining_time(const RlState *s, const RlPrepared *p, double y, double uc) {
+    const RlConfig *c = &p->config;
+    double below, above, total;
+    if (uc > y) {
+        below = y < 0 ? (uc < 0 ? uc : 0.0) - y : 0.0;
+        above = uc > 0 ? uc - (y > 0 ? y : 0.0) : 0.0;
+        total = leg_time(below, c->rateUpNeg.value, p) + leg_time(above, c->rateUp.value, p);
+    } else {
+        below = uc < 0 ? (y < 0 ? y : 0.0) - uc : 0.0;
+        above = y > 0 ? y - (uc > 0 ? uc : 0.0) : 0.0;
+        total = leg_time(below, c->rateDownNeg.value, p) + leg_time(above, c->rateDown.value, p);
+    }
+    if (p->durationLimited) {
+        const double left = c->duration.value - rl_running_time(s);
+        const double cap = left > 0 ? left : 0.0;
+        if (cap < total) total = cap;
+    }
+    return total;
+}
+
+void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
+    const double y = s->y, yp = s->yPrevious;
+    const double uc = rl_target(s->uPrevious, p);
+    const bool ramped = s->decided == RL_DECIDED_RAMP;
+    const bool jumped = p->durationLimited && rl_running_time(s) >= p->durationReached;
+    const bool negative = yp < 0;
+    o->rampActive = ramped && y != uc;
+    o->limitingUp = ramped && !jumped && yp + (negative ? p->maxUpNeg : p->maxUp) < uc;
+    o->limitingDown = ramped && !jumped && yp - (negative ? p->maxDownNeg : p->maxDown) > uc;
+    o->highLimit = isfinite(y) && y >= p->yHigh;
+    o->lowLimit = isfinite(y) && y <= p->yLow;
+    o->dydt = s->decided != RL_DECIDED_NOTHING && isfinite(y) && isfinite(yp) ? (y - yp) / p->period : 0.0;
+    o->remainingTime = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc)
+                           ? remaining_time(s, p, y, uc) : 0.0;
 }

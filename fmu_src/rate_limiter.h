@@ -1,5 +1,5 @@
-/* Rate limiter kernel: the cycle logic of SPEC section 3, shared by every
- * model. Pure C99: no FMI types, no allocation, no globals. */
+/* Rate limiter kernel: the cycle logic of SPEC sections 3 and 6, shared by
+ * every model. Pure C99: no FMI types, no allocation, no globals. */
 #ifndef RATE_LIMITER_H
 #define RATE_LIMITER_H
 
@@ -15,12 +15,19 @@ enum {
     RL_STATUS_RATE_NAN          = 0x8201,
     RL_STATUS_RATE_PERIOD       = 0x8202,
     RL_STATUS_DURATION          = 0x8203,
+    RL_STATUS_LIMITS            = 0x8204,
     RL_STATUS_NO_CYCLE          = 0x8601
 };
 
 enum { RL_ZERO_RATE_HOLD = 1, RL_ZERO_RATE_NO_LIMIT = 2 };
 
 enum { RL_INIT_VALUE = 1, RL_INIT_INPUT = 2, RL_INIT_INPUT_DELAYED = 3 };
+
+/* Which rule decided the last cycle, for the outputs derived from it */
+enum { RL_DECIDED_NOTHING = 0, /* no cycle yet */
+       RL_DECIDED_OTHER = 1,   /* rules 1 to 5 */
+       RL_DECIDED_HOLD = 2,    /* rule 5b */
+       RL_DECIDED_RAMP = 3 };  /* rule 6, the duration jump included */
 
 /* Relative tolerance for time comparisons (cycle ends, duration, delay). */
 #define RL_TIME_TOLERANCE 1e-9
@@ -36,6 +43,9 @@ typedef struct {
  * "or Par" inputs already resolved (rl_resolve). */
 typedef struct {
     RlValue rateUp, rateDown;  /* change per ratePeriod */
+    RlValue rateUpNeg, rateDownNeg; /* the same while the output is < 0 */
+    RlValue yMax, yMin;        /* output limits; NaN: none */
+    bool hold;                 /* rule 5b: freeze the output */
     RlValue ratePeriod;        /* s; 0 = change per cycle */
     RlValue duration;          /* s; 0 = never jump */
     RlValue cycleTime;         /* s; only validated here */
@@ -48,6 +58,8 @@ typedef struct {
     /* true: a non-finite u passes at once (rule 1). false (Siemens): u is
      * only compared with the output, so NaN holds and +-inf ramps. */
     bool passNonFinite;
+    bool limitInitialOutput;   /* the initial output within [yMin, yMax] */
+    int modelMode;             /* the model's own, kept with its cycle's configuration */
 } RlConfig;
 
 /* Per-configuration values derived once, not every cycle. */
@@ -55,12 +67,16 @@ typedef struct {
     RlConfig config;
     double period;             /* T the limits were computed for */
     double maxUp, maxDown;     /* per-cycle limits; +inf = no limit */
+    double maxUpNeg, maxDownNeg; /* the same while the output is < 0 */
+    double yLow, yHigh;        /* output limits; -inf and +inf for none */
     double durationReached;    /* runningTime at or above this jumps */
     double initDelayEnd;       /* elapsed time up to which initMode 3 tracks */
     int status;
     int statusSource;          /* id of the variable that caused status */
     bool plain;                /* only rule 6 can decide a cycle with a
-                                  finite u and y (rl_prepare says when) */
+                                  finite u and y, towards u itself, at the
+                                  same limits whatever the output's sign
+                                  (rl_prepare says when) */
     bool durationLimited;      /* duration > 0 */
 } RlPrepared;
 
@@ -70,7 +86,8 @@ typedef struct {
 typedef struct {
     double y;
     double uPrevious;
-    bool rampActive;
+    double yPrevious;          /* y before the last cycle */
+    unsigned char decided;     /* RL_DECIDED_*: what decided the last cycle */
     uint64_t runCycles;
     double runPeriod;
     double runBase;
@@ -108,41 +125,51 @@ static inline void rl_hold_period(RlState *s, double period) {
     if (s->runPeriod != period) rl_period_changed(s, period);
 }
 
-/* Rule 6's step of y towards u at the per-cycle limits, never past u:
- * every path that ramps (rl_ramp_cycle, rl_run's sub-cycles, and through
- * them the FMUs' common step) takes it from here. */
-static inline double rl_step_towards(double y, double u, const RlPrepared *p) {
-    if (u > y) {
-        const double limited = y + p->maxUp;
-        return limited < u ? limited : u;
+/* Rule 6's step of y towards the target at the per-cycle limits, never
+ * past it: every path that ramps (rl_ramp_cycle, rl_run's sub-cycles, and
+ * through them the FMUs' common step) takes it from here. */
+static inline double rl_step_towards(double y, double target, double maxUp, double maxDown) {
+    if (target > y) {
+        const double limited = y + maxUp;
+        return limited < target ? limited : target;
     }
-    if (u < y) {
-        const double limited = y - p->maxDown;
-        return limited > u ? limited : u;
+    if (target < y) {
+        const double limited = y - maxDown;
+        return limited > target ? limited : target;
     }
     return y;
 }
 
-/* Rule 6: ramp towards u, or jump once the duration has run out. steady:
- * u and y are finite and runPeriod is already p->period (rl_hold_period),
- * which spares two checks; a constant, so each caller gets its own copy. */
+/* The target uc = min(max(u, yMin), yMax); a NaN u stays NaN. */
+static inline double rl_target(double u, const RlPrepared *p) {
+    return u < p->yLow ? p->yLow : u > p->yHigh ? p->yHigh : u;
+}
+
+/* Rule 6: ramp towards uc at the limits picked by the output's sign, or
+ * jump to uc once the duration has run out. steady: u and y are finite,
+ * runPeriod is already p->period (rl_hold_period) and the configuration
+ * is plain (uc is u, the limits are the same for both signs), which
+ * spares the checks; a constant, so each caller gets its own copy. */
 static inline void rl_ramp_cycle(RlState *s, const RlPrepared *p, double u, bool steady) {
-    double y = s->y;
+    const double yp = s->y;
+    const bool negative = !steady && yp < 0;
+    const double target = steady ? u : rl_target(u, p);
+    double y = yp;
     if (u != s->uPrevious) {
         s->runCycles = 0;
         s->runBase = 0.0;
     }
-    if (y != u) {
+    if (y != target) {
         if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
         s->runCycles++;
     }
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
-        y = u;
+        y = target;
     } else {
-        y = rl_step_towards(y, u, p);
+        y = rl_step_towards(y, target, negative ? p->maxUpNeg : p->maxUp, negative ? p->maxDownNeg : p->maxDown);
     }
-    /* the same for finite u and y; != is also true when one is NaN */
-    s->rampActive = steady ? islessgreater(y, u) : y != u;
+    s->decided = RL_DECIDED_RAMP;
+    s->yPrevious = yp;
     s->y = y;
     s->uPrevious = u;
 }
@@ -151,8 +178,8 @@ static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
     rl_ramp_cycle(s, p, u, false);
 }
 
-/* rl_ramp for finite u and y after rl_hold_period(s, p->period): the same
- * y, uPrevious, rampActive and runningTime. */
+/* rl_ramp for finite u and y after rl_hold_period(s, p->period), with a
+ * plain configuration: the same state. */
 static inline void rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
     rl_ramp_cycle(s, p, u, true);
 }
@@ -160,7 +187,7 @@ static inline void rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
 /* Rules 1-6 in their order. */
 void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
 
-/* The common case: finite u and y, no bypass, delay or error, so that of
+/* The common case: finite u and y and a plain configuration, so that of
  * the rules only rule 6 (rl_ramp) applies. */
 static inline bool rl_only_ramps(const RlState *state, const RlPrepared *prepared, double u) {
     return prepared->plain && fabs(u - state->y) <= DBL_MAX;
@@ -180,6 +207,19 @@ static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u
 /* Cycles first..last (of length cycleTime, ending at n * cycleTime) with u
  * held: the same as rl_cycle for each, in fewer instructions. */
 void rl_run(RlState *state, const RlPrepared *prepared, double u, uint64_t first, uint64_t last, double cycleTime);
+
+/* The outputs derived from the last cycle (SPEC sections 3 and 6),
+ * computed when read: they cost the cycles nothing. prepared must be the
+ * configuration the last cycle ran with. */
+typedef struct {
+    bool rampActive;           /* rule 6 decided it and left y != uc */
+    bool limitingUp, limitingDown; /* rule 6 ramped and that limit cut the step */
+    bool highLimit, lowLimit;  /* y finite and at or beyond yMax / yMin */
+    double dydt;               /* (y - yp) / T; 0 if either is not finite */
+    double remainingTime;      /* s the ramp still needs to reach uc */
+} RlOutputs;
+
+void rl_outputs(const RlState *state, const RlPrepared *prepared, RlOutputs *outputs);
 
 /* Short meaning of a status word, for log messages. */
 const char *rl_status_text(int status);

@@ -7,12 +7,11 @@ import math
 
 import pytest
 
-from support.fmu_driver import Instance, call_status
+from support.fmu_driver import MODELS, Instance, call_status
 from support.oracle import oracle_for, output_names
 from test_random import agree
 
 HOSTILE = [math.nan, math.inf, -math.inf, -0.0, 5e-324, 2.2250738585072014e-308, 1e-300, 1e308, -1e308, 1e300]
-MODELS = ["RateLimiter", "LGF_LimRateOfChangeCI", "RateLimit", "Ramp"]
 
 
 def settable(model, version):

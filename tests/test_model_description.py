@@ -13,10 +13,9 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from support.fmu_driver import REPO, Instance, fmu_file, unzipped
+from support.fmu_driver import MODELS, REPO, Instance, fmu_file, unzipped
 from support.process import run as run_bounded
 
-MODELS = sorted(p.stem for p in (REPO / "modelDescription").glob("*.toml"))
 FMI3_TYPE = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enumeration": "Enumeration"}
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 

@@ -27,7 +27,11 @@ parameters = st.fixed_dictionaries({
     "initValue": reals,
     "initDelay": st.sampled_from([0.0, 0.3, 1.0, 2.0]),
     "u": reals,
+    # section 6: limits (none by default, NaN none too), here and in the changes
+    "yMaxPar": st.sampled_from([inf, nan, 5.0, 1.0, 0.0, -2.0]),
+    "yMinPar": st.sampled_from([-inf, nan, -5.0, -1.0, 0.0, 2.0]),
 })
+limits = st.one_of(st.just(nan), st.sampled_from([inf, -inf, 0.0, 3.0, -3.0]), st.floats(-20, 20))
 
 changes = st.fixed_dictionaries({}, optional={
     "u": reals,
@@ -39,12 +43,31 @@ changes = st.fixed_dictionaries({}, optional={
     "rateUpPar": rates,
     "ratePeriod": st.sampled_from([1.0, 0.0, 0.5, -1.0]),
     "zeroRate": st.sampled_from([1, 2]),
+    "rateUpNeg": st.one_of(st.just(nan), rates),
+    "rateDownNeg": st.one_of(st.just(nan), rates),
+    "yMax": limits,
+    "yMin": limits,
+    "hold": st.booleans(),
+    "yMaxPar": st.sampled_from([inf, nan, 4.0]),
 })
 steps = st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), changes), min_size=1, max_size=40)
 
 cycle_times = st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0])
 times = st.sampled_from([0.0, 0.3, 1.0, 2.0, 10.0])
 VENDOR_STRATEGIES = {
+    "LGF_LimRateOfChangeAdvancedCI": (
+        st.fixed_dictionaries({"autoValue": reals, "manualValue": reals, "setPosUpRateLim": rates,
+                               "setPosDownRateLim": rates, "setNegUpRateLim": rates, "setNegDownRateLim": rates,
+                               "setHighLim": limits, "setLowLim": limits, "defaultOutValue": reals,
+                               "enDefaultOutValue": st.booleans(), "track": st.booleans(), "manOp": st.booleans(),
+                               "reset": st.booleans(),
+                               "callOB": st.sampled_from([30, 35, 38, 123, 200, 1, 29, 39, 122, -5]),
+                               "cycleTime": cycle_times}),
+        st.fixed_dictionaries({}, optional={
+            "autoValue": reals, "manualValue": reals, "setPosUpRateLim": rates, "setPosDownRateLim": rates,
+            "setNegUpRateLim": rates, "setNegDownRateLim": rates, "setHighLim": limits, "setLowLim": limits,
+            "defaultOutValue": reals, "enDefaultOutValue": st.booleans(), "track": st.booleans(),
+            "manOp": st.booleans(), "reset": st.booleans()})),
     "LGF_LimRateOfChangeCI": (
         st.fixed_dictionaries({"value": reals, "setChangeRate": rates, "defaultOutValue": reals,
                                "enDefaultOutValue": st.booleans(),

@@ -13,8 +13,8 @@ from support.scenarios import compare, discover, same, simulate
 SCENARIOS = discover()
 
 
-@pytest.mark.parametrize("model,least", [("RateLimiter", 12), ("LGF_LimRateOfChangeCI", 8),
-                                         ("RateLimit", 8), ("Ramp", 8)])
+@pytest.mark.parametrize("model,least", [("RateLimiter", 28), ("LGF_LimRateOfChangeCI", 8),
+                                         ("RateLimit", 8), ("Ramp", 8), ("LGF_LimRateOfChangeAdvancedCI", 6)])
 def test_enough_hand_worked_scenarios(model, least):
     scenarios = [s for s in SCENARIOS if s.model == model]
     assert len(scenarios) >= least

@@ -9,10 +9,10 @@ import zipfile
 
 import pytest
 
-from support.fmu_driver import BUILD_DIR, REPO, fmu_file
+from support.fmu_driver import BUILD_DIR, MODELS as PRODUCT_MODELS, REPO, fmu_file
 from support.process import run as run_bounded
 
-MODELS = ["RateLimiter", "LGF_LimRateOfChangeCI", "RateLimit", "Ramp", "PassThrough"]
+MODELS = PRODUCT_MODELS + ["PassThrough"]
 
 
 def build_setting(pattern, text):

@@ -65,7 +65,7 @@ def values_end(d):
     return 20 + 8 * struct.unpack_from("<I", d, 16)[0]
 
 
-BLOCK = 8 + 8 + 1 + 8 + 8 + 8  # y, uPrevious, rampActive, runCycles, runPeriod, runBase
+BLOCK = 8 + 8 + 8 + 1 + 8 + 8 + 8  # y, uPrevious, yPrevious, decided, runCycles, runPeriod, runBase
 
 BAD_BYTES = {
     "truncated": lambda d: d[: len(d) // 2],
@@ -81,8 +81,20 @@ BAD_BYTES = {
     "boolean 2": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", 2.0)),  # bypass
     "start time infinite": lambda d: value_at(d, values_end(d) + BLOCK, struct.pack("<d", float("inf"))),
     "cycle count 2^60": lambda d: value_at(d, values_end(d) + BLOCK + 16, struct.pack("<Q", 1 << 60)),
-    "running time period NaN": lambda d: value_at(d, values_end(d) + 25, struct.pack("<d", float("nan"))),
-    "running time base negative": lambda d: value_at(d, values_end(d) + 33, struct.pack("<d", -1.0)),
+    "running time period NaN": lambda d: value_at(d, values_end(d) + 33, struct.pack("<d", float("nan"))),
+    "running time base negative": lambda d: value_at(d, values_end(d) + 41, struct.pack("<d", -1.0)),
+    "deciding rule unknown": lambda d: value_at(d, values_end(d) + 24, bytes([7])),
+}
+
+
+# each refused for its own reason
+REASONS = {
+    "truncated": "bytes; expected", "empty": "no header", "padded": "bytes; expected", "corrupted": "checksum",
+    "foreign magic": "no header", "future version": "format version 99", "another model": "another model",
+    "invalid mode": "invalid mode", "enumeration NaN": "impossible value nan for zeroRate",
+    "boolean 2": "impossible value 2 for bypass", "start time infinite": "impossible time",
+    "cycle count 2^60": "impossible time or cycle count", "running time period NaN": "impossible time",
+    "running time base negative": "impossible time", "deciding rule unknown": "invalid rule 7",
 }
 
 
@@ -101,6 +113,7 @@ def test_bad_serialized_state_is_refused_and_the_instance_recovers(version, dama
     assert call_status(api["deserialize"], BAD_BYTES[damage](data)) == 3
     errors = fmu.errors()
     assert len(errors) == 1 and "deserialize" in errors[0][2].lower(), errors
+    assert REASONS[damage] in errors[0][2], errors
     # refused until recovery, as the standard says; a good state recovers it
     assert call_status(fmu.step, 0.25) == 3
     api["set"](good)

@@ -7,10 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from support.fmu_driver import fmu_file
+from support.fmu_driver import MODELS, fmu_file
 from support.process import run as run_bounded
 
-MODELS = ["RateLimiter", "LGF_LimRateOfChangeCI", "RateLimit", "Ramp"]
 
 
 @pytest.mark.parametrize("version", [2, 3])

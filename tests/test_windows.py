@@ -23,7 +23,8 @@ pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
                                 reason="the sanitizer build makes Linux binaries only; the release build runs this")
 WINE_DIR = os.environ.get("RL_WINE_DIR", "/usr/lib/wine")
 SCENARIOS = ["RateLimiter/step_up", "RateLimiter/cycle_steps_of_10", "RateLimiter/status_errors",
-             "LGF_LimRateOfChangeCI/rate_100ms", "RateLimit/duration_jump", "Ramp/ttime_10s_both_ways"]
+             "LGF_LimRateOfChangeCI/rate_100ms", "RateLimit/duration_jump", "Ramp/ttime_10s_both_ways",
+             "RateLimiter/neg_rates_rising", "LGF_LimRateOfChangeAdvancedCI/quadrant_flags"]
 CLIENT_SECONDS = 120  # a run takes under 1 s idle, a few on a busy machine
 
 

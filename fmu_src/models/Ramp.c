@@ -15,11 +15,19 @@ static void configure(const double *v, RlConfig *c) {
     c->initValue = v[VR_rInitValue];
     c->initDelay = v[VR_tInitDelay];
     c->passNonFinite = true;
+    c->rateUpNeg = c->rateUp;     /* the same rates below 0 */
+    c->rateDownNeg = c->rateDown;
+    c->yMax = c->yMin = (RlValue){ NAN, 0 }; /* no output limits */
+    c->hold = false;
+    c->limitInitialOutput = false;
+    c->modelMode = 0;
 }
 
-static void publish(const RlState *block, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
     v[VR_rOut] = block->y;
-    v[VR_xRampActive] = block->rampActive;
+    RlOutputs o;
+    rl_outputs(block, prepared, &o);
+    v[VR_xRampActive] = o.rampActive;
 }
 
 const ModelDefinition fmuModel = {

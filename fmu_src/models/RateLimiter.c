@@ -1,10 +1,15 @@
-/* RateLimiter: the unified block (SPEC section 3), a direct mapping of its
- * variables onto the kernel. */
+/* RateLimiter: the unified block (SPEC sections 3 and 6), a direct mapping
+ * of its variables onto the kernel. */
 #include "RateLimiter_variables.h"
 
 static void configure(const double *v, RlConfig *c) {
     c->rateUp = rl_resolve(v[VR_rateUp], VR_rateUp, v[VR_rateUpPar], VR_rateUpPar);
     c->rateDown = rl_resolve(v[VR_rateDown], VR_rateDown, v[VR_rateDownPar], VR_rateDownPar);
+    c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);
+    c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source);
+    c->yMax = rl_resolve(v[VR_yMax], VR_yMax, v[VR_yMaxPar], VR_yMaxPar);
+    c->yMin = rl_resolve(v[VR_yMin], VR_yMin, v[VR_yMinPar], VR_yMinPar);
+    c->hold = v[VR_hold] != 0;
     c->ratePeriod = (RlValue){ v[VR_ratePeriod], VR_ratePeriod };
     c->duration = rl_resolve(v[VR_duration], VR_duration, v[VR_durationPar], VR_durationPar);
     c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };
@@ -15,12 +20,22 @@ static void configure(const double *v, RlConfig *c) {
     c->initValue = v[VR_initValue];
     c->initDelay = v[VR_initDelay];
     c->passNonFinite = true;
+    c->limitInitialOutput = true;
+    c->modelMode = 0;
 }
 
-static void publish(const RlState *block, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+    RlOutputs o;
+    rl_outputs(block, prepared, &o);
     v[VR_y] = block->y;
-    v[VR_rampActive] = block->rampActive;
+    v[VR_rampActive] = o.rampActive;
     v[VR_runningTime] = rl_running_time(block);
+    v[VR_dydt] = o.dydt;
+    v[VR_limitingUp] = o.limitingUp;
+    v[VR_limitingDown] = o.limitingDown;
+    v[VR_highLimit] = o.highLimit;
+    v[VR_lowLimit] = o.lowLimit;
+    v[VR_remainingTime] = o.remainingTime;
 }
 
 static void publish_status(const RlPrepared *p, double *v) {

@@ -1,5 +1,6 @@
-/* Unit tests of the rate limiter kernel: every rule (0 to 6) and every
- * status code of SPEC section 3. Expected values are worked by hand. */
+/* Unit tests of the rate limiter kernel: every rule (0 to 6, 5b) and every
+ * status code of SPEC sections 3 and 6, and the outputs derived from a
+ * cycle. Expected values are worked by hand. */
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -22,7 +23,9 @@ static void check_eq(const char *file, int line, const char *what, double actual
 }
 
 enum { SRC_RATE_UP = 2, SRC_RATE_DOWN = 3, SRC_DURATION = 6, SRC_RATE_UP_PAR = 7, SRC_RATE_DOWN_PAR = 8,
-       SRC_DURATION_PAR = 10, SRC_RATE_PERIOD = 11, SRC_CYCLE_TIME = 13 };
+       SRC_DURATION_PAR = 10, SRC_RATE_PERIOD = 11, SRC_CYCLE_TIME = 13, SRC_RATE_UP_NEG = 23,
+       SRC_RATE_DOWN_NEG = 24, SRC_Y_MAX = 25, SRC_Y_MIN = 26, SRC_Y_MAX_PAR = 28, SRC_Y_MIN_PAR = 29,
+       SRC_FOLLOWS = 99 /* a Neg rate not set: the other one's value */ };
 
 /* The unified block's defaults: rates 1 per 1 s, no duration, init = input. */
 static RlConfig defaults(void) {
@@ -37,6 +40,19 @@ static RlConfig defaults(void) {
     c.zeroRate = RL_ZERO_RATE_HOLD;
     c.initMode = RL_INIT_INPUT;
     c.passNonFinite = true;
+    c.rateUpNeg = (RlValue){ NAN, SRC_FOLLOWS };
+    c.rateDownNeg = (RlValue){ NAN, SRC_FOLLOWS };
+    c.yMax = (RlValue){ INFINITY, SRC_Y_MAX_PAR };
+    c.yMin = (RlValue){ -INFINITY, SRC_Y_MIN_PAR };
+    c.limitInitialOutput = true;
+    return c;
+}
+
+/* Rule 0 for the Neg rates, as the unified block resolves them: one not
+ * set takes the other rate's value (again after every change of it). */
+static RlConfig *resolved(RlConfig *c) {
+    if (c->rateUpNeg.source == SRC_FOLLOWS) c->rateUpNeg.value = c->rateUp.value;
+    if (c->rateDownNeg.source == SRC_FOLLOWS) c->rateDownNeg.value = c->rateDown.value;
     return c;
 }
 
@@ -48,7 +64,9 @@ typedef struct {
     long cycles;
 } Block;
 
-static void start(Block *b, const RlConfig *c, double u, double period) {
+static void start(Block *b, const RlConfig *config, double u, double period) {
+    RlConfig copy = *config;
+    const RlConfig *c = resolved(&copy);
     b->config = *c;
     b->period = period;
     b->cycles = 0;
@@ -62,7 +80,15 @@ static double cycle(Block *b, double u) {
     return b->state.y;
 }
 
-static void reconfigure(Block *b, const RlConfig *c) {
+static RlOutputs outputs(const Block *b) {
+    RlOutputs o;
+    rl_outputs(&b->state, &b->prepared, &o);
+    return o;
+}
+
+static void reconfigure(Block *b, const RlConfig *config) {
+    RlConfig copy = *config;
+    const RlConfig *c = resolved(&copy);
     b->config = *c;
     rl_prepare(&b->prepared, c, b->period);
 }
@@ -86,92 +112,92 @@ static void test_rule0_limits(void) {
     c.rateUp.value = 10.0;
     c.rateDown.value = 4.0;
     c.ratePeriod.value = 2.0;
-    rl_prepare(&p, &c, 0.5);           /* 10 * 0.5 / 2 and 4 * 0.5 / 2 */
+    rl_prepare(&p, resolved(&c), 0.5);           /* 10 * 0.5 / 2 and 4 * 0.5 / 2 */
     CHECK_EQ(p.maxUp, 2.5);
     CHECK_EQ(p.maxDown, 1.0);
     c.ratePeriod.value = 0.0;          /* per cycle, whatever T */
-    rl_prepare(&p, &c, 0.5);
+    rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, 10.0);
     CHECK_EQ(p.maxDown, 4.0);
     c.rateUp.value = INFINITY;         /* +inf: no limit */
-    rl_prepare(&p, &c, 0.5);
+    rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, INFINITY);
     c.rateUp.value = 0.0;              /* 0: hold (zeroRate 1) ... */
-    rl_prepare(&p, &c, 0.5);
+    rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, 0.0);
     c.zeroRate = RL_ZERO_RATE_NO_LIMIT; /* ... or no limit (zeroRate 2) */
-    rl_prepare(&p, &c, 0.5);
+    rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, INFINITY);
     CHECK_EQ(p.maxDown, 4.0);
     /* Siemens seed: 10 per second at 1 s / 100 ms / 10 ms adds 10 / 1 / 0.1 */
     c = defaults();
     c.rateUp.value = 10.0;
-    rl_prepare(&p, &c, 1.0);
+    rl_prepare(&p, resolved(&c), 1.0);
     CHECK_EQ(p.maxUp, 10.0);
-    rl_prepare(&p, &c, 0.1);
+    rl_prepare(&p, resolved(&c), 0.1);
     CHECK_EQ(p.maxUp, 1.0);
-    rl_prepare(&p, &c, 0.01);
+    rl_prepare(&p, resolved(&c), 0.01);
     CHECK_EQ(p.maxUp, 0.1);
 }
 
 static void test_status_codes(void) {
     RlConfig c = defaults();
     int source = -1;
-    CHECK_EQ(rl_status(&c, &source), RL_STATUS_OK);
+    CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
     CHECK_EQ(source, 0);
 
     c = defaults(); c.rateDown.value = -1.0;
-    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
     c = defaults(); c.rateUp = (RlValue){ -0.5, SRC_RATE_UP };
-    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_UP);
     c = defaults(); c.rateUp.value = -INFINITY;
-    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
 
     c = defaults(); c.rateUp.value = NAN;
-    CHECK_EQ(rl_status(&c, &source), 0x8201);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8201);
     CHECK_EQ(source, SRC_RATE_UP_PAR);
     c = defaults(); c.rateDown.value = NAN;
-    CHECK_EQ(rl_status(&c, &source), 0x8201);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8201);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
     /* first match wins: a negative rate before a NaN one */
     c = defaults(); c.rateUp.value = NAN; c.rateDown.value = -1.0;
-    CHECK_EQ(rl_status(&c, &source), 0x8200);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
 
     c = defaults(); c.ratePeriod.value = -1.0;
-    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
     CHECK_EQ(source, SRC_RATE_PERIOD);
     c.ratePeriod.value = INFINITY;
-    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
     c.ratePeriod.value = NAN;
-    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
 
     c = defaults(); c.duration = (RlValue){ -3.0, SRC_DURATION };
-    CHECK_EQ(rl_status(&c, &source), 0x8203);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     CHECK_EQ(source, SRC_DURATION);
     c.duration = (RlValue){ NAN, SRC_DURATION_PAR };
-    CHECK_EQ(rl_status(&c, &source), 0x8203);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     CHECK_EQ(source, SRC_DURATION_PAR);
     c.duration.value = INFINITY;       /* never reached, but valid */
-    CHECK_EQ(rl_status(&c, &source), RL_STATUS_OK);
+    CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
 
     c = defaults(); c.cycleTime.value = -0.01;
-    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
     CHECK_EQ(source, SRC_CYCLE_TIME);
     c.cycleTime.value = INFINITY;
-    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
     c.cycleTime.value = NAN;
-    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
 
     /* the table's order: rate before ratePeriod before duration before cycle */
     c = defaults(); c.cycleTime.value = -1; c.duration.value = -1; c.ratePeriod.value = -1;
-    CHECK_EQ(rl_status(&c, &source), 0x8202);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
     c.ratePeriod.value = 1;
-    CHECK_EQ(rl_status(&c, &source), 0x8203);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     c.duration.value = 0;
-    CHECK_EQ(rl_status(&c, &source), 0x8601);
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
     CHECK_TRUE(strlen(rl_status_text(0x8203)) > 0);
 }
 
@@ -201,7 +227,7 @@ static void test_rule1_non_finite_input(void) {
     CHECK_EQ(rl_running_time(&b.state), 1.0);
     CHECK_TRUE(isnan(cycle(&b, NAN)));       /* passes at once */
     CHECK_EQ(rl_running_time(&b.state), 0.0); /* and resets runningTime */
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(cycle(&b, INFINITY), INFINITY);
     CHECK_EQ(cycle(&b, -INFINITY), -INFINITY);
     CHECK_EQ(cycle(&b, 5.0), 5.0);            /* rule 4: valid after invalid */
@@ -238,7 +264,7 @@ static void test_rule2_bypass(void) {
     c.bypassValue = 8.0;
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 10.0), 8.0);           /* jumps to bypassValue */
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 0.0);
     c.bypassValue = NAN;                      /* no bypass value: y = u */
     reconfigure(&b, &c);
@@ -252,7 +278,7 @@ static void test_rule2_bypass(void) {
     c.bypass = false;                         /* released: ramps from -2 */
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 4.5), -1.0);
-    CHECK_TRUE(b.state.rampActive);
+    CHECK_TRUE(outputs(&b).rampActive);
     CHECK_EQ(cycle(&b, 4.5), 0.0);
     /* bypass wins over a configuration error */
     c.bypass = true;
@@ -271,9 +297,9 @@ static void test_rule3_init_delay(void) {
     CHECK_EQ(cycle(&b, 5.0), 5.0);            /* ends at 0.1 */
     CHECK_EQ(cycle(&b, -5.0), -5.0);          /* 0.2 */
     CHECK_EQ(cycle(&b, 6.0), 6.0);            /* 3 * 0.1 = 0.30000000000000004: at 0.3 within rounding */
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(cycle(&b, 10.0), 6.1);           /* 0.4: ramps at 1/s */
-    CHECK_TRUE(b.state.rampActive);
+    CHECK_TRUE(outputs(&b).rampActive);
     /* initMode 2 ignores initDelay */
     c.initMode = RL_INIT_INPUT;
     start(&b, &c, 0.0, 0.1);
@@ -304,7 +330,7 @@ static void test_rule5_configuration_error_holds(void) {
     CHECK_EQ(b.prepared.status, 0x8200);
     CHECK_EQ(cycle(&b, 10.0), 1.0);
     CHECK_EQ(cycle(&b, -3.0), 1.0);
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
     c.rateDown.value = 1.0;                   /* fixed: ramps on from the held value */
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, -3.0), 0.0);
@@ -317,12 +343,12 @@ static void test_rule6_ramp(void) {
     c.rateDown.value = 0.5;
     start(&b, &c, 0.0, 0.5);
     CHECK_EQ(cycle(&b, 3.0), 1.0);            /* +2/s * 0.5 s */
-    CHECK_TRUE(b.state.rampActive);
+    CHECK_TRUE(outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 0.5);
     CHECK_EQ(cycle(&b, 3.0), 2.0);
     CHECK_EQ(rl_running_time(&b.state), 1.0);
     CHECK_EQ(cycle(&b, 3.0), 3.0);            /* reaches u, no overshoot */
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 1.5);
     CHECK_EQ(cycle(&b, 3.0), 3.0);            /* y == u: the timer value remains */
     CHECK_EQ(rl_running_time(&b.state), 1.5);
@@ -330,20 +356,20 @@ static void test_rule6_ramp(void) {
     CHECK_EQ(rl_running_time(&b.state), 0.5);
     CHECK_EQ(cycle(&b, 2.5), 2.5);
     CHECK_EQ(cycle(&b, 2.5), 2.5);
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
 
     /* zeroRate 1: a rate of 0 holds that direction only */
     c = defaults();
     c.rateUp.value = 0.0;
     start(&b, &c, 1.0, 1.0);
     CHECK_EQ(cycle(&b, 5.0), 1.0);
-    CHECK_TRUE(b.state.rampActive);
+    CHECK_TRUE(outputs(&b).rampActive);
     CHECK_EQ(cycle(&b, -5.0), 0.0);
     /* zeroRate 2: no limit */
     c.zeroRate = RL_ZERO_RATE_NO_LIMIT;
     start(&b, &c, 1.0, 1.0);
     CHECK_EQ(cycle(&b, 5.0), 5.0);
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
 }
 
 static void test_rule6_duration(void) {
@@ -358,7 +384,7 @@ static void test_rule6_duration(void) {
     }
     CHECK_EQ(rl_running_time(&b.state), 29 * 0.1);
     CHECK_EQ(cycle(&b, 100.0), 100.0);        /* 30 cycles of 0.1 s reach 3 s */
-    CHECK_TRUE(!b.state.rampActive);
+    CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 30 * 0.1);
     CHECK_EQ(cycle(&b, 100.0), 100.0);
     CHECK_EQ(rl_running_time(&b.state), 30 * 0.1); /* remains */
@@ -392,10 +418,24 @@ static void test_running_time_period_change(void) {
 static void check_same_state(const RlState *a, const RlState *b) {
     CHECK_EQ(a->y, b->y);
     CHECK_EQ(a->uPrevious, b->uPrevious);
-    CHECK_EQ(a->rampActive, b->rampActive);
+    CHECK_EQ(a->yPrevious, b->yPrevious);
+    CHECK_EQ(a->decided, b->decided);
     CHECK_EQ(a->runCycles, b->runCycles);
     CHECK_EQ(a->runPeriod, b->runPeriod);
     CHECK_EQ(a->runBase, b->runBase);
+}
+
+static void check_same_outputs(const RlState *a, const RlState *b, const RlPrepared *p) {
+    RlOutputs x, y;
+    rl_outputs(a, p, &x);
+    rl_outputs(b, p, &y);
+    CHECK_EQ(x.rampActive, y.rampActive);
+    CHECK_EQ(x.limitingUp, y.limitingUp);
+    CHECK_EQ(x.limitingDown, y.limitingDown);
+    CHECK_EQ(x.highLimit, y.highLimit);
+    CHECK_EQ(x.lowLimit, y.lowLimit);
+    CHECK_EQ(x.dydt, y.dydt);
+    CHECK_EQ(x.remainingTime, y.remainingTime);
 }
 
 /* The fast paths against the rules in order, over a grid of configurations,
@@ -405,7 +445,8 @@ static void test_fast_paths_equal_rules(void) {
     const double rates[] = { 0.0, 0.3, 1e308, -1.0 };
     const double durations[] = { 0.0, 0.05, 1.0 };
     const double starts[] = { 0.0, NAN, INFINITY };
-    const double inputs[][2] = { { 5.0, -5.0 }, { 0.1, 0.1 }, { NAN, 2.0 }, { INFINITY, -INFINITY }, { 1e308, -1e308 } };
+    const double inputs[][2] = { { 5.0, -5.0 }, { -5.0, 5.0 }, { 0.1, 0.1 }, { NAN, 2.0 }, { INFINITY, -INFINITY },
+                                 { 1e308, -1e308 } };
     const unsigned long counts[] = { 1, 2, 7, 50 };
     const double T = 0.01;
     for (size_t r = 0; r < 4; r++)
@@ -414,8 +455,9 @@ static void test_fast_paths_equal_rules(void) {
     for (int init = RL_INIT_VALUE; init <= RL_INIT_INPUT_DELAYED; init++)
     for (int flags = 0; flags < 4; flags++)
     for (size_t y0 = 0; y0 < 3; y0++)
-    for (size_t in = 0; in < 5; in++)
-    for (size_t n = 0; n < 4; n++) {
+    for (size_t in = 0; in < 6; in++)
+    for (size_t n = 0; n < 4; n++)
+    for (int extra = 0; extra < 6; extra++) {
         RlConfig c = defaults();
         c.rateUp.value = rates[r];
         c.rateDown.value = rates[(r + 1) % 4];
@@ -426,10 +468,17 @@ static void test_fast_paths_equal_rules(void) {
         c.initDelay = 0.02;
         c.bypass = flags & 1;
         c.passNonFinite = flags & 2;
+        /* section 6 in play, one at a time (each must clear plain): other
+         * rates below 0, a high or a low limit, hold */
+        if (extra == 1) c.rateUpNeg = (RlValue){ 0.7, SRC_RATE_UP_NEG };
+        if (extra == 2) c.rateDownNeg = (RlValue){ 2.0, SRC_RATE_DOWN_NEG };
+        if (extra == 3) c.yMax.value = 2.0;
+        if (extra == 4) c.yMin.value = -3.0;
+        if (extra == 5) c.hold = true;
         RlPrepared p;
-        rl_prepare(&p, &c, T);
+        rl_prepare(&p, resolved(&c), T);
         RlState run, cycles, rules;
-        rl_init(&run, &c, 1.0);
+        rl_init(&run, resolved(&c), 1.0);
         cycles = rules = run;
         uint64_t first = 1;
         for (int k = 0; k < 2; k++) { /* two inputs in turn: resets too */
@@ -442,6 +491,7 @@ static void test_fast_paths_equal_rules(void) {
             }
             check_same_state(&run, &cycles);
             check_same_state(&cycles, &rules);
+            check_same_outputs(&run, &rules, &p);
             first = last + 1;
         }
     }
@@ -472,13 +522,13 @@ static void test_steady_ramp_equals_rules(void) {
         c.zeroRate = zero;
         RlPrepared p;
         RlState steady, rules;
-        rl_init(&steady, &c, 1.0);
+        rl_init(&steady, resolved(&c), 1.0);
         rules = steady;
         bool held = false; /* the FMU's fastPeriod: steady steps allowed */
         double elapsed = 0.0;
         for (size_t k = 0; k < 8; k++) {
             if (k == 0 || periods[k] != periods[k - 1]) {
-                rl_prepare(&p, &c, periods[k]);
+                rl_prepare(&p, resolved(&c), periods[k]);
                 held = false;
             }
             for (int n = 0; n < repeat; n++) {
@@ -494,11 +544,199 @@ static void test_steady_ramp_equals_rules(void) {
                 rl_cycle_rules(&rules, &p, u, elapsed);
                 CHECK_EQ(steady.y, rules.y);
                 CHECK_EQ(steady.uPrevious, rules.uPrevious);
-                CHECK_EQ(steady.rampActive, rules.rampActive);
+                CHECK_EQ(steady.yPrevious, rules.yPrevious);
+                CHECK_EQ(steady.decided, rules.decided);
                 CHECK_EQ(rl_running_time(&steady), rl_running_time(&rules));
             }
         }
     }
+}
+
+/* ---- SPEC section 6 ------------------------------------------------- */
+
+static void test_status_section6(void) {
+    RlConfig c = defaults();
+    int source = -1;
+    /* 0x8200 over rateUp, rateDown, rateUpNeg, rateDownNeg in that order */
+    c.rateDownNeg = (RlValue){ -1.0, SRC_RATE_DOWN_NEG };
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
+    CHECK_EQ(source, SRC_RATE_DOWN_NEG);
+    c.rateUpNeg = (RlValue){ -2.0, SRC_RATE_UP_NEG };
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
+    CHECK_EQ(source, SRC_RATE_UP_NEG);
+    c.rateDown.value = -1.0;
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
+    CHECK_EQ(source, SRC_RATE_DOWN_PAR);
+    /* a NaN Neg rate that does not fall back (the Siemens advanced block) */
+    c = defaults(); c.rateUpNeg = (RlValue){ NAN, SRC_RATE_UP_NEG };
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8201);
+    CHECK_EQ(source, SRC_RATE_UP_NEG);
+    /* 0x8204: yMin > yMax, after 0x8203 and before 0x8601 */
+    c = defaults(); c.yMax = (RlValue){ 1.0, SRC_Y_MAX }; c.yMin = (RlValue){ 2.0, SRC_Y_MIN_PAR };
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8204);
+    CHECK_EQ(source, SRC_Y_MIN_PAR);
+    c.cycleTime.value = -1.0;
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8204);
+    c.duration.value = -1.0;
+    CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
+    c = defaults(); c.yMax.value = NAN; c.yMin.value = 5.0;     /* NaN: no limit, never inverted */
+    CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
+    c.yMax.value = 5.0;                                          /* equal limits are fine */
+    CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
+    CHECK_TRUE(strlen(rl_status_text(0x8204)) > 0);
+}
+
+static void test_rates_by_sign(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.rateUp.value = 2.0;
+    c.rateUpNeg = (RlValue){ 1.0, SRC_RATE_UP_NEG };
+    c.rateDown.value = 4.0;
+    c.rateDownNeg = (RlValue){ 0.5, SRC_RATE_DOWN_NEG };
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = -1.0;
+    start(&b, &c, 3.0, 0.5);
+    CHECK_TRUE(!b.prepared.plain);
+    CHECK_EQ(cycle(&b, 3.0), -0.5);     /* below 0: rateUpNeg * 0.5 */
+    CHECK_EQ(cycle(&b, 3.0), 0.0);
+    CHECK_EQ(cycle(&b, 3.0), 1.0);      /* at 0: rateUp * 0.5 */
+    CHECK_EQ(cycle(&b, -3.0), -1.0);    /* from 1 >= 0: rateDown * 0.5 = 2 */
+    CHECK_EQ(cycle(&b, -3.0), -1.25);   /* below 0: rateDownNeg * 0.5 */
+    /* a Neg rate equal to the other keeps the fast paths */
+    c = defaults();
+    start(&b, &c, 0.0, 0.5);
+    CHECK_TRUE(b.prepared.plain);
+}
+
+static void test_output_limits(void) {
+    Block b;
+    RlConfig c = defaults();
+    start(&b, &c, 5.0, 0.5);
+    CHECK_EQ(b.state.y, 5.0);
+    c.yMax.value = 2.0;                 /* tightened below y: ramps into the band */
+    reconfigure(&b, &c);
+    CHECK_TRUE(!b.prepared.plain);
+    CHECK_EQ(cycle(&b, 5.0), 4.5);
+    CHECK_TRUE(outputs(&b).highLimit && outputs(&b).limitingDown && outputs(&b).rampActive);
+    for (int k = 0; k < 5; k++) cycle(&b, 5.0);
+    CHECK_EQ(b.state.y, 2.0);           /* settles at the limit */
+    CHECK_TRUE(outputs(&b).highLimit && !outputs(&b).rampActive && !outputs(&b).limitingDown);
+    c.yMin.value = 3.0;                 /* inverted: status, hold */
+    reconfigure(&b, &c);
+    CHECK_EQ(b.prepared.status, 0x8204);
+    CHECK_EQ(cycle(&b, -5.0), 2.0);
+    CHECK_TRUE(outputs(&b).lowLimit && outputs(&b).highLimit);
+    c.yMax.value = NAN;                 /* NaN after fallback: no limit */
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, -5.0), 2.5);     /* target max(-5, 3) = 3 */
+    CHECK_TRUE(!outputs(&b).highLimit && outputs(&b).lowLimit);
+    /* rules 1 to 4 ignore the limits */
+    c.passNonFinite = true;
+    CHECK_EQ(cycle(&b, INFINITY), INFINITY);
+    CHECK_TRUE(!outputs(&b).highLimit && !outputs(&b).lowLimit);  /* not finite */
+    c.bypass = true;
+    c.bypassValue = -7.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 1.0), -7.0);
+    /* the initial output is limited, unless asked not to or inverted */
+    c = defaults(); c.yMin.value = 1.0;
+    start(&b, &c, -4.0, 1.0);
+    CHECK_EQ(b.state.y, 1.0);
+    c.limitInitialOutput = false;
+    start(&b, &c, -4.0, 1.0);
+    CHECK_EQ(b.state.y, -4.0);
+    c = defaults(); c.yMin.value = 1.0; c.yMax.value = 0.0;
+    start(&b, &c, -4.0, 1.0);
+    CHECK_EQ(b.state.y, -4.0);
+    /* a NaN u stays NaN as the target (the Siemens comparison holds) */
+    c = defaults(); c.passNonFinite = false; c.yMax.value = 2.0;
+    start(&b, &c, 1.0, 1.0);
+    CHECK_EQ(cycle(&b, NAN), 1.0);
+}
+
+static void test_rule5b_hold(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.initMode = RL_INIT_VALUE;
+    start(&b, &c, 10.0, 0.5);
+    cycle(&b, 10.0);
+    CHECK_EQ(cycle(&b, 10.0), 1.0);
+    CHECK_EQ(rl_running_time(&b.state), 1.0);
+    c.hold = true;
+    reconfigure(&b, &c);
+    CHECK_TRUE(!b.prepared.plain);
+    CHECK_EQ(cycle(&b, 10.0), 1.0);
+    CHECK_EQ(cycle(&b, 20.0), 1.0);     /* u changes: still frozen, runningTime too */
+    CHECK_EQ(rl_running_time(&b.state), 1.0);
+    CHECK_TRUE(!outputs(&b).rampActive && !outputs(&b).limitingUp);
+    CHECK_EQ(outputs(&b).dydt, 0.0);
+    CHECK_EQ(outputs(&b).remainingTime, 19.0); /* as if hold were off: (20 - 1) / 1 */
+    c.hold = false;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 20.0), 1.5);     /* u as in the last cycle: runningTime goes on */
+    CHECK_EQ(rl_running_time(&b.state), 1.5);
+    /* an error holds first (rule 5 before 5b) */
+    c.hold = true;
+    c.rateUp.value = -1.0;
+    reconfigure(&b, &c);
+    cycle(&b, 20.0);
+    CHECK_EQ(outputs(&b).remainingTime, 0.0);
+}
+
+static void test_derived_outputs(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.rateUp.value = 2.0;
+    c.rateUpNeg = (RlValue){ 1.0, SRC_RATE_UP_NEG };
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = -2.0;
+    start(&b, &c, 3.0, 0.5);
+    RlOutputs o = outputs(&b);          /* before any cycle */
+    CHECK_EQ(o.dydt, 0.0);
+    CHECK_EQ(o.remainingTime, 0.0);
+    CHECK_TRUE(!o.rampActive && !o.limitingUp && !o.limitingDown);
+    cycle(&b, 3.0);                     /* -1.5: 1.5 / 1 below 0, 3 / 2 above */
+    o = outputs(&b);
+    CHECK_EQ(o.dydt, 1.0);
+    CHECK_EQ(o.remainingTime, 3.0);
+    CHECK_TRUE(o.limitingUp && !o.limitingDown && o.rampActive);
+    /* a rate of 0: +inf when it holds, 0 for its leg when unlimited */
+    c.rateUpNeg.value = 0.0;
+    reconfigure(&b, &c);
+    cycle(&b, 3.0);
+    CHECK_EQ(b.state.y, -1.5);
+    CHECK_EQ(outputs(&b).remainingTime, INFINITY);
+    c.zeroRate = RL_ZERO_RATE_NO_LIMIT;
+    c.rateUp.value = 0.0;
+    reconfigure(&b, &c);
+    cycle(&b, 3.0);                     /* both unlimited: the jump */
+    CHECK_EQ(b.state.y, 3.0);
+    CHECK_EQ(outputs(&b).remainingTime, 0.0);
+    CHECK_EQ(outputs(&b).dydt, 9.0);    /* (3 - -1.5) / 0.5 */
+    /* ratePeriod 0: the rate is per cycle, per second rate / T */
+    c = defaults(); c.ratePeriod.value = 0.0; c.rateDown.value = 0.5;
+    start(&b, &c, 2.0, 0.25);
+    cycle(&b, 0.0);
+    CHECK_EQ(b.state.y, 1.5);
+    CHECK_EQ(outputs(&b).remainingTime, 0.75);  /* 1.5 / (0.5 / 0.25) */
+    CHECK_EQ(outputs(&b).dydt, -2.0);
+    CHECK_TRUE(outputs(&b).limitingDown);
+    /* the duration caps it */
+    c = defaults(); c.duration.value = 1.0;
+    start(&b, &c, 0.0, 0.5);
+    cycle(&b, 10.0);
+    CHECK_EQ(outputs(&b).remainingTime, 0.5);   /* min(9.5, 1 - 0.5) */
+    cycle(&b, 10.0);
+    CHECK_EQ(b.state.y, 10.0);                  /* the jump */
+    CHECK_TRUE(!outputs(&b).limitingUp);
+    CHECK_EQ(outputs(&b).dydt, 19.0);           /* (10 - 0.5) / 0.5 */
+    /* not finite: dydt 0, no limit flag */
+    c = defaults();
+    start(&b, &c, 0.0, 1.0);
+    cycle(&b, NAN);
+    CHECK_EQ(outputs(&b).dydt, 0.0);
+    CHECK_TRUE(!outputs(&b).highLimit && !outputs(&b).lowLimit);
+    CHECK_EQ(outputs(&b).remainingTime, 0.0);
 }
 
 int main(void) {
@@ -517,6 +755,11 @@ int main(void) {
     test_running_time_period_change();
     test_fast_paths_equal_rules();
     test_steady_ramp_equals_rules();
+    test_status_section6();
+    test_rates_by_sign();
+    test_output_limits();
+    test_rule5b_hold();
+    test_derived_outputs();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }

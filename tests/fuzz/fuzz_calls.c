@@ -8,7 +8,13 @@
 
 #include "fmi2Functions.h"
 #include "fmi3Functions.h"
-#include "RateLimiter_variables.h"
+/* the model under test: RateLimiter unless the build names another */
+#ifndef MODEL_VARIABLES
+#define MODEL_VARIABLES RateLimiter_variables.h
+#endif
+#define QUOTED_(x) #x
+#define QUOTED(x) QUOTED_(x)
+#include QUOTED(MODEL_VARIABLES)
 
 typedef struct {
     const uint8_t *data;

@@ -10,7 +10,13 @@
 
 #include "fmi2Functions.h"
 #include "fmi3Functions.h"
-#include "RateLimiter_variables.h"
+/* the model under test: RateLimiter unless the build names another */
+#ifndef MODEL_VARIABLES
+#define MODEL_VARIABLES RateLimiter_variables.h
+#endif
+#define QUOTED_(x) #x
+#define QUOTED(x) QUOTED_(x)
+#include QUOTED(MODEL_VARIABLES)
 
 static void logger2(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2String c, fmi2String m, ...) {
     (void)e; (void)n; (void)s; (void)c; (void)m;
@@ -30,7 +36,7 @@ static void run2(const uint8_t *data, size_t size) {
     if (fmi2DeSerializeFMUstate(c, (const fmi2Byte *)data, size, &state) == fmi2OK) {
         if (fmi2SetFMUstate(c, state) == fmi2OK) {
             fmi2Real y;
-            const fmi2ValueReference vr = VR_y;
+            const fmi2ValueReference vr = fmuModel.outputVr;
             fmi2Real time = 0;
             fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &time);
             fmi2DoStep(c, time, 0.1, fmi2True);
@@ -55,7 +61,7 @@ static void run3(const uint8_t *data, size_t size) {
         if (fmi3SetFMUState(c, state) == fmi3OK) {
             fmi3Boolean a, b, e;
             fmi3Float64 last, y;
-            const fmi3ValueReference vr = VR_y;
+            const fmi3ValueReference vr = fmuModel.outputVr;
             fmi3DoStep(c, 0.0, 0.1, fmi3True, &a, &b, &e, &last);
             fmi3GetFloat64(c, &vr, 1, &y, 1);
         }

@@ -15,6 +15,9 @@ REPO = Path(__file__).resolve().parents[2]
 TESTS = REPO / "tests"  # the working directory of the helper scripts (python -m support.x)
 BUILD_DIR = Path(os.environ.get("RL_BUILD_DIR", REPO / "build"))
 
+# the product models: one TOML file each
+MODELS = sorted(p.stem for p in (REPO / "modelDescription").glob("*.toml"))
+
 _unzipped = {}
 
 

@@ -1,5 +1,5 @@
-"""An independent model of the rate limiter, written from SPEC sections 2
-and 3 (not from the C code), to check the FMUs against.
+"""An independent model of the rate limiter, written from SPEC sections 2,
+3, 6 and 7 (not from the C code), to check the FMUs against.
 
 The oracle speaks the unified block's variable names. It follows the
 project's documented conventions where the contract leaves room:
@@ -14,12 +14,15 @@ TOL = 1e-9
 PARAMETER_DEFAULTS = {
     "rateUpPar": 1.0, "rateDownPar": 1.0, "bypassValuePar": math.nan, "durationPar": 0.0,
     "ratePeriod": 1.0, "zeroRate": 1, "cycleTime": 0.0, "initMode": 2, "initValue": 0.0, "initDelay": 0.0,
+    "yMaxPar": math.inf, "yMinPar": -math.inf,
 }
 INPUT_DEFAULTS = {
     "u": 0.0, "rateUp": math.nan, "rateDown": math.nan, "bypass": False, "bypassValue": math.nan,
-    "duration": math.nan,
+    "duration": math.nan, "rateUpNeg": math.nan, "rateDownNeg": math.nan, "yMax": math.nan, "yMin": math.nan,
+    "hold": False,
 }
-OUTPUTS = ("y", "rampActive", "runningTime", "error", "status", "subFunctionStatus")
+OUTPUTS = ("y", "rampActive", "runningTime", "error", "status", "subFunctionStatus", "dydt", "limitingUp",
+           "limitingDown", "highLimit", "lowLimit", "remainingTime")
 
 
 def finite(x):
@@ -35,23 +38,37 @@ class Resolved:
 class RateLimiterOracle:
     """One instance of the unified block; `vr` maps names to value references
     (for subFunctionStatus). `compare_only=True` is the Siemens reading of a
-    non-finite input: no rule 1, u is only compared with the output."""
+    non-finite input: no rule 1, u is only compared with the output.
+    `neg_fallback=False`: a NaN Neg rate is not replaced by the other rate
+    (LGF_LimRateOfChangeAdvancedCI: a NaN rate is 16#8201).
+    `limit_initial=False`: the initial output is not limited (ibid.)."""
 
-    def __init__(self, vr, start=None, start_time=0.0, compare_only=False):
+    def __init__(self, vr, start=None, start_time=0.0, compare_only=False, neg_fallback=True, limit_initial=True):
         self.vr = vr
         self.values = dict(PARAMETER_DEFAULTS)
         self.values.update(INPUT_DEFAULTS)
         self.values.update(start or {})
         self.compare_only = compare_only
+        self.neg_fallback = neg_fallback
         self.t0 = start_time
         self.time = start_time
         self.cycles_done = 0
         u = self.values["u"]
-        self.y = self.values["initValue"] if self.values["initMode"] == 1 else u
+        y = self.values["initValue"] if self.values["initMode"] == 1 else u
+        # section 6: limited if y is finite and yMin <= yMax (a NaN limit: none)
+        low, high = self.limits()
+        if limit_initial and finite(y) and low <= high:
+            y = min(max(y, low), high)
+        self.y = y
+        self.yp = y
         self.u_prev = u
-        self.ramp_active = False
+        self.decided_by = None          # rule that decided the last cycle: "1-5", "5b", "6"
+        self.jumped = False
+        self.T = math.nan
+        self.rates_used = (math.nan, math.nan)
         self.run_cycles, self.run_T, self.run_base = 0, 0.0, 0.0
         self.status, self.culprit = self.evaluate_status()
+        self.last = self.evaluate_outputs()
 
     # -- rule 0 and the status table -------------------------------------
     def resolve(self, name):
@@ -60,21 +77,41 @@ class RateLimiterOracle:
             return Resolved(self.values[name + "Par"], name + "Par")
         return Resolved(value, name)
 
+    def resolve_neg(self, name):
+        """rateUpNeg / rateDownNeg: NaN falls back to the resolved rateUp /
+        rateDown (section 6)."""
+        value = self.values[name]
+        if math.isnan(value) and self.neg_fallback:
+            return self.resolve(name[:-3])
+        return Resolved(value, name)
+
+    def rates(self):
+        return (self.resolve("rateUp"), self.resolve("rateDown"), self.resolve_neg("rateUpNeg"),
+                self.resolve_neg("rateDownNeg"))
+
+    def limits(self):
+        """yMin and yMax after fallback; NaN means no limit."""
+        low, high = self.resolve("yMin").value, self.resolve("yMax").value
+        return (-math.inf if math.isnan(low) else low), (math.inf if math.isnan(high) else high)
+
     def evaluate_status(self):
-        up, down = self.resolve("rateUp"), self.resolve("rateDown")
+        rates = self.rates()
         period = self.values["ratePeriod"]
         duration = self.resolve("duration")
         cycle = self.values["cycleTime"]
-        for rate in (up, down):
+        for rate in rates:                       # rateUp, rateDown, rateUpNeg, rateDownNeg
             if rate.value < 0:
                 return 0x8200, rate.name
-        for rate in (up, down):
+        for rate in rates:
             if math.isnan(rate.value):
                 return 0x8201, rate.name
         if not finite(period) or period < 0:
             return 0x8202, "ratePeriod"
         if math.isnan(duration.value) or duration.value < 0:
             return 0x8203, duration.name
+        y_min, y_max = self.resolve("yMin"), self.resolve("yMax")
+        if y_min.value > y_max.value:
+            return 0x8204, y_min.name
         if not finite(cycle) or cycle < 0:
             return 0x8601, "cycleTime"
         return 0, None
@@ -98,13 +135,20 @@ class RateLimiterOracle:
             self.run_cycles, self.run_T = 0, T
         self.run_cycles += 1
 
+    def target(self, u):
+        """uc = min(max(u, yMin), yMax); a NaN u stays NaN."""
+        low, high = self.limits()
+        return low if u < low else high if u > high else u
+
     # -- one cycle (rules 1 to 6) ------------------------------------------
     def cycle(self, T, elapsed):
         v = self.values
         u = v["u"]
         yp = self.y
         self.status, self.culprit = self.evaluate_status()
-        by_rule_6 = False
+        self.yp, self.T = yp, T
+        self.jumped = False
+        decided_by = "1-5"
         if not self.compare_only and not finite(u):                      # rule 1
             y = u
             self.running_reset()
@@ -120,24 +164,37 @@ class RateLimiterOracle:
             self.running_reset()
         elif self.status >= 0x8000:                                      # rule 5
             y = yp
+        elif v["hold"]:                                                  # rule 5b
+            y = yp
+            decided_by = "5b"
         else:                                                            # rule 6
-            by_rule_6 = True
+            decided_by = "6"
+            uc = self.target(u)
+            up, down, up_neg, down_neg = self.rates()
+            # the rates by the sign of yp (a non-finite yp: the others)
+            rate_up, rate_down = (up_neg, down_neg) if yp < 0 else (up, down)
+            max_up = self.per_cycle_limit(rate_up.value, T)
+            max_down = self.per_cycle_limit(rate_down.value, T)
+            self.rates_used = (max_up, max_down)
             if u != self.u_prev:
                 self.running_reset()
-            if yp != u:
+            if yp != uc:
                 self.running_add(T)
             duration = self.resolve("duration").value
             if duration > 0 and self.running_time >= duration * (1 - TOL):
-                y = u
-            elif u > yp:
-                y = min(u, yp + self.per_cycle_limit(self.resolve("rateUp").value, T))
-            elif u < yp:
-                y = max(u, yp - self.per_cycle_limit(self.resolve("rateDown").value, T))
+                y = uc
+                self.jumped = True
+            elif uc > yp:
+                y = min(uc, yp + max_up)
+            elif uc < yp:
+                y = max(uc, yp - max_down)
             else:
                 y = yp
-        self.ramp_active = by_rule_6 and y != u
+        self.decided_by = decided_by
         self.y = y
         self.u_prev = u
+        # the outputs are those of the last cycle run (SPEC section 2)
+        self.last = self.evaluate_outputs()
 
     # -- SPEC section 2: a communication step --------------------------------
     def do_step(self, t, h, inputs=None):
@@ -156,15 +213,62 @@ class RateLimiterOracle:
         self.time = end
         return self.outputs()
 
+    # -- section 6: what the last cycle leaves besides y -----------------------
+    def remaining_time(self, y, uc):
+        """The way from y to uc in legs: below 0 at the Neg rate, the rest at
+        the other; each leg's length / rate per second."""
+        up, down, up_neg, down_neg = self.rates()
+        if uc > y:
+            legs = [(min(uc, 0.0) - y, up_neg.value) if y < 0 else (0.0, up_neg.value),
+                    (uc - max(y, 0.0), up.value) if uc > 0 else (0.0, up.value)]
+        else:
+            legs = [(min(y, 0.0) - uc, down_neg.value) if uc < 0 else (0.0, down_neg.value),
+                    (y - max(uc, 0.0), down.value) if y > 0 else (0.0, down.value)]
+        period = self.values["ratePeriod"]
+        total = 0.0
+        for length, rate in legs:
+            if length <= 0:
+                continue                         # not part of the way
+            if rate == 0:
+                total += math.inf if self.values["zeroRate"] == 1 else 0.0
+                continue
+            per_second = rate / period if period > 0 else rate / self.T
+            # IEEE division, as the PLC's: a rate per second that underflows to 0 never arrives
+            total += length / per_second if per_second != 0 else math.inf
+        duration = self.resolve("duration").value
+        if duration > 0:
+            total = min(total, max(0.0, duration - self.running_time))
+        return total
+
     def outputs(self):
+        return dict(self.last)
+
+    def evaluate_outputs(self):
         error = self.status >= 0x8000
+        y, yp = self.y, self.yp
+        uc = self.target(self.u_prev)
+        low, high = self.limits()
+        by_rule_6 = self.decided_by == "6"
+        ramped = by_rule_6 and not self.jumped
+        max_up, max_down = self.rates_used
+        remaining = 0.0
+        if self.decided_by in ("6", "5b") and y != uc and finite(y) and finite(uc):
+            remaining = self.remaining_time(y, uc)
         return {
-            "y": self.y,
-            "rampActive": self.ramp_active,
+            "y": y,
+            "rampActive": by_rule_6 and y != uc,
             "runningTime": self.running_time,
             "error": error,
             "status": self.status,
             "subFunctionStatus": self.vr[self.culprit] if error else 0,
+            "dydt": (y - yp) / self.T if self.decided_by and finite(y) and finite(yp) else 0.0,
+            "limitingUp": ramped and yp + max_up < uc,
+            "limitingDown": ramped and yp - max_down > uc,
+            "highLimit": finite(y) and y >= high,
+            "lowLimit": finite(y) and y <= low,
+            "remainingTime": remaining,
+            # what a vendor mapping needs of the same cycle
+            "_yp": yp, "_mode": self.values.get("mode"),
         }
 
 
@@ -217,6 +321,53 @@ def codesys(v):
     return unified, culprits
 
 
+def siemens_advanced(v):
+    """SPEC section 7: modes (first match wins) reset, manOp,
+    enDefaultOutValue, track set the output as a bypass does; else a ramp
+    towards autoValue within [setLowLim, setHighLim]."""
+    ob = v["callOB"]
+    ob_valid = 30 <= ob <= 38 or ob >= 123
+    if v["reset"]:
+        mode, value = "reset", v["defaultOutValue"] if v["enDefaultOutValue"] else 0.0
+    elif v["manOp"]:
+        mode, value = "manOp", v["manualValue"]
+    elif v["enDefaultOutValue"]:
+        mode, value = "enDefaultOutValue", v["defaultOutValue"]
+    elif v["track"]:
+        mode, value = "track", v["autoValue"]
+    else:
+        mode, value = "ramp", nan
+    unified = {
+        "u": v["autoValue"], "rateUp": v["setPosUpRateLim"], "rateDown": v["setPosDownRateLim"],
+        # quadrants by the output's magnitude: negUp falls below 0, negDown rises
+        "rateDownNeg": v["setNegUpRateLim"], "rateUpNeg": v["setNegDownRateLim"],
+        "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
+        "yMax": v["setHighLim"], "yMin": v["setLowLim"], "yMaxPar": nan, "yMinPar": nan, "hold": False,
+        "bypass": mode != "ramp", "bypassValue": value, "bypassValuePar": nan,
+        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"] if ob_valid else nan,
+        "initMode": 1, "initValue": 0.0, "initDelay": 0.0, "mode": mode,
+    }
+    culprits = {"rateUp": "setPosUpRateLim", "rateDown": "setPosDownRateLim", "rateUpNeg": "setNegDownRateLim",
+                "rateDownNeg": "setNegUpRateLim", "rateUpPar": "setPosUpRateLim", "rateDownPar": "setPosDownRateLim",
+                "yMin": "setLowLim", "yMinPar": "setLowLim", "cycleTime": "cycleTime" if ob_valid else "callOB"}
+    return unified, culprits
+
+
+def siemens_advanced_outputs(out, unified):
+    negative = out["_yp"] < 0          # the quadrant the rate was picked by
+    reset = out["_mode"] == "reset"
+    return {
+        "outputValue": out["y"],
+        "posUpRateLim": out["limitingUp"] and not negative,
+        "posDownRateLim": out["limitingDown"] and not negative,
+        "negUpRateLim": out["limitingDown"] and negative,
+        "negDownRateLim": out["limitingUp"] and negative,
+        "highLim": out["highLimit"] and not reset,
+        "lowLim": out["lowLimit"] and not reset,
+        "error": out["error"], "status": out["status"], "subfunctionStatus": out["subFunctionStatus"],
+    }
+
+
 VENDORS = {
     "LGF_LimRateOfChangeCI": {
         "translate": siemens, "compare_only": True,
@@ -230,6 +381,16 @@ VENDORS = {
                      "DownRate": nan, "DurationPar": 0.0, "BypassValuePar": nan, "UpRatePar": 0.0,
                      "DownRatePar": 0.0, "OutSave": False, "SavedOut": nan, "cycleTime": 0.0},
         "outputs": {"Out": "y", "RunningTime": "runningTime"},
+    },
+    "LGF_LimRateOfChangeAdvancedCI": {
+        "translate": siemens_advanced, "compare_only": True, "neg_fallback": False, "limit_initial": False,
+        "defaults": {"autoValue": 0.0, "manualValue": 0.0, "setPosUpRateLim": 0.0, "setPosDownRateLim": 0.0,
+                     "setNegUpRateLim": 0.0, "setNegDownRateLim": 0.0, "setHighLim": 0.0, "setLowLim": 0.0,
+                     "defaultOutValue": 0.0, "enDefaultOutValue": False, "track": False, "manOp": False,
+                     "reset": False, "callOB": 30, "cycleTime": 0.0},
+        "outputs": siemens_advanced_outputs,
+        "output_names": ["outputValue", "posUpRateLim", "posDownRateLim", "negUpRateLim", "negDownRateLim",
+                         "highLim", "lowLim", "error", "status", "subfunctionStatus"],
     },
     "Ramp": {
         "translate": codesys, "compare_only": False,
@@ -251,7 +412,9 @@ class VendorOracle:
         self.values.update(start or {})
         unified, culprits = self.spec["translate"](self.values)
         self.unified = RateLimiterOracle(self.culprit_vrs(culprits), unified, start_time,
-                                         compare_only=self.spec["compare_only"])
+                                         compare_only=self.spec["compare_only"],
+                                         neg_fallback=self.spec.get("neg_fallback", True),
+                                         limit_initial=self.spec.get("limit_initial", True))
 
     def culprit_vrs(self, culprits):
         return {name: self.vendor_vr[vendor] for name, vendor in culprits.items()}
@@ -266,6 +429,8 @@ class VendorOracle:
 
     def outputs(self):
         out = self.unified.outputs()
+        if callable(self.spec["outputs"]):
+            return self.spec["outputs"](out, self.unified)
         return {vendor: out[name] for vendor, name in self.spec["outputs"].items()}
 
 
@@ -276,4 +441,6 @@ def oracle_for(model, vr, start=None, start_time=0.0):
 
 
 def output_names(model):
-    return list(OUTPUTS) if model == "RateLimiter" else list(VENDORS[model]["outputs"])
+    if model == "RateLimiter":
+        return list(OUTPUTS)
+    return list(VENDORS[model].get("output_names") or VENDORS[model]["outputs"])

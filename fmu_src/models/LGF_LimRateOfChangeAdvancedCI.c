@@ -1,0 +1,83 @@
+/* LGF_LimRateOfChangeAdvancedCI (Siemens, SPEC section 7): rates per
+ * quadrant (per second, 0 holds), output limits, and the modes reset,
+ * manOp, enDefaultOutValue and track (first match wins), each of which
+ * sets the output as a bypass does; the output starts at 0, not limited. */
+#include "LGF_LimRateOfChangeAdvancedCI_variables.h"
+
+enum { MODE_RAMP, MODE_RESET, MODE_MANUAL, MODE_DEFAULT, MODE_TRACK };
+
+/* the cyclic interrupt OBs: 30..38, or 123 and above */
+static bool cyclic_interrupt_ob(double ob) {
+    return (ob >= 30 && ob <= 38) || ob >= 123;
+}
+
+static void configure(const double *v, RlConfig *c) {
+    c->rateUp = (RlValue){ v[VR_setPosUpRateLim], VR_setPosUpRateLim };
+    c->rateDown = (RlValue){ v[VR_setPosDownRateLim], VR_setPosDownRateLim };
+    /* named by the output's magnitude: negUp falls below 0, negDown rises */
+    c->rateDownNeg = (RlValue){ v[VR_setNegUpRateLim], VR_setNegUpRateLim };
+    c->rateUpNeg = (RlValue){ v[VR_setNegDownRateLim], VR_setNegDownRateLim };
+    c->ratePeriod = (RlValue){ 1.0, VR_setPosUpRateLim };
+    c->yMax = (RlValue){ v[VR_setHighLim], VR_setHighLim };
+    c->yMin = (RlValue){ v[VR_setLowLim], VR_setLowLim };
+    c->hold = false;
+    c->duration = (RlValue){ 0.0, 0 };
+    c->cycleTime = cyclic_interrupt_ob(v[VR_callOB]) ? (RlValue){ v[VR_cycleTime], VR_cycleTime }
+                                                     : (RlValue){ NAN, VR_callOB };
+    if (v[VR_reset] != 0) {
+        c->modelMode = MODE_RESET;
+        c->bypassValue = v[VR_enDefaultOutValue] != 0 ? v[VR_defaultOutValue] : 0.0;
+    } else if (v[VR_manOp] != 0) {
+        c->modelMode = MODE_MANUAL;
+        c->bypassValue = v[VR_manualValue];
+    } else if (v[VR_enDefaultOutValue] != 0) {
+        c->modelMode = MODE_DEFAULT;
+        c->bypassValue = v[VR_defaultOutValue];
+    } else if (v[VR_track] != 0) {
+        c->modelMode = MODE_TRACK;
+        c->bypassValue = v[VR_autoValue];
+    } else {
+        c->modelMode = MODE_RAMP;
+        c->bypassValue = NAN;
+    }
+    c->bypass = c->modelMode != MODE_RAMP;
+    c->zeroRate = RL_ZERO_RATE_HOLD;
+    c->initMode = RL_INIT_VALUE;
+    c->initValue = 0.0;
+    c->initDelay = 0.0;
+    c->passNonFinite = false;
+    c->limitInitialOutput = false;
+}
+
+static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+    RlOutputs o;
+    rl_outputs(block, prepared, &o);
+    /* the quadrant of the output the rate was picked by */
+    const bool negative = block->yPrevious < 0;
+    const bool reset = prepared->config.modelMode == MODE_RESET;
+    v[VR_outputValue] = block->y;
+    v[VR_posUpRateLim] = o.limitingUp && !negative;
+    v[VR_posDownRateLim] = o.limitingDown && !negative;
+    v[VR_negUpRateLim] = o.limitingDown && negative;
+    v[VR_negDownRateLim] = o.limitingUp && negative;
+    v[VR_highLim] = o.highLimit && !reset;
+    v[VR_lowLim] = o.lowLimit && !reset;
+}
+
+static void publish_status(const RlPrepared *p, double *v) {
+    v[VR_error] = p->status >= 0x8000;
+    v[VR_status] = p->status;
+    v[VR_subfunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
+}
+
+const ModelDefinition fmuModel = {
+    .identifier = MODEL_IDENTIFIER,
+    .token = MODEL_TOKEN,
+    .variables = modelVariables,
+    .count = MODEL_VARIABLE_COUNT,
+    .inputVr = VR_autoValue,
+    .outputVr = VR_outputValue,
+    .configure = configure,
+    .publish = publish,
+    .publishStatus = publish_status,
+};
