@@ -15,6 +15,15 @@ RlValue rl_resolve(double input, int inputSource, double parameter, int paramete
     return resolved;
 }
 
+void rl_without_section6(RlConfig *c) {
+    c->rateUpNeg = c->rateUp;
+    c->rateDownNeg = c->rateDown;
+    c->yMax = c->yMin = (RlValue){ NAN, 0 };
+    c->hold = false;
+    c->limitInitialOutput = false;
+    c->modelMode = 0;
+}
+
 int rl_status(const RlConfig *c, int *source) {
     const RlValue *culprit = 0;
     int status = RL_STATUS_OK;

@@ -96,6 +96,11 @@ typedef struct {
 /* Rule 0: an "or Par" input that is NaN falls back to its parameter. */
 RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource);
 
+/* The section 6 features off, for the blocks of section 4: the same rates
+ * below 0, no output limits, no hold, the initial output as it is. Call
+ * after the rates are set. */
+void rl_without_section6(RlConfig *config);
+
 /* Status word of a configuration (first match of the status table). */
 int rl_status(const RlConfig *config, int *source);
 

@@ -15,12 +15,7 @@ static void configure(const double *v, RlConfig *c) {
     c->initValue = v[VR_rInitValue];
     c->initDelay = v[VR_tInitDelay];
     c->passNonFinite = true;
-    c->rateUpNeg = c->rateUp;     /* the same rates below 0 */
-    c->rateDownNeg = c->rateDown;
-    c->yMax = c->yMin = (RlValue){ NAN, 0 }; /* no output limits */
-    c->hold = false;
-    c->limitInitialOutput = false;
-    c->modelMode = 0;
+    rl_without_section6(c);
 }
 
 static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
