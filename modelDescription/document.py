@@ -15,6 +15,7 @@ import io
 import math
 import re
 import sys
+import textwrap
 import tomllib
 from pathlib import Path
 
@@ -57,8 +58,9 @@ def ramp_plot(model, stage, path):
     axes.set_xlabel("time [s]")
     axes.grid(True, alpha=0.3)
     settings = ", ".join(f"{k} = {v}" for k, v in start.items()) or "defaults"
-    axes.set_title(f"{model['model']['identifier']}: a step up and down ({settings}, 0.1 s steps)", fontsize=9)
-    axes.legend(loc="lower right", fontsize=8)
+    title = f"{model['model']['identifier']}: a step up and down ({settings}, 0.1 s steps)"
+    axes.set_title("\n".join(textwrap.wrap(title, 90)), fontsize=8)
+    axes.legend(loc="best", fontsize=8)
     figure.tight_layout()
     figure.savefig(path, metadata=PNG_METADATA)
     plt.close(figure)
