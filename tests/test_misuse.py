@@ -208,3 +208,70 @@ def test_communication_point_within_a_relative_1e_9_of_the_time(version):
     assert fmu.raw_step_at(outside, 0.1) == 3
     assert "is not the FMU's time" in fmu.errors()[-1][2]
     fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_status_messages_say_what_the_status_means(version):
+    fmu = Instance("RateLimiter", version)
+    fmu.start()
+    for settings, code, text in (({"rateUpPar": -1.0}, "16#8200", "a rate is negative (rateUpPar = -1)"),
+                                 ({"rateUpPar": 1.0, "yMin": 3.0, "yMax": 2.0}, "16#8204", "yMin is above yMax (yMin = 3)"),
+                                 ({"yMin": math.nan, "ratePeriod": -1.0}, "16#8202",
+                                  "ratePeriod is negative or not finite (ratePeriod = -1)")):
+        fmu.set(**settings)
+        fmu.step(0.5)
+        warning = [m for m in fmu.messages if m[0] == 1][-1]
+        assert warning[1] == "logStatusWarning"
+        assert warning[2] == f"status {code}: {text}; the output holds", warning
+    fmu.set(ratePeriod=1.0, yMax=math.nan)
+    fmu.step(0.5)                                   # cleared: an event, not a warning
+    assert fmu.messages[-1][1:] == ("logEvents", "status 16#0000: no error")
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_wrong_type_messages_name_the_types(version):
+    fmu = Instance("RateLimiter", version)
+    fmu.start()
+    get_integer = "fmi2GetInteger" if version == 2 else "fmi3GetInt32"
+    assert get_raw(fmu, fmu.vr("y"), "Integer") == 3
+    assert f"y (value reference 17) is a Real variable, which {get_integer} cannot access" in fmu.errors()[-1][2]
+    fmu.fmu.reset()
+    fmu.start()
+    set_boolean = "fmi2SetBoolean" if version == 2 else "fmi3SetBoolean"
+    assert set_raw(fmu, fmu.vr("zeroRate"), True, "Boolean") == 3
+    assert f"zeroRate (value reference 12) is a Enumeration variable, which {set_boolean} cannot access" \
+        in fmu.errors()[-1][2]
+    fmu.free()
+
+
+def logged_categories(version, logging_on, categories):
+    """The categories of what an instance logs after SetDebugLogging: a
+    status warning, the status cleared (an event) and a failed call."""
+    fmu = Instance("RateLimiter", version, logging=logging_on)
+    fmu.fmu.setDebugLogging(logging_on, categories)
+    fmu.start(rateUpPar=-1.0)
+    fmu.raw_step(0.5)
+    fmu.set(rateUpPar=1.0)
+    fmu.raw_step(0.5)
+    call_status(fmu.fmu.doStep, fmu.t, -1.0)
+    seen = sorted({m[1] for m in fmu.messages})
+    fmu.free()
+    return seen
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_debug_logging_categories_choose_what_is_logged(version):
+    every = ["logEvents", "logStatusError", "logStatusWarning"]
+    assert logged_categories(version, True, []) == every
+    assert logged_categories(version, True, ["logEvents"]) == (
+        ["logEvents", "logStatusError", "logStatusWarning"] if version == 2 else ["logEvents"])
+    assert logged_categories(version, True, ["logStatusWarning", "logStatusError"]) == [
+        "logStatusError", "logStatusWarning"]
+    # FMI 2 always says why a call failed and warns; FMI 3 follows loggingOn
+    assert logged_categories(version, False, []) == (["logStatusError", "logStatusWarning"] if version == 2 else [])
+    fmu = Instance("RateLimiter", version)
+    with pytest.raises(Exception):
+        fmu.fmu.setDebugLogging(True, ["logNoSuchCategory"])
+    assert 'unknown log category "logNoSuchCategory"' in fmu.errors()[-1][2]
+    fmu.free()

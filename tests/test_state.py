@@ -84,6 +84,12 @@ BAD_BYTES = {
     "running time period NaN": lambda d: value_at(d, values_end(d) + 33, struct.pack("<d", float("nan"))),
     "running time base negative": lambda d: value_at(d, values_end(d) + 41, struct.pack("<d", -1.0)),
     "deciding rule unknown": lambda d: value_at(d, values_end(d) + 24, bytes([7])),
+    # an Integer (status, vr 21) one past the int32 range; at the range's end it is fine (below)
+    "integer 2^31": lambda d: value_at(d, 20 + 8 * 21, struct.pack("<d", 2147483648.0)),
+    "integer not whole": lambda d: value_at(d, 20 + 8 * 21, struct.pack("<d", 0.5)),
+    # short or foreign bytes with a valid CRC: refused by size and magic, not by the CRC
+    "truncated, resealed": lambda d: reseal(d[:-12]),
+    "foreign magic, resealed": lambda d: reseal(b"XXXX" + d[4:]),
 }
 
 
@@ -95,6 +101,8 @@ REASONS = {
     "boolean 2": "impossible value 2 for bypass", "start time infinite": "impossible time",
     "cycle count 2^60": "impossible time or cycle count", "running time period NaN": "impossible time",
     "running time base negative": "impossible time", "deciding rule unknown": "invalid rule 7",
+    "integer 2^31": "impossible value 2.14748e+09 for status", "integer not whole": "impossible value 0.5 for status",
+    "truncated, resealed": "bytes; expected", "foreign magic, resealed": "no header",
 }
 
 
@@ -120,4 +128,18 @@ def test_bad_serialized_state_is_refused_and_the_instance_recovers(version, dama
     fmu.t = t
     assert run_steps(fmu, STEPS[5:9]) == expected
     api["free"](good)
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_integer_at_the_end_of_the_int32_range_in_a_state_is_accepted(version):
+    fmu = started(version)
+    api = state_api(fmu)
+    data = bytes(api["serialize"](api["get"]()))
+    for value in (2147483647.0, -2147483648.0):
+        state = api["deserialize"](value_at(data, 20 + 8 * 21, struct.pack("<d", value)))
+        api["set"](state)
+        assert fmu.get("status") == int(value)
+        api["free"](state)
+    assert not fmu.errors()
     fmu.free()
