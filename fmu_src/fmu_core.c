@@ -151,7 +151,15 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
     return fmu_error(instance, function, "%s = %.17g is outside its range [%g, %g]", v->name, value, v->min, v->max);
 }
 
-static void publish(FmuInstance *instance, bool block);
+/* The time, and the block's outputs when a cycle ran since they were
+ * published (a step that runs no cycle changes no output). */
+static void publish(FmuInstance *instance, bool block) {
+    instance->core.values[0] = instance->core.time; /* the independent variable */
+    if (block) {
+        instance->model->publish(&instance->core.block, &instance->prepared, instance->core.values);
+    }
+    instance->outputsStale = FMU_FRESH;
+}
 
 /* Kernel configuration from the current values; the cycle length and
  * limits are derived again before the next cycle. The outputs derived from
@@ -177,16 +185,6 @@ FMU_NOINLINE static void prepare(FmuInstance *instance, double period) {
     if (instance->model->publishStatus) {
         instance->model->publishStatus(&instance->prepared, instance->core.values);
     }
-}
-
-/* The time, and the block's outputs when a cycle ran since they were
- * published (a step that runs no cycle changes no output). */
-static void publish(FmuInstance *instance, bool block) {
-    instance->core.values[0] = instance->core.time; /* the independent variable */
-    if (block) {
-        instance->model->publish(&instance->core.block, &instance->prepared, instance->core.values);
-    }
-    instance->outputsStale = FMU_FRESH;
 }
 
 /* Outputs at the start from the current parameters and inputs. */
@@ -540,7 +538,7 @@ static FmuStatus check_state(FmuInstance *instance, const char *function, const 
     return FMU_OK;
 }
 
-/* *state, checked, or a new one; NULL after an error */
+/* *state, checked, or a new one, tagged; NULL after an error */
 static FmuState *state_to_fill(FmuInstance *instance, const char *function, void **state) {
     FmuState *target = *state;
     if (target) {
@@ -549,7 +547,9 @@ static FmuState *state_to_fill(FmuInstance *instance, const char *function, void
     target = instance->allocate(instance, sizeof *target);
     if (!target) {
         fmu_error(instance, function, "out of memory");
+        return NULL;
     }
+    target->tag = STATE_TAG;
     return target;
 }
 
@@ -561,7 +561,6 @@ FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **stat
     if (!target) {
         return FMU_ERROR;
     }
-    target->tag = STATE_TAG;
     snapshot(instance, &target->core);
     *state = target;
     return FMU_OK;
@@ -628,7 +627,6 @@ FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, con
     if (!target) {
         return FMU_ERROR;
     }
-    target->tag = STATE_TAG;
     target->core = core;
     *state = target;
     return FMU_OK;
