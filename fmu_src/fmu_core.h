@@ -87,6 +87,17 @@ typedef struct {
 
 extern const ModelDefinition fmuModel;
 
+/* For the Siemens LGF models: cycleTime (the OB interval) counts only when
+ * callOB is a cyclic interrupt OB, 30..38 or 123 and above; else there is
+ * no valid cycle, and callOB is the cause. */
+static inline RlValue fmu_siemens_cycle(double callOB, int callOBVr, double cycleTime, int cycleTimeVr) {
+    const bool cyclic = (callOB >= 30 && callOB <= 38) || callOB >= 123;
+    RlValue cycle;
+    cycle.value = cyclic ? cycleTime : NAN;
+    cycle.source = cyclic ? cycleTimeVr : callOBVr;
+    return cycle;
+}
+
 /* What a step changed since the outputs were last published: the time
  * only (a step that ran no cycle), or the block too. */
 enum { FMU_FRESH = 0, FMU_STALE_TIME = 1, FMU_STALE_ALL = 2 };

@@ -6,11 +6,6 @@
 
 enum { MODE_RAMP, MODE_RESET, MODE_MANUAL, MODE_DEFAULT, MODE_TRACK };
 
-/* the cyclic interrupt OBs: 30..38, or 123 and above */
-static bool cyclic_interrupt_ob(double ob) {
-    return (ob >= 30 && ob <= 38) || ob >= 123;
-}
-
 static void configure(const double *v, RlConfig *c) {
     c->rateUp = (RlValue){ v[VR_setPosUpRateLim], VR_setPosUpRateLim };
     c->rateDown = (RlValue){ v[VR_setPosDownRateLim], VR_setPosDownRateLim };
@@ -22,8 +17,7 @@ static void configure(const double *v, RlConfig *c) {
     c->yMin = (RlValue){ v[VR_setLowLim], VR_setLowLim };
     c->hold = false;
     c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = cyclic_interrupt_ob(v[VR_callOB]) ? (RlValue){ v[VR_cycleTime], VR_cycleTime }
-                                                     : (RlValue){ NAN, VR_callOB };
+    c->cycleTime = fmu_siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     if (v[VR_reset] != 0) {
         c->modelMode = MODE_RESET;
         c->bypassValue = v[VR_enDefaultOutValue] != 0 ? v[VR_defaultOutValue] : 0.0;

@@ -3,17 +3,11 @@
  * a NaN value compared rather than passed, callOB validated. */
 #include "LGF_LimRateOfChangeCI_variables.h"
 
-/* the cyclic interrupt OBs: 30..38, or 123 and above */
-static bool cyclic_interrupt_ob(double ob) {
-    return (ob >= 30 && ob <= 38) || ob >= 123;
-}
-
 static void configure(const double *v, RlConfig *c) {
     c->rateUp = c->rateDown = (RlValue){ v[VR_setChangeRate], VR_setChangeRate };
     c->ratePeriod = (RlValue){ 1.0, VR_setChangeRate };
     c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = cyclic_interrupt_ob(v[VR_callOB]) ? (RlValue){ v[VR_cycleTime], VR_cycleTime }
-                                                     : (RlValue){ NAN, VR_callOB };
+    c->cycleTime = fmu_siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     c->bypass = v[VR_enDefaultOutValue] != 0;
     c->bypassValue = v[VR_defaultOutValue];
     c->zeroRate = RL_ZERO_RATE_HOLD;
