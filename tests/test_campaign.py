@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import fmutrace
 from support.fmu_driver import BUILD_DIR
-from support.scenarios import campaign, discover, write_outputs, write_report
+from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
 
 BIN = Path(sys.executable).parent
 
@@ -71,33 +72,28 @@ def cluster(tmp_path):
                 p.wait(timeout=30)
 
 
-def report(runs, where, folder):
-    outcomes = []
-    for outcome, scenario, result, png in runs:
-        write_outputs(outcome, scenario, result, png, folder)
-        outcomes.append(outcome)
-    write_report(outcomes, folder, 0.0, where)
-    return outcomes
-
-
 def without_timings(text):
-    text = re.sub(r"wall time [0-9.]+ s on [^<\n]*", "wall time", text)
+    text = re.sub(r"\([0-9.]+ s on [^)]*\)\)?", "(T)", text)
+    text = re.sub(r'"(seconds|where)": ("[^"]*"|[0-9.]+)', r'"\1": T', text)
     return re.sub(r"<td>[0-9]+\.[0-9]{2}</td>|\| [0-9]+\.[0-9]{2} \|", "T", text)
 
 
 def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_path):
-    scenarios = discover(["RateLimiter", "Ramp"])
-    distributed, where = campaign(scenarios, BUILD_DIR, scheduler=cluster, timeout=600)
-    assert where == f"Dask, 2 workers at {cluster}"
-    serial, _ = campaign(scenarios, BUILD_DIR, serial=True)
-    a = report(distributed, where, tmp_path / "distributed")
-    b = report(serial, "serial", tmp_path / "serial")
-    assert [(o.scenario, o.version, o.problems) for o in a] == [(o.scenario, o.version, o.problems) for o in b]
-    assert all(o.passed for o in a)
-    for (_, _, ra, pa), (_, _, rb, pb) in zip(distributed, serial):
-        for name in ra.dtype.names:
-            assert np.array_equal(ra[name], rb[name], equal_nan=True)
-        assert pa == pb  # the same plot, byte for byte
-    for page in ("index.html", "summary.md"):
+    fmus = [fmu_path(BUILD_DIR, model, version) for model in ("RateLimiter", "Ramp") for version in FMI_VERSIONS]
+    cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
+    distributed = fmutrace.compare(fmus, cases, report=tmp_path / "distributed", scheduler=cluster, timeout=600)
+    assert distributed.where == f"Dask, 2 workers at {cluster}"
+    serial = fmutrace.compare(fmus, cases, report=tmp_path / "serial", jobs=1)
+    assert serial.where == "1 process"
+    assert len(serial.cases) == 2 * len(discover(["RateLimiter", "Ramp"]))
+    assert [(o.case, o.fmu, o.status, o.messages) for o in distributed.cases] == \
+        [(o.case, o.fmu, o.status, o.messages) for o in serial.cases]
+    assert distributed.passed
+    for a, b in zip(distributed.cases, serial.cases):
+        for name in a.result.dtype.names:
+            assert np.array_equal(a.result[name], b.result[name], equal_nan=True)
+        assert a.png == b.png  # the same plot, byte for byte
+        assert (tmp_path / "distributed" / a.csv).read_bytes() == (tmp_path / "serial" / b.csv).read_bytes()
+    for page in ("index.html", "summary.md", "results.json"):
         assert without_timings((tmp_path / "distributed" / page).read_text()) == \
             without_timings((tmp_path / "serial" / page).read_text())

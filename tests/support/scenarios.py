@@ -1,16 +1,55 @@
-"""The project's reference scenarios (tests/scenarios), read and run by the
-campaign runner of fmutrace, the product code the main job runs."""
+"""The project's reference scenarios (tests/scenarios/<Model>/<name>/),
+read, run and compared by fmutrace, the product code the main job runs."""
+import math
+from functools import lru_cache
 from pathlib import Path
 
-import fmutrace.campaign
-from fmutrace.campaign import (FMI_VERSIONS, campaign, compare, fmu_path, load, same, simulate, write_outputs,
-                               write_report)
+from fmutrace import Fmu, Tolerance, load_case
+from fmutrace.comparison import compare as compare_traces
+from fmutrace.simulation import run_fmpy
 
-__all__ = ["FMI_VERSIONS", "SCENARIO_ROOT", "campaign", "compare", "discover", "fmu_path", "load", "same", "simulate",
-           "write_outputs", "write_report"]
+from support.fmu_driver import BUILD_DIR
 
 SCENARIO_ROOT = Path(__file__).resolve().parents[1] / "scenarios"
+FMI_VERSIONS = (2, 3)
+
+
+def fmu_path(build_dir, model, version):
+    return Path(build_dir) / f"fmi{version}" / f"{model}.fmu"
+
+
+@lru_cache(maxsize=None)
+def _fmu(model):
+    return Fmu(fmu_path(BUILD_DIR, model, 2))
+
+
+def load(folder):
+    """The scenario in folder, named <Model>/<name>, checked against its FMU."""
+    folder = Path(folder)
+    return load_case(folder, _fmu(folder.parent.name), name=f"{folder.parent.name}/{folder.name}")
 
 
 def discover(models=None):
-    return fmutrace.campaign.discover(SCENARIO_ROOT, models)
+    folders = sorted(p.parent for p in SCENARIO_ROOT.glob("*/*/*_ref.csv"))
+    return [load(f) for f in folders if models is None or f.parent.name in models]
+
+
+def simulate(scenario, fmu):
+    """The scenario through fmpy.simulate_fmu on the FMU file fmu."""
+    o = scenario.options
+    return run_fmpy(str(fmu), None, start_time=o["StartTime"], stop_time=o["StopTime"], step_size=o["StepSize"],
+                    inputs=scenario.inputs, start_values=scenario.start_values, outputs=scenario.outputs,
+                    relative_tolerance=o["RelTol"])
+
+
+def compare(scenario, result, reference=None):
+    """Where result differs from the reference (or the rows of it given),
+    bit for bit, as readable lines (none: the same)."""
+    return compare_traces(result, scenario.reference if reference is None else reference, Tolerance()).messages()
+
+
+def same(value, expected):
+    """Bit for bit (any NaN matches any NaN)."""
+    value, expected = float(value), float(expected)
+    return (math.isnan(value) and math.isnan(expected)) or \
+        (value == expected and math.copysign(1, value) == math.copysign(1, expected))

@@ -1,0 +1,145 @@
+"""The fmutrace command.
+
+  fmutrace run FMU [--input IN.csv] [--set NAME=VALUE]... [-o OUT.csv] ...
+  fmutrace compare FMU... CASE... [--report DIR] [--rel-tol R] ...
+
+Exit status: 0 success (compare: every case passes), 1 a case differs or
+the simulation failed, 2 a usage or input error (nothing was run).
+"""
+import argparse
+import sys
+
+from . import __version__
+from .campaign import compare
+from .fmu import is_fmu_file
+from .simulation import SimulationError, simulate
+from .traces import InputError, write_trace
+
+EXAMPLES = """examples:
+  fmutrace run build/fmi3/RateLimiter.fmu --input u.csv --set rateUpPar=2 --step-size 0.1 -o y.csv
+  fmutrace compare build/fmi3/RateLimiter.fmu my_traces/ --report report/
+  fmutrace compare build/fmi2/*.fmu build/fmi3/*.fmu tests/scenarios --jobs 2 --junit junit.xml
+"""
+
+
+def _assignment(text):
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE, not {text!r}")
+    return name.strip(), value.strip()
+
+
+def _non_negative(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"{text} must be >= 0")
+    return value
+
+
+def _positive_int(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text} must be at least 1")
+    return value
+
+
+def parser():
+    main = argparse.ArgumentParser(prog="fmutrace", description="Replay CSV traces through FMI 2 and FMI 3 "
+                                   "co-simulation FMUs with fmpy and report where they differ from references.",
+                                   epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    main.add_argument("--version", action="version", version=f"fmutrace {__version__}")
+    commands = main.add_subparsers(dest="command", required=True, metavar="{run,compare}")
+
+    run = commands.add_parser("run", help="simulate an FMU on a CSV input and write the result",
+                              description="Simulate an FMU on CSV inputs and write the result as CSV.")
+    run.add_argument("fmu", metavar="FMU")
+    run.add_argument("--input", metavar="IN.csv", help="input signals (a row holds from its time on)")
+    run.add_argument("--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[],
+                     help="a start value (repeatable)")
+    run.add_argument("--start-time", type=float, metavar="S", help="default: the input's first time")
+    run.add_argument("--stop-time", type=float, metavar="S", help="default: the input's last time")
+    run.add_argument("--step-size", type=float, metavar="H", help="communication step (default: the FMU's)")
+    run.add_argument("--output-interval", type=float, metavar="H", help="a whole multiple of the step size")
+    run.add_argument("--output", metavar="NAME", action="append", help="a variable to record (repeatable; "
+                     "default: the outputs)")
+    run.add_argument("-o", dest="out", metavar="OUT.csv", help="result file (default: standard output)")
+
+    cmp = commands.add_parser("compare", help="replay cases and compare with their references",
+                              description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
+                              "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
+                              "model and compare with the reference. Exact (bit for bit) unless a tolerance "
+                              "or a tube is given.")
+    cmp.add_argument("paths", nargs="+", metavar="FMU|CASE", help=".fmu files, then case folders or folders "
+                     "holding them (searched recursively)")
+    cmp.add_argument("--report", metavar="DIR", help="write index.html, summary.md, results.json, the results "
+                     "and plots here")
+    cmp.add_argument("--rel-tol", type=_non_negative, default=0.0, metavar="R")
+    cmp.add_argument("--abs-tol", type=_non_negative, default=0.0, metavar="A")
+    cmp.add_argument("--tube-time", type=_non_negative, metavar="S", help="tube half-width in time (with "
+                     "--tube-value), for traces sampled at other instants")
+    cmp.add_argument("--tube-value", type=_non_negative, metavar="V", help="tube half-width in value")
+    cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
+    cmp.add_argument("--jobs", type=_positive_int, metavar="N", help="local worker processes (default: one per "
+                     "core for 20 cases or more, else this process)")
+    cmp.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
+    cmp.add_argument("--plots", choices=("all", "failed", "none"), default="all",
+                     help="which cases get a plot in the report (default: all)")
+    cmp.add_argument("--timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
+    return main
+
+
+def run_command(args, out):
+    result = simulate(args.fmu, input=args.input, start_values=dict(args.set), start_time=args.start_time,
+                      stop_time=args.stop_time, step_size=args.step_size, output_interval=args.output_interval,
+                      outputs=args.output)
+    if args.out:
+        write_trace(args.out, result)
+        print(f"{len(result)} samples of {len(result.dtype.names) - 1} signals written to {args.out}", file=out)
+    else:
+        write_trace(out, result)
+    return 0
+
+
+def compare_command(args, out):
+    fmus = [p for p in args.paths if p.lower().endswith(".fmu") or is_fmu_file(p)]
+    cases = [p for p in args.paths if p not in fmus]
+    if not fmus:
+        raise InputError("no FMU given: name one or more .fmu files before the case folders")
+    if not cases:
+        raise InputError("no case folder given: name the folders of cases after the FMUs")
+    result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
+                     tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
+                     scheduler=args.scheduler, plots=args.plots, timeout=args.timeout)
+    for o in result.failed():
+        print(f"{o.status.upper()}  {o.case} on {o.fmu}", file=out)
+        for message in o.messages[:10]:
+            print(f"      {message}", file=out)
+    print(result.headline(), file=out)
+    if args.report:
+        print(f"report: {args.report.rstrip('/')}/index.html", file=out)
+    if args.junit:
+        print(f"JUnit XML: {args.junit}", file=out)
+    return result.exit_code
+
+
+def main(argv=None, out=None):
+    out = out or sys.stdout
+    args = parser().parse_args(argv)
+    try:
+        return (run_command if args.command == "run" else compare_command)(args, out)
+    except InputError as error:
+        print(f"fmutrace: error: {error}", file=sys.stderr)
+        return 2
+    except SimulationError as error:
+        print(f"fmutrace: {error}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

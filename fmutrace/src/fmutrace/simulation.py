@@ -1,0 +1,132 @@
+"""Simulations through fmpy.simulate_fmu.
+
+fmpy's co-simulation loop applies the inputs at t (a row holds from its
+time on for discrete inputs, continuous ones are interpolated; at a
+repeated time the row after the event), calls doStep(t, h) and records
+the outputs at t + h.
+"""
+import contextlib
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+from fmpy import simulate_fmu
+
+from .fmu import Fmu, unpacked
+from .traces import InputError, read_trace
+
+
+class SimulationError(RuntimeError):
+    """The FMU failed (an FMI error status, a crash of the call)."""
+
+
+def _held_to(inputs, stop_time):
+    """fmpy needs two input samples: a single row is held until stop_time
+    by a copy there (the same signal)."""
+    if inputs is None or len(inputs) != 1:
+        return inputs
+    last = inputs.copy()
+    last["time"] = max(stop_time, float(inputs["time"][0]))
+    return np.concatenate([inputs, last])
+
+
+def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_size, inputs, start_values, outputs,
+             relative_tolerance=None):
+    """One simulation: the result as a structured array ('time' first)."""
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # fmpy's notes on inputs it does not set
+            return simulate_fmu(
+                fmu_location,
+                model_description=model_description,
+                start_time=start_time,
+                stop_time=stop_time,
+                output_interval=step_size,
+                relative_tolerance=relative_tolerance,
+                input=_held_to(inputs, stop_time),
+                start_values=dict(start_values),
+                output=list(outputs),
+                fmi_type="CoSimulation",
+            )
+    except Exception as error:  # fmpy raises FMICallException and plain Exceptions
+        raise SimulationError(f"the simulation failed: {error}") from error
+
+
+def every_nth(result, start_time, step_size, output_interval):
+    """The samples of result at multiples of output_interval from start_time."""
+    if output_interval is None or output_interval == step_size:
+        return result
+    ratio = output_interval / step_size
+    n = round(ratio)
+    if n < 1 or not math.isclose(ratio, n, rel_tol=1e-9):
+        raise InputError(f"the output interval {output_interval:g} s must be a whole multiple of the step size "
+                         f"{step_size:g} s")
+    steps = np.rint((result["time"] - start_time) / step_size).astype(np.int64)
+    return result[steps % n == 0]
+
+
+def simulate(fmu, input=None, start_values=None, start_time=None, stop_time=None, step_size=None,
+             output_interval=None, outputs=None):
+    """Simulate an FMI 2 or FMI 3 co-simulation FMU on input signals.
+
+    fmu              path of the .fmu file
+    input            a CSV file (any dialect fmutrace reads) or a structured
+                     array with a 'time' field, or None
+    start_values     {name: value}; values may be text ("2.5", "true")
+    start_time       default: the input's first time, else the FMU's default
+                     experiment, else 0
+    stop_time        default: the input's last time, else the FMU's default
+    step_size        the communication step (a PLC cycle for these FMUs);
+                     default: the FMU's default step size
+    output_interval  a whole multiple of step_size (default: step_size)
+    outputs          names to record (default: the FMU's outputs)
+
+    Returns a NumPy structured array, 'time' first. Raises InputError for
+    bad input (nothing is run) and SimulationError if the FMU fails.
+    """
+    fmu = fmu if isinstance(fmu, Fmu) else Fmu(fmu)
+    if isinstance(input, (str, Path)):
+        inputs = read_trace(input, fmu.input_problem)
+    elif input is not None:
+        inputs = np.asarray(input)
+        if inputs.dtype.names is None or "time" not in inputs.dtype.names:
+            raise InputError("the input must be a structured array with a 'time' field")
+        for name in inputs.dtype.names:
+            problem = name != "time" and fmu.input_problem(name)
+            if problem:
+                raise InputError(problem)
+    else:
+        inputs = None
+    values = {name: fmu.start_value(name, value) for name, value in (start_values or {}).items()}
+    names = list(outputs) if outputs else fmu.outputs
+    for name in names:
+        problem = fmu.variable_problem(name)
+        if problem:
+            raise InputError(f"output {problem.removeprefix('column ')}")
+
+    def first(*candidates):
+        return next((float(c) for c in candidates if c is not None), None)
+
+    has_input = inputs is not None and len(inputs)
+    start = first(start_time, inputs["time"][0] if has_input else None, fmu.default_start, 0.0)
+    stop = first(stop_time, inputs["time"][-1] if has_input else None, fmu.default_stop)
+    step = first(step_size, fmu.default_step)
+    if step is None:
+        raise InputError(f"{fmu.label} gives no default step size: give one (--step-size)")
+    if not step > 0:
+        raise InputError(f"the step size must be greater than 0, not {step!r}")
+    if stop is None or not stop > start:
+        raise InputError(f"the stop time ({stop!r}) must be after the start time ({start!r})")
+    result = run_fmpy(str(fmu.path), fmu.model_description, start_time=start, stop_time=stop, step_size=step,
+                      inputs=inputs, start_values=values, outputs=names)
+    return every_nth(result, start, step, output_interval)
+
+
+def run_case(case, fmu_bytes):
+    """The result of one case (the FMU given as bytes: unzipped once per
+    process)."""
+    folder, model_description = unpacked(fmu_bytes)
+    o = case.options
+    return run_fmpy(folder, model_description, start_time=o["StartTime"], stop_time=o["StopTime"],
+                    step_size=o["StepSize"], inputs=case.inputs, start_values=case.start_values,
+                    outputs=case.outputs, relative_tolerance=o["RelTol"])
