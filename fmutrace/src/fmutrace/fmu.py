@@ -71,9 +71,10 @@ class Fmu:
         variable = self.variables.get(name)
         if variable is None:
             raise InputError(f"{name!r} is not a variable of {self.label}")
-        if variable.causality == "independent" or variable.variability == "constant":
-            raise InputError(f"{name!r} is {'the independent variable' if variable.causality == 'independent' else 'a constant'}"
-                             f" of {self.label}; it cannot be set")
+        if variable.causality not in ("parameter", "structuralParameter", "input") or \
+                variable.variability == "constant":
+            raise InputError(f"{name!r} is a {variable.variability} {variable.causality} of {self.label}: only "
+                             "parameters and inputs have start values to set")
         text = str(value).strip()
         kind = variable.type
         if kind == "Boolean":

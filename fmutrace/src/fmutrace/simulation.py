@@ -32,8 +32,18 @@ def _held_to(inputs, stop_time):
 
 
 def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_size, inputs, start_values, outputs,
-             relative_tolerance=None):
-    """One simulation: the result as a structured array ('time' first)."""
+             relative_tolerance=None, debug_logging=False):
+    """One simulation: the result as a structured array ('time' first). A
+    failure is a SimulationError that quotes the FMU's warnings and errors:
+    an FMI 3 FMU logs nothing unless logging is on, so a failed run is
+    repeated once with logging on to hear why."""
+    said = []
+
+    def logger(*args):  # FMI 2 (through fmpy's proxy): env, instance, status, category, message
+        status, message = args[-3], args[-1]  # FMI 3: env, status, category, message
+        if status >= 1:  # warning, discard, error, fatal
+            said.append(message.decode(errors="replace") if isinstance(message, bytes) else str(message))
+
     try:
         with contextlib.redirect_stdout(io.StringIO()):  # fmpy's notes on inputs it does not set
             return simulate_fmu(
@@ -47,9 +57,19 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
                 start_values=dict(start_values),
                 output=list(outputs),
                 fmi_type="CoSimulation",
+                logger=logger,
+                debug_logging=debug_logging,
             )
     except Exception as error:  # fmpy raises FMICallException and plain Exceptions
-        raise SimulationError(f"the simulation failed: {error}") from error
+        if not said and not debug_logging:
+            try:
+                run_fmpy(fmu_location, model_description, start_time=start_time, stop_time=stop_time,
+                         step_size=step_size, inputs=inputs, start_values=start_values, outputs=outputs,
+                         relative_tolerance=relative_tolerance, debug_logging=True)
+            except SimulationError as again:
+                raise again from error
+        told = f"; the FMU said: {' | '.join(said[-3:])}" if said else ""
+        raise SimulationError(f"the simulation failed: {str(error).rstrip('.')}{told}") from error
 
 
 def every_nth(result, start_time, step_size, output_interval):
