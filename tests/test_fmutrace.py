@@ -274,12 +274,15 @@ def test_bad_input_exits_2_naming_file_line_and_column(bad, tmp_path):
     case = good_case(tmp_path / "cases" / "one")
     assert fmutrace_cli("compare", RATE_LIMITER[3], tmp_path / "cases").returncode == 0
     (case / file).write_text(text)
+    good_case(tmp_path / "cases" / "two")
     done = fmutrace_cli("compare", RATE_LIMITER[3], tmp_path / "cases", "--report", tmp_path / "report")
     assert done.returncode == 2, done.stdout + done.stderr
     assert done.stderr.startswith("fmutrace: error: ")
     assert message in done.stderr, done.stderr
     assert str(case / file) in done.stderr
-    assert not (tmp_path / "report").exists()  # nothing ran
+    assert "1 of 2 cases pass, 0 differ, 1 invalid" in done.stdout  # the other case ran
+    results = json.loads((tmp_path / "report" / "results.json").read_text())
+    assert [(c["case"], c["status"]) for c in results["cases"]] == [("one", "invalid"), ("two", "pass")]
 
 
 @pytest.mark.parametrize("args,message", [
@@ -356,7 +359,7 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
 
     results = json.loads((report / "results.json").read_text())
     assert results["mode"] == "exact" and results["passed"] is False
-    assert results["counts"] == {"pass": 3, "fail": 2, "error": 0}
+    assert results["counts"] == {"pass": 3, "fail": 2, "error": 0, "invalid": 0}
     off = next(c for c in results["cases"] if c["case"] == "lag_off" and c["fmu"] == "FirstOrderLag (FMI 3)")
     x = next(s for s in off["signals"] if s["name"] == "x")
     assert x["time"] == 1.0 and x["excess"] == pytest.approx(0.01, rel=1e-9) and x["failed"] == 11
@@ -370,7 +373,7 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
 
 def test_api_compare_returns_the_outcomes(tmp_path):
     lag_case(tmp_path / "lag")
-    campaign = fmutrace.compare([LAG[2], LAG[3]], tmp_path, rel_tol=1e-12)
+    campaign = fmutrace.compare([LAG[2], LAG[3]], tmp_path / "lag", rel_tol=1e-12, report=tmp_path / "report")
     assert campaign.passed and campaign.exit_code == 0
     assert [(o.case, o.fmu) for o in campaign.cases] == [("lag", "FirstOrderLag (FMI 2)"),
                                                           ("lag", "FirstOrderLag (FMI 3)")]

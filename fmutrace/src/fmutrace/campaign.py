@@ -8,6 +8,7 @@ once to every worker) and returns the outcome with its result and plot,
 so workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written here.
 """
+import hashlib
 import os
 import sys
 import tempfile
@@ -16,25 +17,31 @@ import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .cases import find_cases, load_case
+from .cases import case_texts, find_cases, load_case
 from .comparison import Comparison, Tolerance, compare as compare_traces
 from .fmu import Fmu
 from .report import plot_case, write_case_files, write_junit, write_report
-from .simulation import SimulationError, run_case
+from .runner import Runner
+from .simulation import SimulationError
 from .traces import InputError
+
+
+STATUSES = ("pass", "fail", "error", "invalid")
 
 
 @dataclass
 class CaseOutcome:
-    """One case on one FMU: 'pass', 'fail' (the result differs) or 'error'
-    (the simulation failed)."""
+    """One case on one FMU: 'pass', 'fail' (the result differs), 'error'
+    (the simulation failed) or 'invalid' (its files are bad: the message
+    names file, line and column). result and png are kept for the cases
+    that get a plot."""
     case: str
     fmu: str                 # the FMU's label, e.g. "RateLimiter (FMI 3)"
     fmu_file: str
     fmu_folder: str          # its folder in the report
     status: str = "pass"
     messages: list = field(default_factory=list)
-    deviations: list = field(default_factory=list)
+    deviations: list = field(default_factory=list)  # of the failing signals
     seconds: float = 0.0
     result: object = None    # structured array
     png: bytes = b""
@@ -60,10 +67,11 @@ class CampaignResult:
 
     @property
     def exit_code(self):
-        return 0 if self.passed else 1
+        """0 every case passes, 1 one differs or failed to simulate, 2 one is invalid."""
+        return 2 if any(o.status == "invalid" for o in self.cases) else 0 if self.passed else 1
 
     def counts(self):
-        return {s: sum(o.status == s for o in self.cases) for s in ("pass", "fail", "error")}
+        return {s: sum(o.status == s for o in self.cases) for s in STATUSES}
 
     def failed(self):
         return [o for o in self.cases if not o.passed]
@@ -71,8 +79,9 @@ class CampaignResult:
     def headline(self):
         c = self.counts()
         text = f"{c['pass']} of {len(self.cases)} cases pass"
-        if c["fail"] or c["error"]:
-            text += f", {c['fail']} differ" + (f", {c['error']} failed to simulate" if c["error"] else "")
+        if not self.passed:
+            text += f", {c['fail']} differ" + (f", {c['error']} failed to simulate" if c["error"] else "") + \
+                (f", {c['invalid']} invalid" if c["invalid"] else "")
         return text + f" ({self.seconds:.1f} s on {self.where})."
 
     def summary(self):
@@ -84,24 +93,54 @@ class CampaignResult:
         return "\n".join(lines)
 
 
-def run_one(case, fmu_bytes, fmu, tolerance, plots):
-    """One case on one FMU, where the work happens (any worker). fmu: the
-    CaseOutcome fields that name it."""
+def run_one(folder, name, texts, runner, fmu, labels, tolerance, plots):
+    """One case on one FMU, where the work happens (any worker): read and
+    checked, simulated, compared, plotted if asked. labels: the CaseOutcome
+    fields that name the FMU."""
     started = time.perf_counter()
-    outcome = CaseOutcome(case.name, **fmu)
+    outcome = CaseOutcome(name, **labels)
     try:
-        outcome.result = run_case(case, fmu_bytes)
-        comparison = compare_traces(outcome.result, case.reference, tolerance)
+        case = load_case(folder, fmu, name, texts)
+    except InputError as error:
+        outcome.status, outcome.messages = "invalid", [str(error)]
+        outcome.seconds = time.perf_counter() - started
+        return outcome
+    comparison = None
+    try:
+        o = case.options
+        result = runner.run(o["StartTime"], o["StopTime"], o["StepSize"], case.inputs, case.start_values,
+                            case.outputs, o["RelTol"])
+        comparison = compare_traces(result, case.reference, tolerance)
         outcome.status = "pass" if comparison.passed else "fail"
     except SimulationError as error:
+        result, outcome.status = None, "error"
         comparison = Comparison(problem=str(error))
-        outcome.status = "error"
-    outcome.deviations = comparison.deviations
+    outcome.deviations = [d for d in comparison.deviations if not d.passed]  # a passing signal says nothing more
     outcome.messages = comparison.messages()
-    if outcome.result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
-        outcome.png = plot_case(case, outcome.result, tolerance, fmu["fmu"])
+    if result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
+        outcome.result = result
+        outcome.png = plot_case(case, result, tolerance, labels["fmu"])
     outcome.seconds = time.perf_counter() - started
     return outcome
+
+
+_workers_fmus = {}  # in a worker process: the FMU's content hash -> (Runner, Fmu), kept from task to task
+
+
+def worker_fmu(fmu_bytes, path):
+    """The Runner (one instance, reused) and the Fmu of these bytes in this
+    process."""
+    key = hashlib.sha256(fmu_bytes).hexdigest()
+    if key not in _workers_fmus:
+        runner = Runner(fmu_bytes)
+        _workers_fmus[key] = runner, Fmu(path, runner.md)
+    return _workers_fmus[key]
+
+
+def run_batch(items, fmu_bytes, path, labels, tolerance, plots):
+    """A Dask task: the cases [(folder, name, texts or None)] of one FMU."""
+    runner, fmu = worker_fmu(fmu_bytes, path)
+    return [run_one(folder, name, texts, runner, fmu, labels, tolerance, plots) for folder, name, texts in items]
 
 
 class Progress:
@@ -158,20 +197,19 @@ def _report_folders(fmus):
 
 
 def plan(fmus, paths):
-    """[(case, fmu)] of every FMU's cases under paths, each checked
-    against its FMU before anything runs (InputError on the first
-    problem)."""
+    """[(fmu, folder, name)] of every FMU's cases under paths (InputError
+    for an FMU without any)."""
     work = []
     for fmu in fmus:
         found = find_cases(paths, fmu.model)
         if not found:
             raise InputError(f"no case of {fmu.label} (no {fmu.model}_ref.csv) under {', '.join(map(str, paths))}")
-        work += [(load_case(folder, fmu, name), fmu) for folder, name in found]
+        work += [(fmu, folder, name) for folder, name in found]
     return work
 
 
 def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, tube_time=None, tube_value=None,
-            junit=None, jobs=None, scheduler=None, plots="all", timeout=None, progress=None):
+            junit=None, jobs=None, scheduler=None, plots=None, timeout=None, progress=None):
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
@@ -186,17 +224,20 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     jobs        1: in this process; N: a local Dask cluster of N processes;
                 None: one per core for 20 cases or more, else 1
     scheduler   address of a Dask scheduler (instead of a local cluster)
-    plots       'all', 'failed' or 'none' (plots are made with a report)
+    plots       which cases get a plot and a result CSV in the report:
+                'all', 'failed' or 'none'; None: all for up to 500 cases,
+                else the failed ones
     timeout     seconds to wait for a cluster's results (None: no bound)
 
     Returns a CampaignResult (.passed, .cases, .summary(), .exit_code).
-    Raises InputError (nothing run) for a bad FMU, case file or option.
+    Raises InputError for a bad FMU, folder or option; a case whose files
+    are bad is reported as 'invalid' (exit code 2) and the others run.
     """
     try:
         tolerance = tolerance or Tolerance(rel_tol, abs_tol, tube_time, tube_value)
     except ValueError as error:
         raise InputError(str(error)) from None
-    if plots not in ("all", "failed", "none"):
+    if plots not in (None, "all", "failed", "none"):
         raise InputError(f"plots must be all, failed or none, not {plots!r}")
     fmu_paths = [fmus] if isinstance(fmus, (str, Path)) else list(fmus)
     case_paths = [cases] if isinstance(cases, (str, Path)) else list(cases)
@@ -204,33 +245,43 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
         raise InputError("give at least one FMU and one case folder")
     loaded = [Fmu(path) for path in fmu_paths]
     work = plan(loaded, case_paths)
-    folders = _report_folders(loaded)
-    names = {f.path: {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]} for f in loaded}
-    fmu_bytes = {f.path: f.path.read_bytes() for f in loaded}
+    if plots is None:
+        plots = "all" if len(work) <= 500 else "failed"
     plots = plots if report else "none"
     if jobs is None:  # a local cluster takes seconds to start: worth it for many cases only
         jobs = os.cpu_count() if len(work) >= 20 else 1
+    folders = _report_folders(loaded)
+    labels = {f.path: {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]} for f in loaded}
+    fmu_bytes = {f.path: f.path.read_bytes() for f in loaded}
 
     started = time.perf_counter()
     bar = Progress(len(work), progress)
     outcomes = [None] * len(work)
-    failed = 0
+    counts = {"done": 0, "failed": 0}
 
     def finished(i, outcome):
-        nonlocal failed
         outcomes[i] = outcome
-        failed += not outcome.passed
+        counts["done"] += 1
+        counts["failed"] += not outcome.passed
         if report:
             write_case_files(outcome, report)
-        bar.update(sum(o is not None for o in outcomes), failed)
+        bar.update(counts["done"], counts["failed"])
 
     try:
         if scheduler is None and jobs <= 1:
-            for i, (case, fmu) in enumerate(work):
-                finished(i, run_one(case, fmu_bytes[fmu.path], names[fmu.path], tolerance, plots))
+            runners = {}
+            try:
+                for i, (fmu, folder, name) in enumerate(work):
+                    if fmu.path not in runners:
+                        runners[fmu.path] = Runner(fmu_bytes[fmu.path])
+                    finished(i, run_one(folder, name, None, runners[fmu.path], fmu, labels[fmu.path], tolerance,
+                                        plots))
+            finally:
+                for runner in runners.values():
+                    runner.close()
             where = "1 process"
         else:
-            where = _on_dask(work, fmu_bytes, names, tolerance, plots, jobs, scheduler, timeout, finished)
+            where = _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, timeout, finished)
     finally:
         bar.close()
     result = CampaignResult(outcomes, tolerance, where, time.perf_counter() - started, Path(report) if report else None)
@@ -241,28 +292,75 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     return result
 
 
-def _on_dask(work, fmu_bytes, names, tolerance, plots, jobs, scheduler, timeout, finished):
+def _batches(work, size):
+    """Consecutive runs of at most size items of one FMU: [(fmu, [(i, folder, name)])]."""
+    batch, current = [], None
+    for i, (fmu, folder, name) in enumerate(work):
+        if batch and (fmu is not current or len(batch) == size):
+            yield current, batch
+            batch = []
+        current = fmu
+        batch.append((i, folder, name))
+    if batch:
+        yield current, batch
+
+
+def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, timeout, finished):
+    """The cases in batches on Dask workers, at most a few batches per
+    worker in flight (the client's memory stays flat); a worker of a remote
+    scheduler gets the files' texts, a local one reads them itself."""
+    import dask
     from dask.distributed import Client, LocalCluster, as_completed
 
     cluster = None
     if scheduler:
         client = Client(scheduler, timeout=timeout or 60)
     else:
-        cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None)
+        # no statistical profiler in the workers: its history grows with the campaign's length
+        with dask.config.set({"distributed.worker.profile.enabled": False}):
+            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
     try:
         client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
         workers = len(client.scheduler_info()["workers"])
         shared = {path: client.scatter(data, broadcast=True) for path, data in fmu_bytes.items()}
-        futures = {client.submit(run_one, case, shared[fmu.path], names[fmu.path], tolerance, plots, pure=False): i
-                   for i, (case, fmu) in enumerate(work)}
+        size = max(1, min(256, -(-len(work) // (8 * workers))))
+        batches = _batches(work, size)
+        in_flight = as_completed()
+        indices = {}
+
+        def submit_next():
+            for fmu, batch in batches:
+                items = [(folder, name, case_texts(folder, fmu.model) if scheduler else None)
+                         for _, folder, name in batch]
+                future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), labels[fmu.path],
+                                       tolerance, plots, pure=False)
+                indices[future] = [i for i, _, _ in batch]
+                in_flight.add(future)
+                return True
+            return False
+
+        for _ in range(3 * workers):
+            submit_next()
         deadline = None if timeout is None else time.monotonic() + timeout
-        for future in as_completed(futures, timeout=timeout):
-            if deadline is not None and time.monotonic() > deadline:
-                raise TimeoutError(f"the cluster did not finish the campaign within {timeout} s")
-            finished(futures[future], future.result())
+        while in_flight.count():
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+            future = next(in_flight) if remaining is None else _next_within(in_flight, remaining, timeout)
+            for i, outcome in zip(indices.pop(future), future.result()):
+                finished(i, outcome)
+            submit_next()
         return f"Dask, {workers} workers" + (f" at {scheduler}" if scheduler else " (local processes)")
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _next_within(in_flight, seconds, timeout):
+    """The next finished future, or TimeoutError once the campaign's bound is up."""
+    deadline = time.monotonic() + seconds
+    while not in_flight.has_ready():
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"the cluster did not finish the campaign within {timeout} s")
+        time.sleep(0.01)
+    return next(in_flight)

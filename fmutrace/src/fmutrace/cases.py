@@ -11,12 +11,14 @@
 Every file is checked against the FMU before anything runs: a problem is
 an InputError naming the file, line and column.
 """
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from .traces import InputError, TraceError, _lines, _split, parse_number, read_trace
+from .traces import InputError, TraceError, _lines, _split, parse_number, read_text, read_trace
 
 OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
+FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
 
 
 @dataclass
@@ -40,20 +42,19 @@ class Case:
         return [n for n in self.reference.dtype.names if n != "time"]
 
 
-def read_options(path, reference, fmu):
+def read_options(path, text, reference, fmu):
     options = {"RelTol": 1e-6}
-    if path.exists():
-        for number, line in _lines(path):
-            cells = _split(line, ",")
-            if len(cells) != 2:
-                raise TraceError(path, number, 1, f"expected 'Name,value', found {line.strip()!r}")
-            key, literal = cells
-            if key not in OPTIONS:
-                raise TraceError(path, number, 1, f"unknown option {key!r} (known: {', '.join(OPTIONS)})")
-            value = parse_number(literal)
-            if value is None or value != value:
-                raise TraceError(path, number, 2, f"{key} {literal!r} is not a number")
-            options[key] = value
+    for number, line in _lines(text or ""):
+        cells = _split(line, ",")
+        if len(cells) != 2:
+            raise TraceError(path, number, 1, f"expected 'Name,value', found {line.strip()!r}")
+        key, literal = cells
+        if key not in OPTIONS:
+            raise TraceError(path, number, 1, f"unknown option {key!r} (known: {', '.join(OPTIONS)})")
+        value = parse_number(literal)
+        if value is None or value != value:
+            raise TraceError(path, number, 2, f"{key} {literal!r} is not a number")
+        options[key] = value
     options.setdefault("StartTime", float(reference["time"][0]))
     options.setdefault("StopTime", float(reference["time"][-1]))
     if "StepSize" not in options:
@@ -61,7 +62,7 @@ def read_options(path, reference, fmu):
             raise InputError(f"{path}: no StepSize: the file is missing or has none, and {fmu.label} gives no "
                              "default step size")
         options["StepSize"] = fmu.default_step
-    where = path if path.exists() else f"{path} (defaults)"
+    where = path if text is not None else f"{path} (defaults)"
     if not options["StepSize"] > 0:
         raise TraceError(where, 0, 0, f"StepSize {options['StepSize']!r} must be greater than 0")
     if not options["StopTime"] > options["StartTime"]:
@@ -70,13 +71,11 @@ def read_options(path, reference, fmu):
     return options
 
 
-def read_start_values(path, fmu):
+def read_start_values(path, text, fmu):
     """The start values of a "name,value" file, each checked against the
     FMU's variable (type, range)."""
     values = {}
-    if not path.exists():
-        return values
-    for number, line in _lines(path):
+    for number, line in _lines(text or ""):
         cells = _split(line, "," if line.count(",") else ";")
         if len(cells) != 2:
             raise TraceError(path, number, 1, f"expected 'name,value', found {line.strip()!r}")
@@ -90,45 +89,92 @@ def read_start_values(path, fmu):
     return values
 
 
-def load_case(folder, fmu, name=None):
-    """The case in folder for fmu's model, checked against the FMU."""
+def case_texts(folder, model):
+    """{file name: text} of the case's files that exist (what a worker
+    without this file system needs)."""
+    texts = {}
+    for suffix in FILES:
+        name = suffix if suffix == "README.md" else f"{model}{suffix}"
+        path = os.path.join(folder, name)
+        try:
+            texts[name] = read_text(path)
+        except TraceError:
+            if os.path.exists(path):  # there but unreadable: say so
+                raise
+    return texts
+
+
+def load_case(folder, fmu, name=None, texts=None):
+    """The case in folder for fmu's model, checked against the FMU; the
+    files' texts may be given (texts from case_texts), else they are read."""
     folder = Path(folder)
     model = fmu.model
-    reference = read_trace(folder / f"{model}_ref.csv", fmu.variable_problem)
-    inputs_file = folder / f"{model}_in.csv"
-    inputs = read_trace(inputs_file, fmu.input_problem) if inputs_file.exists() else None
-    readme = folder / "README.md"
-    description = ""
-    if readme.exists():
-        lines = readme.read_text(errors="replace").strip().splitlines()
-        description = lines[0].lstrip("# ").strip() if lines else ""
+    texts = case_texts(folder, model) if texts is None else texts
+
+    def text(file_name):
+        return texts.get(file_name)
+
+    ref_name = f"{model}_ref.csv"
+    if ref_name not in texts:
+        raise TraceError(folder / ref_name, 0, 0, "no such file")
+    reference = read_trace(folder / ref_name, fmu.variable_problem, text(ref_name))
+    in_name = f"{model}_in.csv"
+    inputs = read_trace(folder / in_name, fmu.input_problem, text(in_name)) if in_name in texts else None
+    readme = (text("README.md") or "").strip().splitlines()
     return Case(
         name=name or folder.name,
         model=model,
         folder=folder,
-        options=read_options(folder / f"{model}_ref.opt", reference, fmu),
-        start_values=read_start_values(folder / f"{model}_start.csv", fmu),
+        options=read_options(folder / f"{model}_ref.opt", text(f"{model}_ref.opt"), reference, fmu),
+        start_values=read_start_values(folder / f"{model}_start.csv", text(f"{model}_start.csv"), fmu),
         inputs=inputs,
         reference=reference,
-        description=description,
+        description=readme[0].lstrip("# ").strip() if readme else "",
     )
 
 
 def find_cases(paths, model):
     """[(folder, name)] of the cases of model under paths, each a case
-    folder itself or a folder searched recursively, sorted by name: the
-    folder's path below the one searched (its own name for a case folder
-    given itself)."""
-    found = {}
-    for path in map(Path, paths):
-        if not path.is_dir():
+    folder itself or a folder searched recursively (through linked folders
+    too, each folder once), sorted by name: the folder's path below the one
+    searched (its own name for a case folder given itself)."""
+    target = f"{model}_ref.csv"
+    found, names = {}, set()
+    for path in paths:
+        root = os.fspath(path)
+        if not os.path.isdir(root):
             raise InputError(f"{path}: no such folder")
-        for reference in sorted(path.rglob(f"{model}_ref.csv")):
-            folder = reference.parent.resolve()
-            relative = reference.parent.relative_to(path).as_posix()
-            name = path.resolve().name if relative == "." else relative
-            if folder not in found:
-                if name in found.values():  # the same name below two folders given
-                    name = f"{path.resolve().name}/{name}"
-                found[folder] = name
-    return sorted(found.items(), key=lambda item: item[1])
+        root_name = os.path.basename(os.path.realpath(root))
+        for folder, relative, key in _walk(root, target):
+            name = relative or root_name
+            if key not in found:
+                if name in names:  # the same name below two folders given
+                    name = f"{root_name}/{name}"
+                names.add(name)
+                found[key] = (Path(folder), name)
+    return sorted(found.values(), key=lambda item: item[1])
+
+
+def _walk(root, file_name):
+    """(folder, path below root, identity) of the folders below root that
+    hold file_name."""
+    stack, seen = [(root, "")], set()
+    while stack:
+        folder, relative = stack.pop()
+        try:
+            status = os.stat(folder)
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        key = (status.st_dev, status.st_ino)
+        if key in seen:
+            continue
+        seen.add(key)
+        holds = False
+        for entry in entries:
+            if entry.name == file_name:
+                holds = holds or entry.is_file()
+            elif entry.is_dir():
+                stack.append((entry.path, f"{relative}/{entry.name}" if relative else entry.name))
+        if holds:
+            yield folder, relative, key

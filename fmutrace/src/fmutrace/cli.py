@@ -4,7 +4,8 @@
   fmutrace compare FMU... CASE... [--report DIR] [--rel-tol R] ...
 
 Exit status: 0 success (compare: every case passes), 1 a case differs or
-the simulation failed, 2 a usage or input error (nothing was run).
+the simulation failed, 2 a usage or input error (a case with bad files is
+reported and the other cases run).
 """
 import argparse
 import sys
@@ -117,6 +118,9 @@ def compare_command(args, out):
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
                      scheduler=args.scheduler, plots=args.plots, timeout=args.timeout)
     for o in result.failed():
+        if o.status == "invalid":
+            print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
+            continue
         print(f"{o.status.upper()}  {o.case} on {o.fmu}", file=out)
         for message in o.messages[:10]:
             print(f"      {message}", file=out)

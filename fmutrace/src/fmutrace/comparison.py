@@ -16,7 +16,7 @@ the value from that instant on, is the one compared. A reference sample
 without a result sample at its time fails.
 """
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -84,7 +84,7 @@ class Deviation:
 
     def as_dict(self):
         """For JSON: the fields that have a value."""
-        return {k: _json_number(v) for k, v in asdict(self).items() if v is not None and v != ""}
+        return {k: _json_number(v) for k, v in vars(self).items() if v is not None and v != ""}
 
 
 def _json_number(value):

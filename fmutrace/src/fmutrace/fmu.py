@@ -24,15 +24,18 @@ REAL_TYPES = ("Real", "Float32", "Float64")
 class Fmu:
     """An FMU file and its model description."""
 
-    def __init__(self, path):
+    def __init__(self, path, model_description=None):
+        """path: the .fmu file; model_description: fmpy's, if read already
+        (a worker has it from the unpacked FMU)."""
         self.path = Path(path)
-        if not self.path.is_file():
-            raise InputError(f"{path}: no such FMU file")
-        try:
-            self.model_description = read_model_description(str(self.path))
-        except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
-            raise InputError(f"{path}: not an FMU ({error})") from None
-        md = self.model_description
+        if model_description is None:
+            if not self.path.is_file():
+                raise InputError(f"{path}: no such FMU file")
+            try:
+                model_description = read_model_description(str(self.path))
+            except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
+                raise InputError(f"{path}: not an FMU ({error})") from None
+        self.model_description = md = model_description
         if md.coSimulation is None:
             raise InputError(f"{path}: {md.modelName} has no Co-Simulation interface")
         self.model = md.modelName

@@ -27,6 +27,8 @@ def plot_case(case, result, tolerance, label):
     has_inputs = case.inputs is not None
     rows = len(names) + 1 + has_inputs
     fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(8, 1.6 * rows + 0.6), squeeze=False)
+    for ax in axes[:, 0]:
+        ax.tick_params(labelsize=7)
     axes = list(axes[:, 0])
     if has_inputs:
         ax = axes.pop(0)
@@ -63,7 +65,8 @@ def plot_case(case, result, tolerance, label):
     deviation_axis.set_xlabel("time [s]")
     title = f"{case.name} on {label}" + (f": {case.description}" if case.description else "")
     fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize=9)
-    fig.tight_layout()
+    height = 1.6 * rows + 0.6  # fixed margins: tight_layout would cost more than the rest of the plot
+    fig.subplots_adjust(left=0.1, right=0.98, top=1 - 0.45 / height, bottom=0.45 / height, hspace=0.12)
     stream = io.BytesIO()
     fig.savefig(stream, dpi=80, format="png", metadata={"Software": None})
     plt.close(fig)
@@ -72,6 +75,8 @@ def plot_case(case, result, tolerance, label):
 
 def write_case_files(outcome, report_dir):
     """<fmu folder>/<case>_out.csv and .png; their paths into outcome."""
+    if outcome.result is None and not outcome.png:
+        return
     stem = Path(report_dir) / outcome.fmu_folder / outcome.case
     stem.parent.mkdir(parents=True, exist_ok=True)
     if outcome.result is not None:
@@ -91,18 +96,25 @@ def results_json(campaign):
         "counts": campaign.counts(),
         "where": campaign.where,
         "seconds": round(campaign.seconds, 3),
-        "cases": [{
-            "case": o.case, "fmu": o.fmu, "fmu_file": o.fmu_file, "status": o.status, "messages": o.messages,
-            "seconds": round(o.seconds, 4), "signals": [d.as_dict() for d in o.deviations],
-            "result_csv": o.csv, "plot": o.plot,
-        } for o in campaign.cases],
+        "cases": [_case_json(o) for o in campaign.cases],
     }
+
+
+def _case_json(o):
+    entry = {"case": o.case, "fmu": o.fmu, "fmu_file": o.fmu_file, "status": o.status, "messages": o.messages,
+             "seconds": round(o.seconds, 4), "signals": [d.as_dict() for d in o.deviations]}
+    if o.csv:
+        entry["result_csv"] = o.csv
+    if o.plot:
+        entry["plot"] = o.plot
+    return entry
 
 
 def junit_xml(campaign):
     """JUnit XML: a test suite per FMU, a test case per case."""
+    counts = campaign.counts()
     suites = ElementTree.Element("testsuites", name="fmutrace", tests=str(len(campaign.cases)),
-                                 failures=str(campaign.counts()["fail"]), errors=str(campaign.counts()["error"]),
+                                 failures=str(counts["fail"]), errors=str(counts["error"] + counts["invalid"]),
                                  time=f"{campaign.seconds:.3f}")
     by_fmu = {}
     for o in campaign.cases:
@@ -111,7 +123,7 @@ def junit_xml(campaign):
         suite = ElementTree.SubElement(
             suites, "testsuite", name=fmu, tests=str(len(outcomes)),
             failures=str(sum(o.status == "fail" for o in outcomes)),
-            errors=str(sum(o.status == "error" for o in outcomes)),
+            errors=str(sum(o.status in ("error", "invalid") for o in outcomes)),
             time=f"{sum(o.seconds for o in outcomes):.3f}")
         for o in outcomes:
             case = ElementTree.SubElement(suite, "testcase", name=o.case, classname=fmu, time=f"{o.seconds:.3f}")
@@ -155,11 +167,12 @@ def write_report(campaign, report_dir):
 <html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
 <style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}}tr.pass td:nth-child(3){{color:#176617}}
-tr.fail td:nth-child(3),tr.error td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</style>
+tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</style>
 </head><body>
 <h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.tolerance.describe())}.</p>
 <table><tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
 {chr(10).join(rows)}
 </table></body></html>
 """)
-    (report_dir / "results.json").write_text(json.dumps(results_json(campaign), indent=1) + "\n")
+    indent = 1 if len(campaign.cases) <= 1000 else None  # a big campaign's file is for programs
+    (report_dir / "results.json").write_text(json.dumps(results_json(campaign), indent=indent) + "\n")

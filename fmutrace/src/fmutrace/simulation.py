@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from fmpy import simulate_fmu
 
-from .fmu import Fmu, unpacked
+from .fmu import Fmu
 from .traces import InputError, read_trace
 
 
@@ -35,17 +35,16 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
              relative_tolerance=None, debug_logging=False):
     """One simulation: the result as a structured array ('time' first). A
     failure is a SimulationError that quotes the FMU's warnings and errors:
-    an FMI 3 FMU logs nothing unless logging is on, so a failed run is
-    repeated once with logging on to hear why."""
-    said = []
-
-    def logger(*args):  # FMI 2 (through fmpy's proxy): env, instance, status, category, message
-        status, message = args[-3], args[-1]  # FMI 3: env, status, category, message
-        if status >= 1:  # warning, discard, error, fatal
-            said.append(message.decode(errors="replace") if isinstance(message, bytes) else str(message))
-
+    an FMI 3 FMU logs nothing unless logging is on, so a failed run that
+    said nothing is repeated once with logging on to hear why."""
+    # fmpy prints the FMU's messages ("[ERROR] ...") with its default logger.
+    # A logger of our own is no option for FMI 2: fmpy's native proxy for
+    # FMI 2 loggers keeps the last one registered for the whole process,
+    # and the callback simulate_fmu makes of it dies when simulate_fmu returns.
+    printed = io.StringIO()
     try:
-        with contextlib.redirect_stdout(io.StringIO()):  # fmpy's notes on inputs it does not set
+        with contextlib.redirect_stdout(printed), np.errstate(invalid="ignore"):  # fmpy's notes; inf - inf in
+            # fmpy's search for input events
             return simulate_fmu(
                 fmu_location,
                 model_description=model_description,
@@ -57,10 +56,10 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
                 start_values=dict(start_values),
                 output=list(outputs),
                 fmi_type="CoSimulation",
-                logger=logger,
                 debug_logging=debug_logging,
             )
     except Exception as error:  # fmpy raises FMICallException and plain Exceptions
+        said = fmu_messages(printed.getvalue())
         if not said and not debug_logging:
             try:
                 run_fmpy(fmu_location, model_description, start_time=start_time, stop_time=stop_time,
@@ -70,6 +69,12 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
                 raise again from error
         told = f"; the FMU said: {' | '.join(said[-3:])}" if said else ""
         raise SimulationError(f"the simulation failed: {str(error).rstrip('.')}{told}") from error
+
+
+def fmu_messages(printed):
+    """The FMU's warnings and errors among the lines fmpy printed."""
+    marks = ("[WARNING] ", "[DISCARD] ", "[ERROR] ", "[FATAL] ")
+    return [line.split("] ", 1)[1] for line in printed.splitlines() if line.startswith(marks)]
 
 
 def every_nth(result, start_time, step_size, output_interval):
@@ -140,13 +145,3 @@ def simulate(fmu, input=None, start_values=None, start_time=None, stop_time=None
     result = run_fmpy(str(fmu.path), fmu.model_description, start_time=start, stop_time=stop, step_size=step,
                       inputs=inputs, start_values=values, outputs=names)
     return every_nth(result, start, step, output_interval)
-
-
-def run_case(case, fmu_bytes):
-    """The result of one case (the FMU given as bytes: unzipped once per
-    process)."""
-    folder, model_description = unpacked(fmu_bytes)
-    o = case.options
-    return run_fmpy(folder, model_description, start_time=o["StartTime"], stop_time=o["StopTime"],
-                    step_size=o["StepSize"], inputs=case.inputs, start_values=case.start_values,
-                    outputs=case.outputs, relative_tolerance=o["RelTol"])

@@ -19,12 +19,16 @@ Anything else raises :class:`TraceError`, which names the file, the line
 and the column.
 """
 import csv
+import io
 import math
-from pathlib import Path
+import re
+import warnings
 
 import numpy as np
 
 TIME_NAMES = ("time", "t", "Time")
+UNUSUAL_LINE_BREAKS = "\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
+_LINE_BREAK = re.compile("\r\n|[\n\r" + UNUSUAL_LINE_BREAKS + "]")  # where str.splitlines() splits
 BOOLEAN_WORDS = {"true": 1.0, "false": 0.0}
 
 
@@ -46,15 +50,26 @@ class TraceError(InputError):
         super().__init__(f"{where}: {message}")
 
 
-def _lines(path):
-    """(line number, text) of the lines that hold data or the header."""
+def read_text(path):
+    """A file's text; a TraceError if it cannot be read or is not UTF-8."""
     try:
-        text = Path(path).read_text(encoding="utf-8-sig")
+        with open(path, encoding="utf-8-sig") as file:
+            return file.read()
     except UnicodeDecodeError as error:
         raise TraceError(path, 0, 0, f"not UTF-8 text ({error.reason} at byte {error.start})") from None
     except OSError as error:
         raise TraceError(path, 0, 0, error.strerror or str(error)) from None
-    for number, line in enumerate(text.splitlines(), start=1):
+
+
+def _lines(text):
+    """(line number, text) of the lines that hold data or the header, split
+    as str.splitlines() splits them, one at a time (a reader that needs only
+    the header does not split the rest)."""
+    number, position, end = 0, 0, len(text)
+    while position < end:
+        cut = _LINE_BREAK.search(text, position)
+        line, position = (text[position:cut.start()], cut.end()) if cut else (text[position:], end)
+        number += 1
         if line.strip() and not line.lstrip().startswith("#"):
             yield number, line
 
@@ -89,14 +104,16 @@ def parse_number(text, decimal_comma=False):
         return None
 
 
-def read_trace(path, known=None):
-    """The trace in path as a structured array with 'time' first.
+def read_trace(path, known=None, text=None):
+    """The trace in path (or its text, given) as a structured array with
+    'time' first.
 
     known: if given, a function of a column's name (time aside) that
     returns why the column is not allowed, or None if it is; a column
     that is not allowed is a TraceError at its place in the header.
     """
-    lines = _lines(path)
+    text = read_text(path) if text is None else text.removeprefix("\ufeff")
+    lines = _lines(text)
     try:
         header_line, header = next(lines)
     except StopIteration:
@@ -122,6 +139,44 @@ def read_trace(path, known=None):
             if problem:
                 raise TraceError(path, header_line, i + 1, problem)
     order = [time_index] + [i for i in range(len(names)) if i != time_index]
+    dtype = [("time", np.float64)] + [(names[i], np.float64) for i in order[1:]]
+    table = _plain_body(text, header_line, separator, len(names))
+    if table is not None:
+        table = table[:, order]
+        times = table[:, 0]
+        if np.isfinite(times).all() and (np.diff(times) >= 0).all():
+            trace = np.empty(len(table), dtype=dtype)
+            for j, (name, _) in enumerate(dtype):
+                trace[name] = table[:, j]
+            return trace
+    return _read_rows(path, lines, names, order, time_index, separator, dtype, header_line)
+
+
+def _plain_body(text, header_line, separator, columns):
+    """The samples of a plain body (',' separated numbers, nothing else
+    the general reader would have to interpret) as an (n, columns) array
+    read by NumPy's C parser; None for any other body, which the general
+    reader then reads or explains. Both read a number with a correctly
+    rounded conversion, so they give the same bits (a test checks it)."""
+    if separator != "," or any(c in text for c in UNUSUAL_LINE_BREAKS) or \
+            ("\r" in text and "\r" in text.replace("\r\n", "")):
+        return None  # splitlines() would count the lines otherwise
+    body = text.split("\n", header_line)[-1]
+    if '"' in body or "#" in body:
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # an empty body warns: the general reader says what is wrong
+            table = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, dtype=np.float64, ndmin=2)
+    except (ValueError, UserWarning):
+        return None
+    if table.shape[1] != columns or not len(table):
+        return None
+    return table
+
+
+def _read_rows(path, lines, names, order, time_index, separator, dtype, header_line):
+    """The general reader: every cell by itself, every problem placed."""
     decimal_comma = separator == ";"
     rows = []
     previous_time = -math.inf
@@ -134,9 +189,8 @@ def read_trace(path, known=None):
         for i in order:
             value = parse_number(cells[i], decimal_comma)
             if value is None:
-                shown = cells[i] if cells[i] else "an empty cell"
-                raise TraceError(path, number, i + 1, f"{shown!r} in column {names[i]!r} is not a number"
-                                 if cells[i] else f"{shown} in column {names[i]!r}")
+                raise TraceError(path, number, i + 1, f"{cells[i]!r} in column {names[i]!r} is not a number"
+                                 if cells[i] else f"an empty cell in column {names[i]!r}")
             row.append(value)
         if not math.isfinite(row[0]):
             raise TraceError(path, number, time_index + 1, f"time {cells[time_index]!r} is not a finite number")
@@ -147,7 +201,6 @@ def read_trace(path, known=None):
         rows.append(tuple(row))
     if not rows:
         raise TraceError(path, header_line, 0, "no samples: the file has a header line only")
-    dtype = [("time", np.float64)] + [(names[i], np.float64) for i in order[1:]]
     return np.array(rows, dtype=dtype)
 
 
