@@ -1,7 +1,8 @@
 """A regression campaign on a Dask distributed cluster: a scheduler and two
 workers started here on loopback, the scenarios sent to them with their
-FMUs, and the report the same as a serial run in this process (table,
-results and plots; only the timings differ)."""
+FMUs (or read by them, --shared-files), and the report the same as a
+serial run in this process (table, results and plots; only the timings
+differ)."""
 import json
 import re
 import subprocess
@@ -83,7 +84,9 @@ def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_pa
     cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
     distributed = fmutrace.compare(fmus, cases, report=tmp_path / "distributed", scheduler=cluster, timeout=600)
     assert distributed.where == f"Dask, 2 workers at {cluster}"
+    shared = fmutrace.compare(fmus, cases, scheduler=cluster, shared_files=True, timeout=600)
     serial = fmutrace.compare(fmus, cases, report=tmp_path / "serial", jobs=1)
+    assert [(o.case, o.status) for o in shared.cases] == [(o.case, o.status) for o in serial.cases]
     assert serial.where == "1 process"
     assert len(serial.cases) == 2 * len(discover(["RateLimiter", "Ramp"]))
     assert [(o.case, o.fmu, o.status, o.messages) for o in distributed.cases] == \

@@ -27,6 +27,8 @@ from .traces import InputError
 
 
 STATUSES = ("pass", "fail", "error", "invalid")
+BATCH_CASES = 256              # cases per Dask task at most
+BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
 
 
 @dataclass
@@ -209,7 +211,7 @@ def plan(fmus, paths):
 
 
 def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, tube_time=None, tube_value=None,
-            junit=None, jobs=None, scheduler=None, plots=None, timeout=None, progress=None):
+            junit=None, jobs=None, scheduler=None, shared_files=False, plots=None, timeout=None, progress=None):
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
@@ -224,6 +226,8 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     jobs        1: in this process; N: a local Dask cluster of N processes;
                 None: one per core for 20 cases or more, else 1
     scheduler   address of a Dask scheduler (instead of a local cluster)
+    shared_files  the scheduler's workers see the case folders at the same
+                paths (they read the files; else they are sent the texts)
     plots       which cases get a plot and a result CSV in the report:
                 'all', 'failed' or 'none'; None: all for up to 500 cases,
                 else the failed ones
@@ -281,7 +285,8 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
                     runner.close()
             where = "1 process"
         else:
-            where = _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, timeout, finished)
+            where = _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout,
+                             finished)
     finally:
         bar.close()
     result = CampaignResult(outcomes, tolerance, where, time.perf_counter() - started, Path(report) if report else None)
@@ -292,23 +297,28 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     return result
 
 
-def _batches(work, size):
-    """Consecutive runs of at most size items of one FMU: [(fmu, [(i, folder, name)])]."""
-    batch, current = [], None
+def _batches(work, size, ship_texts):
+    """Consecutive runs of one FMU's cases, [(fmu, [(i, folder, name, texts)])]:
+    at most size cases, and with their files' texts (ship_texts) at most
+    BATCH_TEXT_BYTES of them, so that a worker's queue stays small."""
+    batch, current, volume = [], None, 0
     for i, (fmu, folder, name) in enumerate(work):
-        if batch and (fmu is not current or len(batch) == size):
+        texts = case_texts(folder, fmu.model) if ship_texts else None
+        if batch and (fmu is not current or len(batch) == size or volume >= BATCH_TEXT_BYTES):
             yield current, batch
-            batch = []
+            batch, volume = [], 0
         current = fmu
-        batch.append((i, folder, name))
+        volume += sum(map(len, texts.values())) if texts else 0
+        batch.append((i, str(folder), name, texts))
     if batch:
         yield current, batch
 
 
-def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, timeout, finished):
+def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout, finished):
     """The cases in batches on Dask workers, at most a few batches per
-    worker in flight (the client's memory stays flat); a worker of a remote
-    scheduler gets the files' texts, a local one reads them itself."""
+    worker in flight (the client's memory stays flat). Workers of a local
+    cluster, or of a remote one that sees the same files (shared_files),
+    read the cases themselves; others get the files' texts."""
     import dask
     from dask.distributed import Client, LocalCluster, as_completed
 
@@ -324,18 +334,18 @@ def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, timeout
         client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
         workers = len(client.scheduler_info()["workers"])
         shared = {path: client.scatter(data, broadcast=True) for path, data in fmu_bytes.items()}
-        size = max(1, min(256, -(-len(work) // (8 * workers))))
-        batches = _batches(work, size)
+        # about 8 batches per worker; at most BATCH_CASES cases each (a task's cost is a few milliseconds)
+        size = max(1, min(BATCH_CASES, -(-len(work) // (8 * workers))))
+        batches = _batches(work, size, ship_texts=bool(scheduler) and not shared_files)
         in_flight = as_completed()
         indices = {}
 
         def submit_next():
             for fmu, batch in batches:
-                items = [(folder, name, case_texts(folder, fmu.model) if scheduler else None)
-                         for _, folder, name in batch]
+                items = [(folder, name, texts) for _, folder, name, texts in batch]
                 future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), labels[fmu.path],
                                        tolerance, plots, pure=False)
-                indices[future] = [i for i, _, _ in batch]
+                indices[future] = [i for i, _, _, _ in batch]
                 in_flight.add(future)
                 return True
             return False

@@ -89,6 +89,8 @@ def parser():
     cmp.add_argument("--jobs", type=_positive_int, metavar="N", help="local worker processes (default: one per "
                      "core for 20 cases or more, else this process)")
     cmp.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
+    cmp.add_argument("--shared-files", action="store_true", help="the scheduler's workers see the case folders at "
+                     "the same paths (else they are sent the files)")
     cmp.add_argument("--plots", choices=("all", "failed", "none"), default="all",
                      help="which cases get a plot in the report (default: all)")
     cmp.add_argument("--timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
@@ -116,7 +118,8 @@ def compare_command(args, out):
         raise InputError("no case folder given: name the folders of cases after the FMUs")
     result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
-                     scheduler=args.scheduler, plots=args.plots, timeout=args.timeout)
+                     scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
+                     timeout=args.timeout)
     for o in result.failed():
         if o.status == "invalid":
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
