@@ -197,6 +197,20 @@ def test_tube_for_traces_sampled_at_other_instants(tmp_path):
     assert exact.returncode == 1 and "the result has no sample at t=0.25" in exact.stdout
 
 
+def test_tube_checks_the_result_where_the_reference_says_something(tmp_path):
+    """A recording that ends at 1 s of a 2 s run: the samples after it are
+    not checked (against the last recorded value they would fail: x keeps
+    rising)."""
+    case = recorder_case(tmp_path / "recorder")
+    ref = case / "FirstOrderLag_ref.csv"
+    ref.write_text("".join(line for line in ref.read_text().splitlines(keepends=True)[:6]))  # 0 .. 1 s
+    done = fmutrace_cli("compare", LAG[3], tmp_path, "--tube-time", 0.1, "--tube-value", 0.001, "--report",
+                        tmp_path / "report")
+    assert done.returncode == 0, done.stdout
+    outcome = json.loads((tmp_path / "report" / "results.json").read_text())["cases"][0]
+    assert outcome["status"] == "pass"
+
+
 def test_tube_fails_where_the_result_leaves_it_and_says_by_how_much(tmp_path):
     recorder_case(tmp_path / "recorder", start="tau,1.0\n")  # twice as fast: leaves the tube at once
     done = fmutrace_cli("compare", LAG[3], tmp_path, "--tube-time", 0.1, "--tube-value", 0.001,

@@ -6,7 +6,8 @@ tube       the reference drawn as a polyline (a repeated time is a
            vertical jump), widened by tube_time in time and tube_value in
            value, as the Modelica Association's csv-compare draws it: a
            result sample passes when some point of the reference lies
-           within tube_time of its time and tube_value of its value. For
+           within tube_time of its time and tube_value of its value (the
+           samples inside the reference's time range are checked). For
            traces sampled at other instants than the FMU's steps.
 
 In the exact and tolerance modes each reference sample is compared with
@@ -174,14 +175,14 @@ def _polyline_at(times, values, at):
 
 def tube_bounds(reference_time, reference_values, times, tube_time, tube_value):
     """The tube's lower and upper bound at each of times (NaN outside the
-    reference's time range widened by tube_time)."""
+    reference's time range: there the reference says nothing)."""
     lower = np.full(len(times), np.nan)
     upper = np.full(len(times), np.nan)
     t_first, t_last = reference_time[0], reference_time[-1]
     for i, t in enumerate(times):
-        start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
-        if start > end:
+        if not t_first <= t <= t_last:
             continue
+        start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
         inside = reference_values[np.searchsorted(reference_time, start, "left"):
                                   np.searchsorted(reference_time, end, "right")]
         edges = [_polyline_at(reference_time, reference_values, start),
