@@ -20,7 +20,8 @@ from pathlib import Path
 from .cases import case_texts, find_cases, load_case
 from .comparison import Comparison, Tolerance, compare as compare_traces
 from .fmu import Fmu
-from .report import plot_case, write_case_files, write_junit, write_report
+from .journal import Journal, ReportLock, campaign_key, case_key, outcome_from
+from .report import case_json, plot_case, write_case_files, write_junit, write_report
 from .runner import Runner
 from .simulation import SimulationError
 from .traces import InputError
@@ -29,6 +30,7 @@ from .traces import InputError
 STATUSES = ("pass", "fail", "error", "invalid")
 BATCH_CASES = 256              # cases per Dask task at most
 BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
+BATCH_ATTEMPTS = 3             # a batch lost with its worker is sent again, so many times in all
 
 
 @dataclass
@@ -211,7 +213,8 @@ def plan(fmus, paths):
 
 
 def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, tube_time=None, tube_value=None,
-            junit=None, jobs=None, scheduler=None, shared_files=False, plots=None, timeout=None, progress=None):
+            junit=None, jobs=None, scheduler=None, shared_files=False, plots=None, timeout=None, progress=None,
+            resume=False):
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
@@ -232,6 +235,8 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
                 'all', 'failed' or 'none'; None: all for up to 500 cases,
                 else the failed ones
     timeout     seconds to wait for a cluster's results (None: no bound)
+    resume      take the cases the report's journal (results.jsonl) holds
+                from it, run the others (after a campaign was stopped)
 
     Returns a CampaignResult (.passed, .cases, .summary(), .exit_code).
     Raises InputError for a bad FMU, folder or option; a case whose files
@@ -259,36 +264,63 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     fmu_bytes = {f.path: f.path.read_bytes() for f in loaded}
 
     started = time.perf_counter()
-    bar = Progress(len(work), progress)
     outcomes = [None] * len(work)
     counts = {"done": 0, "failed": 0}
-
-    def finished(i, outcome):
-        outcomes[i] = outcome
-        counts["done"] += 1
-        counts["failed"] += not outcome.passed
-        if report:
-            write_case_files(outcome, report)
-        bar.update(counts["done"], counts["failed"])
-
+    lock = journal = None
+    if report:
+        lock = ReportLock(report)
     try:
-        if scheduler is None and jobs <= 1:
-            runners = {}
-            try:
-                for i, (fmu, folder, name) in enumerate(work):
-                    if fmu.path not in runners:
-                        runners[fmu.path] = Runner(fmu_bytes[fmu.path])
-                    finished(i, run_one(folder, name, None, runners[fmu.path], fmu, labels[fmu.path], tolerance,
-                                        plots))
-            finally:
-                for runner in runners.values():
-                    runner.close()
-            where = "1 process"
-        else:
-            where = _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout,
-                             finished)
+        if report:
+            journal = Journal(report, campaign_key(fmu_bytes, tolerance, plots), resume)
+        keys = [case_key(fmu.path, folder) for fmu, folder, _ in work]
+        todo = []
+        for i, (fmu, folder, name) in enumerate(work):
+            entry = journal.done.get(keys[i]) if journal else None
+            if entry is not None:  # finished by the campaign resumed
+                outcomes[i] = outcome_from(entry, CaseOutcome, labels[fmu.path]["fmu_folder"])
+                counts["done"] += 1
+                counts["failed"] += not outcomes[i].passed
+            else:
+                todo.append((i, fmu, folder, name))
+        bar = Progress(len(work), progress)
+
+        def finished(i, outcome):
+            outcomes[i] = outcome
+            counts["done"] += 1
+            counts["failed"] += not outcome.passed
+            if report:
+                write_case_files(outcome, report)
+                journal.record(keys[i], case_json(outcome))
+            bar.update(counts["done"], counts["failed"])
+
+        try:
+            if not todo:
+                where = "the journal"
+            elif scheduler is None and jobs <= 1:
+                runners = {}
+                try:
+                    for i, fmu, folder, name in todo:
+                        if fmu.path not in runners:
+                            runners[fmu.path] = Runner(fmu_bytes[fmu.path])
+                        finished(i, run_one(folder, name, None, runners[fmu.path], fmu, labels[fmu.path],
+                                            tolerance, plots))
+                finally:
+                    for runner in runners.values():
+                        runner.close()
+                where = "1 process"
+            else:
+                where = _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout,
+                                 finished)
+        finally:
+            bar.close()
     finally:
-        bar.close()
+        if journal:
+            journal.close()
+        if lock:
+            lock.release()
+    resumed = len(work) - len(todo)
+    if resumed and todo:
+        where += f" ({resumed} cases from the journal)"
     result = CampaignResult(outcomes, tolerance, where, time.perf_counter() - started, Path(report) if report else None)
     if report:
         write_report(result, report)
@@ -297,12 +329,12 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     return result
 
 
-def _batches(work, size, ship_texts):
+def _batches(todo, size, ship_texts):
     """Consecutive runs of one FMU's cases, [(fmu, [(i, folder, name, texts)])]:
     at most size cases, and with their files' texts (ship_texts) at most
     BATCH_TEXT_BYTES of them, so that a worker's queue stays small."""
     batch, current, volume = [], None, 0
-    for i, (fmu, folder, name) in enumerate(work):
+    for i, fmu, folder, name in todo:
         texts = case_texts(folder, fmu.model) if ship_texts else None
         if batch and (fmu is not current or len(batch) == size or volume >= BATCH_TEXT_BYTES):
             yield current, batch
@@ -314,7 +346,7 @@ def _batches(work, size, ship_texts):
         yield current, batch
 
 
-def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout, finished):
+def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout, finished):
     """The cases in batches on Dask workers, at most a few batches per
     worker in flight (the client's memory stays flat). Workers of a local
     cluster, or of a remote one that sees the same files (shared_files),
@@ -335,20 +367,22 @@ def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
         workers = len(client.scheduler_info()["workers"])
         shared = {path: client.scatter(data, broadcast=True) for path, data in fmu_bytes.items()}
         # about 8 batches per worker; at most BATCH_CASES cases each (a task's cost is a few milliseconds)
-        size = max(1, min(BATCH_CASES, -(-len(work) // (8 * workers))))
-        batches = _batches(work, size, ship_texts=bool(scheduler) and not shared_files)
+        size = max(1, min(BATCH_CASES, -(-len(todo) // (8 * workers))))
+        batches = _batches(todo, size, ship_texts=bool(scheduler) and not shared_files)
         in_flight = as_completed()
-        indices = {}
+        submitted = {}  # future -> (fmu, batch, attempt)
+
+        def submit(fmu, batch, attempt):
+            items = [(folder, name, texts) for _, folder, name, texts in batch]
+            future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), labels[fmu.path], tolerance,
+                                   plots, pure=False)
+            submitted[future] = fmu, batch, attempt
+            in_flight.add(future)
 
         def submit_next():
             for fmu, batch in batches:
-                items = [(folder, name, texts) for _, folder, name, texts in batch]
-                future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), labels[fmu.path],
-                                       tolerance, plots, pure=False)
-                indices[future] = [i for i, _, _, _ in batch]
-                in_flight.add(future)
-                return True
-            return False
+                submit(fmu, batch, 1)
+                return
 
         for _ in range(3 * workers):
             submit_next()
@@ -356,7 +390,19 @@ def _on_dask(work, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
         while in_flight.count():
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             future = next(in_flight) if remaining is None else _next_within(in_flight, remaining, timeout)
-            for i, outcome in zip(indices.pop(future), future.result()):
+            fmu, batch, attempt = submitted.pop(future)
+            try:
+                outcomes = future.result()
+            except Exception as error:  # its worker died, or the result was lost with a worker
+                if attempt < BATCH_ATTEMPTS:
+                    # the FMU's bytes again too: the copies may have gone with the workers
+                    shared[fmu.path] = client.scatter(fmu_bytes[fmu.path], broadcast=True)
+                    submit(fmu, batch, attempt + 1)
+                    continue
+                outcomes = [CaseOutcome(name, **labels[fmu.path], status="error",
+                                        messages=[f"lost with its Dask worker {attempt} times: {type(error).__name__}: "
+                                                  f"{error}"]) for _, _, name, _ in batch]
+            for (i, _, _, _), outcome in zip(batch, outcomes):
                 finished(i, outcome)
             submit_next()
         return f"Dask, {workers} workers" + (f" at {scheduler}" if scheduler else " (local processes)")

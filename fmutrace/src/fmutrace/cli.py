@@ -94,6 +94,8 @@ def parser():
     cmp.add_argument("--plots", choices=("all", "failed", "none"), default="all",
                      help="which cases get a plot in the report (default: all)")
     cmp.add_argument("--timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
+    cmp.add_argument("--resume", action="store_true", help="take the cases the report's journal holds from it and "
+                     "run the others (after a stopped campaign; needs --report)")
     return main
 
 
@@ -116,10 +118,12 @@ def compare_command(args, out):
         raise InputError("no FMU given: name one or more .fmu files before the case folders")
     if not cases:
         raise InputError("no case folder given: name the folders of cases after the FMUs")
+    if args.resume and not args.report:
+        raise InputError("--resume continues the campaign of a report folder: give it with --report")
     result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
                      scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
-                     timeout=args.timeout)
+                     timeout=args.timeout, resume=args.resume)
     for o in result.failed():
         if o.status == "invalid":
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)

@@ -96,11 +96,11 @@ def results_json(campaign):
         "counts": campaign.counts(),
         "where": campaign.where,
         "seconds": round(campaign.seconds, 3),
-        "cases": [_case_json(o) for o in campaign.cases],
+        "cases": [case_json(o) for o in campaign.cases],
     }
 
 
-def _case_json(o):
+def case_json(o):
     entry = {"case": o.case, "fmu": o.fmu, "fmu_file": o.fmu_file, "status": o.status, "messages": o.messages,
              "seconds": round(o.seconds, 4), "signals": [d.as_dict() for d in o.deviations]}
     if o.csv:

@@ -199,7 +199,11 @@ class Runner:
                 self._last_time = FFI.new("double *")
             self.fresh = True
         elif not self.fresh:
-            self.fmu.reset()
+            try:
+                self.fmu.reset()
+            except Exception:  # an FMU without a working reset gets a new instance per trace
+                self._drop_instance()
+                return self._instance()
         self.fresh = False
         return self.fmu
 

@@ -1,0 +1,112 @@
+"""A campaign's journal: results.jsonl in the report folder, one line per
+finished case, appended and flushed as each case finishes, so that a
+campaign whose client is killed loses nothing it finished; `--resume`
+reads it back and runs only the rest. The folder is locked while a
+campaign writes it: a second campaign into the same folder is refused.
+
+The first line describes the campaign (comparison, plots, the FMUs by
+content hash); a resumed campaign must be the same campaign. A line cut
+short by a kill is ignored (its case runs again).
+"""
+import fcntl
+import hashlib
+import json
+import os
+from pathlib import Path
+
+from .comparison import Deviation
+from .traces import InputError
+
+JOURNAL = "results.jsonl"
+NUMBERS = ("time", "value", "lower", "upper", "excess", "largest_excess", "largest_at")  # "nan", "inf" in JSON
+LOCK = ".fmutrace.lock"
+
+
+class ReportLock:
+    """An exclusive lock on a report folder (flock on a file in it: the
+    lock goes with the process that holds it, however it ends)."""
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.path = self.folder / LOCK
+        self.file = open(self.path, "a+")
+        try:
+            fcntl.flock(self.file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.file.seek(0)
+            holder = self.file.read().strip() or "another process"
+            self.file.close()
+            raise InputError(f"{self.folder}: another campaign is writing this report folder ({holder}); wait for "
+                             "it to finish or choose another folder") from None
+        self.file.seek(0)
+        self.file.truncate()
+        self.file.write(f"pid {os.getpid()}\n")
+        self.file.flush()
+
+    def release(self):
+        if not self.file.closed:
+            self.file.seek(0)
+            self.file.truncate()
+            fcntl.flock(self.file, fcntl.LOCK_UN)
+            self.file.close()
+
+
+def campaign_key(fmu_bytes, tolerance, plots):
+    return {"tolerance": {k: v for k, v in vars(tolerance).items() if v is not None}, "plots": plots,
+            "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values())}
+
+
+def case_key(fmu_file, folder):
+    return f"{fmu_file}|{os.path.realpath(folder)}"
+
+
+class Journal:
+    """results.jsonl: read back for a resume, appended to as cases finish."""
+
+    def __init__(self, folder, key, resume):
+        self.path = Path(folder) / JOURNAL
+        self.done = {}
+        if resume and self.path.exists():
+            lines = self.path.read_text().splitlines()
+            header = _parse(lines[0]) if lines else None
+            if header is not None and header.get("campaign") != key:
+                raise InputError(f"{self.path}: made by a campaign with other FMUs or options; resume it with "
+                                 "the same ones, or start afresh without --resume")
+            for line in lines[1:]:
+                entry = _parse(line)
+                if entry is not None and "key" in entry:
+                    self.done[entry["key"]] = entry
+            self.file = open(self.path, "a")
+            if header is None:
+                self._write({"campaign": key})
+        else:
+            self.file = open(self.path, "w")
+            self._write({"campaign": key})
+
+    def _write(self, entry):
+        self.file.write(json.dumps(entry) + "\n")
+        self.file.flush()  # in the OS's hands: a killed client loses nothing written
+
+    def record(self, key, entry):
+        self._write(dict(entry, key=key))
+
+    def close(self):
+        self.file.close()
+
+
+def _parse(line):
+    try:
+        return json.loads(line)
+    except ValueError:
+        return None  # cut short by a kill
+
+
+def outcome_from(entry, outcome_class, fmu_folder):
+    """A CaseOutcome from its journal entry."""
+    return outcome_class(
+        case=entry["case"], fmu=entry["fmu"], fmu_file=entry["fmu_file"], fmu_folder=fmu_folder,
+        status=entry["status"], messages=entry["messages"],
+        deviations=[Deviation(**{k: float(v) if k in NUMBERS and isinstance(v, str) else v for k, v in d.items()})
+                    for d in entry["signals"]],
+        seconds=entry["seconds"], csv=entry.get("result_csv", ""), plot=entry.get("plot", ""))

@@ -1,0 +1,157 @@
+"""Campaigns that lose nothing: results journaled as each case finishes, a
+killed client resumed without recomputing, a second campaign into the same
+report folder refused, a Dask worker killed in the middle."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import fmutrace
+from support.fmu_driver import BUILD_DIR
+from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
+from support.reports import without_timings
+
+FMUTRACE = Path(sys.executable).parent / "fmutrace"
+PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
+WAIT = 120
+
+
+def pass_through_cases(root, count):
+    """count cases: y(t + 0.1) = u(t), u = k from t = 0.2 on (worked by hand)."""
+    for k in range(count):
+        folder = root / f"case_{k:03d}"
+        folder.mkdir(parents=True)
+        (folder / "PassThrough_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
+        (folder / "PassThrough_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
+        (folder / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    return root
+
+
+def start(args):
+    return subprocess.Popen([str(FMUTRACE), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+
+
+def finish(process):
+    try:
+        out, err = process.communicate(timeout=WAIT)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        raise AssertionError("fmutrace did not finish within the bound") from None
+    return process.returncode, out, err
+
+
+def wait_for(condition, what):
+    deadline = time.monotonic() + WAIT
+    while not condition():
+        assert time.monotonic() < deadline, f"{what} did not happen within {WAIT} s"
+        time.sleep(0.05)
+
+
+def journal_keys(report):
+    lines = (report / "results.jsonl").read_text().splitlines()
+    keys = []
+    for line in lines[1:]:
+        try:
+            keys.append(json.loads(line)["key"])
+        except ValueError:
+            pass  # the line the kill cut short
+    return keys
+
+
+def comparable(report):
+    results = json.loads((report / "results.json").read_text())
+    return [(c["case"], c["fmu"], c["status"], c["messages"], c.get("plot")) for c in results["cases"]]
+
+
+def test_a_killed_client_resumes_without_recomputing(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 40)
+    undisturbed = tmp_path / "undisturbed"
+    code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", undisturbed, "--jobs", 1,
+                                 "--plots", "all"]))
+    assert code == 0, out
+
+    report = tmp_path / "report"
+    process = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all"])
+    wait_for(lambda: (report / "results.jsonl").exists() and len(journal_keys(report)) >= 5, "five journaled cases")
+    os.killpg(process.pid, signal.SIGKILL)
+    process.communicate(timeout=WAIT)
+    done = journal_keys(report)
+    assert 5 <= len(done) < 40 and len(set(done)) == len(done)
+
+    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots",
+                                   "all", "--resume"]))
+    assert code == 0, out + err
+    assert f"({len(done)} cases from the journal)" in out
+    keys = journal_keys(report)
+    assert len(keys) == 40 and len(set(keys)) == 40  # every case exactly once: nothing done twice
+    assert keys[:len(done)] == done
+    assert comparable(report) == comparable(undisturbed)
+    assert without_timings((report / "summary.md").read_text()) == \
+        without_timings((undisturbed / "summary.md").read_text())
+
+    code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume"]))
+    assert code == 0 and "on the journal" in out  # all done: nothing runs
+
+
+def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 3)
+    report = tmp_path / "report"
+    assert finish(start(["compare", PASS_THROUGH, cases, "--report", report]))[0] == 0
+    code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume", "--rel-tol",
+                                 "1e-3"]))
+    assert code == 2 and "made by a campaign with other FMUs or options" in err
+    code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--resume"]))
+    assert code == 2 and "give it with --report" in err
+
+
+def test_a_second_campaign_into_the_same_report_folder_is_refused(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 30)
+    report = tmp_path / "report"
+    first = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all"])
+    wait_for(lambda: (report / "results.jsonl").exists() and journal_keys(report), "the first campaign's start")
+    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1]))
+    assert code == 2, out + err
+    assert f"another campaign is writing this report folder (pid {first.pid})" in err
+    code, out, _ = finish(first)
+    assert code == 0 and "30 of 30 cases pass" in out  # undisturbed
+    assert len(set(journal_keys(report))) == 30
+    assert json.loads((report / "results.json").read_text())["counts"]["pass"] == 30
+    code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1]))
+    assert code == 0  # the lock went with the first campaign
+
+
+def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
+    """SIGKILL to a Dask worker process while it works: its batches run
+    again elsewhere, the campaign completes, each case once, the same
+    report as a run in one process."""
+    from dask.distributed import Client
+
+    fmus = [fmu_path(BUILD_DIR, model, version) for model in ("RateLimiter", "Ramp") for version in FMI_VERSIONS]
+    cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
+    report = tmp_path / "killed"
+    result = {}
+    campaign = threading.Thread(target=lambda: result.setdefault("campaign", fmutrace.compare(
+        fmus, cases, report=report, scheduler=cluster, timeout=600, plots="all")))
+    campaign.start()
+    wait_for(lambda: (report / "results.jsonl").exists() and len(journal_keys(report)) >= 3, "three finished cases")
+    with Client(cluster, timeout=WAIT) as client:
+        pids = client.run(os.getpid)
+        victim = sorted(pids.values())[0]
+        os.kill(victim, signal.SIGKILL)
+        campaign.join(timeout=600)
+        assert not campaign.is_alive()
+        assert victim not in client.run(os.getpid).values()  # it died (its nanny starts another)
+    killed = result["campaign"]
+    assert killed.passed, killed.summary()
+    total = 2 * len(discover(["RateLimiter", "Ramp"]))
+    keys = journal_keys(report)
+    assert len(killed.cases) == total and len(keys) == total and len(set(keys)) == total
+    fmutrace.compare(fmus, cases, report=tmp_path / "serial", jobs=1, plots="all")
+    assert comparable(report) == comparable(tmp_path / "serial")
+    for page in ("index.html", "summary.md"):
+        assert without_timings((report / page).read_text()) == without_timings((tmp_path / "serial" / page).read_text())
