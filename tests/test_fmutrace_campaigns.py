@@ -10,6 +10,8 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
+
 import fmutrace
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
@@ -155,3 +157,46 @@ def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
     assert comparable(report) == comparable(tmp_path / "serial")
     for page in ("index.html", "summary.md"):
         assert without_timings((report / page).read_text()) == without_timings((tmp_path / "serial" / page).read_text())
+
+
+FAULTY = {v: BUILD_DIR / "fixtures" / f"fmi{v}" / "Faulty.fmu" for v in (2, 3)}
+
+
+def faulty_cases(root, values):
+    """Cases of the Faulty fixture: y(t + 0.1) = u(t) with u = k from 0.2
+    on; k = 13 crashes its process, k = 17 hangs."""
+    for k in values:
+        folder = root / f"case_{k:02d}"
+        folder.mkdir(parents=True)
+        (folder / "Faulty_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
+        (folder / "Faulty_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
+        (folder / "Faulty_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    return root
+
+
+@pytest.mark.parametrize("version,jobs", [(2, 2), (3, 2), (3, 1)])
+def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, jobs, tmp_path):
+    """On workers the batch that holds it kills its worker, is run again
+    case by case in child processes, and only the crashing case fails; in
+    one process (with --timeout, which runs the cases in a child) the
+    same."""
+    cases = faulty_cases(tmp_path / "cases", [1, 2, 13, 4, 5, 6])
+    args = ["compare", FAULTY[version], cases, "--report", tmp_path / "report", "--jobs", jobs]
+    code, out, err = finish(start(args + (["--timeout", 60] if jobs == 1 else [])))
+    assert code == 1, out + err
+    assert f"ERROR  case_13 on Faulty (FMI {version})\n" \
+           "      the simulation's process was killed by signal SIGSEGV while running this case" in out
+    assert "5 of 6 cases pass, 0 differ, 1 failed to simulate" in out
+    assert len(set(journal_keys(tmp_path / "report"))) == 6
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
+    cases = faulty_cases(tmp_path / "cases", [1, 17, 3, 13, 5])
+    started = time.monotonic()
+    code, out, err = finish(start(["compare", FAULTY[3], cases, "--jobs", jobs, "--timeout", 3]))
+    assert code == 1, out + err
+    assert "ERROR  case_17 on Faulty (FMI 3)\n      stopped after the per-case timeout of 3 s" in out
+    assert "ERROR  case_13 on Faulty (FMI 3)\n      the simulation's process was killed by signal SIGSEGV" in out
+    assert "3 of 5 cases pass, 0 differ, 2 failed to simulate" in out
+    assert time.monotonic() - started < 60

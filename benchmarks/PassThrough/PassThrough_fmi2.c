@@ -1,10 +1,14 @@
 /* PassThrough, FMI 2: the least a Co-Simulation FMU can do per step
  * (y = u). The functions it does not need are stubs (tests/fixtures/stubs.py). */
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "PassThrough_variables.h"
+#ifndef FIXTURE_VARIABLES_H  /* another fixture built from these sources names its own */
+#define FIXTURE_VARIABLES_H "PassThrough_variables.h"
+#endif
+#include FIXTURE_VARIABLES_H
 
 typedef struct {
     fmi2CallbackFunctions functions;
@@ -67,6 +71,10 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
     Instance *instance = c;
+#ifdef FIXTURE_FAULTS  /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
+    if (instance->values[VR_u] == 13.0) raise(SIGSEGV);
+    if (instance->values[VR_u] == 17.0) for (;;) { }
+#endif
     instance->values[VR_y] = instance->values[VR_u];
     instance->values[VR_time] = currentCommunicationPoint + communicationStepSize;
     return fmi2OK;

@@ -1,10 +1,14 @@
 /* PassThrough, FMI 3: the least a Co-Simulation FMU can do per step
  * (y = u). The functions it does not need are stubs (tests/fixtures/stubs.py). */
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fmi3Functions.h"
-#include "PassThrough_variables.h"
+#ifndef FIXTURE_VARIABLES_H  /* another fixture built from these sources names its own */
+#define FIXTURE_VARIABLES_H "PassThrough_variables.h"
+#endif
+#include FIXTURE_VARIABLES_H
 
 typedef struct {
     double values[MODEL_VARIABLE_COUNT];
@@ -70,6 +74,10 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     (void)noSetFMUStatePriorToCurrentPoint;
     Instance *self = instance;
+#ifdef FIXTURE_FAULTS  /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
+    if (self->values[VR_u] == 13.0) raise(SIGSEGV);
+    if (self->values[VR_u] == 17.0) for (;;) { }
+#endif
     self->values[VR_y] = self->values[VR_u];
     self->values[VR_time] = currentCommunicationPoint + communicationStepSize;
     *eventHandlingNeeded = fmi3False;

@@ -9,6 +9,7 @@ so workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written here.
 """
 import hashlib
+import logging
 import os
 import sys
 import tempfile
@@ -20,6 +21,7 @@ from pathlib import Path
 from .cases import case_texts, find_cases, load_case
 from .comparison import Comparison, Tolerance, compare as compare_traces
 from .fmu import Fmu
+from .isolated import run_isolated
 from .journal import Journal, ReportLock, campaign_key, case_key, outcome_from
 from .report import case_json, plot_case, write_case_files, write_junit, write_report
 from .runner import Runner
@@ -141,8 +143,11 @@ def worker_fmu(fmu_bytes, path):
     return _workers_fmus[key]
 
 
-def run_batch(items, fmu_bytes, path, labels, tolerance, plots):
-    """A Dask task: the cases [(folder, name, texts or None)] of one FMU."""
+def run_batch(items, fmu_bytes, path, labels, tolerance, plots, isolate=False, case_timeout=None):
+    """A Dask task: the cases [(folder, name, texts or None)] of one FMU, in
+    this worker, or (isolate) in child processes of it."""
+    if isolate:
+        return run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout, CaseOutcome)
     runner, fmu = worker_fmu(fmu_bytes, path)
     return [run_one(folder, name, texts, runner, fmu, labels, tolerance, plots) for folder, name, texts in items]
 
@@ -214,7 +219,7 @@ def plan(fmus, paths):
 
 def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, tube_time=None, tube_value=None,
             junit=None, jobs=None, scheduler=None, shared_files=False, plots=None, timeout=None, progress=None,
-            resume=False):
+            resume=False, case_timeout=None):
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
@@ -235,6 +240,8 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
                 'all', 'failed' or 'none'; None: all for up to 500 cases,
                 else the failed ones
     timeout     seconds to wait for a cluster's results (None: no bound)
+    case_timeout  seconds a case may run (None: no bound): a case over it
+                is stopped and reported (cases then run in child processes)
     resume      take the cases the report's journal (results.jsonl) holds
                 from it, run the others (after a campaign was stopped)
 
@@ -296,6 +303,14 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
         try:
             if not todo:
                 where = "the journal"
+            elif scheduler is None and jobs <= 1 and case_timeout is not None:
+                for fmu in loaded:  # in child processes: a case over the timeout is stopped by killing its process
+                    mine = [(i, folder, name) for i, f, folder, name in todo if f is fmu]
+                    arrived = iter(mine)
+                    run_isolated([(str(folder), name, None) for _, folder, name in mine], fmu_bytes[fmu.path],
+                                 str(fmu.path), labels[fmu.path], tolerance, plots, case_timeout, CaseOutcome,
+                                 on_outcome=lambda outcome: finished(next(arrived)[0], outcome))
+                where = "1 process at a time (isolated)"
             elif scheduler is None and jobs <= 1:
                 runners = {}
                 try:
@@ -310,7 +325,7 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
                 where = "1 process"
             else:
                 where = _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout,
-                                 finished)
+                                 case_timeout, finished)
         finally:
             bar.close()
     finally:
@@ -346,7 +361,8 @@ def _batches(todo, size, ship_texts):
         yield current, batch
 
 
-def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout, finished):
+def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_files, timeout, case_timeout,
+             finished):
     """The cases in batches on Dask workers, at most a few batches per
     worker in flight (the client's memory stays flat). Workers of a local
     cluster, or of a remote one that sees the same files (shared_files),
@@ -358,9 +374,11 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
     if scheduler:
         client = Client(scheduler, timeout=timeout or 60)
     else:
-        # no statistical profiler in the workers: its history grows with the campaign's length
-        with dask.config.set({"distributed.worker.profile.enabled": False}):
-            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None)
+        # no statistical profiler in the workers (its history grows with the campaign's length); a task
+        # whose worker dies is not tried on others: the batch is run isolated instead (below)
+        with dask.config.set({"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}):
+            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   silence_logs=logging.CRITICAL)  # a worker's death is reported by the campaign
         client = Client(cluster)
     try:
         client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
@@ -370,18 +388,18 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
         size = max(1, min(BATCH_CASES, -(-len(todo) // (8 * workers))))
         batches = _batches(todo, size, ship_texts=bool(scheduler) and not shared_files)
         in_flight = as_completed()
-        submitted = {}  # future -> (fmu, batch, attempt)
+        submitted = {}  # future -> (fmu, batch, isolated, attempt)
 
-        def submit(fmu, batch, attempt):
+        def submit(fmu, batch, isolated, attempt):
             items = [(folder, name, texts) for _, folder, name, texts in batch]
             future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), labels[fmu.path], tolerance,
-                                   plots, pure=False)
-            submitted[future] = fmu, batch, attempt
+                                   plots, isolated, case_timeout, pure=False)
+            submitted[future] = fmu, batch, isolated, attempt
             in_flight.add(future)
 
         def submit_next():
-            for fmu, batch in batches:
-                submit(fmu, batch, 1)
+            for fmu, batch in batches:  # with a per-case timeout every batch runs isolated: a hang needs a process
+                submit(fmu, batch, case_timeout is not None, 1)  # to kill
                 return
 
         for _ in range(3 * workers):
@@ -390,14 +408,14 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
         while in_flight.count():
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             future = next(in_flight) if remaining is None else _next_within(in_flight, remaining, timeout)
-            fmu, batch, attempt = submitted.pop(future)
+            fmu, batch, isolated, attempt = submitted.pop(future)
             try:
                 outcomes = future.result()
-            except Exception as error:  # its worker died, or the result was lost with a worker
+            except Exception as error:  # its worker died (an FMU crashed it?), or the result was lost with a worker
                 if attempt < BATCH_ATTEMPTS:
                     # the FMU's bytes again too: the copies may have gone with the workers
                     shared[fmu.path] = client.scatter(fmu_bytes[fmu.path], broadcast=True)
-                    submit(fmu, batch, attempt + 1)
+                    submit(fmu, batch, True, attempt + 1)  # isolated: a crashing case fails alone
                     continue
                 outcomes = [CaseOutcome(name, **labels[fmu.path], status="error",
                                         messages=[f"lost with its Dask worker {attempt} times: {type(error).__name__}: "

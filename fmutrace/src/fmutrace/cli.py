@@ -93,7 +93,9 @@ def parser():
                      "the same paths (else they are sent the files)")
     cmp.add_argument("--plots", choices=("all", "failed", "none"), default="all",
                      help="which cases get a plot in the report (default: all)")
-    cmp.add_argument("--timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
+    cmp.add_argument("--timeout", type=_non_negative, metavar="S", help="seconds a case may run: one over it is "
+                     "stopped and reported (the cases then run in child processes)")
+    cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
     cmp.add_argument("--resume", action="store_true", help="take the cases the report's journal holds from it and "
                      "run the others (after a stopped campaign; needs --report)")
     return main
@@ -123,7 +125,7 @@ def compare_command(args, out):
     result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
                      scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
-                     timeout=args.timeout, resume=args.resume)
+                     timeout=args.cluster_timeout, case_timeout=args.timeout, resume=args.resume)
     for o in result.failed():
         if o.status == "invalid":
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)

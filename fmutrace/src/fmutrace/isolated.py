@@ -1,0 +1,104 @@
+"""Cases in child processes, so that a case whose FMU crashes the process
+or hangs is reported by itself and the others still run.
+
+`run_isolated` starts `python -m fmutrace.isolated`, sends it the cases
+(pickled, on standard input) and reads back one outcome per case as it
+finishes (length-prefixed pickles on the child's own copy of standard
+output; what the FMU prints goes nowhere). When the child dies, the case it
+was running gets an error naming the signal; when a case runs longer than
+the per-case timeout, the child is killed and the case gets an error
+saying so. Either way a new child takes the cases after it.
+"""
+import os
+import pickle
+import queue
+import signal
+import struct
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+HEADER = struct.Struct("!Q")
+
+
+def _package_root():
+    """The folder (or zip) fmutrace is imported from: the child's PYTHONPATH."""
+    return str(Path(__file__).resolve().parent.parent)
+
+
+def _reader(stream, out):
+    """Outcomes from the child into out; None at its end."""
+    try:
+        while True:
+            header = stream.read(HEADER.size)
+            if len(header) < HEADER.size:
+                break
+            out.put(pickle.loads(stream.read(HEADER.unpack(header)[0])))
+    finally:
+        out.put(None)
+
+
+def run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout, outcome_class, on_outcome=None):
+    """[outcome] of items [(folder, name, texts)], the cases in a child
+    process; a crash or a case over case_timeout seconds (None: no bound)
+    fails that case only. on_outcome(outcome), if given, hears of each as
+    it arrives."""
+    outcomes = []
+    remaining = list(items)
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))
+    while remaining:
+        child = subprocess.Popen([sys.executable, "-m", "fmutrace.isolated"], stdin=subprocess.PIPE,
+                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=environment)
+        child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, tolerance, plots)))
+        child.stdin.close()
+        arrived = queue.Queue()
+        threading.Thread(target=_reader, args=(child.stdout, arrived), daemon=True).start()
+        for index, (_, name, _) in enumerate(remaining):
+            started = time.monotonic()
+            try:
+                outcome = arrived.get(timeout=case_timeout)
+            except queue.Empty:
+                child.kill()
+                child.wait()
+                outcome = outcome_class(name, **labels, status="error",
+                                        messages=[f"stopped after the per-case timeout of {case_timeout:g} s"],
+                                        seconds=time.monotonic() - started)
+            if outcome is None:  # the child died running this case
+                code = child.wait()
+                cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
+                outcome = outcome_class(name, **labels, status="error",
+                                        messages=[f"the simulation's process was {cause} while running this case"],
+                                        seconds=time.monotonic() - started)
+            outcomes.append(outcome)
+            if on_outcome:
+                on_outcome(outcome)
+            if outcome.status == "error" and child.poll() is not None:
+                remaining = remaining[index + 1:]
+                break
+        else:
+            remaining = []
+            child.wait()
+    return outcomes
+
+
+def main():
+    """The child: the cases from standard input, the outcomes out as they finish."""
+    out = os.fdopen(os.dup(1), "wb")
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes
+    items, fmu_bytes, path, labels, tolerance, plots = pickle.loads(sys.stdin.buffer.read())
+    from .campaign import run_one, worker_fmu
+
+    runner, fmu = worker_fmu(fmu_bytes, path)
+    for folder, name, texts in items:
+        data = pickle.dumps(run_one(folder, name, texts, runner, fmu, labels, tolerance, plots))
+        out.write(HEADER.pack(len(data)) + data)
+        out.flush()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
