@@ -1,7 +1,7 @@
 """Cases in child processes, so that a case whose FMU crashes the process
 or hangs is reported by itself and the others still run.
 
-`run_isolated` starts `python -m fmutrace.isolated`, sends it the cases
+`run_isolated` starts a Python child running `main` below, sends it the cases
 (pickled, on standard input) and reads back one outcome per case as it
 finishes (length-prefixed pickles on the child's own copy of standard
 output; what the FMU prints goes nowhere). When the child dies, the case it
@@ -16,16 +16,25 @@ import signal
 import struct
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
 
 HEADER = struct.Struct("!Q")
+CHILD = "import sys, fmutrace.isolated; sys.exit(fmutrace.isolated.main())"
 
 
 def _package_root():
     """The folder (or zip) fmutrace is imported from: the child's PYTHONPATH."""
     return str(Path(__file__).resolve().parent.parent)
+
+
+def _last_words(file):
+    """'; it said: <its last line>' of what a dead child wrote to stderr."""
+    file.seek(0)
+    lines = [line.strip() for line in file.read()[-4000:].decode(errors="replace").splitlines() if line.strip()]
+    return f"; it said: {lines[-1][:200]}" if lines else ""
 
 
 def _reader(stream, out):
@@ -50,8 +59,9 @@ def run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout,
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))
     while remaining:
-        child = subprocess.Popen([sys.executable, "-m", "fmutrace.isolated"], stdin=subprocess.PIPE,
-                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=environment)
+        said = tempfile.TemporaryFile()  # the child's last words, if it dies
+        child = subprocess.Popen([sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 stderr=said, env=environment)
         child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, tolerance, plots)))
         child.stdin.close()
         arrived = queue.Queue()
@@ -70,7 +80,8 @@ def run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout,
                 code = child.wait()
                 cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
                 outcome = outcome_class(name, **labels, status="error",
-                                        messages=[f"the simulation's process was {cause} while running this case"],
+                                        messages=[f"the simulation's process was {cause} while running this case"
+                                                  + _last_words(said)],
                                         seconds=time.monotonic() - started)
             outcomes.append(outcome)
             if on_outcome:
@@ -99,6 +110,3 @@ def main():
         out.flush()
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())
