@@ -105,19 +105,22 @@ function(add_fmu model version)
     list(APPEND entries ${doc_files})
   endif()
 
-  # the product models also carry Windows x86_64 binaries (cmake/Windows.cmake)
-  set(windows_dll)
-  if(NOT ARG_TOML AND WINDOWS_BUILD_DIR)
-    if(version EQUAL 2)
-      set(windows_platform win64)
-    else()
-      set(windows_platform x86_64-windows)
-    endif()
-    set(windows_dll ${WINDOWS_BUILD_DIR}/fmi${version}/${model}.dll)
-    list(APPEND copies
-      COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/binaries/${windows_platform}
-      COMMAND ${CMAKE_COMMAND} -E copy ${windows_dll} ${stage}/binaries/${windows_platform}/)
-    list(APPEND entries binaries/${windows_platform}/${model}.dll)
+  # the product models also carry the binaries of other platforms (cmake/CrossBuilds.cmake)
+  set(cross_libraries)
+  set(cross_targets)
+  if(NOT ARG_TOML)
+    foreach(name IN LISTS CROSS_BUILDS)
+      set(cross_platform ${CROSS_${name}_PLATFORM${version}})
+      if(cross_platform)
+        set(cross_library ${CROSS_${name}_DIR}/fmi${version}/${model}${CROSS_${name}_SUFFIX})
+        list(APPEND copies
+          COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/binaries/${cross_platform}
+          COMMAND ${CMAKE_COMMAND} -E copy ${cross_library} ${stage}/binaries/${cross_platform}/)
+        list(APPEND entries binaries/${cross_platform}/${model}${CROSS_${name}_SUFFIX})
+        list(APPEND cross_libraries ${cross_library})
+        list(APPEND cross_targets ${name}_binaries)
+      endif()
+    endforeach()
   endif()
   list(SORT entries)
 
@@ -129,11 +132,12 @@ function(add_fmu model version)
     COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" -- ${entries}
     COMMAND zip_normalize ${fmu}
     WORKING_DIRECTORY ${stage}
-    DEPENDS zip_normalize ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs} ${windows_dll}
+    DEPENDS zip_normalize ${lib} ${sources} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs}
+            ${cross_libraries}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})
-  if(windows_dll)
-    add_dependencies(${lib}_fmu windows_binaries)
-  endif()
+  foreach(target IN LISTS cross_targets)
+    add_dependencies(${lib}_fmu ${target})
+  endforeach()
   add_dependencies(fmus ${lib}_fmu)
 endfunction()

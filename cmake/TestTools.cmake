@@ -6,6 +6,7 @@
 #   clang-14, libclang-rt-14-dev    libFuzzer with ASan/UBSan (ctest fuzz_*; cmake/Fuzz.cmake)
 #   valgrind                        memcheck (ctest memcheck_*) and callgrind (benchmarks)
 #   libtbb12, unzip                 ecospy, another importer (test_importers, test_closed_loop)
+#   qemu-user                       the aarch64 binaries and harnesses under emulation (test_aarch64)
 # Python packages: tests/requirements.txt (cmake/PythonEnv.cmake).
 # A tool that still cannot be had makes its tests fail and say why.
 
@@ -35,6 +36,13 @@ find_program(VALGRIND valgrind)
 if(NOT VALGRIND)
   apt_install("No valgrind for the memcheck tests" valgrind)
   find_program(VALGRIND valgrind)
+endif()
+
+# qemu-user: the aarch64 Linux binaries run under emulation
+find_program(QEMU_AARCH64 qemu-aarch64)
+if(NOT QEMU_AARCH64)
+  apt_install("No qemu-aarch64 for the aarch64 test" qemu-user)
+  find_program(QEMU_AARCH64 qemu-aarch64)
 endif()
 
 # ecospy's native library needs libtbb12, and unzip for FMUs

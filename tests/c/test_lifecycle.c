@@ -19,6 +19,7 @@
 
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
+#include "fmu_library.h"
 
 /* ---- live allocations: interposed malloc and FMI 2 callbacks ------------ */
 
@@ -94,27 +95,8 @@ static int failures;
 /* ---- the FMU --------------------------------------------------------- */
 
 static int version;
-static void *library;
 static char token[128];
 static unsigned uVr, yVr;
-
-static void *symbol(const char *name) {
-    void *s = dlsym(library, name);
-    if (!s) {
-        fprintf(stderr, "%s not exported\n", name);
-        exit(2);
-    }
-    return s;
-}
-
-typedef void (*AnyFunction)(void);
-
-static AnyFunction function(const char *name) {
-    void *s = symbol(name);
-    AnyFunction f;
-    memcpy(&f, &s, sizeof f); /* dlsym's object pointer as a function pointer */
-    return f;
-}
 
 #define F2(name) ((name##TYPE *)function(#name))
 #define F3(name) ((name##TYPE *)function(#name))
@@ -319,8 +301,12 @@ int main(int argc, char **argv) {
     version = atoi(argv[1]);
     char identifier[128], binary[4096];
     read_description(argv[2], identifier, sizeof identifier);
-    snprintf(binary, sizeof binary, "%s/binaries/%s/%s.so", argv[2], version == 2 ? "linux64" : "x86_64-linux",
-             identifier);
+#if defined(__aarch64__)
+    const char *platform = version == 2 ? "aarch64-linux (none in FMI 2)" : "aarch64-linux";
+#else
+    const char *platform = version == 2 ? "linux64" : "x86_64-linux";
+#endif
+    snprintf(binary, sizeof binary, "%s/binaries/%s/%s.so", argv[2], platform, identifier);
     library = dlopen(binary, RTLD_NOW | RTLD_LOCAL);
     if (!library) {
         fprintf(stderr, "%s\n", dlerror());

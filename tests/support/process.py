@@ -46,8 +46,8 @@ def run(args, *, timeout, what, check=False, **popen):
     showing the output so far. check: a non-zero exit raises an
     AssertionError with the output."""
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        process = subprocess.Popen(args, stdin=subprocess.DEVNULL, stdout=out, stderr=err,
-                                   start_new_session=True, **popen)
+        stdin = popen.pop("stdin", subprocess.DEVNULL)  # a file to read, or nothing
+        process = subprocess.Popen(args, stdin=stdin, stdout=out, stderr=err, start_new_session=True, **popen)
         try:
             process.wait(timeout=timeout)
             timed_out = False
