@@ -1,8 +1,10 @@
 """The FMI 3 FMUs' aarch64-linux binaries, cross-compiled by the same CMake
 project (cmake/CrossBuilds.cmake), run under Debian's qemu-user: the C
-lifecycle harness cross-compiled for aarch64 passes, and every reference
+lifecycle harness cross-compiled for aarch64 passes, every reference
 scenario of every model driven by the same script (tests/c/run_trace.c)
-prints the same bits as the x86_64 binary."""
+prints the same bits as the x86_64 binary, and an FMU state serialized by
+one platform's binary is restored by the other's and continues bit for
+bit."""
 import os
 import zipfile
 
@@ -38,10 +40,11 @@ def test_lifecycle_harness_under_emulation():
     assert "FMI 3: passed" in done.stdout
 
 
-def script(scenario, md):
-    """The scenario as run_trace's script: start values and the inputs at
-    the start, initialization, then per step the inputs (a row holds from
-    its time on), the step, the recorded outputs."""
+def script_parts(scenario, md):
+    """The scenario as run_trace's script: the start (start values and the
+    inputs at the start, initialization, the outputs) and one block per
+    step (the inputs, a row holding from its time on; the step; the
+    recorded outputs)."""
     variables = {v.name: v for v in md.modelVariables}
 
     def set_line(name, value):
@@ -50,20 +53,22 @@ def script(scenario, md):
         literal = float(value).hex() if kind == "F" else str(int(value))
         return f"set {kind} {v.valueReference} {literal}"
 
-    def get_lines():
-        return [f"get {KINDS[variables[name].type]} {variables[name].valueReference}" for name in scenario.outputs]
-
+    gets = [f"get {KINDS[variables[name].type]} {variables[name].valueReference}" for name in scenario.outputs]
     o = scenario.options
     start, h = o["StartTime"], o["StepSize"]
     n = round((o["StopTime"] - start) / h)
     times = [start + k * h for k in range(n + 1)]
-    lines = [set_line(name, value) for name, value in scenario.start_values.items()]
-    lines += [set_line(name, value) for name, value in input_values(scenario, start).items()]
-    lines += [f"init {start.hex()}"] + get_lines()
-    for t, end in zip(times, times[1:]):
-        lines += [set_line(name, value) for name, value in input_values(scenario, t).items()]
-        lines += [f"step {t.hex()} {(end - t).hex()}"] + get_lines()
-    return "\n".join(lines) + "\n"
+    head = [set_line(name, value) for name, value in scenario.start_values.items()]
+    head += [set_line(name, value) for name, value in input_values(scenario, start).items()]
+    head += [f"init {start.hex()}"] + gets
+    blocks = [[set_line(name, value) for name, value in input_values(scenario, t).items()]
+              + [f"step {t.hex()} {(end - t).hex()}"] + gets for t, end in zip(times, times[1:])]
+    return head, blocks
+
+
+def script(scenario, md):
+    head, blocks = script_parts(scenario, md)
+    return "\n".join(head + [line for block in blocks for line in block]) + "\n"
 
 
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.id for s in SCENARIOS])
@@ -100,3 +105,34 @@ def test_the_harness_gives_the_reference(tmp_path):
     values = [float.fromhex(line) for line in done.stdout.split()]
     assert values == [float(v) for v in scenario.reference["y"]]
 
+
+
+def run_script(platform, stage, model, token, text, tmp_path, what):
+    (tmp_path / "script").write_text(text)
+    command = [str(BUILD_DIR / "run_trace")] if platform == "x86_64-linux" else QEMU + [str(CROSS / "run_trace")]
+    with open(tmp_path / "script") as script_file:
+        done = run_bounded(command + [str(stage / "binaries" / platform / f"{model}.so"), token], timeout=300,
+                           stdin=script_file, what=what, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
+
+
+@pytest.mark.parametrize("saved_on,restored_on", [("x86_64-linux", "aarch64-linux"), ("aarch64-linux", "x86_64-linux")])
+@pytest.mark.parametrize("name", ["RateLimiter/asymmetric", "RateLimiter/duration_jump", "Ramp/ttime_tuned_in_run",
+                                  "LGF_LimRateOfChangeAdvancedCI/inverted_limits", "RateLimit/duration_48h"])
+def test_a_state_serialized_on_one_platform_continues_on_the_other(name, saved_on, restored_on, tmp_path):
+    scenario = next(s for s in SCENARIOS if s.id == name)
+    stage = BUILD_DIR / "stage" / "fmi3" / scenario.model
+    md = read_model_description(str(stage / "modelDescription.xml"))
+    head, blocks = script_parts(scenario, md)
+    whole = run_script("x86_64-linux", stage, scenario.model, md.guid, script(scenario, md), tmp_path, "whole run")
+    middle = len(blocks) // 2
+    first = head + [line for block in blocks[:middle] for line in block] + ["save state.bin"]
+    second = ["load state.bin"] + [line for block in blocks[middle:] for line in block]
+    before = run_script(saved_on, stage, scenario.model, md.guid, "\n".join(first) + "\n", tmp_path,
+                        f"first half on {saved_on}")
+    assert (tmp_path / "state.bin").stat().st_size > 0
+    after = run_script(restored_on, stage, scenario.model, md.guid, "\n".join(second) + "\n", tmp_path,
+                       f"second half on {restored_on}")
+    assert len(whole) > len(before) > 0
+    assert before + after == whole

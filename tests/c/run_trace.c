@@ -10,6 +10,8 @@
  *                init <startTime>
  *                step <t> <h>                  (C99 %a)
  *                get <F|I|B> <vr>              prints the value (Float64 as %a)
+ *                save <file>                   the FMU state, serialized, into file
+ *                load <file>                   the FMU state of file, deserialized and set
  * Exit 1 on any status above Warning, naming the line. */
 #include <stdio.h>
 
@@ -45,6 +47,12 @@ int main(int argc, char **argv) {
     fmi3GetInt32TYPE *get_int = (fmi3GetInt32TYPE *)function("fmi3GetInt32");
     fmi3GetBooleanTYPE *get_bool = (fmi3GetBooleanTYPE *)function("fmi3GetBoolean");
     fmi3FreeInstanceTYPE *free_instance = (fmi3FreeInstanceTYPE *)function("fmi3FreeInstance");
+    fmi3GetFMUStateTYPE *get_state = (fmi3GetFMUStateTYPE *)function("fmi3GetFMUState");
+    fmi3SetFMUStateTYPE *set_state = (fmi3SetFMUStateTYPE *)function("fmi3SetFMUState");
+    fmi3FreeFMUStateTYPE *free_state = (fmi3FreeFMUStateTYPE *)function("fmi3FreeFMUState");
+    fmi3SerializedFMUStateSizeTYPE *state_size = (fmi3SerializedFMUStateSizeTYPE *)function("fmi3SerializedFMUStateSize");
+    fmi3SerializeFMUStateTYPE *serialize = (fmi3SerializeFMUStateTYPE *)function("fmi3SerializeFMUState");
+    fmi3DeserializeFMUStateTYPE *deserialize = (fmi3DeserializeFMUStateTYPE *)function("fmi3DeserializeFMUState");
 
     fmi3Instance c = instantiate("trace", argv[2], NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL,
                                  log_message, NULL);
@@ -52,7 +60,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "instantiation failed\n");
         return 1;
     }
-    char line[256], kind;
+    char line[256], kind, path[200];
     unsigned vr;
     long line_number = 0;
     int status = fmi3OK;
@@ -97,6 +105,25 @@ int main(int argc, char **argv) {
                 status = get_bool(c, &r, 1, &v, 1);
                 printf("%d\n", v ? 1 : 0);
             }
+        } else if (sscanf(line, "save %199s", path) == 1) {
+            fmi3FMUState state = NULL;
+            size_t size = 0;
+            static fmi3Byte bytes[1 << 16];
+            status = get_state(c, &state);
+            if (status <= fmi3Warning) status = state_size(c, state, &size);
+            if (status <= fmi3Warning && size <= sizeof bytes) status = serialize(c, state, bytes, size);
+            FILE *f = fopen(path, "wb");
+            if (!f || fwrite(bytes, 1, size, f) != size || fclose(f) != 0 || size > sizeof bytes) status = fmi3Error;
+            free_state(c, &state);
+        } else if (sscanf(line, "load %199s", path) == 1) {
+            static fmi3Byte bytes[1 << 16];
+            FILE *f = fopen(path, "rb");
+            const size_t size = f ? fread(bytes, 1, sizeof bytes, f) : 0;
+            if (f) fclose(f);
+            fmi3FMUState state = NULL;
+            status = deserialize(c, bytes, size, &state);
+            if (status <= fmi3Warning) status = set_state(c, state);
+            free_state(c, &state);
         } else {
             fprintf(stderr, "line %ld: cannot read '%s'\n", line_number, line);
             return 2;
