@@ -11,12 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fmpy import extract
+from fmpy import extract, read_model_description
 from fmpy.util import read_csv
 
 from support.fmu_driver import BUILD_DIR, TESTS, fmu_file
 from support.scenarios import SCENARIO_ROOT, compare, load
 from support.process import run
+from support.run_trace import halves, run_script
 from support.wine import RemotingServer, environment, make_prefix, remoting_copy
 
 pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
@@ -91,3 +92,24 @@ def test_a_run_longer_than_the_servers_lock_file_poll(wine, tmp_path):
     result = windows_and_linux(wine, load(folder), tmp_path)
     assert len(result) == 401 and result["time"][-1] == 200.0
     assert np.all(result["y"][result["time"] >= 6.0] == 10.0)
+
+
+@pytest.mark.parametrize("saved_on,restored_on", [("x86_64-linux", "x86_64-windows"),
+                                                  ("x86_64-windows", "aarch64-linux")])
+@pytest.mark.parametrize("name", ["RateLimiter/asymmetric", "LGF_LimRateOfChangeAdvancedCI/inverted_limits"])
+def test_a_state_serialized_on_one_platform_continues_on_another(name, saved_on, restored_on, wine, tmp_path):
+    """FMI 3 states are portable: half a run on one platform's binary, its
+    state serialized to a file, the other half on another's (Windows under
+    wine, aarch64 under qemu) gives the whole run's bits on x86_64 Linux
+    (with test_aarch64's aarch64 -> x86_64 a full circle)."""
+    scenario = load(SCENARIO_ROOT / name)
+    stage = Path(BUILD_DIR) / "stage" / "fmi3" / scenario.model
+    md = read_model_description(str(stage / "modelDescription.xml"))
+    first, second, whole_script = halves(scenario, md, "state.bin")
+    env = dict(wine, WINE_DIR=WINE_DIR)
+    whole = run_script("x86_64-linux", stage, scenario.model, md.guid, whole_script, tmp_path, "whole run")
+    before = run_script(saved_on, stage, scenario.model, md.guid, first, tmp_path, f"first half on {saved_on}", env)
+    after = run_script(restored_on, stage, scenario.model, md.guid, second, tmp_path, f"second half on {restored_on}",
+                       env)
+    assert len(whole) > len(before) > 0
+    assert before + after == whole

@@ -1,7 +1,7 @@
 /* An FMI 3 co-simulation binary driven by a script on standard input, the
  * outputs printed bit for bit: the same script gives the same text on every
  * platform whose binary computes the same numbers (the aarch64 build runs
- * under qemu-user).
+ * under qemu-user, the Windows build under wine).
  *
  *   run_trace <binary.so> <instantiationToken> < script
  *
@@ -30,11 +30,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "usage: run_trace <binary.so> <instantiationToken> < script\n");
         return 2;
     }
-    library = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
-    if (!library) {
-        fprintf(stderr, "%s\n", dlerror());
-        return 2;
-    }
+    if (!open_library(argv[1])) return 2;
     fmi3InstantiateCoSimulationTYPE *instantiate = (fmi3InstantiateCoSimulationTYPE *)function("fmi3InstantiateCoSimulation");
     fmi3EnterInitializationModeTYPE *enter = (fmi3EnterInitializationModeTYPE *)function("fmi3EnterInitializationMode");
     fmi3ExitInitializationModeTYPE *leave = (fmi3ExitInitializationModeTYPE *)function("fmi3ExitInitializationMode");

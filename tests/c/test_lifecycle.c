@@ -307,11 +307,7 @@ int main(int argc, char **argv) {
     const char *platform = version == 2 ? "linux64" : "x86_64-linux";
 #endif
     snprintf(binary, sizeof binary, "%s/binaries/%s/%s.so", argv[2], platform, identifier);
-    library = dlopen(binary, RTLD_NOW | RTLD_LOCAL);
-    if (!library) {
-        fprintf(stderr, "%s\n", dlerror());
-        return 2;
-    }
+    if (!open_library(binary)) return 2;
     counting = 1;
     full_simulation();
     instantiate_free(atol(argv[3]));
