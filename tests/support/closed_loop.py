@@ -4,9 +4,14 @@ RateLimiter, whose output is the plant's actuator command. Run by one
 importer (one process each), communication step H, N steps; writes time,
 RateLimiter y and plant x after every step.
 
-    python -m support.closed_loop <fmpy|ecospy|libcosimpy> <FMI version> <build dir> <result.csv>
+    python -m support.closed_loop <fmpy|ecospy|libcosimpy|ssp-ecospy|ssp-libcosimpy|ssp-fmpy> <FMI version>
+                                  <build dir> <result.csv>
+
+The ssp-* runs read build/ssp/RateLimiterLoop.ssp (FMI 2 FMUs) instead of
+coupling the FMUs here.
 """
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -14,13 +19,17 @@ from fmpy import extract, read_model_description
 from fmpy.util import write_csv
 
 
-H, N = 0.1, 100
-PLANT = {"tau": 2.0, "Kp": 0.8, "setpoint": 10.0, "x0": 0.0}
-# u starts as the first transfer makes it, so that initialisation does not
-# depend on whether an importer transfers before or after it; initMode
-# keeps its default (the output starts at u): Ecos and libcosim cannot set
-# Enumeration variables
-LIMITER = {"rateUpPar": 1.0, "rateDownPar": 1.0, "u": PLANT["Kp"] * (PLANT["setpoint"] - PLANT["x0"])}
+# the system's one description, also the SSP package's source
+SYSTEM = tomllib.loads((Path(__file__).resolve().parents[2] / "modelDescription" / "RateLimiterLoop.toml").read_text())
+H = SYSTEM["system"]["stepSize"]
+N = round((SYSTEM["system"]["stopTime"] - SYSTEM["system"]["startTime"]) / H)
+PLANT = next(c["parameters"] for c in SYSTEM["component"] if c["name"] == "plant")
+LIMITER = next(c["parameters"] for c in SYSTEM["component"] if c["name"] == "rl")
+assert LIMITER["u"] == PLANT["Kp"] * (PLANT["setpoint"] - PLANT["x0"])  # what the first transfer gives
+
+
+def ssp_path(build):
+    return Path(build) / "ssp" / "RateLimiterLoop.ssp"
 
 
 def paths(build, version):
@@ -104,7 +113,65 @@ def run_libcosimpy(build, version):
     return rows
 
 
-RUNNERS = {"fmpy": run_fmpy, "ecospy": run_ecospy, "libcosimpy": run_libcosimpy}
+def run_ssp_ecospy(build, version):
+    """The SSP package as it is: Ecos reads it (the parameter set by the
+    SSV files' name)."""
+    from ecospy import EcosSimulation
+
+    simulation = EcosSimulation(ssp_path=str(ssp_path(build)), step_size=H)
+    simulation.init(0.0, SYSTEM["system"]["name"])
+    rows = []
+    for k in range(N):
+        simulation.step()
+        rows.append(((k + 1) * H, simulation.get_real("rl::y"), simulation.get_real("plant::x")))
+    simulation.terminate()
+    simulation.free()
+    return rows
+
+
+def run_ssp_libcosimpy(build, version):
+    """The SSP package as it is: libcosim reads it (the step size given)."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    execution = CosimExecution.from_ssp_file(str(ssp_path(build)), step_size=int(round(H * 1e9)))
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    index = {(s.name.decode() if isinstance(s.name, bytes) else s.name): s.index for s in execution.slave_infos()}
+    vr_rl = {v.name: v.valueReference for v in read_model_description(str(paths(build, 2)[0])).modelVariables}
+    vr_plant = {v.name: v.valueReference for v in read_model_description(str(paths(build, 2)[1])).modelVariables}
+    rows = []
+    for k in range(N):
+        execution.step(1)
+        rows.append(((k + 1) * H, observer.last_real_values(index["rl"], [vr_rl["y"]])[0],
+                     observer.last_real_values(index["plant"], [vr_plant["x"]])[0]))
+    return rows
+
+
+def run_ssp_fmpy(build, version):
+    """fmpy's SSP support reads the package and runs it, but applies only a
+    parameter set given to simulate_ssp, not the components' bindings: the
+    SSV files' values, read from the package by fmpy, are given."""
+    from fmpy.ssp.ssd import read_ssd, read_ssv
+    from fmpy.ssp.simulation import simulate_ssp
+
+    ssd = read_ssd(str(ssp_path(build)))
+    parameters = []
+    for component in ssd.system.elements:
+        for binding in component.parameterBindings:
+            for parameter in read_ssv(str(ssp_path(build)), resource=binding.source).parameters:
+                parameter.name = f"{component.name}.{parameter.name}"
+                parameters.append(parameter)
+    parameter_set = read_ssv(str(ssp_path(build)), resource=ssd.system.elements[0].parameterBindings[0].source)
+    parameter_set.parameters = parameters
+    result = simulate_ssp(str(ssp_path(build)), stop_time=N * H, step_size=H, parameter_set=parameter_set)
+    return [(float(t), float(y), float(x)) for t, y, x in zip(result["time"], result["rl.y"], result["plant.x"])][1:]
+
+
+RUNNERS = {"fmpy": run_fmpy, "ecospy": run_ecospy, "libcosimpy": run_libcosimpy, "ssp-ecospy": run_ssp_ecospy,
+           "ssp-libcosimpy": run_ssp_libcosimpy, "ssp-fmpy": run_ssp_fmpy}
 
 
 def main(importer, version, build, out):
