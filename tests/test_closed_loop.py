@@ -102,8 +102,9 @@ def test_fmpy_reads_the_ssp_package_and_runs_it_its_own_way(tmp_path):
     connections and the bindings with the TOML's values; simulate_ssp runs
     the loop (given the SSV values as its parameter set: it does not apply
     bindings) to the same steady state, but not step for step as the
-    oracle couples (its master records after a first transfer and step),
-    so it is not compared with the oracle."""
+    oracle couples: its master takes the first step before any connection
+    is transferred (the inputs at 0) and records each row after its step
+    under the step's start time."""
     from fmpy.ssp.ssd import read_ssd, read_ssv
 
     package = str(BUILD_DIR / "ssp" / "RateLimiterLoop.ssp")
