@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The SSP 1.0 package of a system described in a TOML file
-(modelDescription/RateLimiterLoop.toml): SystemStructure.ssd with the
+(modelDescription/systems/RateLimiterLoop.toml): SystemStructure.ssd with the
 components, their connectors (kind and type from the FMUs' model
 descriptions) and connections, the parameter values in an SSV file per
 component (bound to it: the binding every importer tested reads), both

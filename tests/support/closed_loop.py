@@ -20,7 +20,8 @@ from fmpy.util import write_csv
 
 
 # the system's one description, also the SSP package's source
-SYSTEM = tomllib.loads((Path(__file__).resolve().parents[2] / "modelDescription" / "RateLimiterLoop.toml").read_text())
+SYSTEM_TOML = Path(__file__).resolve().parents[2] / "modelDescription" / "systems" / "RateLimiterLoop.toml"
+SYSTEM = tomllib.loads(SYSTEM_TOML.read_text())
 H = SYSTEM["system"]["stepSize"]
 N = round((SYSTEM["system"]["stopTime"] - SYSTEM["system"]["startTime"]) / H)
 PLANT = next(c["parameters"] for c in SYSTEM["component"] if c["name"] == "plant")
