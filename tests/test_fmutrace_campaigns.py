@@ -22,15 +22,20 @@ PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
 WAIT = 120
 
 
-def pass_through_cases(root, count):
-    """count cases: y(t + 0.1) = u(t), u = k from t = 0.2 on (worked by hand)."""
-    for k in range(count):
-        folder = root / f"case_{k:03d}"
+def step_cases(root, model, values):
+    """A case per value k, worked by hand for PassThrough's equation
+    y(t + 0.1) = u(t): u = k from t = 0.2 on."""
+    for k in values:
+        folder = root / f"case_{k:02d}"
         folder.mkdir(parents=True)
-        (folder / "PassThrough_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
-        (folder / "PassThrough_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
-        (folder / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+        (folder / f"{model}_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
+        (folder / f"{model}_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
+        (folder / f"{model}_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
     return root
+
+
+def pass_through_cases(root, count):
+    return step_cases(root, "PassThrough", range(count))
 
 
 def start(args):
@@ -165,15 +170,9 @@ CRASH = "exited with status 1" if os.environ.get("RL_SANITIZED") == "1" else "ki
 
 
 def faulty_cases(root, values):
-    """Cases of the Faulty fixture: y(t + 0.1) = u(t) with u = k from 0.2
-    on; k = 13 crashes its process, k = 17 hangs."""
-    for k in values:
-        folder = root / f"case_{k:02d}"
-        folder.mkdir(parents=True)
-        (folder / "Faulty_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
-        (folder / "Faulty_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
-        (folder / "Faulty_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
-    return root
+    """Cases of the Faulty fixture (PassThrough's equation): k = 13 crashes
+    its process, k = 17 hangs."""
+    return step_cases(root, "Faulty", values)
 
 
 @pytest.mark.parametrize("version,jobs", [(2, 2), (3, 2), (3, 1)])

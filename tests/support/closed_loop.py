@@ -62,6 +62,31 @@ def run_fmpy(build, version):
     return rows
 
 
+def ecos_rows(simulation):
+    """N steps of an initialised Ecos simulation: (t, rl y, plant x) after each."""
+    rows = []
+    for k in range(N):
+        simulation.step()
+        rows.append(((k + 1) * H, simulation.get_real("rl::y"), simulation.get_real("plant::x")))
+    simulation.terminate()
+    simulation.free()
+    return rows
+
+
+def libcosim_rows(execution, rl, plant, vr_rl, vr_plant):
+    """N steps of a libcosim execution: (t, rl y, plant x) after each."""
+    from libcosimpy.CosimObserver import CosimObserver
+
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    rows = []
+    for k in range(N):
+        execution.step(1)
+        rows.append(((k + 1) * H, observer.last_real_values(rl, [vr_rl["y"]])[0],
+                     observer.last_real_values(plant, [vr_plant["x"]])[0]))
+    return rows
+
+
 def run_ecospy(build, version):
     from ecospy import EcosSimulation, EcosSimulationStructure
 
@@ -76,19 +101,12 @@ def run_ecospy(build, version):
     structure.add_parameter_set("loop", parameters)
     simulation = EcosSimulation(structure=structure, step_size=H)
     simulation.init(0.0, "loop")
-    rows = []
-    for k in range(N):
-        simulation.step()
-        rows.append(((k + 1) * H, simulation.get_real("rl::y"), simulation.get_real("plant::x")))
-    simulation.terminate()
-    simulation.free()
-    return rows
+    return ecos_rows(simulation)
 
 
 def run_libcosimpy(build, version):
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
     log_output_level(CosimLogLevel.ERROR)
@@ -98,20 +116,13 @@ def run_libcosimpy(build, version):
     execution = CosimExecution.from_step_size(step_size=int(round(H * 1e9)))
     rl = execution.add_local_slave(CosimLocalSlave(fmu_path=str(rl_path), instance_name="rl"))
     plant = execution.add_local_slave(CosimLocalSlave(fmu_path=str(plant_path), instance_name="plant"))
-    observer = CosimObserver.create_last_value()
-    execution.add_observer(observer)
     for name, value in PLANT.items():
         execution.real_initial_value(plant, vr_plant[name], value)
     for name, value in LIMITER.items():
         execution.real_initial_value(rl, vr_rl[name], value)
     execution.connect_real_variables(plant, vr_plant["demand"], rl, vr_rl["u"])
     execution.connect_real_variables(rl, vr_rl["y"], plant, vr_plant["command"])
-    rows = []
-    for k in range(N):
-        execution.step(1)
-        rows.append(((k + 1) * H, observer.last_real_values(rl, [vr_rl["y"]])[0],
-                     observer.last_real_values(plant, [vr_plant["x"]])[0]))
-    return rows
+    return libcosim_rows(execution, rl, plant, vr_rl, vr_plant)
 
 
 def run_ssp_ecospy(build, version):
@@ -121,34 +132,20 @@ def run_ssp_ecospy(build, version):
 
     simulation = EcosSimulation(ssp_path=str(ssp_path(build)), step_size=H)
     simulation.init(0.0, SYSTEM["system"]["name"])
-    rows = []
-    for k in range(N):
-        simulation.step()
-        rows.append(((k + 1) * H, simulation.get_real("rl::y"), simulation.get_real("plant::x")))
-    simulation.terminate()
-    simulation.free()
-    return rows
+    return ecos_rows(simulation)
 
 
 def run_ssp_libcosimpy(build, version):
     """The SSP package as it is: libcosim reads it (the step size given)."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
 
     log_output_level(CosimLogLevel.ERROR)
     execution = CosimExecution.from_ssp_file(str(ssp_path(build)), step_size=int(round(H * 1e9)))
-    observer = CosimObserver.create_last_value()
-    execution.add_observer(observer)
     index = {(s.name.decode() if isinstance(s.name, bytes) else s.name): s.index for s in execution.slave_infos()}
     vr_rl = {v.name: v.valueReference for v in read_model_description(str(paths(build, 2)[0])).modelVariables}
     vr_plant = {v.name: v.valueReference for v in read_model_description(str(paths(build, 2)[1])).modelVariables}
-    rows = []
-    for k in range(N):
-        execution.step(1)
-        rows.append(((k + 1) * H, observer.last_real_values(index["rl"], [vr_rl["y"]])[0],
-                     observer.last_real_values(index["plant"], [vr_plant["x"]])[0]))
-    return rows
+    return libcosim_rows(execution, index["rl"], index["plant"], vr_rl, vr_plant)
 
 
 def run_ssp_fmpy(build, version):

@@ -279,7 +279,8 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     try:
         if report:
             journal = Journal(report, campaign_key(fmu_bytes, tolerance, plots), resume)
-        keys = [case_key(fmu.path, folder) for fmu, folder, _ in work]
+        # a case's journal key (its FMU and real folder): only a journaled campaign needs them
+        keys = [case_key(fmu.path, folder) for fmu, folder, _ in work] if journal else None
         todo = []
         for i, (fmu, folder, name) in enumerate(work):
             entry = journal.done.get(keys[i]) if journal else None
