@@ -149,7 +149,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
     if (stopTimeDefined && !(stopTime >= startTime)) {
         return (fmi2Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
     }
-    return (fmi2Status)fmu_setup_experiment(I, startTime);
+    return (fmi2Status)fmu_setup_experiment(I, FN, startTime);
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {

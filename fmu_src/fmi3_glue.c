@@ -153,7 +153,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
     if (stopTimeDefined && !(stopTime >= startTime)) {
         return (fmi3Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
     }
-    CHECK(fmu_setup_experiment(I, startTime));
+    CHECK(fmu_setup_experiment(I, FN, startTime));
     return (fmi3Status)fmu_enter_initialization(I);
 }
 

@@ -211,9 +211,9 @@ static void snapshot(FmuInstance *instance, FmuCore *state) {
     *state = instance->core;
 }
 
-FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime) {
+FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime) {
     if (!isfinite(startTime)) {
-        return fmu_error(instance, "setup", "startTime %g is not finite", startTime);
+        return fmu_error(instance, function, "startTime %g is not finite", startTime);
     }
     instance->core.startTime = startTime;
     instance->core.time = startTime;

@@ -274,7 +274,7 @@ static inline bool fmu_set_one(FmuInstance *instance, const char *function, int 
     return true;
 }
 
-FmuStatus fmu_setup_experiment(FmuInstance *instance, double startTime);
+FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime);
 FmuStatus fmu_enter_initialization(FmuInstance *instance);
 FmuStatus fmu_exit_initialization(FmuInstance *instance);
 /* currentCommunicationPoint within a relative RL_TIME_TOLERANCE of the

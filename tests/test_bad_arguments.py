@@ -2,11 +2,15 @@
 exported function, nValues 0 and mismatched, duplicate value references,
 stop time before start time. Each gets the right status, and the instance
 stays usable where the standard allows."""
-from ctypes import c_bool, c_double, c_int, c_size_t, c_uint, c_void_p
+from ctypes import byref, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint, c_void_p
 
 import pytest
+from fmpy import calloc, free
+from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
+                       fmi2CallbackLoggerTYPE)
+from fmpy.fmi3 import fmi3LogMessageCallback
 
-from support.fmu_driver import Instance
+from support.fmu_driver import Instance, call_status
 from test_conformance import NOT_INSTANCE_CALLS, exported_functions
 
 
@@ -94,5 +98,176 @@ def test_stop_time_before_start_time_is_refused(version):
         fmu.fmu.reset()  # the standard's way on from an error
         fmu.start(start_time=10.0)
         fmu.step(0.5)
+    finally:
+        fmu.free()
+
+
+# ---- the checks of every value reference, whatever its place in the array ----
+
+def accessors(fmu, kind):
+    f = fmu.fmu
+    if kind == "real":
+        return (f.getReal, f.setReal) if fmu.version == 2 else (f.getFloat64, f.setFloat64)
+    return (f.getBoolean, f.setBoolean)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_every_value_reference_of_an_array_is_checked_before_any_is_used(version):
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        get, set_ = accessors(fmu, "real")
+        y, u, bypass = fmu.vr("y"), fmu.vr("u"), fmu.vr("bypass")
+        function = {2: ("fmi2GetReal", "fmi2SetReal"), 3: ("fmi3GetFloat64", "fmi3SetFloat64")}[version]
+        for vrs in ([y, 999], [999, y], [999, y, y]):
+            assert call_status(get, vrs) == 3, vrs
+            assert fmu.errors()[-1][2] == f"{function[0]}: unknown value reference 999"
+            fmu.fmu.reset()
+            fmu.start()
+        for vrs in ([bypass, y], [y, bypass]):  # a Boolean among Reals
+            assert call_status(get, vrs) == 3, vrs
+            assert fmu.errors()[-1][2] == (f"{function[0]}: bypass (value reference {bypass}) is a Boolean "
+                                           f"variable, which {function[0]} cannot access")
+            fmu.fmu.reset()
+            fmu.start()
+        for vrs in ([u, 999], [999, u]):  # nothing is set when one is refused
+            assert call_status(set_, vrs, [7.0, 7.0]) == 3, vrs
+            assert fmu.errors()[-1][2] == f"{function[1]}: unknown value reference 999"
+            fmu.fmu.reset()
+            fmu.start()
+            assert fmu.get("u") == 0.0
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_time_and_outputs_cannot_be_set(version):
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        set_ = accessors(fmu, "real")[1]
+        name = "fmi2SetReal" if version == 2 else "fmi3SetFloat64"
+        assert call_status(set_, [fmu.vr("time")], [5.0]) == 3
+        assert fmu.errors()[-1][2] == f"{name}: time is an independent variable and cannot be set"
+        fmu.fmu.reset()
+        fmu.start()
+        assert call_status(set_, [fmu.vr("y")], [5.0]) == 3
+        assert fmu.errors()[-1][2] == f"{name}: y is an output and cannot be set"
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("start_time", [float("inf"), float("nan")])
+def test_a_start_time_that_is_not_finite_is_refused_naming_the_function(version, start_time):
+    fmu = Instance("RateLimiter", version)
+    try:
+        c, dll = fmu.fmu.component, fmu.fmu.dll
+        if version == 2:
+            name = "fmi2SetupExperiment"
+            setup = dll.fmi2SetupExperiment
+            setup.argtypes, setup.restype = [c_void_p, c_int, c_double, c_double, c_int, c_double], c_int
+            assert setup(c, 0, 0.0, start_time, 0, 0.0) == 3
+        else:
+            name = "fmi3EnterInitializationMode"
+            enter = dll.fmi3EnterInitializationMode
+            enter.argtypes, enter.restype = [c_void_p, c_bool, c_double, c_double, c_bool, c_double], c_int
+            assert enter(c, False, 0.0, start_time, False, 0.0) == 3
+        assert [m[2] for m in fmu.errors()] == [f"{name}: startTime {start_time} is not finite"]
+    finally:
+        fmu.free()
+
+
+# ---- instantiation: refusals, and an importer without a logger ----
+
+def fmi3_instantiate(dll, name, token, event_mode=False, n_required=0, logging=True, log=None):
+    instantiate = dll.fmi3InstantiateCoSimulation
+    instantiate.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_bool, c_bool, c_void_p, c_size_t,
+                            c_void_p, fmi3LogMessageCallback, c_void_p]
+    instantiate.restype = c_void_p
+    required = (c_uint * 1)(1)
+    return instantiate(name, token, None, False, logging, event_mode, False, required, n_required, None,
+                       fmi3LogMessageCallback(log) if log else fmi3LogMessageCallback(), None)
+
+
+def test_fmi3_instantiation_refusals_name_the_first_problem():
+    fmu = Instance("RateLimiter", 3)
+    try:
+        token = fmu.md.instantiationToken.encode()
+        cases = [
+            ((b"", b"wrong", True, 1), "instanceName is missing"),
+            ((b"a", b"wrong", True, 1), "the instantiationToken does not match this FMU's model description"),
+            ((b"a", token, True, 1), "this FMU has no Event Mode (hasEventMode = false)"),
+            ((b"a", token, False, 1), "this FMU provides no intermediate update"),
+        ]
+        for (name, given, event_mode, n_required), reason in cases:
+            messages = []
+            log = lambda env, status, category, message: messages.append((status, category, message))  # noqa: E731
+            assert fmi3_instantiate(fmu.fmu.dll, name, given, event_mode, n_required, log=log) is None
+            assert messages == [(3, b"logStatusError", reason.encode())], (reason, messages)
+            # without loggingOn, or without a logger: refused, nothing said, nothing called
+            messages.clear()
+            assert fmi3_instantiate(fmu.fmu.dll, name, given, event_mode, n_required, logging=False, log=log) is None
+            assert fmi3_instantiate(fmu.fmu.dll, name, given, event_mode, n_required) is None
+            assert messages == []
+    finally:
+        fmu.free()
+
+
+def test_fmi2_instantiation_refusals_name_the_first_problem():
+    fmu = Instance("RateLimiter", 2)
+    try:
+        dll = fmu.fmu.dll
+        instantiate = dll.fmi2Instantiate
+        instantiate.argtypes = [c_char_p, c_int, c_char_p, c_char_p, c_void_p, c_int, c_int]
+        instantiate.restype = c_void_p
+        messages = []
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((s, c, m)))
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        guid = fmu.md.guid.encode()
+        cases = [((b"", 0, b"wrong"), "instanceName is missing"),
+                 ((b"a", 0, b"wrong"), "this FMU supports Co-Simulation only"),
+                 ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description")]
+        for (name, kind, given), reason in cases:
+            messages.clear()
+            assert instantiate(name, kind, given, None, byref(callbacks), 0, 0) is None
+            assert messages == [(3, b"logStatusError", reason.encode())], (reason, messages)
+        assert instantiate(b"a", 1, guid, None, None, 0, 0) is None  # no callbacks: nothing to allocate with
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_an_importer_without_a_logger_gets_statuses_and_no_crash(version):
+    """A NULL logger is allowed (FMI 3 says so; FMI 2 importers pass one):
+    errors are returned, nothing is called."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        dll = fmu.fmu.dll
+        if version == 2:
+            instantiate = dll.fmi2Instantiate
+            instantiate.argtypes = [c_char_p, c_int, c_char_p, c_char_p, c_void_p, c_int, c_int]
+            instantiate.restype = c_void_p
+            callbacks = fmi2CallbackFunctions()
+            callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+            callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+            c = instantiate(b"quiet", 1, fmu.md.guid.encode(), None, byref(callbacks), 0, 1)
+            do_step = dll.fmi2DoStep
+            do_step.argtypes, do_step.restype = [c_void_p, c_double, c_double, c_int], c_int
+            step = lambda: do_step(c, 0.0, 0.1, 1)  # noqa: E731
+        else:
+            c = fmi3_instantiate(dll, b"quiet", fmu.md.instantiationToken.encode())
+            do_step = dll.fmi3DoStep
+            do_step.argtypes = [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4
+            do_step.restype = c_int
+            flags, when = (c_bool * 3)(), c_double()
+            step = lambda: do_step(c, 0.0, 0.1, True, flags, byref(flags, 1), byref(flags, 2), byref(when))  # noqa: E731
+        assert c
+        assert step() == 3  # a step before initialization: refused, said to nobody
+        release = getattr(dll, f"fmi{version}FreeInstance")
+        release.argtypes, release.restype = [c_void_p], None
+        release(c)
     finally:
         fmu.free()

@@ -5,9 +5,11 @@ import struct
 import sys
 import zlib
 
+from ctypes import byref, c_int, c_size_t, c_void_p
+
 import pytest
 
-from support.fmu_driver import TESTS, Instance, call_status, run_steps, state_api
+from support.fmu_driver import MODELS, TESTS, Instance, call_status, run_steps, state_api
 from support.process import run as run_bounded
 
 # inputs and step sizes of a run: ramps, a change, NaN, sub-cycling steps
@@ -90,6 +92,11 @@ BAD_BYTES = {
     # short or foreign bytes with a valid CRC: refused by size and magic, not by the CRC
     "truncated, resealed": lambda d: reseal(d[:-12]),
     "foreign magic, resealed": lambda d: reseal(b"XXXX" + d[4:]),
+    "foreign magic below, resealed": lambda d: reseal(b"ABCD" + d[4:]),  # sorts before the magic
+    # counts are exact doubles up to 2^53 (accepted there, below), not one past
+    "cycle count 2^53 + 1": lambda d: value_at(d, values_end(d) + BLOCK + 16, struct.pack("<Q", (1 << 53) + 1)),
+    "running cycle count 2^53 + 1": lambda d: value_at(d, values_end(d) + 25, struct.pack("<Q", (1 << 53) + 1)),
+    "enumeration below its range": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", 0.0)),  # zeroRate
 }
 
 
@@ -103,6 +110,9 @@ REASONS = {
     "running time base negative": "impossible time", "deciding rule unknown": "invalid rule 7",
     "integer 2^31": "impossible value 2.14748e+09 for status", "integer not whole": "impossible value 0.5 for status",
     "truncated, resealed": "bytes; expected", "foreign magic, resealed": "no header",
+    "foreign magic below, resealed": "no header", "cycle count 2^53 + 1": "impossible time or cycle count",
+    "running cycle count 2^53 + 1": "impossible time or cycle count",
+    "enumeration below its range": "impossible value 0 for zeroRate",
 }
 
 
@@ -142,4 +152,54 @@ def test_integer_at_the_end_of_the_int32_range_in_a_state_is_accepted(version):
         assert fmu.get("status") == int(value)
         api["free"](state)
     assert not fmu.errors()
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_cycle_counts_of_two_to_the_53_in_a_state_are_accepted(version):
+    fmu = started(version)
+    api = state_api(fmu)
+    data = bytes(api["serialize"](api["get"]()))
+    for offset in (values_end(data) + BLOCK + 16, values_end(data) + 25):  # cycles, running cycles
+        state = api["deserialize"](value_at(data, offset, struct.pack("<Q", 1 << 53)))
+        api["free"](state)
+    assert not fmu.errors()
+    fmu.free()
+
+
+def fnv1a(text):
+    h = 2166136261
+    for byte in text.encode():
+        h = ((h ^ byte) * 16777619) % 2 ** 32
+    return h
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_serialized_state_layout(version, model):
+    """docs/fmi.md: magic "RLFS", format version 2, the FNV-1a hash of the
+    instantiation token, the payload size, the values; a CRC-32 of all before it at the end."""
+    fmu = Instance(model, version)
+    fmu.start()
+    api = state_api(fmu)
+    data = bytes(api["serialize"](api["get"]()))
+    token = fmu.md.guid if version == 2 else fmu.md.instantiationToken
+    magic, format_version, model_hash, payload, count = struct.unpack_from("<4sIIII", data)
+    assert (magic, format_version, model_hash) == (b"RLFS", 2, fnv1a(token))
+    assert payload == len(data) - 16 - 4 and count == len(fmu.md.modelVariables)
+    assert struct.unpack("<I", data[-4:])[0] == zlib.crc32(data[:-4])
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_null_serialized_state_is_refused(version):
+    fmu = started(version)
+    dll, c = fmu.fmu.dll, fmu.fmu.component
+    name = "fmi2DeSerializeFMUstate" if version == 2 else "fmi3DeserializeFMUState"
+    function = getattr(dll, name)
+    function.argtypes, function.restype = [c_void_p, c_void_p, c_size_t, c_void_p], c_int
+    state = c_void_p()
+    assert function(c, None, 100, byref(state)) == 3
+    assert [m[2] for m in fmu.errors()] == [f"{name}: the serialized state is NULL"]
+    assert not state
     fmu.free()

@@ -739,6 +739,35 @@ static void test_derived_outputs(void) {
     CHECK_EQ(outputs(&b).remainingTime, 0.0);
 }
 
+/* The vendor blocks have none of section 6: rl_without_section6 turns every
+ * one of its features off, whatever the configuration held. */
+static void test_without_section6(void) {
+    RlConfig c = defaults();
+    c.rateUp = (RlValue){ 4.0, SRC_RATE_UP };
+    c.rateDown = (RlValue){ 3.0, SRC_RATE_DOWN };
+    c.rateUpNeg = (RlValue){ 2.0, SRC_RATE_UP_NEG };
+    c.rateDownNeg = (RlValue){ 1.0, SRC_RATE_DOWN_NEG };
+    c.yMax = (RlValue){ 5.0, SRC_Y_MAX };
+    c.yMin = (RlValue){ -5.0, SRC_Y_MIN };
+    c.hold = true;
+    c.limitInitialOutput = true;
+    c.modelMode = 3;
+    rl_without_section6(&c);
+    CHECK_EQ(c.rateUpNeg.value, 4.0);
+    CHECK_EQ(c.rateUpNeg.source, SRC_RATE_UP);
+    CHECK_EQ(c.rateDownNeg.value, 3.0);
+    CHECK_EQ(c.rateDownNeg.source, SRC_RATE_DOWN);
+    CHECK_TRUE(isnan(c.yMax.value) && isnan(c.yMin.value));
+    CHECK_TRUE(!c.hold);
+    CHECK_TRUE(!c.limitInitialOutput);
+    CHECK_EQ(c.modelMode, 0);
+    /* and so a held vendor block ramps */
+    Block b;
+    start(&b, &c, 0.0, 1.0);
+    cycle(&b, 10.0);
+    CHECK_EQ(b.state.y, 4.0);
+}
+
 int main(void) {
     test_rule0_resolve();
     test_rule0_limits();
@@ -760,6 +789,7 @@ int main(void) {
     test_output_limits();
     test_rule5b_hold();
     test_derived_outputs();
+    test_without_section6();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }

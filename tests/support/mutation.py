@@ -1,0 +1,433 @@
+"""Mutation testing of the kernel, the core and the FMI glue.
+
+    cd tests && python -m support.mutation --build-dir ../build [--sample N --seed S] [--jobs J]
+
+universalmutator (pinned in tests/requirements.txt) writes every mutant of
+each file in FILES: one line changed. Each mutant is compiled with the
+release flags of the build (its compile_commands.json). Then:
+
+- a mutant that does not compile (the build has -Werror) is stillborn;
+- a mutant whose object code equals the original's cannot change behaviour
+  (trivial compiler equivalence): equivalent, proved by the compiler;
+- mutants with the same object code as each other are one mutant: the
+  first is tested, the others share its outcome;
+- every other one is linked into the ten product FMUs (and the kernel's C
+  tests), which then run: the kernel's C tests, then TESTS through pytest,
+  stopping at the first failure. A failure or a hang kills the mutant.
+
+A mutant that survives must be killed by a new test, or be listed in
+tests/equivalent_mutants.txt with a one-line proof that it cannot change
+behaviour. The exit status is 1 for a survivor not on that list, a listed
+mutant that a test kills (--check-listed) or an entry that names no mutant.
+"""
+import argparse
+import hashlib
+import json
+import os
+import random
+import shlex
+import shutil
+import sys
+import time
+import zipfile
+from collections import Counter, defaultdict
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from support.fmu_driver import MODELS
+from support.process import Timeout, run
+
+REPO = Path(__file__).resolve().parents[2]
+SOURCE = REPO / "fmu_src"
+FILES = ("rate_limiter.c", "rate_limiter.h", "fmu_core.c", "fmi2_glue.c", "fmi3_glue.c")
+KERNEL = ("rate_limiter.c", "rate_limiter.h")
+EQUIVALENTS = REPO / "tests" / "equivalent_mutants.txt"
+PLATFORM = {2: "linux64", 3: "x86_64-linux"}
+# pytest files, cheapest and sharpest first (the run stops at the first failure)
+TESTS = ("test_conformance.py", "test_reference.py", "test_misuse.py", "test_bad_arguments.py", "test_state.py",
+         "test_vendor_interpretations.py", "test_long_runs.py", "test_model_description.py", "test_random.py",
+         "test_hostile.py")
+COMPILE_SECONDS = 120
+KERNEL_SECONDS = 120
+PYTEST_SECONDS = 600  # a mutant that makes a test loop for ever is killed by this bound
+
+
+@dataclass
+class Mutant:
+    file: str       # name in fmu_src
+    line: int       # 1-based
+    before: str
+    after: str
+    text: str       # the whole mutated file
+    key: str = ""   # file | before | after: what tests/equivalent_mutants.txt names
+    outcome: str = ""   # stillborn, equivalent, listed, killed, survived
+    detail: str = ""    # the compiler's or the killing test's word
+    digest: str = ""    # the mutated objects' hash
+
+    def __post_init__(self):
+        self.key = f"fmu_src/{self.file} | {self.before.strip()} | {self.after.strip()}"
+
+    def label(self):
+        return f"{self.file}:{self.line}: {self.before.strip()}  =>  {self.after.strip()}"
+
+
+def universalmutator(venv_bin):
+    exe = venv_bin / "mutate"
+    if not exe.exists():
+        sys.exit(f"{exe} not found: universalmutator is installed by the test command (tests/requirements.txt)")
+    return exe
+
+
+def generate(file, work, venv_bin):
+    """Every mutant of fmu_src/<file>, as universalmutator writes them."""
+    original = (SOURCE / file).read_text()
+    digest = hashlib.sha256(original.encode()).hexdigest()[:16]
+    folder = work / "mutants" / f"{file}-{digest}"
+    if not (folder / "done").exists():
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        run([str(universalmutator(venv_bin)), str(SOURCE / file), "c", "--noCheck", "--mutantDir", str(folder)],
+            cwd=folder, timeout=600, what=f"universalmutator on {file}", check=True)
+        (folder / "done").touch()
+    lines = original.splitlines(keepends=True)
+    mutants = []
+    stem, suffix = file.rsplit(".", 1)
+    for path in sorted(folder.glob(f"{stem}.mutant.*.{suffix}"), key=lambda p: int(p.name.split(".")[-2])):
+        text = path.read_text()
+        changed = text.splitlines(keepends=True)
+        if len(changed) != len(lines):
+            continue  # universalmutator changes one line; anything else is not one of ours
+        diff = [i for i, (a, b) in enumerate(zip(lines, changed)) if a != b]
+        if len(diff) == 1:
+            i = diff[0]
+            mutants.append(Mutant(file, i + 1, lines[i].rstrip("\n"), changed[i].rstrip("\n"), text))
+    return mutants
+
+
+def read_equivalents(path=None):
+    """{key: proof}: blocks of 'file', '- before', '+ after', 'why: proof'."""
+    path = path or EQUIVALENTS
+    entries, block = {}, {}
+    for number, line in enumerate(path.read_text().splitlines(), 1):
+        if not line.strip() or line.startswith("#"):
+            continue
+        if line.startswith("  - "):
+            block["before"] = line[4:]
+        elif line.startswith("  + "):
+            block["after"] = line[4:]
+        elif line.startswith("  why: "):
+            if set(block) != {"file", "before", "after"}:
+                raise SystemExit(f"{path}:{number}: 'why:' without its file, '-' and '+' lines")
+            entries[f"{block['file']} | {block['before'].strip()} | {block['after'].strip()}"] = line[7:]
+            block = {}
+        elif not line.startswith(" "):
+            block = {"file": line.strip()}
+        else:
+            raise SystemExit(f"{path}:{number}: not a line of an entry: {line!r}")
+    return entries
+
+
+class Builder:
+    """Compiles and links as the build tree does, from its compile_commands.json."""
+
+    def __init__(self, build_dir, work):
+        self.build = build_dir
+        self.work = work
+        database = json.loads((build_dir / "compile_commands.json").read_text())
+        self.commands = {}  # translation unit (path under fmu_src or tests/c) -> compiler arguments
+        for entry in database:
+            source = Path(entry["file"])
+            target = entry.get("output") or entry["command"].split(" -o ")[1].split()[0]
+            if target.startswith(tuple(f"CMakeFiles/{name}.dir/" for name in self.targets())):
+                name = source.relative_to(REPO).as_posix()
+                self.commands.setdefault(name, shlex.split(entry["command"]))
+        self.units = sorted(u for u in self.commands if u.startswith("fmu_src/"))
+        self.links = {t: (build_dir / "CMakeFiles" / f"{t}.dir" / "link.txt").read_text().split() for t in self.targets()}
+
+    @staticmethod
+    def targets():
+        return [f"{m}_fmi{v}" for m in MODELS for v in (2, 3)] + ["test_kernel"]
+
+    def compile(self, tree, unit, output):
+        """Compile tree/<unit> with the build's flags; tree stands in for the source tree."""
+        args = [str(tree / unit) if a == str(REPO / unit) else a.replace(str(SOURCE), str(tree / "fmu_src"))
+                for a in self.commands[unit]]
+        for flag in ("-MT", "-MF"):  # no dependency files
+            if flag in args:
+                i = args.index(flag)
+                del args[i:i + 2]
+        args = [a for a in args if a != "-MD"]
+        args[args.index("-o") + 1] = str(output)
+        # the object code must not depend on where the tree is (the last map that matches wins)
+        args.append(f"-ffile-prefix-map={tree}=.")
+        output.parent.mkdir(parents=True, exist_ok=True)
+        return run(args, cwd=self.build, timeout=COMPILE_SECONDS, what=f"compiling {unit}")
+
+    def link(self, target, objects, output):
+        """Link target from objects ({unit: path}), into output."""
+        args = list(self.links[target])
+        for i, a in enumerate(args):
+            if a.endswith(".c.o"):
+                unit = a.split(".dir/", 1)[1][:-2]
+                args[i] = str(objects[unit])
+        args[args.index("-o") + 1] = str(output)
+        output.parent.mkdir(parents=True, exist_ok=True)
+        run(args, cwd=self.build, timeout=COMPILE_SECONDS, what=f"linking {target}", check=True)
+
+
+def units_of(file, builder):
+    """The translation units whose objects a change of fmu_src/<file> can change."""
+    if file.endswith(".c"):
+        return [f"fmu_src/{file}"]
+    return builder.units + ["tests/c/test_kernel.c"]
+
+
+def write_tree(folder, file, text):
+    """A copy of fmu_src with <file> replaced by text."""
+    shutil.rmtree(folder, ignore_errors=True)
+    shutil.copytree(SOURCE, folder / "fmu_src")
+    (folder / "fmu_src" / file).write_text(text)
+    (folder / "tests" / "c").mkdir(parents=True)
+    shutil.copy(REPO / "tests" / "c" / "test_kernel.c", folder / "tests" / "c")
+
+
+def object_name(unit):
+    return unit.replace("/", "_") + ".o"
+
+
+@dataclass
+class Baseline:
+    tree: Path
+    objects: dict = field(default_factory=dict)  # unit -> path
+    digests: dict = field(default_factory=dict)  # unit -> sha256 of the object
+
+
+def compile_baseline(builder, work):
+    base = Baseline(work / "baseline")
+    shutil.rmtree(base.tree, ignore_errors=True)
+    base.tree.mkdir(parents=True)
+    shutil.copytree(SOURCE, base.tree / "fmu_src")
+    (base.tree / "tests" / "c").mkdir(parents=True)
+    shutil.copy(REPO / "tests" / "c" / "test_kernel.c", base.tree / "tests" / "c")
+    for unit in builder.units + ["tests/c/test_kernel.c"]:
+        out = base.tree / "obj" / object_name(unit)
+        done = builder.compile(base.tree, unit, out)
+        if done.returncode:
+            sys.exit(f"the unmutated {unit} does not compile:\n{done.stderr}")
+        base.objects[unit] = out
+        base.digests[unit] = hashlib.sha256(out.read_bytes()).hexdigest()
+    return base
+
+
+def compile_mutant(mutant, index, builder, base, work):
+    """Stillborn, equivalent, or the mutated objects' digest."""
+    tree = work / "run" / str(index)
+    write_tree(tree, mutant.file, mutant.text)
+    changed = []
+    for unit in units_of(mutant.file, builder):
+        out = tree / "obj" / object_name(unit)
+        done = builder.compile(tree, unit, out)
+        if done.returncode:
+            mutant.outcome = "stillborn"
+            first = [line for line in done.stderr.splitlines() if "error" in line]
+            mutant.detail = first[0] if first else done.stderr.strip()[-200:]
+            shutil.rmtree(tree, ignore_errors=True)
+            return
+        digest = hashlib.sha256(out.read_bytes()).hexdigest()
+        if digest != base.digests[unit]:
+            changed.append(f"{unit}:{digest}")
+    if not changed:
+        mutant.outcome = "equivalent"
+        mutant.detail = "the same object code as the original"
+        shutil.rmtree(tree, ignore_errors=True)
+        return
+    mutant.digest = hashlib.sha256("\n".join(changed).encode()).hexdigest()
+
+
+def fmu_bytes(build_dir, model, version, library):
+    """The product FMU with its host binary replaced by library."""
+    source = build_dir / f"fmi{version}" / f"{model}.fmu"
+    inside = f"binaries/{PLATFORM[version]}/{model}.so"
+    with zipfile.ZipFile(source) as z_in:
+        entries = [(info.filename, library.read_bytes() if info.filename == inside else z_in.read(info))
+                   for info in z_in.infolist()]
+    return entries
+
+
+def test_mutant(mutant, index, builder, base, work, venv_python):
+    """Link the mutated objects into the FMUs and the kernel tests; run them."""
+    tree = work / "run" / str(index)
+    objects = dict(base.objects)
+    for unit in units_of(mutant.file, builder):
+        objects[unit] = tree / "obj" / object_name(unit)
+    build = tree / "build"
+    try:
+        if mutant.file in KERNEL:
+            kernel = tree / "test_kernel"
+            builder.link("test_kernel", objects, kernel)
+            try:
+                done = run([str(kernel)], timeout=KERNEL_SECONDS, what="the kernel's C tests")
+            except Timeout:
+                return "killed", f"the kernel's C tests did not end within {KERNEL_SECONDS} s"
+            if done.returncode:
+                failed = [line for line in done.stdout.splitlines() if ", expected " in line]
+                return "killed", "kernel C tests: " + (failed[0] if failed else f"exit {done.returncode}")
+        for version in (2, 3):
+            if mutant.file == f"fmi{5 - version}_glue.c":
+                # the other version's glue: its FMUs are the original ones
+                (build / f"fmi{version}").parent.mkdir(parents=True, exist_ok=True)
+                (build / f"fmi{version}").symlink_to(builder.build / f"fmi{version}", target_is_directory=True)
+                continue
+            for model in MODELS:
+                library = tree / "lib" / f"fmi{version}" / f"{model}.so"
+                builder.link(f"{model}_fmi{version}", objects, library)
+                out = build / f"fmi{version}" / f"{model}.fmu"
+                out.parent.mkdir(parents=True, exist_ok=True)
+                with zipfile.ZipFile(out, "w", zipfile.ZIP_STORED) as z_out:
+                    for name, data in fmu_bytes(builder.build, model, version, library):
+                        z_out.writestr(name, data)
+            if mutant.file not in KERNEL or mutant.file.endswith(".h"):
+                # the C lifecycle harness: every kind of call, allocations balanced, many instances
+                stage = tree / "stage" / f"fmi{version}" / "RateLimiter"
+                (stage / "binaries" / PLATFORM[version]).mkdir(parents=True)
+                shutil.copy(builder.build / "stage" / f"fmi{version}" / "RateLimiter" / "modelDescription.xml", stage)
+                shutil.copy(tree / "lib" / f"fmi{version}" / "RateLimiter.so", stage / "binaries" / PLATFORM[version])
+                try:
+                    done = run([str(builder.build / "test_lifecycle"), str(version), str(stage), "2000", "200"],
+                               timeout=KERNEL_SECONDS, what="the lifecycle harness")
+                except Timeout:
+                    return "killed", f"test_lifecycle (FMI {version}) did not end within {KERNEL_SECONDS} s"
+                if done.returncode:
+                    lines = (done.stdout + done.stderr).strip().splitlines()
+                    return "killed", f"test_lifecycle (FMI {version}): " + (lines[-1] if lines else
+                                                                          f"exit {done.returncode}")
+        env = dict(os.environ, RL_BUILD_DIR=str(build))
+        args = [str(venv_python), "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "--hypothesis-seed=0",
+                "-o", "timeout=300", *TESTS]
+        try:
+            done = run(args, cwd=REPO / "tests", env=env, timeout=PYTEST_SECONDS, what="pytest")
+        except Timeout:
+            return "killed", f"pytest did not end within {PYTEST_SECONDS} s"
+        if done.returncode:
+            failed = [line for line in done.stdout.splitlines() if line.startswith(("FAILED", "ERROR"))]
+            last = done.stdout.strip().splitlines()[-1:] or [f"pytest exited with {done.returncode}"]
+            return "killed", (failed or last)[0][:300]
+        return "survived", ""
+    finally:
+        shutil.rmtree(tree, ignore_errors=True)
+
+
+def parallel(jobs, function, items):
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        return list(pool.map(function, items))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--build-dir", type=Path, required=True, help="a build tree of the test command")
+    parser.add_argument("--files", nargs="+", default=list(FILES), choices=FILES)
+    parser.add_argument("--sample", type=int, help="test this many mutants, drawn with --seed")
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--report", type=Path, help="write every mutant's outcome here (JSON)")
+    parser.add_argument("--check-listed", action="store_true",
+                        help="test the listed equivalents too: each must survive")
+    parser.add_argument("--listed", action="store_true", help="test only the listed equivalents")
+    args = parser.parse_args(argv)
+    build_dir = args.build_dir.resolve()
+    work = build_dir / "mutation"
+    venv_bin = Path(sys.executable).parent
+    started = time.monotonic()
+
+    equivalents = read_equivalents()
+    mutants = [m for f in args.files for m in generate(f, work, venv_bin)]
+    generated = len(mutants)
+    # an entry must name a mutant there is (the list follows the code)
+    stale = sorted(set(equivalents) - {m.key for m in mutants}) if set(args.files) == set(FILES) else []
+    for key in stale:
+        print(f"STALE {EQUIVALENTS.name}: no such mutant: {key}")
+    if args.listed:  # the list's entries alone, each tested: each must survive
+        mutants = [m for m in mutants if m.key in equivalents]
+        args.check_listed = True
+    if args.sample is not None and args.sample < len(mutants):
+        mutants = sorted(random.Random(args.seed).sample(mutants, args.sample), key=lambda m: (m.file, m.line))
+    print(f"{generated} mutants of {', '.join(args.files)}; testing {len(mutants)}"
+          + (f" (seeded sample, seed {args.seed})" if args.sample is not None else ""), flush=True)
+
+    builder = Builder(build_dir, work)
+    base = compile_baseline(builder, work)
+    shutil.rmtree(work / "run", ignore_errors=True)
+    parallel(args.jobs, lambda im: compile_mutant(im[1], im[0], builder, base, work), list(enumerate(mutants)))
+
+    # one test per distinct object code; a listed equivalent covers its whole group and is not run
+    groups = defaultdict(list)
+    for index, m in enumerate(mutants):
+        if not m.outcome:
+            groups[m.digest].append((index, m))
+    to_test = []
+    for members in groups.values():
+        listed = [m for _, m in members if m.key in equivalents]
+        if listed and args.check_listed:
+            to_test.append(members[0])
+        elif listed:
+            for _, m in members:
+                m.outcome = "listed"
+                m.detail = equivalents[m.key] if m in listed else f"same object code as {listed[0].label()}"
+        else:
+            to_test.append(members[0])
+    print(f"compiled in {time.monotonic() - started:.0f} s; running the tests on {len(to_test)} distinct mutants",
+          flush=True)
+
+    def test(item):
+        index, m = item
+        m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable)
+        print("." if m.outcome == "killed" else "S", end="", flush=True)
+        if m.key in equivalents:  # --check-listed: the proof must hold
+            m.outcome, m.detail = ("listed", equivalents[m.key]) if m.outcome == "survived" else \
+                ("wrongly listed", f"listed as equivalent, but {m.detail}")
+
+    parallel(args.jobs, test, to_test)
+    print()
+    for members in groups.values():
+        tested = members[0][1]
+        for _, m in members[1:]:
+            if not m.outcome:
+                m.outcome, m.detail = tested.outcome, f"same object code as {tested.label()}: {tested.detail}"
+                if tested.outcome == "listed":
+                    m.detail = f"same object code as {tested.label()}"
+    shutil.rmtree(work / "run", ignore_errors=True)
+
+    print(summary(mutants))
+    survivors = [m for m in mutants if m.outcome == "survived"]
+    for m in survivors:
+        print(f"SURVIVED {m.label()}")
+    wrong = [m for m in mutants if m.outcome == "wrongly listed"]
+    for m in wrong:
+        print(f"WRONGLY LISTED {m.label()}: {m.detail}")
+    if args.report:
+        args.report.write_text(json.dumps([dict(file=m.file, line=m.line, before=m.before, after=m.after,
+                                                 outcome=m.outcome, detail=m.detail) for m in mutants], indent=1))
+    print(f"{time.monotonic() - started:.0f} s")
+    return 1 if survivors or wrong or stale else 0
+
+
+def summary(mutants):
+    """Per file: how many of each outcome, and the score (killed of those not equivalent)."""
+    counts = defaultdict(Counter)
+    for m in mutants:
+        counts[m.file][m.outcome] += 1
+        counts["all"][m.outcome] += 1
+    rows = ["| file | mutants | stillborn | same object code | listed equivalent | killed | survived | score |",
+            "|---|---|---|---|---|---|---|---|"]
+    for file in [f for f in FILES if f in counts] + ["all"]:
+        c = counts[file]
+        live = c["killed"] + c["survived"]
+        score = f"{100 * c['killed'] / live:.1f} %" if live else "-"
+        rows.append(f"| {file} | {sum(c.values())} | {c['stillborn']} | {c['equivalent']} | {c['listed']} "
+                    f"| {c['killed']} | {c['survived']} | {score} |")
+    return "\n".join(rows)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
