@@ -451,3 +451,37 @@ def test_the_readme_pytest_example_runs(tmp_path):
                        what="the README's pytest example", cwd=REPO)
     assert done.returncode == 0, done.stdout + done.stderr
     assert re.search(r"\b[1-9]\d* passed", done.stdout)
+
+
+def test_find_cases_names_each_case_folder_once(tmp_path):
+    """Names are the paths below the folder searched, sorted; a case folder
+    given itself takes its own name; a name found below two folders given
+    is prefixed with the second one's name; linked folders are followed,
+    each folder once, and a link loop ends."""
+    def case(folder):
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "M_ref.csv").write_text("time,y\n0,0\n")
+        return folder
+
+    one, two = tmp_path / "one", tmp_path / "two"
+    case(one / "b")
+    case(one / "a" / "deep")
+    case(one / "a")
+    case(two / "b")
+    case(two / "c")
+    (one / "z").mkdir()
+    (one / "z" / "link_to_b").symlink_to(one / "b")  # b again: once, by its first path in sorted order
+    (one / "0_link_to_c").symlink_to(two / "c")  # c, first reached from one: named there
+    (one / "a" / "loop").symlink_to(one)  # a loop: ends
+    (tmp_path / "other").mkdir()
+    (one / "a" / "not_a_case").mkdir()
+    found = fmutrace.find_cases([one, two], "M")
+    assert [(str(folder.relative_to(tmp_path)), name) for folder, name in found] == [
+        ("one/0_link_to_c", "0_link_to_c"), ("one/a", "a"), ("one/a/deep", "a/deep"), ("one/b", "b"),
+        ("two/b", "two/b")]
+    assert [name for _, name in fmutrace.find_cases([two / "c"], "M")] == ["c"]  # a case folder itself
+    # case folders given themselves, two of one name: the second is prefixed with its own name
+    assert fmutrace.find_cases([two / "c", one / "b", two / "b"], "M")[:] == [
+        (one / "b", "b"), (two / "b", "b/b"), (two / "c", "c")]
+    assert found[-1] == (two / "b", "two/b") and found[2:4] == [(one / "a" / "deep", "a/deep"), (one / "b", "b")]
+    assert len(fmutrace.find_cases([tmp_path / "other"], "M")) == 0

@@ -105,6 +105,38 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
     assert code == 0 and "on the journal" in out  # all done: nothing runs
 
 
+def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 6)
+    report = tmp_path / "report"
+    assert fmutrace.compare(PASS_THROUGH, cases, report=report, jobs=1).passed
+    journal = report / "results.jsonl"
+    lines = journal.read_bytes().splitlines(keepends=True)
+    journal.write_bytes(b"".join(lines[:4]) + lines[4][:25])  # three cases whole, the fourth cut by a kill
+    campaign = fmutrace.compare(PASS_THROUGH, cases, report=report, jobs=1, resume=True)
+    assert campaign.passed and campaign.where == "1 process (3 cases from the journal)"
+    assert [o.case for o in campaign.cases] == [f"case_{k:02d}" for k in range(6)]
+    keys = journal_keys(report)
+    assert len(keys) == 6 and len(set(keys)) == 6
+    assert [json.loads(c)["counts"] for c in [(report / "results.json").read_text()]] == \
+        [{"pass": 6, "fail": 0, "error": 0, "invalid": 0}]
+
+
+def test_a_journaled_campaign_gives_its_outcomes_and_results_back(tmp_path):
+    """With a report, the outcomes are read back from the journal and the
+    results from their CSV files: the outcomes of a campaign kept in memory,
+    and the results worked by hand (y(t + 0.1) = u(t))."""
+    cases = step_cases(tmp_path / "cases", "PassThrough", [3, 4])
+    in_memory = fmutrace.compare(PASS_THROUGH, cases, jobs=1)
+    journaled = fmutrace.compare(PASS_THROUGH, cases, jobs=1, plots="all", report=tmp_path / "report")
+    assert len(journaled.cases) == len(in_memory.cases) == 2
+    for k, kept, read in zip((3, 4), in_memory.cases, journaled.cases):
+        assert (read.case, read.fmu, read.status, read.messages) == (kept.case, kept.fmu, kept.status, kept.messages)
+        assert list(read.result["time"]) == pytest.approx([0, 0.1, 0.2, 0.3, 0.4], abs=1e-15)
+        assert list(read.result["y"]) == [0, 0, 0, k, k]
+    assert journaled.cases[-1].case == "case_04" and journaled.cases[0:1][0].case == "case_03"
+    assert journaled.counts() == in_memory.counts() == {"pass": 2, "fail": 0, "error": 0, "invalid": 0}
+
+
 def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 3)
     report = tmp_path / "report"

@@ -97,6 +97,7 @@ BAD_BYTES = {
     "cycle count 2^53 + 1": lambda d: value_at(d, values_end(d) + BLOCK + 16, struct.pack("<Q", (1 << 53) + 1)),
     "running cycle count 2^53 + 1": lambda d: value_at(d, values_end(d) + 25, struct.pack("<Q", (1 << 53) + 1)),
     "enumeration below its range": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", 0.0)),  # zeroRate
+    "enumeration above its range": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", 3.0)),
 }
 
 
@@ -113,6 +114,7 @@ REASONS = {
     "foreign magic below, resealed": "no header", "cycle count 2^53 + 1": "impossible time or cycle count",
     "running cycle count 2^53 + 1": "impossible time or cycle count",
     "enumeration below its range": "impossible value 0 for zeroRate",
+    "enumeration above its range": "impossible value 3 for zeroRate",
 }
 
 
@@ -150,6 +152,20 @@ def test_integer_at_the_end_of_the_int32_range_in_a_state_is_accepted(version):
         state = api["deserialize"](value_at(data, 20 + 8 * 21, struct.pack("<d", value)))
         api["set"](state)
         assert fmu.get("status") == int(value)
+        api["free"](state)
+    assert not fmu.errors()
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_enumeration_at_the_ends_of_its_range_in_a_state_is_accepted(version):
+    fmu = started(version)
+    api = state_api(fmu)
+    data = bytes(api["serialize"](api["get"]()))
+    for value in (1, 2):  # zeroRate: hold, no limit
+        state = api["deserialize"](value_at(data, 20 + 8 * 12, struct.pack("<d", float(value))))
+        api["set"](state)
+        assert fmu.get("zeroRate") == value
         api["free"](state)
     assert not fmu.errors()
     fmu.free()

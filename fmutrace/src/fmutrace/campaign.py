@@ -8,13 +8,19 @@ once to every worker) and returns the outcome with its result and plot,
 so workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written here.
 """
+import gc
 import hashlib
+import json
 import logging
 import os
 import sys
 import tempfile
 import time
 import zipfile
+from array import array
+from bisect import bisect_right
+from itertools import accumulate
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,15 +29,22 @@ from .comparison import Comparison, Tolerance, compare as compare_traces
 from .fmu import Fmu
 from .isolated import run_isolated
 from .journal import Journal, ReportLock, campaign_key, case_key, outcome_from
-from .report import case_json, plot_case, write_case_files, write_junit, write_report
+from .report import case_json, light, plot_case, write_case_files, write_junit, write_report
 from .runner import Runner
 from .simulation import SimulationError
-from .traces import InputError
+from .traces import InputError, read_trace
 
 
 STATUSES = ("pass", "fail", "error", "invalid")
 BATCH_CASES = 256              # cases per Dask task at most
 BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
+# Dask keeps its last messages for its developers (distributed.admin.low-level-log-length, 1000): a
+# message that sends a batch keeps the batch's cases, so a campaign's client (and a local cluster's
+# scheduler, in its process) would grow with the first 1000 batches. A few are enough here.
+SHORT_LOGS = {"distributed.admin.low-level-log-length": 16}
+# no statistical profiler in the workers (its history grows with the campaign's length)
+LOCAL_CLUSTER = {"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}
+GC_BATCHES = 32               # batches between full garbage collections in the client
 BATCH_ATTEMPTS = 3             # a batch lost with its worker is sent again, so many times in all
 
 
@@ -59,25 +72,68 @@ class CaseOutcome:
         return self.status == "pass"
 
 
+class JournaledCases(Sequence):
+    """The outcomes of a campaign with a report folder, read from its
+    journal when asked: the client keeps where each case's line starts (8
+    bytes a case), so its memory does not grow with the campaign. A case
+    with a result CSV in the report gets its result read from it (bit for
+    bit the one written); light() leaves the results out."""
+
+    def __init__(self, report_dir, journal_path, offsets, fmu_folders):
+        self.report_dir, self.path = Path(report_dir), Path(journal_path)
+        self.offsets, self.fmu_folders = offsets, fmu_folders
+
+    def __len__(self):
+        return len(self.offsets)
+
+    def _outcome(self, journal, offset, results=True):
+        journal.seek(offset)
+        entry = json.loads(journal.readline())
+        outcome = outcome_from(entry, CaseOutcome, self.fmu_folders[entry["fmu_file"]])
+        if results and outcome.csv:
+            outcome.result = read_trace(self.report_dir / outcome.csv)
+        return outcome
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        with open(self.path, "rb") as journal:
+            return self._outcome(journal, self.offsets[index])
+
+    def __iter__(self, results=True):
+        with open(self.path, "rb") as journal:
+            for offset in self.offsets:
+                yield self._outcome(journal, offset, results)
+
+    def light(self):
+        """The outcomes without their results (for the report's pages)."""
+        return self.__iter__(results=False)
+
+
 @dataclass
 class CampaignResult:
-    cases: list
+    cases: Sequence          # of CaseOutcome, in the order of the FMUs and their cases
     tolerance: Tolerance
     where: str = ""
     seconds: float = 0.0
     report_dir: Path = None
+    _counts: dict = field(default=None, repr=False)  # by status, when known
 
     @property
     def passed(self):
-        return all(o.passed for o in self.cases)
+        return self.counts()["pass"] == len(self.cases)
 
     @property
     def exit_code(self):
         """0 every case passes, 1 one differs or failed to simulate, 2 one is invalid."""
-        return 2 if any(o.status == "invalid" for o in self.cases) else 0 if self.passed else 1
+        return 2 if self.counts()["invalid"] else 0 if self.passed else 1
 
     def counts(self):
-        return {s: sum(o.status == s for o in self.cases) for s in STATUSES}
+        if self._counts is None:
+            self._counts = dict.fromkeys(STATUSES, 0)
+            for o in light(self.cases):
+                self._counts[o.status] += 1
+        return self._counts
 
     def failed(self):
         return [o for o in self.cases if not o.passed]
@@ -205,16 +261,52 @@ def _report_folders(fmus):
     return folders
 
 
+class Plan(Sequence):
+    """(fmu, folder, name) of every FMU's cases, one after the other: the
+    FMUs' case lists (CaseList) indexed through, not copied; folders as text."""
+
+    def __init__(self, parts):
+        self.parts = parts  # [(fmu, CaseList)]
+        self.starts = list(accumulate((len(found) for _, found in parts), initial=0))
+
+    def __len__(self):
+        return self.starts[-1]
+
+    def __getitem__(self, index):
+        part = bisect_right(self.starts, index) - 1
+        fmu, found = self.parts[part]
+        return (fmu, *found.text(index - self.starts[part]))
+
+    def __iter__(self):
+        for fmu, found in self.parts:
+            for i in range(len(found)):
+                yield (fmu, *found.text(i))
+
+
+class Todo:
+    """The cases still to run, by their place in the plan: (i, fmu, folder, name)."""
+
+    def __init__(self, work, indices):
+        self.work, self.indices = work, indices
+
+    def __len__(self):
+        return len(self.indices)
+
+    def __iter__(self):
+        for i in self.indices:
+            yield (i, *self.work[i])
+
+
 def plan(fmus, paths):
-    """[(fmu, folder, name)] of every FMU's cases under paths (InputError
-    for an FMU without any)."""
-    work = []
+    """A Plan of every FMU's cases under paths (InputError for an FMU
+    without any)."""
+    parts = []
     for fmu in fmus:
         found = find_cases(paths, fmu.model)
         if not found:
             raise InputError(f"no case of {fmu.label} (no {fmu.model}_ref.csv) under {', '.join(map(str, paths))}")
-        work += [(fmu, folder, name) for folder, name in found]
-    return work
+        parts.append((fmu, found))
+    return Plan(parts)
 
 
 def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, tube_time=None, tube_value=None,
@@ -271,38 +363,42 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
     fmu_bytes = {f.path: f.path.read_bytes() for f in loaded}
 
     started = time.perf_counter()
-    outcomes = [None] * len(work)
-    counts = {"done": 0, "failed": 0}
+    # with a report, the outcomes live in its journal and this process keeps their offsets there
+    outcomes = array("q", bytes(8 * len(work))) if report else [None] * len(work)
+    counts = dict.fromkeys(STATUSES, 0)
     lock = journal = None
     if report:
         lock = ReportLock(report)
     try:
         if report:
             journal = Journal(report, campaign_key(fmu_bytes, tolerance, plots), resume)
-        # a case's journal key (its FMU and real folder): only a journaled campaign needs them
-        keys = [case_key(fmu.path, folder) for fmu, folder, _ in work] if journal else None
-        todo = []
-        for i, (fmu, folder, name) in enumerate(work):
-            entry = journal.done.get(keys[i]) if journal else None
-            if entry is not None:  # finished by the campaign resumed
-                outcomes[i] = outcome_from(entry, CaseOutcome, labels[fmu.path]["fmu_folder"])
-                counts["done"] += 1
-                counts["failed"] += not outcomes[i].passed
-            else:
-                todo.append((i, fmu, folder, name))
+        if journal and journal.done:
+            indices = array("q")
+            for i, (fmu, folder, name) in enumerate(work):
+                offset = journal.done.get(case_key(fmu.path, folder))
+                if offset is not None:  # finished by the campaign resumed
+                    outcomes[i] = offset
+                    counts[journal.entry(offset)["status"]] += 1
+                else:
+                    indices.append(i)
+            journal.done = None  # read: not needed any more
+        else:
+            indices = range(len(work))
+        todo = Todo(work, indices)
         bar = Progress(len(work), progress)
 
         def finished(i, outcome):
-            outcomes[i] = outcome
-            counts["done"] += 1
-            counts["failed"] += not outcome.passed
+            counts[outcome.status] += 1
             if report:
                 write_case_files(outcome, report)
-                journal.record(keys[i], case_json(outcome))
-            bar.update(counts["done"], counts["failed"])
+                fmu, folder, _ = work[i]
+                outcomes[i] = journal.record(case_key(fmu.path, folder), case_json(outcome))
+            else:
+                outcomes[i] = outcome
+            bar.update(sum(counts.values()), sum(counts.values()) - counts["pass"])
 
         try:
-            if not todo:
+            if not len(todo):
                 where = "the journal"
             elif scheduler is None and jobs <= 1 and case_timeout is not None:
                 for fmu in loaded:  # in child processes: a case over the timeout is stopped by killing its process
@@ -335,9 +431,12 @@ def compare(fmus, cases, report=None, tolerance=None, rel_tol=0.0, abs_tol=0.0, 
         if lock:
             lock.release()
     resumed = len(work) - len(todo)
-    if resumed and todo:
+    if resumed and len(todo):
         where += f" ({resumed} cases from the journal)"
-    result = CampaignResult(outcomes, tolerance, where, time.perf_counter() - started, Path(report) if report else None)
+    cases = JournaledCases(report, journal.path, outcomes, {str(f.path): folders[f.path] for f in loaded}) if report \
+        else outcomes
+    result = CampaignResult(cases, tolerance, where, time.perf_counter() - started, Path(report) if report else None,
+                            counts)
     if report:
         write_report(result, report)
     if junit:
@@ -372,15 +471,15 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
     from dask.distributed import Client, LocalCluster, as_completed
 
     cluster = None
-    if scheduler:
-        client = Client(scheduler, timeout=timeout or 60)
-    else:
-        # no statistical profiler in the workers (its history grows with the campaign's length); a task
-        # whose worker dies is not tried on others: the batch is run isolated instead (below)
-        with dask.config.set({"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}):
-            cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None,
-                                   silence_logs=logging.CRITICAL)  # a worker's death is reported by the campaign
-        client = Client(cluster)
+    with dask.config.set(SHORT_LOGS):
+        if scheduler:
+            client = Client(scheduler, timeout=timeout or 60)
+        else:
+            # a task whose worker dies is not tried on others: the batch is run isolated instead (below)
+            with dask.config.set(LOCAL_CLUSTER):
+                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None,
+                                       silence_logs=logging.CRITICAL)  # a worker's death is reported by the campaign
+            client = Client(cluster)
     try:
         client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
         workers = len(client.scheduler_info()["workers"])
@@ -403,6 +502,7 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
                 submit(fmu, batch, case_timeout is not None, 1)  # to kill
                 return
 
+        collected = 0
         for _ in range(3 * workers):
             submit_next()
         deadline = None if timeout is None else time.monotonic() + timeout
@@ -423,6 +523,12 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
                                                   f"{error}"]) for _, _, name, _ in batch]
             for (i, _, _, _), outcome in zip(batch, outcomes):
                 finished(i, outcome)
+            del outcomes
+            collected += 1
+            if collected % GC_BATCHES == 0:
+                # Dask leaves each result's unpickled objects in reference cycles; the generational
+                # collector would let them pile up until a rare full collection
+                gc.collect()
             submit_next()
         return f"Dask, {workers} workers" + (f" at {scheduler}" if scheduler else " (local processes)")
     finally:

@@ -12,6 +12,8 @@ Every file is checked against the FMU before anything runs: a problem is
 an InputError naming the file, line and column.
 """
 import os
+from array import array
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -133,48 +135,90 @@ def load_case(folder, fmu, name=None, texts=None):
     )
 
 
+class CaseList(Sequence):
+    """(folder, name) of each case, sorted by name, kept compact for
+    campaigns of many cases: a case costs its name's text and three bytes
+    (which folder searched, and how its name was made); the folder is
+    made again when asked for."""
+
+    RELATIVE, ROOT, PREFIXED = 0, 1, 2  # name = path below the root; the root's own name; root name / path
+
+    def __init__(self, roots, names, root_of, kinds):
+        self.roots = roots  # [(path, its name)]
+        self.names, self.root_of, self.kinds = names, root_of, kinds
+
+    def __len__(self):
+        return len(self.names)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        folder, name = self.text(index)
+        return Path(folder), name
+
+    def text(self, index):
+        """(folder, name) with the folder as text: Path interns every part
+        of a path for good, a campaign of many cases must not."""
+        name, kind = self.names[index], self.kinds[index]
+        root, root_name = self.roots[self.root_of[index]]
+        if kind == self.ROOT:
+            return root, name
+        return os.path.join(root, name if kind == self.RELATIVE else name[len(root_name) + 1:]), name
+
+
 def find_cases(paths, model):
     """[(folder, name)] of the cases of model under paths, each a case
     folder itself or a folder searched recursively (through linked folders
     too, each folder once), sorted by name: the folder's path below the one
-    searched (its own name for a case folder given itself)."""
+    searched (its own name for a case folder given itself). A CaseList."""
     target = f"{model}_ref.csv"
-    found, names = {}, set()
+    seen = set()
+    names, root_of, kinds, roots = [], array("H"), array("b"), []
+    taken = set() if len(paths) > 1 else None  # names: only folders searched together can give one twice
     for path in paths:
         root = os.fspath(path)
         if not os.path.isdir(root):
             raise InputError(f"{path}: no such folder")
         root_name = os.path.basename(os.path.realpath(root))
-        for folder, relative, key in _walk(root, target):
-            name = relative or root_name
-            if key not in found:
-                if name in names:  # the same name below two folders given
-                    name = f"{root_name}/{name}"
-                names.add(name)
-                found[key] = (Path(folder), name)
-    return sorted(found.values(), key=lambda item: item[1])
+        roots.append((root, root_name))
+        for relative in _walk(root, "", target, seen):
+            name, kind = (relative, CaseList.RELATIVE) if relative else (root_name, CaseList.ROOT)
+            if taken is not None:
+                if name in taken:  # the same name below two folders given
+                    name, kind = f"{root_name}/{name}", CaseList.PREFIXED if relative else CaseList.ROOT
+                taken.add(name)
+            names.append(name)
+            root_of.append(len(roots) - 1)
+            kinds.append(kind)
+    order = sorted(range(len(names)), key=names.__getitem__)
+    return CaseList(roots, [names[i] for i in order], array("H", (root_of[i] for i in order)),
+                    array("b", (kinds[i] for i in order)))
 
 
-def _walk(root, file_name):
-    """(folder, path below root, identity) of the folders below root that
-    hold file_name."""
-    stack, seen = [(root, "")], set()
-    while stack:
-        folder, relative = stack.pop()
-        try:
-            status = os.stat(folder)
-            entries = list(os.scandir(folder))
-        except OSError:
-            continue
-        key = (status.st_dev, status.st_ino)
-        if key in seen:
-            continue
-        seen.add(key)
-        holds = False
-        for entry in entries:
-            if entry.name == file_name:
-                holds = holds or entry.is_file()
-            elif entry.is_dir():
-                stack.append((entry.path, f"{relative}/{entry.name}" if relative else entry.name))
-        if holds:
-            yield folder, relative, key
+def _walk(folder, relative, file_name, seen):
+    """The paths below the root (relative) of the folders from folder on
+    that hold file_name, each folder once (seen: their identities), by the
+    first path to it in sorted order. Depth first, holding the names of one
+    folder's subfolders per level: memory grows with the depth and the
+    widest folder's names, not with the whole tree."""
+    try:
+        status = os.stat(folder)
+        identity = (status.st_dev << 64) | status.st_ino
+        if identity in seen:
+            return
+        with os.scandir(folder) as entries:
+            subfolders = sorted(e.name for e in entries if e.name != file_name and _is_folder(e))
+    except OSError:
+        return
+    seen.add(identity)
+    if os.path.isfile(os.path.join(folder, file_name)):
+        yield relative
+    for name in subfolders:
+        yield from _walk(os.path.join(folder, name), f"{relative}/{name}" if relative else name, file_name, seen)
+
+
+def _is_folder(entry):
+    try:
+        return entry.is_dir()
+    except OSError:
+        return False

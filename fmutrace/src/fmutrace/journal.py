@@ -62,37 +62,58 @@ def case_key(fmu_file, folder):
 
 
 class Journal:
-    """results.jsonl: read back for a resume, appended to as cases finish."""
+    """results.jsonl: read back for a resume, appended to as cases finish.
+    A case's entry is found again by where its line starts (done, record):
+    the campaign keeps that offset, not the outcome."""
 
     def __init__(self, folder, key, resume):
         self.path = Path(folder) / JOURNAL
-        self.done = {}
+        self.done = {}  # key -> offset of the case's line, of a campaign resumed
         if resume and self.path.exists():
-            lines = self.path.read_text().splitlines()
-            header = _parse(lines[0]) if lines else None
-            if header is not None and header.get("campaign") != key:
-                raise InputError(f"{self.path}: made by a campaign with other FMUs or options; resume it with "
-                                 "the same ones, or start afresh without --resume")
-            for line in lines[1:]:
-                entry = _parse(line)
-                if entry is not None and "key" in entry:
-                    self.done[entry["key"]] = entry
-            self.file = open(self.path, "a")
+            with open(self.path, "rb") as journal:
+                header = _parse(journal.readline())
+                if header is not None and header.get("campaign") != key:
+                    raise InputError(f"{self.path}: made by a campaign with other FMUs or options; resume it with "
+                                     "the same ones, or start afresh without --resume")
+                offset = journal.tell()
+                for line in journal:
+                    entry = _parse(line)
+                    if entry is not None and "key" in entry:
+                        self.done[entry["key"]] = offset
+                    offset += len(line)
+            self.file = open(self.path, "ab")
+            if self.file.tell() and not _ends_a_line(self.path):
+                self.file.write(b"\n")  # close a line cut short by the kill: the next entry starts afresh
             if header is None:
                 self._write({"campaign": key})
         else:
-            self.file = open(self.path, "w")
+            self.file = open(self.path, "wb")
             self._write({"campaign": key})
+        self.reader = open(self.path, "rb")
 
     def _write(self, entry):
-        self.file.write(json.dumps(entry) + "\n")
+        offset = self.file.tell()
+        self.file.write(json.dumps(entry).encode() + b"\n")
         self.file.flush()  # in the OS's hands: a killed client loses nothing written
+        return offset
 
     def record(self, key, entry):
-        self._write(dict(entry, key=key))
+        """Append a finished case; the offset of its line."""
+        return self._write(dict(entry, key=key))
+
+    def entry(self, offset):
+        self.reader.seek(offset)
+        return json.loads(self.reader.readline())
 
     def close(self):
         self.file.close()
+        self.reader.close()
+
+
+def _ends_a_line(path):
+    with open(path, "rb") as journal:
+        journal.seek(-1, os.SEEK_END)
+        return journal.read(1) == b"\n"
 
 
 def _parse(line):

@@ -6,7 +6,7 @@ import io
 import json
 import os
 from pathlib import Path
-from xml.etree import ElementTree
+from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
 
@@ -73,6 +73,11 @@ def plot_case(case, result, tolerance, label):
     return stream.getvalue()
 
 
+def light(cases):
+    """The outcomes, without their results where they must be read (a journaled campaign's)."""
+    return cases.light() if hasattr(cases, "light") else iter(cases)
+
+
 def write_case_files(outcome, report_dir):
     """<fmu folder>/<case>_out.csv and .png; their paths into outcome."""
     if outcome.result is None and not outcome.png:
@@ -87,8 +92,9 @@ def write_case_files(outcome, report_dir):
         outcome.plot = os.path.relpath(f"{stem}.png", report_dir)
 
 
-def results_json(campaign):
-    return {
+def write_results_json(campaign, path):
+    """results.json, a case at a time (a campaign's cases may not fit in memory at once)."""
+    head = {
         "format": RESULTS_FORMAT,
         "mode": campaign.tolerance.mode,
         "tolerance": {k: v for k, v in vars(campaign.tolerance).items() if v is not None},
@@ -96,8 +102,12 @@ def results_json(campaign):
         "counts": campaign.counts(),
         "where": campaign.where,
         "seconds": round(campaign.seconds, 3),
-        "cases": [case_json(o) for o in campaign.cases],
     }
+    with open(path, "w") as out:
+        out.write(json.dumps(head)[:-1] + ', "cases": [')
+        for n, o in enumerate(light(campaign.cases)):
+            out.write(("," if n else "") + "\n" + json.dumps(case_json(o)))
+        out.write("\n]}\n")
 
 
 def case_json(o):
@@ -110,60 +120,54 @@ def case_json(o):
     return entry
 
 
-def junit_xml(campaign):
-    """JUnit XML: a test suite per FMU, a test case per case."""
+def write_junit(campaign, path):
+    """JUnit XML: a test suite per FMU, a test case per case; a suite's
+    totals first (one pass over the cases), then its cases (one pass per FMU)."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
     counts = campaign.counts()
-    suites = ElementTree.Element("testsuites", name="fmutrace", tests=str(len(campaign.cases)),
-                                 failures=str(counts["fail"]), errors=str(counts["error"] + counts["invalid"]),
-                                 time=f"{campaign.seconds:.3f}")
-    by_fmu = {}
-    for o in campaign.cases:
-        by_fmu.setdefault(o.fmu, []).append(o)
-    for fmu, outcomes in by_fmu.items():
-        suite = ElementTree.SubElement(
-            suites, "testsuite", name=fmu, tests=str(len(outcomes)),
-            failures=str(sum(o.status == "fail" for o in outcomes)),
-            errors=str(sum(o.status in ("error", "invalid") for o in outcomes)),
-            time=f"{sum(o.seconds for o in outcomes):.3f}")
-        for o in outcomes:
-            case = ElementTree.SubElement(suite, "testcase", name=o.case, classname=fmu, time=f"{o.seconds:.3f}")
-            if o.status != "pass":
-                element = ElementTree.SubElement(case, "failure" if o.status == "fail" else "error",
-                                                 message=o.messages[0] if o.messages else o.status)
-                element.text = "\n".join(o.messages)
-    ElementTree.indent(suites)
-    return ElementTree.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
+    suites = {}  # fmu -> [tests, failures, errors, seconds]
+    for o in light(campaign.cases):
+        totals = suites.setdefault(o.fmu, [0, 0, 0, 0.0])
+        totals[0] += 1
+        totals[1] += o.status == "fail"
+        totals[2] += o.status in ("error", "invalid")
+        totals[3] += o.seconds
+    with open(path, "w") as out:
+        out.write("<?xml version='1.0' encoding='utf-8'?>\n")
+        out.write(f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts["fail"]}" '
+                  f'errors="{counts["error"] + counts["invalid"]}" time="{campaign.seconds:.3f}">\n')
+        for fmu, (tests, failures, errors, seconds) in suites.items():
+            out.write(f'  <testsuite name={quoteattr(fmu)} tests="{tests}" failures="{failures}" errors="{errors}" '
+                      f'time="{seconds:.3f}">\n')
+            for o in light(campaign.cases):
+                if o.fmu != fmu:
+                    continue
+                case = f'    <testcase name={quoteattr(o.case)} classname={quoteattr(fmu)} time="{o.seconds:.3f}"'
+                if o.status == "pass":
+                    out.write(case + " />\n")
+                    continue
+                kind = "failure" if o.status == "fail" else "error"
+                message = o.messages[0] if o.messages else o.status
+                out.write(f"{case}>\n      <{kind} message={quoteattr(message)}>{escape(chr(10).join(o.messages))}"
+                          f"</{kind}>\n    </testcase>\n")
+            out.write("  </testsuite>\n")
+        out.write("</testsuites>\n")
 
 
 def _verdict(o):
     return "pass" if o.passed else f"{o.status.upper()}: " + "; ".join(o.messages[:3])
 
 
-def write_junit(campaign, path):
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(junit_xml(campaign))
-
-
 def write_report(campaign, report_dir):
-    """index.html, summary.md and results.json into report_dir (the case
-    files are written as the cases finish)."""
+    """index.html, summary.md and results.json into report_dir, a case at
+    a time (the case files are written as the cases finish)."""
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     headline = campaign.headline()
-    lines = ["# fmutrace", "", headline, "", f"Comparison: {campaign.tolerance.describe()}.", "",
-             "| case | FMU | result | seconds | plot |", "|---|---|---|---|---|"]
-    rows = []
-    for o in campaign.cases:
-        verdict = _verdict(o)
-        lines.append(f"| {o.case} | {o.fmu} | {verdict.replace('|', '/')} | {o.seconds:.2f} | "
-                     + (f"[png]({o.plot})" if o.plot else "") + " |")
-        image = f'<a href="{html.escape(o.plot)}"><img src="{html.escape(o.plot)}" loading="lazy"></a>' \
-            if o.plot else ""
-        csv = f'<br><a href="{html.escape(o.csv)}">result CSV</a>' if o.csv else ""
-        rows.append(f'<tr class="{o.status}"><td>{html.escape(o.case)}</td><td>{html.escape(o.fmu)}</td>'
-                    f'<td>{html.escape(verdict)}{csv}</td><td>{o.seconds:.2f}</td><td>{image}</td></tr>')
-    (report_dir / "summary.md").write_text("\n".join(lines) + "\n")
-    (report_dir / "index.html").write_text(f"""<!DOCTYPE html>
+    with open(report_dir / "summary.md", "w") as summary, open(report_dir / "index.html", "w") as page:
+        summary.write("\n".join(["# fmutrace", "", headline, "", f"Comparison: {campaign.tolerance.describe()}.", "",
+                                 "| case | FMU | result | seconds | plot |", "|---|---|---|---|---|"]) + "\n")
+        page.write(f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
 <style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}}tr.pass td:nth-child(3){{color:#176617}}
@@ -171,8 +175,15 @@ tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){{col
 </head><body>
 <h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.tolerance.describe())}.</p>
 <table><tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
-{chr(10).join(rows)}
-</table></body></html>
 """)
-    indent = 1 if len(campaign.cases) <= 1000 else None  # a big campaign's file is for programs
-    (report_dir / "results.json").write_text(json.dumps(results_json(campaign), indent=indent) + "\n")
+        for o in light(campaign.cases):
+            verdict = _verdict(o)
+            summary.write(f"| {o.case} | {o.fmu} | {verdict.replace('|', '/')} | {o.seconds:.2f} | "
+                          + (f"[png]({o.plot})" if o.plot else "") + " |\n")
+            image = f'<a href="{html.escape(o.plot)}"><img src="{html.escape(o.plot)}" loading="lazy"></a>' \
+                if o.plot else ""
+            csv = f'<br><a href="{html.escape(o.csv)}">result CSV</a>' if o.csv else ""
+            page.write(f'<tr class="{o.status}"><td>{html.escape(o.case)}</td><td>{html.escape(o.fmu)}</td>'
+                       f'<td>{html.escape(verdict)}{csv}</td><td>{o.seconds:.2f}</td><td>{image}</td></tr>\n')
+        page.write("</table></body></html>\n")
+    write_results_json(campaign, report_dir / "results.json")
