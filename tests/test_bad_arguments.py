@@ -104,11 +104,9 @@ def test_stop_time_before_start_time_is_refused(version):
 
 # ---- the checks of every value reference, whatever its place in the array ----
 
-def accessors(fmu, kind):
+def real_accessors(fmu):
     f = fmu.fmu
-    if kind == "real":
-        return (f.getReal, f.setReal) if fmu.version == 2 else (f.getFloat64, f.setFloat64)
-    return (f.getBoolean, f.setBoolean)
+    return (f.getReal, f.setReal) if fmu.version == 2 else (f.getFloat64, f.setFloat64)
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -116,7 +114,7 @@ def test_every_value_reference_of_an_array_is_checked_before_any_is_used(version
     fmu = Instance("RateLimiter", version)
     try:
         fmu.start()
-        get, set_ = accessors(fmu, "real")
+        get, set_ = real_accessors(fmu)
         y, u, bypass = fmu.vr("y"), fmu.vr("u"), fmu.vr("bypass")
         function = {2: ("fmi2GetReal", "fmi2SetReal"), 3: ("fmi3GetFloat64", "fmi3SetFloat64")}[version]
         for vrs in ([y, 999], [999, y], [999, y, y]):
@@ -145,7 +143,7 @@ def test_time_and_outputs_cannot_be_set(version):
     fmu = Instance("RateLimiter", version)
     try:
         fmu.start()
-        set_ = accessors(fmu, "real")[1]
+        set_ = real_accessors(fmu)[1]
         name = "fmi2SetReal" if version == 2 else "fmi3SetFloat64"
         assert call_status(set_, [fmu.vr("time")], [5.0]) == 3
         assert fmu.errors()[-1][2] == f"{name}: time is an independent variable and cannot be set"

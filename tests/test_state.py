@@ -143,29 +143,22 @@ def test_bad_serialized_state_is_refused_and_the_instance_recovers(version, dama
     fmu.free()
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_integer_at_the_end_of_the_int32_range_in_a_state_is_accepted(version):
-    fmu = started(version)
-    api = state_api(fmu)
-    data = bytes(api["serialize"](api["get"]()))
-    for value in (2147483647.0, -2147483648.0):
-        state = api["deserialize"](value_at(data, 20 + 8 * 21, struct.pack("<d", value)))
-        api["set"](state)
-        assert fmu.get("status") == int(value)
-        api["free"](state)
-    assert not fmu.errors()
-    fmu.free()
+# values at the ends of their variable's range: accepted (one past them is refused, above)
+RANGE_ENDS = {"status": (21, (2147483647, -2147483648)),  # an Integer: the int32 range
+              "zeroRate": (12, (1, 2))}  # an Enumeration: hold, no limit
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_enumeration_at_the_ends_of_its_range_in_a_state_is_accepted(version):
+@pytest.mark.parametrize("name", sorted(RANGE_ENDS))
+def test_values_at_the_ends_of_their_range_in_a_state_are_accepted(version, name):
     fmu = started(version)
     api = state_api(fmu)
     data = bytes(api["serialize"](api["get"]()))
-    for value in (1, 2):  # zeroRate: hold, no limit
-        state = api["deserialize"](value_at(data, 20 + 8 * 12, struct.pack("<d", float(value))))
+    vr, values = RANGE_ENDS[name]
+    for value in values:
+        state = api["deserialize"](value_at(data, 20 + 8 * vr, struct.pack("<d", float(value))))
         api["set"](state)
-        assert fmu.get("zeroRate") == value
+        assert fmu.get(name) == value
         api["free"](state)
     assert not fmu.errors()
     fmu.free()
