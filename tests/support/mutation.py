@@ -173,7 +173,14 @@ class Builder:
                 args[i] = str(objects[unit])
         args[args.index("-o") + 1] = str(output)
         output.parent.mkdir(parents=True, exist_ok=True)
-        run(args, cwd=self.build, timeout=COMPILE_SECONDS, what=f"linking {target}", check=True)
+        done = run(args, cwd=self.build, timeout=COMPILE_SECONDS, what=f"linking {target}")
+        if done.returncode:  # a mutant that hides or renames a function: it does not build
+            errors = [line for line in done.stderr.splitlines() if "undefined" in line or "error" in line]
+            raise Stillborn(f"linking {target}: " + (errors[0] if errors else done.stderr.strip()[-200:]))
+
+
+class Stillborn(Exception):
+    """The mutant does not build."""
 
 
 def units_of(file, builder):
@@ -314,6 +321,8 @@ def test_mutant(mutant, index, builder, base, work, venv_python):
             last = done.stdout.strip().splitlines()[-1:] or [f"pytest exited with {done.returncode}"]
             return "killed", (failed or last)[0][:300]
         return "survived", ""
+    except Stillborn as error:
+        return "stillborn", str(error)
     finally:
         shutil.rmtree(tree, ignore_errors=True)
 
@@ -382,7 +391,7 @@ def main(argv=None):
     def test(item):
         index, m = item
         m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable)
-        print("." if m.outcome == "killed" else "S", end="", flush=True)
+        print({"killed": ".", "survived": "S"}.get(m.outcome, "x"), end="", flush=True)  # x: does not link
         if m.key in equivalents:  # --check-listed: the proof must hold
             m.outcome, m.detail = ("listed", equivalents[m.key]) if m.outcome == "survived" else \
                 ("wrongly listed", f"listed as equivalent, but {m.detail}")
