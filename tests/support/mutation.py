@@ -388,15 +388,20 @@ def main(argv=None):
     print(f"compiled in {time.monotonic() - started:.0f} s; running the tests on {len(to_test)} distinct mutants",
           flush=True)
 
+    progress = open(work / "outcomes.jsonl", "w")  # each tested mutant as it finishes: a long run shows its survivors
+
     def test(item):
         index, m = item
         m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable)
+        progress.write(json.dumps(dict(label=m.label(), outcome=m.outcome, detail=m.detail)) + "\n")
+        progress.flush()
         print({"killed": ".", "survived": "S"}.get(m.outcome, "x"), end="", flush=True)  # x: does not link
         if m.key in equivalents:  # --check-listed: the proof must hold
             m.outcome, m.detail = ("listed", equivalents[m.key]) if m.outcome == "survived" else \
                 ("wrongly listed", f"listed as equivalent, but {m.detail}")
 
     parallel(args.jobs, test, to_test)
+    progress.close()
     print()
     for members in groups.values():
         tested = members[0][1]
