@@ -768,6 +768,22 @@ static void test_without_section6(void) {
     CHECK_EQ(b.state.y, 4.0);
 }
 
+/* rl_init sets every field of the state: a state that held another run
+ * (an instance reset, a block reused) starts afresh. */
+static void test_init_of_a_used_state(void) {
+    RlConfig c = defaults();
+    RlState s = { .y = 7.0, .uPrevious = 8.0, .yPrevious = 9.0, .decided = RL_DECIDED_RAMP, .runCycles = 5,
+                  .runPeriod = 0.5, .runBase = 3.0 };
+    rl_init(&s, &c, 2.0);
+    CHECK_EQ(s.y, 2.0);
+    CHECK_EQ(s.yPrevious, 2.0);
+    CHECK_EQ(s.uPrevious, 2.0);
+    CHECK_EQ(s.decided, RL_DECIDED_NOTHING);
+    CHECK_EQ(s.runCycles, 0);
+    CHECK_EQ(s.runPeriod, 0.0);
+    CHECK_EQ(s.runBase, 0.0);
+}
+
 int main(void) {
     test_rule0_resolve();
     test_rule0_limits();
@@ -790,6 +806,7 @@ int main(void) {
     test_rule5b_hold();
     test_derived_outputs();
     test_without_section6();
+    test_init_of_a_used_state();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }
