@@ -190,11 +190,12 @@ def units_of(file, builder):
     return builder.units + ["tests/c/test_kernel.c"]
 
 
-def write_tree(folder, file, text):
-    """A copy of fmu_src with <file> replaced by text."""
+def write_tree(folder, file=None, text=None):
+    """A copy of fmu_src (and the kernel's tests) with <file> replaced by text."""
     shutil.rmtree(folder, ignore_errors=True)
     shutil.copytree(SOURCE, folder / "fmu_src")
-    (folder / "fmu_src" / file).write_text(text)
+    if file:
+        (folder / "fmu_src" / file).write_text(text)
     (folder / "tests" / "c").mkdir(parents=True)
     shutil.copy(REPO / "tests" / "c" / "test_kernel.c", folder / "tests" / "c")
 
@@ -212,11 +213,7 @@ class Baseline:
 
 def compile_baseline(builder, work):
     base = Baseline(work / "baseline")
-    shutil.rmtree(base.tree, ignore_errors=True)
-    base.tree.mkdir(parents=True)
-    shutil.copytree(SOURCE, base.tree / "fmu_src")
-    (base.tree / "tests" / "c").mkdir(parents=True)
-    shutil.copy(REPO / "tests" / "c" / "test_kernel.c", base.tree / "tests" / "c")
+    write_tree(base.tree)
     for unit in builder.units + ["tests/c/test_kernel.c"]:
         out = base.tree / "obj" / object_name(unit)
         done = builder.compile(base.tree, unit, out)
