@@ -19,6 +19,11 @@ A mutant that survives must be killed by a new test, or be listed in
 tests/equivalent_mutants.txt with a one-line proof that it cannot change
 behaviour. The exit status is 1 for a survivor not on that list, a listed
 mutant that a test kills (--check-listed) or an entry that names no mutant.
+
+Every outcome is appended to build/mutation/journal.jsonl as it is known.
+--resume keeps the recorded stillborn, equivalent and killed outcomes of
+mutants of the same sources (tests are only ever added: a kill stands) and
+tests the rest, survivors included.
 """
 import argparse
 import hashlib
@@ -48,9 +53,23 @@ PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 TESTS = ("test_conformance.py", "test_reference.py", "test_misuse.py", "test_bad_arguments.py", "test_state.py",
          "test_vendor_interpretations.py", "test_long_runs.py", "test_model_description.py", "test_random.py",
          "test_hostile.py")
+# outcomes a resumed run keeps: they depend on the sources and the build's flags alone, or (killed) stand
+# because tests are only added
+KEPT = ("stillborn", "equivalent", "killed")
 COMPILE_SECONDS = 120
 KERNEL_SECONDS = 120
 PYTEST_SECONDS = 600  # a mutant that makes a test loop for ever is killed by this bound
+
+
+def inputs_digest(build_dir):
+    """What a mutant's outcome depends on besides its own text: the other sources and the build's flags."""
+    h = hashlib.sha256()
+    files = sorted(p for p in SOURCE.rglob("*") if p.is_file()) + [REPO / "tests" / "c" / "test_kernel.c",
+                                                                  build_dir / "compile_commands.json"]
+    for path in files:
+        h.update(str(path.relative_to(REPO) if path.is_relative_to(REPO) else path.name).encode() + b"\0")
+        h.update(path.read_bytes() + b"\0")
+    return h.hexdigest()
 
 
 @dataclass
@@ -64,6 +83,7 @@ class Mutant:
     outcome: str = ""   # stillborn, equivalent, listed, killed, survived
     detail: str = ""    # the compiler's or the killing test's word
     digest: str = ""    # the mutated objects' hash
+    identity: str = ""  # its name in the journal: this mutant of these sources with these flags
 
     def __post_init__(self):
         self.key = f"fmu_src/{self.file} | {self.before.strip()} | {self.after.strip()}"
@@ -324,6 +344,31 @@ def test_mutant(mutant, index, builder, base, work, venv_python):
         shutil.rmtree(tree, ignore_errors=True)
 
 
+class Journal:
+    """Append-only record of outcomes, one JSON line per mutant, flushed as each is known."""
+
+    def __init__(self, path, resume):
+        self.kept = {}
+        if resume and path.exists():
+            for line in path.read_text().splitlines():
+                try:
+                    record = json.loads(line)
+                except json.JSONDecodeError:
+                    continue  # a line cut by a kill
+                if record.get("outcome") in KEPT:
+                    self.kept[record["identity"]] = (record["outcome"], record["detail"])
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.file = open(path, "a" if resume else "w")
+        self.file.write("\n")  # closes a line cut by a kill
+
+    def record(self, m, outcome, detail):
+        self.file.write(json.dumps(dict(identity=m.identity, label=m.label(), outcome=outcome, detail=detail)) + "\n")
+        self.file.flush()
+
+    def close(self):
+        self.file.close()
+
+
 def parallel(jobs, function, items):
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         return list(pool.map(function, items))
@@ -340,6 +385,8 @@ def main(argv=None):
     parser.add_argument("--check-listed", action="store_true",
                         help="test the listed equivalents too: each must survive")
     parser.add_argument("--listed", action="store_true", help="test only the listed equivalents")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the stillborn, equivalent and killed outcomes in the journal; test the rest")
     args = parser.parse_args(argv)
     build_dir = args.build_dir.resolve()
     work = build_dir / "mutation"
@@ -361,10 +408,29 @@ def main(argv=None):
     print(f"{generated} mutants of {', '.join(args.files)}; testing {len(mutants)}"
           + (f" (seeded sample, seed {args.seed})" if args.sample is not None else ""), flush=True)
 
+    journal = Journal(work / "journal.jsonl", args.resume)
+    inputs = inputs_digest(build_dir)
+    for m in mutants:
+        m.identity = hashlib.sha256(f"{inputs}\0{m.file}\0{m.text}".encode()).hexdigest()
+        if m.identity in journal.kept:
+            m.outcome, m.detail = journal.kept[m.identity]
+            if m.outcome == "killed" and m.key in equivalents:
+                m.outcome, m.detail = "wrongly listed", f"listed as equivalent, but {m.detail}"
+    kept = sum(1 for m in mutants if m.outcome)
+    if args.resume:
+        print(f"{kept} outcomes kept from {work / 'journal.jsonl'}", flush=True)
+
     builder = Builder(build_dir, work)
     base = compile_baseline(builder, work)
     shutil.rmtree(work / "run", ignore_errors=True)
-    parallel(args.jobs, lambda im: compile_mutant(im[1], im[0], builder, base, work), list(enumerate(mutants)))
+
+    def compile_one(item):
+        index, m = item
+        compile_mutant(m, index, builder, base, work)
+        if m.outcome:
+            journal.record(m, m.outcome, m.detail)
+
+    parallel(args.jobs, compile_one, [(i, m) for i, m in enumerate(mutants) if not m.outcome])
 
     # one test per distinct object code; a listed equivalent covers its whole group and is not run
     groups = defaultdict(list)
@@ -385,20 +451,18 @@ def main(argv=None):
     print(f"compiled in {time.monotonic() - started:.0f} s; running the tests on {len(to_test)} distinct mutants",
           flush=True)
 
-    progress = open(work / "outcomes.jsonl", "w")  # each tested mutant as it finishes: a long run shows its survivors
-
     def test(item):
         index, m = item
         m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable)
-        progress.write(json.dumps(dict(label=m.label(), outcome=m.outcome, detail=m.detail)) + "\n")
-        progress.flush()
+        for _, member in groups[m.digest]:  # the same object code: the same outcome
+            journal.record(member, m.outcome, m.detail if member is m else f"same object code as {m.label()}")
         print({"killed": ".", "survived": "S"}.get(m.outcome, "x"), end="", flush=True)  # x: does not link
         if m.key in equivalents:  # --check-listed: the proof must hold
             m.outcome, m.detail = ("listed", equivalents[m.key]) if m.outcome == "survived" else \
                 ("wrongly listed", f"listed as equivalent, but {m.detail}")
 
     parallel(args.jobs, test, to_test)
-    progress.close()
+    journal.close()
     print()
     for members in groups.values():
         tested = members[0][1]
