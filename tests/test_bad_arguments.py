@@ -2,6 +2,7 @@
 exported function, nValues 0 and mismatched, duplicate value references,
 stop time before start time. Each gets the right status, and the instance
 stays usable where the standard allows."""
+import ctypes
 from ctypes import byref, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint, c_void_p
 
 import pytest
@@ -267,5 +268,40 @@ def test_an_importer_without_a_logger_gets_statuses_and_no_crash(version):
         release = getattr(dll, f"fmi{version}FreeInstance")
         release.argtypes, release.restype = [c_void_p], None
         release(c)
+    finally:
+        fmu.free()
+
+
+# FMI 3 accessors of types that no variable of these FMUs has
+NO_VARIABLES = ("Float32", "Int8", "UInt8", "Int16", "UInt16", "UInt32", "UInt64", "String", "Binary")
+
+
+@pytest.mark.parametrize("kind", NO_VARIABLES)
+def test_fmi3_accessors_of_types_without_variables_refuse_every_value_reference(kind):
+    fmu = Instance("RateLimiter", 3)
+    try:
+        fmu.start()
+        c, dll = fmu.fmu.component, fmu.fmu.dll
+        u = fmu.vr("u")
+        buffer = ctypes.create_string_buffer(4096)
+        sizes = (c_size_t * 4)()
+        for access in ("Get", "Set"):
+            name = f"fmi3{access}{kind}"
+            function = getattr(dll, name)
+            if kind == "Binary":  # (instance, vr, nvr, valueSizes, values, nValues)
+                function.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t]
+            else:
+                function.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t]
+            function.restype = c_int
+            for vrs, message in (([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                                 ([u, u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                                 ([999, u], "unknown value reference 999")):
+                array = (c_uint * len(vrs))(*vrs)
+                args = (sizes, buffer) if kind == "Binary" else (buffer,)
+                assert function(c, array, len(vrs), *args, len(vrs)) == 3, (name, vrs)
+                assert fmu.errors()[-1][2] == f"{name}: {message}", (name, vrs)
+                fmu.fmu.reset()
+                fmu.start()
+        assert fmu.get("u") == 0.0
     finally:
         fmu.free()

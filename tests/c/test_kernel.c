@@ -304,6 +304,20 @@ static void test_rule3_init_delay(void) {
     c.initMode = RL_INIT_INPUT;
     start(&b, &c, 0.0, 0.1);
     CHECK_EQ(cycle(&b, 5.0), 0.1);
+    /* tracking ends with the cycle that ends at most initDelay + 1e-9 * T:
+     * the tolerance scales with the cycle (5e-9 s is 5e-8 of 0.1 s but 5e-10 of 10 s) */
+    c.initMode = RL_INIT_INPUT_DELAYED;
+    c.initDelay = 0.3 - 5e-9;
+    start(&b, &c, 0.0, 0.1);
+    cycle(&b, 0.0);
+    cycle(&b, 0.0);
+    CHECK_EQ(cycle(&b, 5.0), 0.1);            /* ends at 0.3: past the delay, ramps */
+    c.initDelay = 30.0 - 5e-9;
+    start(&b, &c, 0.0, 10.0);
+    cycle(&b, 0.0);
+    cycle(&b, 0.0);
+    CHECK_EQ(cycle(&b, 500.0), 500.0);        /* ends at 30: within 1e-9 * 10 s, tracks */
+    CHECK_EQ(cycle(&b, 0.0), 490.0);
 }
 
 static void test_rule4_invalid_previous_output(void) {
@@ -648,6 +662,15 @@ static void test_output_limits(void) {
     c = defaults(); c.yMin.value = 1.0; c.yMax.value = 0.0;
     start(&b, &c, -4.0, 1.0);
     CHECK_EQ(b.state.y, -4.0);
+    /* ... and only a finite one: an infinite initial output stays as it is */
+    c = defaults(); c.yMin.value = -1.0; c.yMax.value = 2.0;
+    start(&b, &c, INFINITY, 1.0);
+    CHECK_EQ(b.state.y, INFINITY);
+    start(&b, &c, -INFINITY, 1.0);
+    CHECK_EQ(b.state.y, -INFINITY);
+    c.initMode = RL_INIT_VALUE; c.initValue = INFINITY;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(b.state.y, INFINITY);
     /* a NaN u stays NaN as the target (the Siemens comparison holds) */
     c = defaults(); c.passNonFinite = false; c.yMax.value = 2.0;
     start(&b, &c, 1.0, 1.0);

@@ -62,11 +62,10 @@ PYTEST_SECONDS = 600  # a mutant that makes a test loop for ever is killed by th
 
 
 def inputs_digest(build_dir):
-    """What a mutant's outcome depends on besides its own text: the other sources and the build's flags."""
+    """What a mutant's outcome depends on besides its own text and the tests: the product's other sources
+    and the build's flags. Tests are only added, so a kill stands when they change."""
     h = hashlib.sha256()
-    files = sorted(p for p in SOURCE.rglob("*") if p.is_file()) + [REPO / "tests" / "c" / "test_kernel.c",
-                                                                  build_dir / "compile_commands.json"]
-    for path in files:
+    for path in sorted(p for p in SOURCE.rglob("*") if p.is_file()) + [build_dir / "compile_commands.json"]:
         h.update(str(path.relative_to(REPO) if path.is_relative_to(REPO) else path.name).encode() + b"\0")
         h.update(path.read_bytes() + b"\0")
     return h.hexdigest()
@@ -385,6 +384,8 @@ def main(argv=None):
     parser.add_argument("--check-listed", action="store_true",
                         help="test the listed equivalents too: each must survive")
     parser.add_argument("--listed", action="store_true", help="test only the listed equivalents")
+    parser.add_argument("--only", nargs="+", metavar="TEXT",
+                        help="test only the mutants whose label (file:line: before  =>  after) contains one of these")
     parser.add_argument("--resume", action="store_true",
                         help="keep the stillborn, equivalent and killed outcomes in the journal; test the rest")
     args = parser.parse_args(argv)
@@ -403,6 +404,8 @@ def main(argv=None):
     if args.listed:  # the list's entries alone, each tested: each must survive
         mutants = [m for m in mutants if m.key in equivalents]
         args.check_listed = True
+    if args.only:
+        mutants = [m for m in mutants if any(text in m.label() for text in args.only)]
     if args.sample is not None and args.sample < len(mutants):
         mutants = sorted(random.Random(args.seed).sample(mutants, args.sample), key=lambda m: (m.file, m.line))
     print(f"{generated} mutants of {', '.join(args.files)}; testing {len(mutants)}"
