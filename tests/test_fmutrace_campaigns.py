@@ -137,6 +137,18 @@ def test_a_journaled_campaign_gives_its_outcomes_and_results_back(tmp_path):
     assert journaled.counts() == in_memory.counts() == {"pass": 2, "fail": 0, "error": 0, "invalid": 0}
 
 
+def test_the_failed_cases_of_a_journaled_campaign_with_or_without_their_results(tmp_path):
+    """The command prints the failing cases' messages only: failed(results=False) gives them without reading
+    each result back from its CSV file."""
+    cases = step_cases(tmp_path / "cases", "PassThrough", [3, 4, 5])
+    (cases / "case_04" / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,4\n0.4,9\n")
+    campaign = fmutrace.compare(PASS_THROUGH, cases, jobs=1, report=tmp_path / "report")
+    whole, light = campaign.failed(), campaign.failed(results=False)
+    assert [o.case for o in whole] == [o.case for o in light] == ["case_04"]
+    assert whole[0].messages == light[0].messages and whole[0].status == light[0].status == "fail"
+    assert list(whole[0].result["y"]) == [0, 0, 0, 4, 4] and light[0].result is None
+
+
 def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 3)
     report = tmp_path / "report"

@@ -8,7 +8,6 @@ once to every worker) and returns the outcome with its result and plot,
 so workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written here.
 """
-import gc
 import hashlib
 import json
 import logging
@@ -44,7 +43,6 @@ BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they
 SHORT_LOGS = {"distributed.admin.low-level-log-length": 16}
 # no statistical profiler in the workers (its history grows with the campaign's length)
 LOCAL_CLUSTER = {"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}
-GC_BATCHES = 32               # batches between full garbage collections in the client
 BATCH_ATTEMPTS = 3             # a batch lost with its worker is sent again, so many times in all
 
 
@@ -135,8 +133,10 @@ class CampaignResult:
                 self._counts[o.status] += 1
         return self._counts
 
-    def failed(self):
-        return [o for o in self.cases if not o.passed]
+    def failed(self, results=True):
+        """The outcomes that did not pass; results=False leaves out what a journaled campaign must read from
+        disk (each case's result), keeping the messages."""
+        return [o for o in (self.cases if results else light(self.cases)) if not o.passed]
 
     def headline(self):
         c = self.counts()
@@ -149,7 +149,7 @@ class CampaignResult:
     def summary(self):
         """The headline and every failing case with its messages."""
         lines = [self.headline()]
-        for o in self.failed():
+        for o in self.failed(results=False):
             lines.append(f"{o.status.upper()}  {o.case} on {o.fmu}")
             lines += [f"      {m}" for m in o.messages]
         return "\n".join(lines)
@@ -502,7 +502,6 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
                 submit(fmu, batch, case_timeout is not None, 1)  # to kill
                 return
 
-        collected = 0
         for _ in range(3 * workers):
             submit_next()
         deadline = None if timeout is None else time.monotonic() + timeout
@@ -524,11 +523,6 @@ def _on_dask(todo, fmu_bytes, labels, tolerance, plots, jobs, scheduler, shared_
             for (i, _, _, _), outcome in zip(batch, outcomes):
                 finished(i, outcome)
             del outcomes
-            collected += 1
-            if collected % GC_BATCHES == 0:
-                # Dask leaves each result's unpickled objects in reference cycles; the generational
-                # collector would let them pile up until a rare full collection
-                gc.collect()
             submit_next()
         return f"Dask, {workers} workers" + (f" at {scheduler}" if scheduler else " (local processes)")
     finally:

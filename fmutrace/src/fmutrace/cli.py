@@ -126,7 +126,7 @@ def compare_command(args, out):
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
                      scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
                      timeout=args.cluster_timeout, case_timeout=args.timeout, resume=args.resume)
-    for o in result.failed():
+    for o in result.failed(results=False):
         if o.status == "invalid":
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
             continue
