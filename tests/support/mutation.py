@@ -32,6 +32,7 @@ import os
 import random
 import shlex
 import shutil
+import signal
 import sys
 import time
 import zipfile
@@ -41,7 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from support.fmu_driver import MODELS
-from support.process import Timeout, run
+from support.process import Timeout, kill_all, run
 
 REPO = Path(__file__).resolve().parents[2]
 SOURCE = REPO / "fmu_src"
@@ -389,6 +390,13 @@ def main(argv=None):
     parser.add_argument("--resume", action="store_true",
                         help="keep the stillborn, equivalent and killed outcomes in the journal; test the rest")
     args = parser.parse_args(argv)
+
+    def stop(signum, frame):  # the tests running go too; the journal has every outcome known so far
+        kill_all()
+        os._exit(128 + signum)
+
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, stop)
     build_dir = args.build_dir.resolve()
     work = build_dir / "mutation"
     venv_bin = Path(sys.executable).parent

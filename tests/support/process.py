@@ -40,6 +40,15 @@ def kill_session(process):
         pass
 
 
+LIVE = set()  # the sessions run() is waiting for, from any thread
+
+
+def kill_all():
+    """Kill every session run() is waiting for (a caller that is itself stopped leaves none behind)."""
+    for process in list(LIVE):
+        kill_session(process)
+
+
 def run(args, *, timeout, what, check=False, **popen):
     """Run args to the end within timeout seconds, output kept as text.
     Timeout: the session is killed and Timeout raised, naming what and
@@ -48,11 +57,14 @@ def run(args, *, timeout, what, check=False, **popen):
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         stdin = popen.pop("stdin", subprocess.DEVNULL)  # a file to read, or nothing
         process = subprocess.Popen(args, stdin=stdin, stdout=out, stderr=err, start_new_session=True, **popen)
+        LIVE.add(process)
         try:
             process.wait(timeout=timeout)
             timed_out = False
         except subprocess.TimeoutExpired:
             timed_out = True
+        finally:
+            LIVE.discard(process)
         # anything the child left running in its session goes with it
         kill_session(process)
         out.seek(0)
