@@ -66,9 +66,11 @@ def inputs_digest(build_dir):
     """What a mutant's outcome depends on besides its own text and the tests: the product's other sources
     and the build's flags. Tests are only added, so a kill stands when they change."""
     h = hashlib.sha256()
-    for path in sorted(p for p in SOURCE.rglob("*") if p.is_file()) + [build_dir / "compile_commands.json"]:
-        h.update(str(path.relative_to(REPO) if path.is_relative_to(REPO) else path.name).encode() + b"\0")
-        h.update(path.read_bytes() + b"\0")
+    for path in sorted(p for p in SOURCE.rglob("*") if p.is_file()):
+        h.update(path.relative_to(REPO).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    # the flags, wherever the clone and its build tree are: a journal can be carried to another tree
+    flags = (build_dir / "compile_commands.json").read_text()
+    h.update(flags.replace(str(build_dir), "<build>").replace(str(REPO), "<repo>").encode())
     return h.hexdigest()
 
 
