@@ -225,6 +225,9 @@ def enter(fmu, state):
         assert call_status(fmu.fmu.doStep, fmu.t, 0.0) == 3  # h = 0: error
 
 
+# the states as the refusals name them (FMI 2's Error state: after a failed call)
+STATE_TEXT = {**{(v, state): state for v in (2, 3) for state in STATES}, (2, E): "Error (after a failed call)"}
+
 CASES = [(v, name, state) for v in (2, 3) for name in sorted(exported_functions(v)) if name not in NOT_INSTANCE_CALLS
          for state in STATES]
 
@@ -246,6 +249,8 @@ def test_every_function_in_every_state(version, function, state):
             assert status == 3, (function, state, status)
             assert len(new_errors) == 1, (function, state, fmu.messages)
             assert new_errors[0][2].startswith(f"{function}: "), new_errors  # it names the function first
+            if function in (FMI2_ALLOWED if version == 2 else FMI3_ALLOWED):  # refused for the state: says which
+                assert new_errors[0][2] == f"{function}: not allowed in {STATE_TEXT[version, row]}", new_errors
     finally:
         fmu.free()
 
