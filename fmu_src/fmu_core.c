@@ -25,13 +25,14 @@ const char *fmu_mode_name(int mode) {
     }
 }
 
+/* with its article, for "is a Real variable" */
 static const char *type_name(FmuType type) {
     switch (type) {
-    case FMU_REAL: return "Real";
-    case FMU_INTEGER: return "Integer";
-    case FMU_BOOLEAN: return "Boolean";
-    case FMU_ENUMERATION: return "Enumeration";
-    default: return "unsupported";
+    case FMU_REAL: return "a Real";
+    case FMU_INTEGER: return "an Integer";
+    case FMU_BOOLEAN: return "a Boolean";
+    case FMU_ENUMERATION: return "an Enumeration";
+    default: return "an unsupported";
     }
 }
 
@@ -135,7 +136,7 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
     }
     const FmuVariable *v = &model->variables[vr];
     if (!(TYPE_BIT(v->type) & typeMask)) {
-        return fmu_error(instance, function, "%s (value reference %u) is a %s variable, which %s cannot access",
+        return fmu_error(instance, function, "%s (value reference %u) is %s variable, which %s cannot access",
                          v->name, vr, type_name(v->type), function);
     }
     if (!set) {

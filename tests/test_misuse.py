@@ -232,17 +232,26 @@ def test_status_messages_say_what_the_status_means(version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_wrong_type_messages_name_the_types(version):
+    """Each of the four types, with its article."""
     fmu = Instance("RateLimiter", version)
     fmu.start()
     get_integer = "fmi2GetInteger" if version == 2 else "fmi3GetInt32"
-    assert get_raw(fmu, fmu.vr("y"), "Integer") == 3
-    assert f"y (value reference 17) is a Real variable, which {get_integer} cannot access" in fmu.errors()[-1][2]
-    fmu.fmu.reset()
-    fmu.start()
+    get_real = "fmi2GetReal" if version == 2 else "fmi3GetFloat64"
     set_boolean = "fmi2SetBoolean" if version == 2 else "fmi3SetBoolean"
-    assert set_raw(fmu, fmu.vr("zeroRate"), True, "Boolean") == 3
-    assert f"zeroRate (value reference 12) is a Enumeration variable, which {set_boolean} cannot access" \
-        in fmu.errors()[-1][2]
+    for call, message in (
+            (lambda: get_raw(fmu, fmu.vr("y"), "Integer"), f"y (value reference 17) is a Real variable, which "
+                                                           f"{get_integer} cannot access"),
+            (lambda: set_raw(fmu, fmu.vr("zeroRate"), True, "Boolean"), f"zeroRate (value reference 12) is an "
+                                                                        f"Enumeration variable, which {set_boolean} "
+                                                                        "cannot access"),
+            (lambda: get_raw(fmu, fmu.vr("status"), "Real"), f"status (value reference {fmu.vr('status')}) is an "
+                                                             f"Integer variable, which {get_real} cannot access"),
+            (lambda: get_raw(fmu, fmu.vr("bypass"), "Real"), f"bypass (value reference {fmu.vr('bypass')}) is a "
+                                                             f"Boolean variable, which {get_real} cannot access")):
+        assert call() == 3, message
+        assert fmu.errors()[-1][2].endswith(": " + message), fmu.errors()[-1]
+        fmu.fmu.reset()
+        fmu.start()
     fmu.free()
 
 
