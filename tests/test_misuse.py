@@ -107,6 +107,32 @@ def test_reset_recovers_from_error(version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_reset_is_as_good_as_a_new_instance(version):
+    """After fmi*Reset the instance is as after instantiation, whatever ran
+    before: FMI 2 without fmi2SetupExperiment starts at time 0 (the default
+    start time), and a valid configuration logs no status line (no status
+    was reported in the new run)."""
+    fmu = Instance("RateLimiter", version)
+    fmu.start(start_time=1.0, rateUpPar=-1.0)
+    fmu.step(0.5)
+    assert [m[2] for m in fmu.messages if "status" in m[2]] == [
+        "status 16#8200: a rate is negative (rateUpPar = -1); the output holds"]
+    fmu.fmu.reset()
+    fmu.messages.clear()
+    if version == 2:
+        fmu.fmu.enterInitializationMode()
+    else:
+        fmu.fmu.enterInitializationMode(startTime=0.0)
+    fmu.fmu.exitInitializationMode()
+    fmu.t = 0.0
+    fmu.set(u=1.0)
+    fmu.step(0.5)
+    assert fmu.get("y") == 0.5 and fmu.get("time") == 0.5
+    assert fmu.messages == []
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_nan_values_in_a_set_of_several_are_all_or_nothing(version):
     fmu = Instance("RateLimiter", version)
     fmu.start()

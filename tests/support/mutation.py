@@ -34,6 +34,7 @@ import shlex
 import shutil
 import signal
 import sys
+import threading
 import time
 import zipfile
 from collections import Counter, defaultdict
@@ -281,7 +282,53 @@ def fmu_bytes(build_dir, model, version, library):
     return entries
 
 
-def test_mutant(mutant, index, builder, base, work, venv_python):
+class Sanitized:
+    """The survivors' last stage: the mutant built with the sanitizer tree's flags (ASan and UBSan, any
+    finding fatal), then the kernel's C tests (kernel mutants) and the lifecycle harness on RateLimiter. An
+    out-of-bounds read or undefined behaviour that changes no value the tests see is still a bug."""
+
+    def __init__(self, build_dir, work):
+        self.builder = Builder(build_dir, work / "sanitized")
+        self.base = None
+        self.lock = threading.Lock()
+
+    def check(self, mutant, tree):
+        with self.lock:  # the unmutated objects, once
+            if self.base is None:
+                self.base = compile_baseline(self.builder, self.builder.work)
+        builder, out = self.builder, tree / "sanitized"
+        objects = dict(self.base.objects)
+        for unit in units_of(mutant.file, builder):
+            objects[unit] = out / "obj" / object_name(unit)
+            done = builder.compile(tree, unit, objects[unit])
+            if done.returncode:
+                raise Stillborn(f"with the sanitizers: {done.stderr.strip()[-200:]}")
+        harnesses = []
+        if mutant.file in KERNEL:
+            builder.link("test_kernel", objects, out / "test_kernel")
+            harnesses.append(("the kernel's C tests", [str(out / "test_kernel")]))
+        for version in (2, 3):
+            if mutant.file == f"fmi{5 - version}_glue.c":
+                continue  # that version's binaries are the original ones
+            stage = out / "stage" / f"fmi{version}" / "RateLimiter"
+            builder.link(f"RateLimiter_fmi{version}", objects, stage / "binaries" / PLATFORM[version] / "RateLimiter.so")
+            shutil.copy(builder.build / "stage" / f"fmi{version}" / "RateLimiter" / "modelDescription.xml", stage)
+            harnesses.append((f"test_lifecycle (FMI {version})",
+                              [str(builder.build / "test_lifecycle"), str(version), str(stage), "2000", "200"]))
+        for what, args in harnesses:
+            try:
+                done = run(args, timeout=KERNEL_SECONDS * 5, what=f"{what} with the sanitizers")
+            except Timeout:
+                return "killed", f"{what} with the sanitizers did not end within {KERNEL_SECONDS * 5} s"
+            if done.returncode:
+                found = [line for line in done.stderr.splitlines() if "ERROR:" in line or "runtime error" in line]
+                lines = found or (done.stdout + done.stderr).strip().splitlines()
+                return "killed", f"{what} with the sanitizers: " + (lines[0] if found else lines[-1] if lines else
+                                                                     f"exit {done.returncode}")[:300]
+        return "survived", ""
+
+
+def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None):
     """Link the mutated objects into the FMUs and the kernel tests; run them."""
     tree = work / "run" / str(index)
     objects = dict(base.objects)
@@ -339,7 +386,7 @@ def test_mutant(mutant, index, builder, base, work, venv_python):
             failed = [line for line in done.stdout.splitlines() if line.startswith(("FAILED", "ERROR"))]
             last = done.stdout.strip().splitlines()[-1:] or [f"pytest exited with {done.returncode}"]
             return "killed", (failed or last)[0][:300]
-        return "survived", ""
+        return sanitized.check(mutant, tree) if sanitized else ("survived", "")
     except Stillborn as error:
         return "stillborn", str(error)
     finally:
@@ -389,6 +436,8 @@ def main(argv=None):
     parser.add_argument("--listed", action="store_true", help="test only the listed equivalents")
     parser.add_argument("--only", nargs="+", metavar="TEXT",
                         help="test only the mutants whose label (file:line: before  =>  after) contains one of these")
+    parser.add_argument("--sanitizer-build", type=Path,
+                        help="a build tree with -DRL_SANITIZE=ON (default: <build-dir>/sanitize, if built)")
     parser.add_argument("--resume", action="store_true",
                         help="keep the stillborn, equivalent and killed outcomes in the journal; test the rest")
     args = parser.parse_args(argv)
@@ -435,6 +484,10 @@ def main(argv=None):
 
     builder = Builder(build_dir, work)
     base = compile_baseline(builder, work)
+    sanitizer_build = (args.sanitizer_build or build_dir / "sanitize").resolve()
+    sanitized = Sanitized(sanitizer_build, work) if (sanitizer_build / "test_lifecycle").exists() else None
+    if not sanitized:
+        print(f"no sanitizer tree at {sanitizer_build}: survivors are not built with the sanitizers", flush=True)
     shutil.rmtree(work / "run", ignore_errors=True)
 
     def compile_one(item):
@@ -466,7 +519,7 @@ def main(argv=None):
 
     def test(item):
         index, m = item
-        m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable)
+        m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable, sanitized)
         for _, member in groups[m.digest]:  # the same object code: the same outcome
             journal.record(member, m.outcome, m.detail if member is m else f"same object code as {m.label()}")
         print({"killed": ".", "survived": "S"}.get(m.outcome, "x"), end="", flush=True)  # x: does not link
