@@ -38,6 +38,8 @@ static const char *type_name(FmuType type) {
 
 void fmu_init_instance(FmuInstance *instance) {
     instance->model = &fmuModel;
+    instance->inputVr = fmuModel.inputVr;
+    instance->outputVr = fmuModel.outputVr;
     fmu_reset(instance);
 }
 
@@ -56,11 +58,6 @@ void fmu_reset(FmuInstance *instance) {
     instance->fastPeriod = NAN;
     instance->outputsStale = FMU_FRESH;
     instance->cycleTime = 0.0;
-    instance->inputVr = model->inputVr;
-    const FmuVariable *u = &model->variables[model->inputVr], *y = &model->variables[model->outputVr];
-    instance->fastInputVr = u->type == FMU_REAL && u->causality == FMU_INPUT && u->variability != FMU_FIXED &&
-                            u->min == -INFINITY && u->max == INFINITY ? model->inputVr : UINT_MAX;
-    instance->fastOutputVr = y->type == FMU_REAL && y->causality == FMU_OUTPUT ? model->outputVr : UINT_MAX;
 }
 
 static void log_message(FmuInstance *instance, FmuStatus status, const char *fmt, va_list args) {

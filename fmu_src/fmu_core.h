@@ -131,10 +131,11 @@ struct FmuInstance {
      * there too (see there why it never exceeds the general one). */
     double fastPeriod, fastTolerance;
     double cycleTime;       /* sub-cycle length, 0 = one cycle per step */
-    unsigned inputVr;       /* model->inputVr, one load nearer */
-    /* The calls of every step need no table lookup: u when it is an
-     * unranged Real input, y when it is a Real output (else UINT_MAX). */
-    unsigned fastInputVr, fastOutputVr;
+    /* model->inputVr and outputVr, one load nearer. Every model's u is an
+     * unranged, non-fixed Real input and its y a Real output (checked
+     * against each model's TOML by test_model_description.py), so the
+     * calls of every step, set u and get y as Reals, need no table lookup. */
+    unsigned inputVr, outputVr;
     const ModelDefinition *model;
     FmuLogFunction *logFunction;
     int logCategories;      /* enabled categories */
@@ -230,7 +231,7 @@ static inline FmuStatus fmu_check_set(FmuInstance *instance, const char *functio
                                                        : fmu_access_error(instance, function, typeMask, vr, value, true);
 }
 
-/* fmu_set of u when vr == fastInputVr: nothing to check. */
+/* fmu_set of u as a Real: nothing to check. */
 static inline void fmu_set_input(FmuInstance *instance, double value) {
     instance->core.values[instance->inputVr] = value;
     if (instance->core.mode == MODE_INITIALIZATION) {
@@ -250,10 +251,10 @@ static inline void fmu_set(FmuInstance *instance, unsigned vr, double value) {
 }
 
 /* One value, the common call of every get and set: inline, the error path
- * out of line. false: refused (logged, error mode). u and y, when they are
- * plain Real variables, need no table lookup. */
+ * out of line. false: refused (logged, error mode). u and y as Reals need
+ * no table lookup. */
 static inline bool fmu_get_one(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double *value) {
-    if (!(typeMask == TYPE_BIT(FMU_REAL) && vr == instance->fastOutputVr) && !fmu_readable(instance, typeMask, vr)) {
+    if (!(typeMask == TYPE_BIT(FMU_REAL) && vr == instance->outputVr) && !fmu_readable(instance, typeMask, vr)) {
         fmu_access_error(instance, function, typeMask, vr, 0.0, false);
         return false;
     }
@@ -262,7 +263,7 @@ static inline bool fmu_get_one(FmuInstance *instance, const char *function, int 
 }
 
 static inline bool fmu_set_one(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value) {
-    if (typeMask == TYPE_BIT(FMU_REAL) && vr == instance->fastInputVr) {
+    if (typeMask == TYPE_BIT(FMU_REAL) && vr == instance->inputVr) {
         fmu_set_input(instance, value);
         return true;
     }

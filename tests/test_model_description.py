@@ -90,6 +90,21 @@ def test_compiled_variable_table_is_the_toml(model, version):
         fmu.free()
 
 
+@pytest.mark.parametrize("model", MODELS)
+def test_the_cycle_input_takes_any_real_and_the_output_is_a_real_output(model):
+    """fmu_core sets u and gets y as Reals without a table lookup: every
+    model's input (its C file's inputVr) must be an unranged, non-fixed Real
+    input and its output a Real output, as its TOML declares them."""
+    source = (REPO / "fmu_src" / "models" / f"{model}.c").read_text()
+    names = {role: re.search(rf"\.{role}Vr = VR_(\w+),", source).group(1) for role in ("input", "output")}
+    variables = {v["name"]: v for v in toml(model)["variable"]}
+    u, y = variables[names["input"]], variables[names["output"]]
+    assert (u["type"], u["causality"], u["variability"]) in {("Real", "input", "discrete"),
+                                                             ("Real", "input", "continuous")}, u
+    assert "min" not in u and "max" not in u, u
+    assert (y["type"], y["causality"]) == ("Real", "output"), y
+
+
 @pytest.mark.parametrize("version,platform", [(2, "linux64"), (3, "x86_64-linux"), (3, "aarch64-linux")])
 @pytest.mark.parametrize("model", MODELS)
 @pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",

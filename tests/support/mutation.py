@@ -22,8 +22,8 @@ mutant that a test kills (--check-listed) or an entry that names no mutant.
 
 Every outcome is appended to build/mutation/journal.jsonl as it is known.
 --resume keeps the recorded stillborn, equivalent and killed outcomes of
-mutants of the same sources (tests are only ever added: a kill stands) and
-tests the rest, survivors included.
+mutants of the same sources (tests are only ever added: a kill stands),
+and the survivors of the same tests; it tests the rest.
 """
 import argparse
 import hashlib
@@ -61,6 +61,15 @@ KEPT = ("stillborn", "equivalent", "killed")
 COMPILE_SECONDS = 120
 KERNEL_SECONDS = 120
 PYTEST_SECONDS = 600  # a mutant that makes a test loop for ever is killed by this bound
+
+
+def tests_digest(sanitized):
+    """The tests a survivor survived: every file under tests/ but the list of equivalents."""
+    h = hashlib.sha256(b"sanitized" if sanitized else b"")
+    for path in sorted(p for p in (REPO / "tests").rglob("*") if p.is_file() and p != EQUIVALENTS and
+                       not any(part.startswith((".", "__pycache__")) for part in p.relative_to(REPO).parts)):
+        h.update(path.relative_to(REPO).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()
 
 
 def inputs_digest(build_dir):
@@ -396,22 +405,27 @@ def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None)
 class Journal:
     """Append-only record of outcomes, one JSON line per mutant, flushed as each is known."""
 
-    def __init__(self, path, resume):
+    def __init__(self, path, resume, tests):
         self.kept = {}
+        self.tests = tests
         if resume and path.exists():
             for line in path.read_text().splitlines():
                 try:
                     record = json.loads(line)
                 except json.JSONDecodeError:
                     continue  # a line cut by a kill
-                if record.get("outcome") in KEPT:
+                if record.get("outcome") in KEPT or (record.get("outcome") == "survived" and
+                                                     record.get("tests") == tests):
                     self.kept[record["identity"]] = (record["outcome"], record["detail"])
         path.parent.mkdir(parents=True, exist_ok=True)
         self.file = open(path, "a" if resume else "w")
         self.file.write("\n")  # closes a line cut by a kill
 
     def record(self, m, outcome, detail):
-        self.file.write(json.dumps(dict(identity=m.identity, label=m.label(), outcome=outcome, detail=detail)) + "\n")
+        record = dict(identity=m.identity, label=m.label(), outcome=outcome, detail=detail)
+        if outcome == "survived":  # kept while the tests are these
+            record["tests"] = self.tests
+        self.file.write(json.dumps(record) + "\n")
         self.file.flush()
 
     def close(self):
@@ -439,7 +453,8 @@ def main(argv=None):
     parser.add_argument("--sanitizer-build", type=Path,
                         help="a build tree with -DRL_SANITIZE=ON (default: <build-dir>/sanitize, if built)")
     parser.add_argument("--resume", action="store_true",
-                        help="keep the stillborn, equivalent and killed outcomes in the journal; test the rest")
+                        help="keep the journal's stillborn, equivalent and killed outcomes, and its survivors of "
+                             "the same tests; test the rest")
     args = parser.parse_args(argv)
 
     def stop(signum, frame):  # the tests running go too; the journal has every outcome known so far
@@ -470,7 +485,11 @@ def main(argv=None):
     print(f"{generated} mutants of {', '.join(args.files)}; testing {len(mutants)}"
           + (f" (seeded sample, seed {args.seed})" if args.sample is not None else ""), flush=True)
 
-    journal = Journal(work / "journal.jsonl", args.resume)
+    sanitizer_build = (args.sanitizer_build or build_dir / "sanitize").resolve()
+    sanitizing = (sanitizer_build / "test_lifecycle").exists()
+    if not sanitizing:
+        print(f"no sanitizer tree at {sanitizer_build}: survivors are not built with the sanitizers", flush=True)
+    journal = Journal(work / "journal.jsonl", args.resume, tests_digest(sanitizing))
     inputs = inputs_digest(build_dir)
     for m in mutants:
         m.identity = hashlib.sha256(f"{inputs}\0{m.file}\0{m.text}".encode()).hexdigest()
@@ -478,16 +497,15 @@ def main(argv=None):
             m.outcome, m.detail = journal.kept[m.identity]
             if m.outcome == "killed" and m.key in equivalents:
                 m.outcome, m.detail = "wrongly listed", f"listed as equivalent, but {m.detail}"
+            elif m.outcome == "survived" and m.key in equivalents:
+                m.outcome, m.detail = "listed", equivalents[m.key]
     kept = sum(1 for m in mutants if m.outcome)
     if args.resume:
         print(f"{kept} outcomes kept from {work / 'journal.jsonl'}", flush=True)
 
     builder = Builder(build_dir, work)
     base = compile_baseline(builder, work)
-    sanitizer_build = (args.sanitizer_build or build_dir / "sanitize").resolve()
-    sanitized = Sanitized(sanitizer_build, work) if (sanitizer_build / "test_lifecycle").exists() else None
-    if not sanitized:
-        print(f"no sanitizer tree at {sanitizer_build}: survivors are not built with the sanitizers", flush=True)
+    sanitized = Sanitized(sanitizer_build, work) if sanitizing else None
     shutil.rmtree(work / "run", ignore_errors=True)
 
     def compile_one(item):
