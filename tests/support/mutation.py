@@ -34,7 +34,6 @@ import shlex
 import shutil
 import signal
 import sys
-import threading
 import time
 import zipfile
 from collections import Counter, defaultdict
@@ -298,13 +297,10 @@ class Sanitized:
 
     def __init__(self, build_dir, work):
         self.builder = Builder(build_dir, work / "sanitized")
-        self.base = None
-        self.lock = threading.Lock()
+        # the unmutated objects, from the sources as they are at the start, as the release ones
+        self.base = compile_baseline(self.builder, self.builder.work)
 
     def check(self, mutant, tree):
-        with self.lock:  # the unmutated objects, once
-            if self.base is None:
-                self.base = compile_baseline(self.builder, self.builder.work)
         builder, out = self.builder, tree / "sanitized"
         objects = dict(self.base.objects)
         for unit in units_of(mutant.file, builder):
