@@ -305,3 +305,100 @@ def test_fmi3_accessors_of_types_without_variables_refuse_every_value_reference(
         assert fmu.get("u") == 0.0
     finally:
         fmu.free()
+
+
+def test_fmi2_instantiation_with_memory_refused_returns_null_and_frees_what_it_got():
+    """The importer's allocateMemory fails on its first call (the instance)
+    or its second (the name): no instance, nothing held, no crash."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        dll = fmu.fmu.dll
+        instantiate = dll.fmi2Instantiate
+        instantiate.argtypes = [c_char_p, c_int, c_char_p, c_char_p, c_void_p, c_int, c_int]
+        instantiate.restype = c_void_p
+        for failing in (1, 2):
+            live, calls = set(), []
+
+            def allocate(count, size):
+                calls.append(size)
+                if len(calls) == failing:
+                    return None
+                block = calloc(count, size)
+                live.add(block)
+                return block
+
+            def release(block):
+                live.discard(block)
+                free(block)
+
+            callbacks = fmi2CallbackFunctions()
+            callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: None)
+            callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(allocate)
+            callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(release)
+            assert instantiate(b"a", 1, fmu.md.guid.encode(), None, byref(callbacks), 0, 0) is None, failing
+            assert len(calls) == 2 and live == set(), (failing, calls, live)
+    finally:
+        fmu.free()
+
+
+def accessor(fmu, name):
+    function = getattr(fmu.fmu.dll, name)
+    function.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p] + ([c_size_t] if fmu.version == 3 else [])
+    function.restype = c_int
+    return function
+
+
+ACCESSOR_TYPES = {2: ("Real", "Integer", "Boolean", "String"), 3: ("Float64", "Int32", "Int64", "Boolean", "String")}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_null_array_is_refused_naming_which_one(version):
+    """Every getter and setter, one value or two: a NULL value reference
+    array or a NULL value array is an error that says which, not a crash."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        values = ctypes.create_string_buffer(64)
+        vrs = (c_uint * 2)(fmu.vr("u"), fmu.vr("u"))
+        for kind in ACCESSOR_TYPES[version]:
+            for access in ("Get", "Set"):
+                name = f"fmi{version}{access}{kind}"
+                function = accessor(fmu, name)
+                for n in (1, 2):
+                    for vr, array, which in ((None, values, "value reference array"), (vrs, None, "value array")):
+                        assert function(fmu.fmu.component, vr, n, array, *([n] if version == 3 else [])) == 3
+                        assert fmu.errors()[-1][2] == f"{name}: the {which} is NULL", (name, n)
+                        fmu.fmu.reset()
+                        fmu.start()
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_foreign_fmu_state_is_refused_by_every_state_function(version):
+    """Its size, serializing it and freeing it: an error naming the function,
+    nothing written or freed, no crash (setting one: test_misuse.py)."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        c, dll = fmu.fmu.component, fmu.fmu.dll
+        junk = ctypes.create_string_buffer(b"\x5a" * 4096)
+        foreign = ctypes.cast(junk, c_void_p)
+        names = {2: ("fmi2SerializedFMUstateSize", "fmi2SerializeFMUstate", "fmi2FreeFMUstate"),
+                 3: ("fmi3SerializedFMUStateSize", "fmi3SerializeFMUState", "fmi3FreeFMUState")}[version]
+        size, out = c_size_t(7), ctypes.create_string_buffer(4096)
+        calls = {names[0]: ([c_void_p, c_void_p, c_void_p], (c, foreign, byref(size))),
+                 names[1]: ([c_void_p, c_void_p, c_void_p, c_size_t], (c, foreign, out, 4096)),
+                 names[2]: ([c_void_p, c_void_p], (c, byref(foreign)))}
+        for name, (argtypes, args) in calls.items():
+            function = getattr(dll, name)
+            function.argtypes, function.restype = argtypes, c_int
+            assert function(*args) == 3, name
+            assert fmu.errors()[-1][2].startswith(f"{name}: ") and "not an FMU state" in fmu.errors()[-1][2], \
+                fmu.errors()[-1]
+            fmu.fmu.reset()
+            fmu.start()
+        assert size.value == 7 and out.raw == bytes(4096) and foreign.value == ctypes.addressof(junk)
+        assert junk.raw == b"\x5a" * 4096 + b"\0"
+    finally:
+        fmu.free()

@@ -95,9 +95,18 @@ class Mutant:
     detail: str = ""    # the compiler's or the killing test's word
     digest: str = ""    # the mutated objects' hash
     identity: str = ""  # its name in the journal: this mutant of these sources with these flags
+    above: tuple = ()   # the lines above it, nearest first: tell apart mutants of lines that read the same
 
     def __post_init__(self):
         self.key = f"fmu_src/{self.file} | {self.before.strip()} | {self.after.strip()}"
+
+    def keys(self):
+        """The keys an entry of the list can name it by: with the lines above it (most first), then without."""
+        return [" | ".join((self.key,) + self.above[:n]) for n in range(len(self.above), 0, -1)] + [self.key]
+
+    def proof(self, equivalents):
+        """The list's proof for this mutant, or None."""
+        return next((equivalents[k] for k in self.keys() if k in equivalents), None)
 
     def label(self):
         return f"{self.file}:{self.line}: {self.before.strip()}  =>  {self.after.strip()}"
@@ -132,7 +141,8 @@ def generate(file, work, venv_bin):
         diff = [i for i, (a, b) in enumerate(zip(lines, changed)) if a != b]
         if len(diff) == 1:
             i = diff[0]
-            mutants.append(Mutant(file, i + 1, lines[i].rstrip("\n"), changed[i].rstrip("\n"), text))
+            mutants.append(Mutant(file, i + 1, lines[i].rstrip("\n"), changed[i].rstrip("\n"), text,
+                                  above=tuple(line.strip() for line in reversed(lines[max(0, i - 3):i]))))
     return mutants
 
 
@@ -147,10 +157,13 @@ def read_equivalents(path=None):
             block["before"] = line[4:]
         elif line.startswith("  + "):
             block["after"] = line[4:]
+        elif line.startswith("  above: "):  # each one line further up
+            block.setdefault("above", []).append(line[9:].strip())
         elif line.startswith("  why: "):
-            if set(block) != {"file", "before", "after"}:
+            if not {"file", "before", "after"} <= set(block) <= {"file", "before", "after", "above"}:
                 raise SystemExit(f"{path}:{number}: 'why:' without its file, '-' and '+' lines")
-            entries[f"{block['file']} | {block['before'].strip()} | {block['after'].strip()}"] = line[7:]
+            key = [f"{block['file']} | {block['before'].strip()} | {block['after'].strip()}"] + block.get("above", [])
+            entries[" | ".join(key)] = line[7:]
             block = {}
         elif not line.startswith(" "):
             block = {"file": line.strip()}
@@ -468,11 +481,12 @@ def main(argv=None):
     mutants = [m for f in args.files for m in generate(f, work, venv_bin)]
     generated = len(mutants)
     # an entry must name a mutant there is (the list follows the code)
-    stale = sorted(set(equivalents) - {m.key for m in mutants}) if set(args.files) == set(FILES) else []
+    named = {k for m in mutants for k in m.keys()}
+    stale = sorted(set(equivalents) - named) if set(args.files) == set(FILES) else []
     for key in stale:
         print(f"STALE {EQUIVALENTS.name}: no such mutant: {key}")
     if args.listed:  # the list's entries alone, each tested: each must survive
-        mutants = [m for m in mutants if m.key in equivalents]
+        mutants = [m for m in mutants if m.proof(equivalents)]
         args.check_listed = True
     if args.only:
         mutants = [m for m in mutants if any(text in m.label() for text in args.only)]
@@ -491,10 +505,10 @@ def main(argv=None):
         m.identity = hashlib.sha256(f"{inputs}\0{m.file}\0{m.text}".encode()).hexdigest()
         if m.identity in journal.kept:
             m.outcome, m.detail = journal.kept[m.identity]
-            if m.outcome == "killed" and m.key in equivalents:
+            if m.outcome == "killed" and m.proof(equivalents):
                 m.outcome, m.detail = "wrongly listed", f"listed as equivalent, but {m.detail}"
-            elif m.outcome == "survived" and m.key in equivalents:
-                m.outcome, m.detail = "listed", equivalents[m.key]
+            elif m.outcome == "survived" and m.proof(equivalents):
+                m.outcome, m.detail = "listed", m.proof(equivalents)
     kept = sum(1 for m in mutants if m.outcome)
     if args.resume:
         print(f"{kept} outcomes kept from {work / 'journal.jsonl'}", flush=True)
@@ -519,13 +533,13 @@ def main(argv=None):
             groups[m.digest].append((index, m))
     to_test = []
     for members in groups.values():
-        listed = [m for _, m in members if m.key in equivalents]
+        listed = [m for _, m in members if m.proof(equivalents)]
         if listed and args.check_listed:
             to_test.append(members[0])
         elif listed:
             for _, m in members:
                 m.outcome = "listed"
-                m.detail = equivalents[m.key] if m in listed else f"same object code as {listed[0].label()}"
+                m.detail = m.proof(equivalents) if m in listed else f"same object code as {listed[0].label()}"
         else:
             to_test.append(members[0])
     print(f"compiled in {time.monotonic() - started:.0f} s; running the tests on {len(to_test)} distinct mutants",
@@ -537,8 +551,8 @@ def main(argv=None):
         for _, member in groups[m.digest]:  # the same object code: the same outcome
             journal.record(member, m.outcome, m.detail if member is m else f"same object code as {m.label()}")
         print({"killed": ".", "survived": "S"}.get(m.outcome, "x"), end="", flush=True)  # x: does not link
-        if m.key in equivalents:  # --check-listed: the proof must hold
-            m.outcome, m.detail = ("listed", equivalents[m.key]) if m.outcome == "survived" else \
+        if m.proof(equivalents):  # --check-listed: the proof must hold
+            m.outcome, m.detail = ("listed", m.proof(equivalents)) if m.outcome == "survived" else \
                 ("wrongly listed", f"listed as equivalent, but {m.detail}")
 
     parallel(args.jobs, test, to_test)
