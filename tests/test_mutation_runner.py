@@ -1,0 +1,74 @@
+"""The mutation runner's bookkeeping (tests/support/mutation.py): how the
+list of equivalent mutants names a mutant, and what a resumed run keeps
+from the journal. The runs themselves: ctest mutation_sample."""
+import json
+
+from support.mutation import Journal, Mutant, read_equivalents
+
+LIST = """# comment
+fmu_src/fmu_core.c
+  - x = 0;
+  + x = 1;
+  why: plain entry.
+
+fmu_src/fmu_core.c
+  - } else {
+  + }  {
+  above: b = 2;
+  above: a = 1;
+  why: named by the two lines above it.
+"""
+
+
+def mutant(before, after, above=(), text="text"):
+    return Mutant("fmu_core.c", 10, before, after, text, above=tuple(above))
+
+
+def test_an_entry_names_a_mutant_by_its_line_or_also_by_the_lines_above(tmp_path):
+    path = tmp_path / "list.txt"
+    path.write_text(LIST)
+    equivalents = read_equivalents(path)
+    assert len(equivalents) == 2
+    assert mutant("  x = 0;", "  x = 1;", ["anything"]).proof(equivalents) == "plain entry."
+    assert mutant("x = 0;", "x = 2;").proof(equivalents) is None
+    assert mutant("} else {", "}  {", ["b = 2;", "a = 1;", "z"]).proof(equivalents) == \
+        "named by the two lines above it."
+    assert mutant("} else {", "}  {", ["b = 2;", "other"]).proof(equivalents) is None  # another line like it
+    assert mutant("} else {", "}  {", ["b = 2;"]).proof(equivalents) is None
+
+
+def test_a_list_entry_without_its_lines_is_refused(tmp_path):
+    path = tmp_path / "list.txt"
+    path.write_text("fmu_src/fmu_core.c\n  + x = 1;\n  why: no '-' line.\n")
+    try:
+        read_equivalents(path)
+    except SystemExit as error:
+        assert "'why:' without its file, '-' and '+' lines" in str(error)
+    else:
+        raise AssertionError("an entry without its '-' line was read")
+
+
+def test_a_resumed_run_keeps_kills_always_and_survivors_of_the_same_tests(tmp_path):
+    path = tmp_path / "journal.jsonl"
+    killed, survived, stillborn = (mutant("a;", f"b{k};", text=str(k)) for k in range(3))
+    for m, identity in ((killed, "k"), (survived, "s"), (stillborn, "x")):
+        m.identity = identity
+    journal = Journal(path, resume=False, tests="tests-1")
+    journal.record(killed, "killed", "FAILED test_x")
+    journal.record(survived, "survived", "")
+    journal.record(stillborn, "stillborn", "error: ...")
+    journal.close()
+    with open(path, "a") as cut:  # a line cut by a kill
+        cut.write('{"identity": "t", "outcome": "kil')
+    same = Journal(path, resume=True, tests="tests-1")
+    same.close()
+    assert same.kept == {"k": ("killed", "FAILED test_x"), "s": ("survived", ""), "x": ("stillborn", "error: ...")}
+    other = Journal(path, resume=True, tests="tests-2")
+    other.close()
+    assert set(other.kept) == {"k", "x"}  # a survivor meets the new tests
+    records = [json.loads(line) for line in path.read_text().splitlines() if line.startswith("{") and
+               line.endswith("}")]
+    assert [r["identity"] for r in records] == ["k", "s", "x"] and records[1]["tests"] == "tests-1"
+    fresh = Journal(path, resume=False, tests="tests-1")  # not resumed: a new journal
+    fresh.close()
+    assert fresh.kept == {} and path.read_text().strip() == ""
