@@ -402,3 +402,24 @@ def test_a_foreign_fmu_state_is_refused_by_every_state_function(version):
         assert junk.raw == b"\x5a" * 4096 + b"\0"
     finally:
         fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_set_debug_logging_refuses_a_null_category_array_and_escapes_a_bad_name(version):
+    """nCategories 1 with no array: an error, not a read through NULL. An
+    unknown category is quoted in the error with every '%' made '?', since
+    FMI 2 loggers may treat the message as a format string."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        name = f"fmi{version}SetDebugLogging"
+        function = getattr(fmu.fmu.dll, name)
+        function.argtypes = [c_void_p, c_bool if version == 3 else c_int, c_size_t, c_void_p]
+        function.restype = c_int
+        assert function(fmu.fmu.component, 1, 1, None) == 3
+        assert fmu.errors()[-1][2] == f"{name}: the category array is NULL"
+        fmu.fmu.reset()
+        categories = (c_char_p * 1)(b"bad%s%n")
+        assert function(fmu.fmu.component, 1, 1, categories) == 3
+        assert fmu.errors()[-1][2] == f'{name}: unknown log category "bad?s?n"'
+    finally:
+        fmu.free()
