@@ -213,13 +213,17 @@ def test_fmi3_instantiation_refusals_name_the_first_problem():
         fmu.free()
 
 
+def fmi2_instantiate_function(dll):
+    instantiate = dll.fmi2Instantiate
+    instantiate.argtypes = [c_char_p, c_int, c_char_p, c_char_p, c_void_p, c_int, c_int]
+    instantiate.restype = c_void_p
+    return instantiate
+
+
 def test_fmi2_instantiation_refusals_name_the_first_problem():
     fmu = Instance("RateLimiter", 2)
     try:
-        dll = fmu.fmu.dll
-        instantiate = dll.fmi2Instantiate
-        instantiate.argtypes = [c_char_p, c_int, c_char_p, c_char_p, c_void_p, c_int, c_int]
-        instantiate.restype = c_void_p
+        instantiate = fmi2_instantiate_function(fmu.fmu.dll)
         messages = []
         callbacks = fmi2CallbackFunctions()
         callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((s, c, m)))
@@ -312,10 +316,7 @@ def test_fmi2_instantiation_with_memory_refused_returns_null_and_frees_what_it_g
     or its second (the name): no instance, nothing held, no crash."""
     fmu = Instance("RateLimiter", 2)
     try:
-        dll = fmu.fmu.dll
-        instantiate = dll.fmi2Instantiate
-        instantiate.argtypes = [c_char_p, c_int, c_char_p, c_char_p, c_void_p, c_int, c_int]
-        instantiate.restype = c_void_p
+        instantiate = fmi2_instantiate_function(fmu.fmu.dll)
         for failing in (1, 2):
             live, calls = set(), []
 
