@@ -62,21 +62,24 @@ KERNEL_SECONDS = 120
 PYTEST_SECONDS = 600  # a mutant that makes a test loop for ever is killed by this bound
 
 
+def hash_files(h, paths):
+    """h fed each file's path in the repository and its bytes, in path order."""
+    for path in sorted(paths):
+        h.update(path.relative_to(REPO).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return h
+
+
 def tests_digest(sanitized):
     """The tests a survivor survived: every file under tests/ but the list of equivalents."""
-    h = hashlib.sha256(b"sanitized" if sanitized else b"")
-    for path in sorted(p for p in (REPO / "tests").rglob("*") if p.is_file() and p != EQUIVALENTS and
-                       not any(part.startswith((".", "__pycache__")) for part in p.relative_to(REPO).parts)):
-        h.update(path.relative_to(REPO).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return h.hexdigest()
+    tests = (p for p in (REPO / "tests").rglob("*") if p.is_file() and p != EQUIVALENTS and
+             not any(part.startswith((".", "__pycache__")) for part in p.relative_to(REPO).parts))
+    return hash_files(hashlib.sha256(b"sanitized" if sanitized else b""), tests).hexdigest()
 
 
 def inputs_digest(build_dir):
     """What a mutant's outcome depends on besides its own text and the tests: the product's other sources
     and the build's flags. Tests are only added, so a kill stands when they change."""
-    h = hashlib.sha256()
-    for path in sorted(p for p in SOURCE.rglob("*") if p.is_file()):
-        h.update(path.relative_to(REPO).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    h = hash_files(hashlib.sha256(), (p for p in SOURCE.rglob("*") if p.is_file()))
     # the flags, wherever the clone and its build tree are: a journal can be carried to another tree
     flags = (build_dir / "compile_commands.json").read_text()
     h.update(flags.replace(str(build_dir), "<build>").replace(str(REPO), "<repo>").encode())
@@ -303,6 +306,28 @@ def fmu_bytes(build_dir, model, version, library):
     return entries
 
 
+def lifecycle_command(builder, objects, stage, version):
+    """RateLimiter (FMI version) linked from objects and unpacked in stage as test_lifecycle loads it; the
+    command that runs the harness on it: every kind of call, allocations balanced, many instances."""
+    builder.link(f"RateLimiter_fmi{version}", objects, stage / "binaries" / PLATFORM[version] / "RateLimiter.so")
+    shutil.copy(builder.build / "stage" / f"fmi{version}" / "RateLimiter" / "modelDescription.xml", stage)
+    return [str(builder.build / "test_lifecycle"), str(version), str(stage), "2000", "200"]
+
+
+def harness_kill(what, args, timeout, telling):
+    """None if the C harness passes; else ("killed", why), why being its first line that telling picks,
+    else its last line."""
+    try:
+        done = run(args, timeout=timeout, what=what)
+    except Timeout:
+        return "killed", f"{what} did not end within {timeout} s"
+    if not done.returncode:
+        return None
+    lines = (done.stdout + done.stderr).strip().splitlines()
+    told = [line for line in lines if telling(line)]
+    return "killed", f"{what}: " + (told[0] if told else lines[-1] if lines else f"exit {done.returncode}")[:300]
+
+
 class Sanitized:
     """The survivors' last stage: the mutant built with the sanitizer tree's flags (ASan and UBSan, any
     finding fatal), then the kernel's C tests (kernel mutants) and the lifecycle harness on RateLimiter. An
@@ -326,23 +351,14 @@ class Sanitized:
             builder.link("test_kernel", objects, out / "test_kernel")
             harnesses.append(("the kernel's C tests", [str(out / "test_kernel")]))
         for version in (2, 3):
-            if mutant.file == f"fmi{5 - version}_glue.c":
-                continue  # that version's binaries are the original ones
-            stage = out / "stage" / f"fmi{version}" / "RateLimiter"
-            builder.link(f"RateLimiter_fmi{version}", objects, stage / "binaries" / PLATFORM[version] / "RateLimiter.so")
-            shutil.copy(builder.build / "stage" / f"fmi{version}" / "RateLimiter" / "modelDescription.xml", stage)
-            harnesses.append((f"test_lifecycle (FMI {version})",
-                              [str(builder.build / "test_lifecycle"), str(version), str(stage), "2000", "200"]))
+            if mutant.file != f"fmi{5 - version}_glue.c":  # else that version's binaries are the original ones
+                harnesses.append((f"test_lifecycle (FMI {version})",
+                                  lifecycle_command(builder, objects, out / "stage" / f"fmi{version}", version)))
         for what, args in harnesses:
-            try:
-                done = run(args, timeout=KERNEL_SECONDS * 5, what=f"{what} with the sanitizers")
-            except Timeout:
-                return "killed", f"{what} with the sanitizers did not end within {KERNEL_SECONDS * 5} s"
-            if done.returncode:
-                found = [line for line in done.stderr.splitlines() if "ERROR:" in line or "runtime error" in line]
-                lines = found or (done.stdout + done.stderr).strip().splitlines()
-                return "killed", f"{what} with the sanitizers: " + (lines[0] if found else lines[-1] if lines else
-                                                                     f"exit {done.returncode}")[:300]
+            kill = harness_kill(f"{what} with the sanitizers", args, KERNEL_SECONDS * 5,
+                                lambda line: "ERROR:" in line or "runtime error" in line)
+            if kill:
+                return kill
         return "survived", ""
 
 
@@ -357,13 +373,10 @@ def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None)
         if mutant.file in KERNEL:
             kernel = tree / "test_kernel"
             builder.link("test_kernel", objects, kernel)
-            try:
-                done = run([str(kernel)], timeout=KERNEL_SECONDS, what="the kernel's C tests")
-            except Timeout:
-                return "killed", f"the kernel's C tests did not end within {KERNEL_SECONDS} s"
-            if done.returncode:
-                failed = [line for line in done.stdout.splitlines() if ", expected " in line]
-                return "killed", "kernel C tests: " + (failed[0] if failed else f"exit {done.returncode}")
+            kill = harness_kill("the kernel's C tests", [str(kernel)], KERNEL_SECONDS,
+                                lambda line: ", expected " in line)
+            if kill:
+                return kill
         for version in (2, 3):
             if mutant.file == f"fmi{5 - version}_glue.c":
                 # the other version's glue: its FMUs are the original ones
@@ -379,20 +392,11 @@ def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None)
                     for name, data in fmu_bytes(builder.build, model, version, library):
                         z_out.writestr(name, data)
             if mutant.file not in KERNEL or mutant.file.endswith(".h"):
-                # the C lifecycle harness: every kind of call, allocations balanced, many instances
-                stage = tree / "stage" / f"fmi{version}" / "RateLimiter"
-                (stage / "binaries" / PLATFORM[version]).mkdir(parents=True)
-                shutil.copy(builder.build / "stage" / f"fmi{version}" / "RateLimiter" / "modelDescription.xml", stage)
-                shutil.copy(tree / "lib" / f"fmi{version}" / "RateLimiter.so", stage / "binaries" / PLATFORM[version])
-                try:
-                    done = run([str(builder.build / "test_lifecycle"), str(version), str(stage), "2000", "200"],
-                               timeout=KERNEL_SECONDS, what="the lifecycle harness")
-                except Timeout:
-                    return "killed", f"test_lifecycle (FMI {version}) did not end within {KERNEL_SECONDS} s"
-                if done.returncode:
-                    lines = (done.stdout + done.stderr).strip().splitlines()
-                    return "killed", f"test_lifecycle (FMI {version}): " + (lines[-1] if lines else
-                                                                          f"exit {done.returncode}")
+                kill = harness_kill(f"test_lifecycle (FMI {version})",
+                                    lifecycle_command(builder, objects, tree / "stage" / f"fmi{version}", version),
+                                    KERNEL_SECONDS, lambda line: False)
+                if kill:
+                    return kill
         env = dict(os.environ, RL_BUILD_DIR=str(build))
         args = [str(venv_python), "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "--hypothesis-seed=0",
                 "-o", "timeout=300", *TESTS]
