@@ -123,6 +123,12 @@ def test_every_value_reference_of_an_array_is_checked_before_any_is_used(version
             assert fmu.errors()[-1][2] == f"{function[0]}: unknown value reference 999"
             fmu.fmu.reset()
             fmu.start()
+        first_unknown = len(fmu.variables)  # value references are 0 to count - 1
+        for access, values in ((get, ()), (set_, ([7.0],))):
+            assert call_status(access, [first_unknown], *values) == 3
+            assert fmu.errors()[-1][2] == f"{function[access is set_]}: unknown value reference {first_unknown}"
+            fmu.fmu.reset()
+            fmu.start()
         for vrs in ([bypass, y], [y, bypass]):  # a Boolean among Reals
             assert call_status(get, vrs) == 3, vrs
             assert fmu.errors()[-1][2] == (f"{function[0]}: bypass (value reference {bypass}) is a Boolean "
@@ -407,9 +413,10 @@ def test_a_foreign_fmu_state_is_refused_by_every_state_function(version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_set_debug_logging_refuses_a_null_category_array_and_escapes_a_bad_name(version):
-    """nCategories 1 with no array: an error, not a read through NULL. An
-    unknown category is quoted in the error with every '%' made '?', since
-    FMI 2 loggers may treat the message as a format string."""
+    """nCategories 1 with no array, or a NULL entry in it: an error, not a
+    read through NULL. An unknown category is quoted in the error with every
+    '%' made '?', since FMI 2 loggers may treat the message as a format
+    string; a reason is cut at 399 characters."""
     fmu = Instance("RateLimiter", version)
     try:
         name = f"fmi{version}SetDebugLogging"
@@ -422,5 +429,13 @@ def test_set_debug_logging_refuses_a_null_category_array_and_escapes_a_bad_name(
         categories = (c_char_p * 1)(b"bad%s%n")
         assert function(fmu.fmu.component, 1, 1, categories) == 3
         assert fmu.errors()[-1][2] == f'{name}: unknown log category "bad?s?n"'
+        fmu.fmu.reset()
+        categories = (c_char_p * 2)(b"logEvents", None)  # a NULL entry: refused by name, not read
+        assert function(fmu.fmu.component, 1, 2, categories) == 3
+        assert fmu.errors()[-1][2] == f'{name}: unknown log category "(null)"'
+        fmu.fmu.reset()
+        long_name = "x" * 1000  # the reason is cut at 399 characters (docs/fmi.md)
+        assert function(fmu.fmu.component, 1, 1, (c_char_p * 1)(long_name.encode())) == 3
+        assert fmu.errors()[-1][2] == f"{name}: " + f'unknown log category "{long_name}"'[:399]
     finally:
         fmu.free()

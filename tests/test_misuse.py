@@ -51,8 +51,11 @@ MISUSES = {
     "wrong type (get)": (lambda f: get_raw(f, f.vr("y"), "Integer"), "Real variable"),
     "wrong type (set)": (lambda f: set_raw(f, f.vr("u"), True, "Boolean"), "Real variable"),
     "setting an output": (lambda f: set_raw(f, f.vr("y"), 1.0), "output"),
-    "fixed parameter after initialisation": (lambda f: set_raw(f, f.vr("cycleTime"), 0.1), "fixed parameter"),
-    "enumeration out of range": (lambda f: set_raw(f, f.vr("zeroRate"), 7, "Integer"), "outside its range"),
+    "fixed parameter after initialisation": (lambda f: set_raw(f, f.vr("cycleTime"), 0.1),
+                                             ": cycleTime is a fixed parameter and cannot be set after initialization"),
+    # the ZeroRate items are hold = 1 and noLimit = 2
+    "enumeration out of range": (lambda f: set_raw(f, f.vr("zeroRate"), 7, "Integer"),
+                                 ": zeroRate = 7 is outside its range [1, 2]"),
     "null arrays": (null_arrays, "NULL"),
     "call in the wrong state": (lambda f: call_status(f.fmu.exitInitializationMode), "not allowed in Step Mode"),
     "foreign FMU state": (foreign_state, "not an FMU state"),

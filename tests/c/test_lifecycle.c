@@ -158,6 +158,10 @@ static void full_simulation(void) {
     CHECK(c != NULL);
     if (!c) return;
     CHECK(start(c));
+    /* debug logging: every category by name */
+    static const char *const every[] = { "logStatusError", "logStatusWarning", "logEvents" };
+    CHECK((version == 2 ? F2(fmi2SetDebugLogging)(c, fmi2True, 3, every)
+                        : F3(fmi3SetDebugLogging)(c, fmi3True, 3, every)) == 0);
     double t = 0.0;
     for (int k = 0; k < 200; k++, t += 0.01) {
         CHECK(set_u(c, input(k, 0)) == 0);
@@ -198,6 +202,10 @@ static void full_simulation(void) {
         set_u(c, input(k, 1));
         CHECK(step(c, t, 0.01) == 0);
     }
+    /* an unknown (NULL) category: refused; the reset below recovers */
+    static const char *const unknown[] = { "logEvents", NULL };
+    CHECK((version == 2 ? F2(fmi2SetDebugLogging)(c, fmi2True, 2, unknown)
+                        : F3(fmi3SetDebugLogging)(c, fmi3True, 2, unknown)) == fmi2Error);
     /* reset and run again, then terminate */
     CHECK((version == 2 ? F2(fmi2Reset)(c) : F3(fmi3Reset)(c)) == 0);
     CHECK(start(c));
