@@ -3,13 +3,12 @@ subnormals, 1e308, huge and tiny rates, cycleTime of 1e-9 and 1e9. Never a
 crash or an endless step; where the contract's status table applies the FMU
 agrees with the oracle bit for bit; a value outside a declared range is
 refused with an error and the last good value kept."""
-import functools
 import math
 
 import pytest
 
 from support.fmu_driver import MODELS, Instance, call_status
-from support.oracle import oracle_for, output_names
+from support.oracle import kept, oracle_for, output_names
 from test_random import agree
 
 HOSTILE = [math.nan, math.inf, -math.inf, -0.0, 5e-324, 2.2250738585072014e-308, 1e-300, 1e308, -1e308, 1e300]
@@ -96,7 +95,7 @@ def test_hostile_value_in_every_variable(model, version, value_index):
             fmu.free()
 
 
-@functools.lru_cache(maxsize=None)
+@kept
 def tiny_cycle_oracle(vr_items, start_items):
     """The oracle's 1,000,000 cycles (about 20 s of Python), worked once for both FMI versions."""
     oracle = oracle_for("RateLimiter", dict(vr_items), dict(start_items))

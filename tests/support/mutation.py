@@ -397,7 +397,7 @@ def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None)
                                     KERNEL_SECONDS, lambda line: False)
                 if kill:
                     return kill
-        env = dict(os.environ, RL_BUILD_DIR=str(build))
+        env = dict(os.environ, RL_BUILD_DIR=str(build), RL_ORACLE_CACHE=str(work / "oracle"))
         args = [str(venv_python), "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "--hypothesis-seed=0",
                 "-o", "timeout=300", *TESTS]
         try:

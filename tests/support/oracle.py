@@ -6,8 +6,13 @@ project's documented conventions where the contract leaves room:
 runningTime is counted in whole cycles (cycles * T, with the sum started
 afresh when T changes), and time comparisons use a relative 1e-9.
 """
+import functools
+import hashlib
+import json
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 TOL = 1e-9
 
@@ -444,3 +449,25 @@ def output_names(model):
     if model == "RateLimiter":
         return list(OUTPUTS)
     return list(VENDORS[model].get("output_names") or VENDORS[model]["outputs"])
+
+
+def kept(function):
+    """function's results kept for its arguments; with RL_ORACLE_CACHE (a folder; the mutation runner
+    sets it) also on disk between processes, under the hash of this file, the name and the arguments,
+    so that a slow oracle run is worked once for many runs of the same tests."""
+    @functools.lru_cache(maxsize=None)
+    def wrapper(*args):
+        folder = os.environ.get("RL_ORACLE_CACHE")
+        if not folder:
+            return function(*args)
+        key = hashlib.sha256(Path(__file__).read_bytes() + f"{function.__qualname__}{args!r}".encode()).hexdigest()
+        path = Path(folder) / f"{key}.json"
+        if path.exists():
+            return json.loads(path.read_text())  # floats, NaN and inf come back bit for bit
+        result = function(*args)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial = path.with_suffix(f".{os.getpid()}")
+        partial.write_text(json.dumps(result))
+        os.replace(partial, path)  # a reader sees the whole result or none
+        return result
+    return wrapper
