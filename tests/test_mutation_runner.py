@@ -1,9 +1,9 @@
 """The mutation runner's bookkeeping (tests/support/mutation.py): how the
-list of equivalent mutants names a mutant, and what a resumed run keeps
-from the journal. The runs themselves: ctest mutation_sample."""
+list of equivalent mutants names a mutant, what a resumed run keeps from
+the journal, and how mutants with the same object code share an outcome. The runs themselves: ctest mutation_sample."""
 import json
 
-from support.mutation import Journal, Mutant, read_equivalents
+from support.mutation import Journal, Mutant, read_equivalents, settle
 
 LIST = """# comment
 fmu_src/fmu_core.c
@@ -72,3 +72,28 @@ def test_a_resumed_run_keeps_kills_always_and_survivors_of_the_same_tests(tmp_pa
     fresh = Journal(path, resume=False, tests="tests-1")  # not resumed: a new journal
     fresh.close()
     assert fresh.kept == {} and path.read_text().strip() == ""
+
+
+def test_mutants_with_the_same_object_code_share_the_tested_ones_outcome(tmp_path):
+    path = tmp_path / "list.txt"
+    path.write_text(LIST)
+    equivalents = read_equivalents(path)
+
+    def group(outcome, *afters):
+        members = [mutant("x = 0;", after) for after in afters]
+        members[0].outcome, members[0].detail = outcome, "FAILED test_y" if outcome == "killed" else ""
+        return members
+
+    plain = group("killed", "x = 2;", "x = 3;")
+    survived_listed = group("survived", "x = 2;", "x = 1;")     # a later member is on the list
+    killed_listed = group("killed", "x = 2;", "x = 1;")
+    listed_first = group("listed", "x = 1;", "x = 2;")          # listed, not tested
+    settle([plain, survived_listed, killed_listed, listed_first], equivalents)
+    assert [m.outcome for m in plain] == ["killed", "killed"]
+    assert plain[1].detail == "same object code as fmu_core.c:10: x = 0;  =>  x = 2;: FAILED test_y"
+    assert [m.outcome for m in survived_listed] == ["listed", "listed"]
+    assert survived_listed[0].detail == "same object code as fmu_core.c:10: x = 0;  =>  x = 1;"
+    assert survived_listed[1].detail == "plain entry."
+    assert [m.outcome for m in killed_listed] == ["killed", "wrongly listed"]
+    assert killed_listed[1].detail == "listed as equivalent, but FAILED test_y"
+    assert [m.outcome for m in listed_first] == ["listed", "listed"]

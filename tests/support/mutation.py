@@ -34,6 +34,7 @@ import shlex
 import shutil
 import signal
 import sys
+import threading
 import time
 import zipfile
 from collections import Counter, defaultdict
@@ -521,54 +522,42 @@ def main(argv=None):
     base = compile_baseline(builder, work)
     sanitized = Sanitized(sanitizer_build, work) if sanitizing else None
     shutil.rmtree(work / "run", ignore_errors=True)
+    groups = {}  # object code digest -> the mutants that compile to it; the first one is tested for all
+    lock = threading.Lock()
 
-    def compile_one(item):
+    def compile_and_test(item):
+        """Compiled just before it is tested, so a stopped run loses only the mutants in hand."""
         index, m = item
         compile_mutant(m, index, builder, base, work)
-        if m.outcome:
-            journal.record(m, m.outcome, m.detail)
+        with lock:
+            if m.outcome:  # stillborn, or the original's object code
+                journal.record(m, m.outcome, m.detail)
+                return
+            members = groups.setdefault(m.digest, [])
+            members.append(m)
+            first = members[0]
+            if first is not m:
+                shutil.rmtree(work / "run" / str(index), ignore_errors=True)
+                if first.outcome not in ("", "listed"):  # else the first one records its group when tested
+                    journal.record(m, first.outcome, f"same object code as {first.label()}")
+                return
+            if m.proof(equivalents) and not args.check_listed:
+                shutil.rmtree(work / "run" / str(index), ignore_errors=True)
+                m.outcome, m.detail = "listed", m.proof(equivalents)
+                return
+        outcome, detail = test_mutant(m, index, builder, base, work, sys.executable, sanitized)
+        with lock:
+            m.outcome, m.detail = outcome, detail
+            for member in members:
+                journal.record(member, outcome, detail if member is m else f"same object code as {m.label()}")
+        print({"killed": ".", "survived": "S"}.get(outcome, "x"), end="", flush=True)  # x: does not link
 
-    parallel(args.jobs, compile_one, [(i, m) for i, m in enumerate(mutants) if not m.outcome])
-
-    # one test per distinct object code; a listed equivalent covers its whole group and is not run
-    groups = defaultdict(list)
-    for index, m in enumerate(mutants):
-        if not m.outcome:
-            groups[m.digest].append((index, m))
-    to_test = []
-    for members in groups.values():
-        listed = [m for _, m in members if m.proof(equivalents)]
-        if listed and args.check_listed:
-            to_test.append(members[0])
-        elif listed:
-            for _, m in members:
-                m.outcome = "listed"
-                m.detail = m.proof(equivalents) if m in listed else f"same object code as {listed[0].label()}"
-        else:
-            to_test.append(members[0])
-    print(f"compiled in {time.monotonic() - started:.0f} s; running the tests on {len(to_test)} distinct mutants",
-          flush=True)
-
-    def test(item):
-        index, m = item
-        m.outcome, m.detail = test_mutant(m, index, builder, base, work, sys.executable, sanitized)
-        for _, member in groups[m.digest]:  # the same object code: the same outcome
-            journal.record(member, m.outcome, m.detail if member is m else f"same object code as {m.label()}")
-        print({"killed": ".", "survived": "S"}.get(m.outcome, "x"), end="", flush=True)  # x: does not link
-        if m.proof(equivalents):  # --check-listed: the proof must hold
-            m.outcome, m.detail = ("listed", m.proof(equivalents)) if m.outcome == "survived" else \
-                ("wrongly listed", f"listed as equivalent, but {m.detail}")
-
-    parallel(args.jobs, test, to_test)
+    todo = [(i, m) for i, m in enumerate(mutants) if not m.outcome]
+    print(f"compiling and testing {len(todo)}", flush=True)
+    parallel(args.jobs, compile_and_test, todo)
     journal.close()
     print()
-    for members in groups.values():
-        tested = members[0][1]
-        for _, m in members[1:]:
-            if not m.outcome:
-                m.outcome, m.detail = tested.outcome, f"same object code as {tested.label()}: {tested.detail}"
-                if tested.outcome == "listed":
-                    m.detail = f"same object code as {tested.label()}"
+    settle(groups.values(), equivalents)
     shutil.rmtree(work / "run", ignore_errors=True)
 
     print(summary(mutants))
@@ -583,6 +572,24 @@ def main(argv=None):
                                                  outcome=m.outcome, detail=m.detail) for m in mutants], indent=1))
     print(f"{time.monotonic() - started:.0f} s")
     return 1 if survivors or wrong or stale else 0
+
+
+def settle(groups, equivalents):
+    """Each group of mutants with the same object code takes its tested first member's outcome. A group
+    with a listed member is listed if it survived; if it was killed, its listed members are wrongly listed."""
+    for members in groups:
+        first = members[0]
+        listed = [m for m in members if m.proof(equivalents)]
+        for m in members[1:]:
+            m.outcome, m.detail = first.outcome, f"same object code as {first.label()}: {first.detail}"
+        if not listed:
+            continue
+        if first.outcome in ("survived", "listed"):
+            for m in members:
+                m.outcome, m.detail = "listed", m.proof(equivalents) or f"same object code as {listed[0].label()}"
+        elif first.outcome == "killed":
+            for m in listed:
+                m.outcome, m.detail = "wrongly listed", f"listed as equivalent, but {first.detail}"
 
 
 def summary(mutants):
