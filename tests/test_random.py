@@ -126,6 +126,30 @@ def run_against_oracle(model, version, start, run, skipped=()):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_outputs_in_initialization_mode_follow_what_is_set(version):
+    """In Initialization Mode the outputs are the initial ones of the
+    parameters and inputs set so far, read after each set."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        vr = {name: fmu.vr(name) for name in fmu.variables}
+        if version == 2:
+            fmu.fmu.setupExperiment(startTime=0.0)
+            fmu.fmu.enterInitializationMode()
+        else:
+            fmu.fmu.enterInitializationMode(startTime=0.0)
+        start = {}
+        for values in ({"u": 3.0}, {"initMode": 1, "initValue": 7.0}, {"yMaxPar": 5.0}, {"rateUpPar": -1.0},
+                       {"initMode": 2, "u": -2.0}):
+            fmu.set(**values)
+            start.update(values)
+            expected = oracle_for("RateLimiter", vr, start).outputs()
+            for name in output_names("RateLimiter"):
+                assert agree(fmu.get(name), expected[name]), (start, name, fmu.get(name), expected[name])
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("skipped", [(), (0,)])
 def test_steps_that_end_no_cycle_change_no_output(version, skipped):
     """SPEC section 2: a step that ends no cycle changes nothing, also when a
