@@ -127,6 +127,22 @@ def test_tiny_cycle_time_runs_or_is_refused(version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_a_step_of_exactly_the_most_cycles_runs(version):
+    """At most 1e8 cycles per step (docs/fmi.md): a step of exactly 1e8
+    cycles of 2^-20 s (both exact in binary) runs them; y ramps at 1 per s,
+    2^-20 per cycle, and reaches u = 1 exactly after 2^20 cycles."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start(cycleTime=2.0 ** -20)
+        fmu.set(u=1.0)
+        assert fmu.raw_step(1e8 * 2.0 ** -20) == 0, fmu.messages
+        assert fmu.get("y") == 1.0 and fmu.get("time") == 1e8 * 2.0 ** -20
+        assert not fmu.errors()
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_huge_cycle_time_holds(version):
     """cycleTime 1e9: no cycle ends within 10 s, so the output holds at its
     initial value (SPEC section 2: a step that ends no cycle changes nothing)."""

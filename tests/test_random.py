@@ -52,6 +52,8 @@ changes = st.fixed_dictionaries({}, optional={
     "hold": st.booleans(),
     "yMaxPar": st.sampled_from([inf, nan, 4.0]),
 })
+# the cycles end at startTime + n * cycleTime: off the grid of 0 too
+start_times = st.sampled_from([0.0, 0.0, 1.0, -0.3, 12.5])
 steps = st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), changes), min_size=1, max_size=40)
 
 cycle_times = st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0])
@@ -101,13 +103,13 @@ def agree(fmu_value, oracle_value):
     return (math.isnan(a) and math.isnan(b)) or a == b
 
 
-def run_against_oracle(model, version, start, run, skipped=()):
+def run_against_oracle(model, version, start, run, skipped=(), start_time=0.0):
     """skipped: the steps after which the outputs are not read (the last one always is)."""
     fmu = Instance(model, version)
     try:
         vr = {name: fmu.vr(name) for name in fmu.variables}
-        fmu.start(**start)
-        oracle = oracle_for(model, vr, start)
+        fmu.start(start_time=start_time, **start)
+        oracle = oracle_for(model, vr, start, start_time)
         names = output_names(model)
         expected = oracle.outputs()
         for name in names:
@@ -132,13 +134,14 @@ def test_outputs_in_initialization_mode_follow_what_is_set(version):
     fmu = Instance("RateLimiter", version)
     try:
         vr = {name: fmu.vr(name) for name in fmu.variables}
+        start = {"initMode": 1, "initValue": 4.0}  # set before Initialization Mode
+        fmu.set(**start)
         if version == 2:
             fmu.fmu.setupExperiment(startTime=0.0)
             fmu.fmu.enterInitializationMode()
         else:
             fmu.fmu.enterInitializationMode(startTime=0.0)
-        start = {}
-        for values in ({"u": 3.0}, {"initMode": 1, "initValue": 7.0}, {"yMaxPar": 5.0}, {"rateUpPar": -1.0},
+        for values in ({}, {"u": 3.0}, {"initValue": 7.0}, {"yMaxPar": 5.0}, {"rateUpPar": -1.0},
                        {"initMode": 2, "u": -2.0}):
             fmu.set(**values)
             start.update(values)
@@ -164,9 +167,9 @@ def test_steps_that_end_no_cycle_change_no_output(version, skipped):
 
 @pytest.mark.parametrize("version", [2, 3])
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(start=parameters, run=steps, skipped=st.sets(st.integers(0, 39)))
-def test_rate_limiter_agrees_with_oracle(version, start, run, skipped):
-    run_against_oracle("RateLimiter", version, start, run, skipped)
+@given(start=parameters, run=steps, skipped=st.sets(st.integers(0, 39)), start_time=start_times)
+def test_rate_limiter_agrees_with_oracle(version, start, run, skipped, start_time):
+    run_against_oracle("RateLimiter", version, start, run, skipped, start_time)
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -178,4 +181,5 @@ def test_vendor_model_agrees_with_oracle(model, version, data):
     start = data.draw(start_strategy, label="start")
     run = data.draw(st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), change_strategy),
                              min_size=1, max_size=40), label="run")
-    run_against_oracle(model, version, start, run, data.draw(st.sets(st.integers(0, 39)), label="skipped"))
+    run_against_oracle(model, version, start, run, data.draw(st.sets(st.integers(0, 39)), label="skipped"),
+                       data.draw(start_times, label="start_time"))

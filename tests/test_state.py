@@ -61,6 +61,34 @@ def test_a_state_taken_before_the_outputs_were_read_holds_them(version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_leaving_initialization_mode_counts_cycles_from_zero(version):
+    """A state of Initialization Mode with a cycle count (resealed: no run
+    makes one) starts afresh: leaving Initialization Mode counts cycles from
+    0. 2 per s in cycles of 0.25 s: two cycles of 0.5 in 0.5 s."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        api = state_api(fmu)
+        if version == 2:
+            fmu.fmu.setupExperiment(startTime=0.0)
+            fmu.fmu.enterInitializationMode()
+        else:
+            fmu.fmu.enterInitializationMode(startTime=0.0)
+        fmu.set(rateUpPar=2.0, cycleTime=0.25)
+        state = api["get"]()
+        data = bytes(api["serialize"](state))
+        counted = api["deserialize"](value_at(data, values_end(data) + BLOCK + 16, struct.pack("<Q", 5)))
+        api["set"](counted)
+        fmu.fmu.exitInitializationMode()
+        fmu.set(u=10.0)
+        fmu.step(0.5)
+        assert (fmu.get("y"), fmu.get("runningTime")) == (1.0, 0.5)
+        api["free"](counted)
+        api["free"](state)
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_serialized_state_continues_bit_identically_in_a_new_process(version, tmp_path):
     fmu = started(version)
     api = state_api(fmu)
