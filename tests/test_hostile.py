@@ -4,6 +4,7 @@ crash or an endless step; where the contract's status table applies the FMU
 agrees with the oracle bit for bit; a value outside a declared range is
 refused with an error and the last good value kept."""
 import math
+import sys
 
 import pytest
 
@@ -139,6 +140,20 @@ def test_a_step_of_exactly_the_most_cycles_runs(version):
         assert fmu.raw_step(1e8 * 2.0 ** -20) == 0, fmu.messages
         assert fmu.get("y") == 1.0 and fmu.get("time") == 1e8 * 2.0 ** -20
         assert not fmu.errors()
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_the_largest_finite_step_is_taken(version):
+    """communicationStepSize must be finite and > 0, and the largest double
+    is: one cycle of that length, at 1 per s, takes y to u."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        fmu.set(u=5.0)
+        assert fmu.raw_step(sys.float_info.max) == 0, fmu.messages
+        assert fmu.get("y") == 5.0 and fmu.get("time") == sys.float_info.max
     finally:
         fmu.free()
 

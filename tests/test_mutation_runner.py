@@ -48,6 +48,17 @@ def test_a_list_entry_without_its_lines_is_refused(tmp_path):
         raise AssertionError("an entry without its '-' line was read")
 
 
+def test_a_mutant_listed_twice_is_refused(tmp_path):
+    path = tmp_path / "list.txt"
+    path.write_text(LIST + LIST.split("\n\n")[0].replace("# comment\n", "\n") + "\n")
+    try:
+        read_equivalents(path)
+    except SystemExit as error:
+        assert "this mutant is listed already" in str(error)
+    else:
+        raise AssertionError("a mutant listed twice was read")
+
+
 def test_a_resumed_run_keeps_kills_always_and_survivors_of_the_same_tests(tmp_path):
     path = tmp_path / "journal.jsonl"
     killed, survived, stillborn = (mutant("a;", f"b{k};", text=str(k)) for k in range(3))

@@ -166,8 +166,11 @@ def read_equivalents(path=None):
         elif line.startswith("  why: "):
             if not {"file", "before", "after"} <= set(block) <= {"file", "before", "after", "above"}:
                 raise SystemExit(f"{path}:{number}: 'why:' without its file, '-' and '+' lines")
-            key = [f"{block['file']} | {block['before'].strip()} | {block['after'].strip()}"] + block.get("above", [])
-            entries[" | ".join(key)] = line[7:]
+            key = " | ".join([f"{block['file']} | {block['before'].strip()} | {block['after'].strip()}"] +
+                             block.get("above", []))
+            if key in entries:
+                raise SystemExit(f"{path}:{number}: this mutant is listed already")
+            entries[key] = line[7:]
             block = {}
         elif not line.startswith(" "):
             block = {"file": line.strip()}
