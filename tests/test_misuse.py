@@ -41,10 +41,14 @@ def foreign_state(fmu):
 
 # name: (misuse, words the log message must contain)
 MISUSES = {
-    "step size zero": (lambda f: call_status(f.fmu.doStep, f.t, 0.0), "communicationStepSize"),
-    "step size negative": (lambda f: call_status(f.fmu.doStep, f.t, -0.5), "communicationStepSize"),
-    "step size NaN": (lambda f: call_status(f.fmu.doStep, f.t, math.nan), "communicationStepSize"),
-    "step size infinite": (lambda f: call_status(f.fmu.doStep, f.t, math.inf), "communicationStepSize"),
+    "step size zero": (lambda f: call_status(f.fmu.doStep, f.t, 0.0),
+                       "DoStep: communicationStepSize must be finite and > 0, not 0"),
+    "step size negative": (lambda f: call_status(f.fmu.doStep, f.t, -0.5),
+                           "DoStep: communicationStepSize must be finite and > 0, not -0.5"),
+    "step size NaN": (lambda f: call_status(f.fmu.doStep, f.t, math.nan),
+                      "DoStep: communicationStepSize must be finite and > 0, not nan"),
+    "step size infinite": (lambda f: call_status(f.fmu.doStep, f.t, math.inf),
+                           "DoStep: communicationStepSize must be finite and > 0, not inf"),
     "communication point not the FMU's time": (lambda f: call_status(f.fmu.doStep, f.t + 0.1, 0.5), "currentCommunicationPoint"),
     "communication point NaN": (lambda f: call_status(f.fmu.doStep, math.nan, 0.5), "currentCommunicationPoint"),
     "unknown value reference": (lambda f: set_raw(f, 999, 1.0), "unknown value reference 999"),
@@ -237,7 +241,26 @@ def test_communication_point_within_a_relative_1e_9_of_the_time(version):
     outside = fmu.get("time") * (1 + 1.1e-9)
     assert fmu.raw_step_at(outside, 0.1) == 3
     assert "is not the FMU's time" in fmu.errors()[-1][2]
+    # relative to the FMU's time, not to the communication point: a start
+    # time and a point just beyond 1e-9 of it, though within 1e-9 of itself
+    start, t = next((s, t) for s in (1 + i / 1024 for i in range(4096)) if (t := just_outside(s)))
+    fmu.fmu.reset()
+    fmu.start(start_time=start)
+    assert fmu.raw_step_at(t, 0.1) == 3
+    assert f"currentCommunicationPoint {t:.17g} is not the FMU's time {start:.17g}" in fmu.errors()[-1][2]
     fmu.free()
+
+
+def just_outside(time):
+    """A point more than a relative 1e-9 from time but within 1e-9 of itself (the doubles near the edge,
+    checked as the FMU does), or None."""
+    ulp = math.ulp(time)
+    edge = math.floor(1e-9 * time / ulp)
+    for k in range(edge - 2, edge + 3):
+        t = time + k * ulp
+        if abs(t - time) > 1e-9 * abs(time) and abs(t - time) <= 1e-9 * abs(t):
+            return t
+    return None
 
 
 @pytest.mark.parametrize("version", [2, 3])
