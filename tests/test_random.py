@@ -24,7 +24,7 @@ parameters = st.fixed_dictionaries({
     "durationPar": durations,
     "ratePeriod": st.sampled_from([1.0, 0.0, 0.5, 2.0, -1.0, inf]),
     "zeroRate": st.sampled_from([1, 2]),
-    "cycleTime": st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0]),
+    "cycleTime": st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, 1.0, -1.0]),
     "initMode": st.sampled_from([1, 2, 3]),
     "initValue": reals,
     "initDelay": st.sampled_from([0.0, 0.3, 1.0, 2.0]),
@@ -121,6 +121,7 @@ def run_against_oracle(model, version, start, run, skipped=(), start_time=0.0):
             expected = oracle.do_step(t, h, inputs)
             if k in skipped and k < len(run) - 1:
                 continue
+            assert fmu.get("time") == fmu.t, (k, t, h)
             for name in names:
                 assert agree(fmu.get(name), expected[name]), (k, t, h, name, fmu.get(name), expected[name])
     finally:
@@ -150,6 +151,18 @@ def test_outputs_in_initialization_mode_follow_what_is_set(version):
                 assert agree(fmu.get(name), expected[name]), (start, name, fmu.get(name), expected[name])
     finally:
         fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("start,run,start_time", [
+    # cycles of 1 s in steps of 0.5 s: a cycle ends every other step
+    ({"cycleTime": 1.0, "u": 0.0}, [(0.5, {"u": 10.0})] * 6, 0.0),
+    # the initial delay counts from the start time (one cycle per step)
+    ({"initMode": 3, "initDelay": 1.0, "u": 0.0},
+     [(0.5, {"u": 5.0}), (0.5, {"u": 2.0}), (0.5, {"u": 8.0}), (0.5, {"u": -1.0})], 10.0),
+])
+def test_directed_runs_agree_with_oracle(version, start, run, start_time):
+    run_against_oracle("RateLimiter", version, start, run, start_time=start_time)
 
 
 @pytest.mark.parametrize("version", [2, 3])
