@@ -251,6 +251,21 @@ def test_communication_point_within_a_relative_1e_9_of_the_time(version):
     fmu.free()
 
 
+@pytest.mark.parametrize("version", [2, 3])
+def test_the_common_step_judges_the_communication_point_alike(version):
+    """Steps of 1e-12 s with nothing changed but u take the common step; a
+    point 5e-10 s from the FMU's time (2e-12) is far beyond a relative 1e-9
+    of it there too."""
+    fmu = Instance("RateLimiter", version)
+    fmu.start()
+    fmu.set(u=1.0)
+    fmu.step(1e-12)
+    fmu.step(1e-12)
+    assert fmu.raw_step_at(fmu.t + 5e-10, 1e-12) == 3
+    assert "is not the FMU's time" in fmu.errors()[-1][2]
+    fmu.free()
+
+
 def just_outside(time):
     """A point more than a relative 1e-9 from time but within 1e-9 of itself (the doubles near the edge,
     checked as the FMU does), or None."""
