@@ -472,6 +472,8 @@ def main(argv=None):
     parser.add_argument("--resume", action="store_true",
                         help="keep the journal's stillborn, equivalent and killed outcomes, and its survivors of "
                              "the same tests; test the rest")
+    parser.add_argument("--status", action="store_true",
+                        help="with --resume: print the table from the journal alone, testing nothing")
     args = parser.parse_args(argv)
 
     def stop(signum, frame):  # the tests running go too; the journal has every outcome known so far
@@ -520,6 +522,15 @@ def main(argv=None):
     kept = sum(1 for m in mutants if m.outcome)
     if args.resume:
         print(f"{kept} outcomes kept from {work / 'journal.jsonl'}", flush=True)
+    if args.status:  # a long run's progress: what the journal knows of these sources and tests
+        for m in mutants:
+            if not m.outcome:
+                m.outcome, m.detail = ("listed", m.proof(equivalents)) if m.proof(equivalents) else ("untested", "")
+        print(summary(mutants))
+        for m in mutants:
+            if m.outcome == "survived":
+                print(f"SURVIVED {m.label()}")
+        return 0
 
     builder = Builder(build_dir, work)
     base = compile_baseline(builder, work)
@@ -601,14 +612,15 @@ def summary(mutants):
     for m in mutants:
         counts[m.file][m.outcome] += 1
         counts["all"][m.outcome] += 1
-    rows = ["| file | mutants | stillborn | same object code | listed equivalent | killed | survived | score |",
-            "|---|---|---|---|---|---|---|---|"]
+    untested = counts["all"]["untested"] > 0  # --status
+    rows = ["| file | mutants | stillborn | same object code | listed equivalent | killed | survived | score |"
+            + (" untested |" if untested else ""), "|---|---|---|---|---|---|---|---|" + ("---|" if untested else "")]
     for file in [f for f in FILES if f in counts] + ["all"]:
         c = counts[file]
         live = c["killed"] + c["survived"]
         score = f"{100 * c['killed'] / live:.1f} %" if live else "-"
         rows.append(f"| {file} | {sum(c.values())} | {c['stillborn']} | {c['equivalent']} | {c['listed']} "
-                    f"| {c['killed']} | {c['survived']} | {score} |")
+                    f"| {c['killed']} | {c['survived']} | {score} |" + (f" {c['untested']} |" if untested else ""))
     return "\n".join(rows)
 
 
