@@ -1,6 +1,7 @@
 """FMU states: rollback with get/set, and serialize / deserialize into a new
 process, continue bit-identically; bad serialized bytes are refused."""
 import json
+import math
 import struct
 import sys
 import zlib
@@ -55,6 +56,30 @@ def test_a_state_taken_before_the_outputs_were_read_holds_them(version):
         api["set"](state)
         fmu.t = 0.5
         assert (fmu.get("y"), fmu.get("runningTime"), fmu.get("time")) == (1.0, 0.5, 0.5)
+        api["free"](state)
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_restored_state_has_its_own_outputs(version):
+    """After a rate changed, a restored state's outputs are still its own:
+    remainingTime 9 s at 1 per s, not at the 4 per s set since."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        api = state_api(fmu)
+        fmu.start(rateUpPar=1.0)
+        fmu.set(u=10.0)
+        fmu.step(1.0)
+        assert (fmu.get("y"), fmu.get("remainingTime")) == (1.0, 9.0)
+        state = api["get"]()
+        fmu.set(rateUp=4.0)
+        fmu.step(1.0)
+        assert (fmu.get("y"), fmu.get("remainingTime")) == (5.0, 1.25)
+        api["set"](state)
+        fmu.t = 1.0
+        assert (fmu.get("y"), fmu.get("remainingTime")) == (1.0, 9.0)
+        assert math.isnan(fmu.get("rateUp"))  # the state's input: not connected
         api["free"](state)
     finally:
         fmu.free()
