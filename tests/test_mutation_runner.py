@@ -1,7 +1,10 @@
 """The mutation runner's bookkeeping (tests/support/mutation.py): how the
 list of equivalent mutants names a mutant, what a resumed run keeps from
-the journal, and how mutants with the same object code share an outcome. The runs themselves: ctest mutation_sample."""
+the journal, and how mutants with the same object code share an outcome.
+The runs themselves: ctest mutation_sample."""
 import json
+
+import pytest
 
 from support.mutation import Journal, Mutant, read_equivalents, settle
 
@@ -40,23 +43,15 @@ def test_an_entry_names_a_mutant_by_its_line_or_also_by_the_lines_above(tmp_path
 def test_a_list_entry_without_its_lines_is_refused(tmp_path):
     path = tmp_path / "list.txt"
     path.write_text("fmu_src/fmu_core.c\n  + x = 1;\n  why: no '-' line.\n")
-    try:
+    with pytest.raises(SystemExit, match="'why:' without its file, '-' and '\\+' lines"):
         read_equivalents(path)
-    except SystemExit as error:
-        assert "'why:' without its file, '-' and '+' lines" in str(error)
-    else:
-        raise AssertionError("an entry without its '-' line was read")
 
 
 def test_a_mutant_listed_twice_is_refused(tmp_path):
     path = tmp_path / "list.txt"
     path.write_text(LIST + LIST.split("\n\n")[0].replace("# comment\n", "\n") + "\n")
-    try:
+    with pytest.raises(SystemExit, match="this mutant is listed already"):
         read_equivalents(path)
-    except SystemExit as error:
-        assert "this mutant is listed already" in str(error)
-    else:
-        raise AssertionError("a mutant listed twice was read")
 
 
 def test_a_resumed_run_keeps_kills_always_and_survivors_of_the_same_tests(tmp_path):
