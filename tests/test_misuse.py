@@ -263,6 +263,14 @@ def test_the_common_step_judges_the_communication_point_alike(version):
     fmu.step(1e-12)
     assert fmu.raw_step_at(fmu.t + 5e-10, 1e-12) == 3
     assert "is not the FMU's time" in fmu.errors()[-1][2]
+    # before time 0 times must match exactly: a point 0.05 s off is refused
+    fmu.fmu.reset()
+    fmu.start(start_time=-1.0)
+    fmu.set(u=1.0)
+    fmu.step(0.1)
+    fmu.step(0.1)
+    assert fmu.raw_step_at(fmu.t + 0.05, 0.1) == 3
+    assert "is not the FMU's time" in fmu.errors()[-1][2]
     fmu.free()
 
 

@@ -63,8 +63,10 @@ def test_a_state_taken_before_the_outputs_were_read_holds_them(version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_a_restored_state_has_its_own_outputs(version):
-    """After a rate changed, a restored state's outputs are still its own:
-    remainingTime 9 s at 1 per s, not at the 4 per s set since."""
+    """After a rate changed, a restored state's outputs and rate are still
+    its own: remainingTime 9 s at 1 per s, not at the 4 per s set since,
+    whether the outputs were read before the restore or not, and the next
+    step ramps at 1 per s again."""
     fmu = Instance("RateLimiter", version)
     try:
         api = state_api(fmu)
@@ -76,10 +78,13 @@ def test_a_restored_state_has_its_own_outputs(version):
         fmu.set(rateUp=4.0)
         fmu.step(1.0)
         assert (fmu.get("y"), fmu.get("remainingTime")) == (5.0, 1.25)
+        fmu.step(1.0)  # y = 9, not read
         api["set"](state)
         fmu.t = 1.0
         assert (fmu.get("y"), fmu.get("remainingTime")) == (1.0, 9.0)
         assert math.isnan(fmu.get("rateUp"))  # the state's input: not connected
+        fmu.step(1.0)
+        assert (fmu.get("y"), fmu.get("remainingTime")) == (2.0, 8.0)
         api["free"](state)
     finally:
         fmu.free()
