@@ -137,11 +137,7 @@ def test_outputs_in_initialization_mode_follow_what_is_set(version):
         vr = {name: fmu.vr(name) for name in fmu.variables}
         start = {"initMode": 1, "initValue": 4.0}  # set before Initialization Mode
         fmu.set(**start)
-        if version == 2:
-            fmu.fmu.setupExperiment(startTime=0.0)
-            fmu.fmu.enterInitializationMode()
-        else:
-            fmu.fmu.enterInitializationMode(startTime=0.0)
+        fmu.enter_initialization()
         for values in ({}, {"u": 3.0}, {"initValue": 7.0}, {"yMaxPar": 5.0}, {"rateUpPar": -1.0},
                        {"initMode": 2, "u": -2.0}):
             fmu.set(**values)

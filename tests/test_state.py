@@ -99,11 +99,7 @@ def test_a_restored_state_serializes_to_the_same_bytes(version, mode):
     try:
         api = state_api(fmu)
         if mode != "Instantiated":
-            if version == 2:
-                fmu.fmu.setupExperiment(startTime=0.0)
-                fmu.fmu.enterInitializationMode()
-            else:
-                fmu.fmu.enterInitializationMode(startTime=0.0)
+            fmu.enter_initialization()
             fmu.set(u=2.0)
         if mode == "Step Mode":
             fmu.fmu.exitInitializationMode()
@@ -127,11 +123,7 @@ def test_leaving_initialization_mode_counts_cycles_from_zero(version):
     fmu = Instance("RateLimiter", version)
     try:
         api = state_api(fmu)
-        if version == 2:
-            fmu.fmu.setupExperiment(startTime=0.0)
-            fmu.fmu.enterInitializationMode()
-        else:
-            fmu.fmu.enterInitializationMode(startTime=0.0)
+        fmu.enter_initialization()
         fmu.set(rateUpPar=2.0, cycleTime=0.25)
         state = api["get"]()
         data = bytes(api["serialize"](state))

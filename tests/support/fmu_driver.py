@@ -97,13 +97,17 @@ class Instance:
     def start(self, start_time=0.0, **start_values):
         """Set start values, then initialise at start_time."""
         self.set(**start_values)
+        self.enter_initialization(start_time)
+        self.fmu.exitInitializationMode()
+
+    def enter_initialization(self, start_time=0.0):
+        """Into Initialization Mode at start_time (FMI 2: after fmi2SetupExperiment)."""
         self.t = start_time
         if self.version == 2:
             self.fmu.setupExperiment(startTime=start_time)
             self.fmu.enterInitializationMode()
         else:
             self.fmu.enterInitializationMode(startTime=start_time)
-        self.fmu.exitInitializationMode()
 
     def step(self, h):
         self.fmu.doStep(currentCommunicationPoint=self.t, communicationStepSize=h)
