@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from support.mutation import Journal, Mutant, read_equivalents, settle
+from support.mutation import Journal, Mutant, read_equivalents, report_failures, settle
 
 LIST = """# comment
 fmu_src/fmu_core.c
@@ -103,3 +103,14 @@ def test_mutants_with_the_same_object_code_share_the_tested_ones_outcome(tmp_pat
     assert [m.outcome for m in killed_listed] == ["killed", "wrongly listed"]
     assert killed_listed[1].detail == "listed as equivalent, but FAILED test_y"
     assert [m.outcome for m in listed_first] == ["listed", "listed"]
+
+
+def test_survivors_and_wrongly_listed_mutants_are_printed_and_counted(capsys):
+    outcomes = ("killed", "survived", "listed", "wrongly listed", "stillborn", "untested")
+    mutants = [mutant("x = 0;", f"x = {i};") for i in range(len(outcomes))]
+    for m, outcome in zip(mutants, outcomes):
+        m.outcome, m.detail = outcome, f"why {outcome}"
+    assert report_failures(mutants) == 2
+    assert capsys.readouterr().out.splitlines() == [
+        "SURVIVED fmu_core.c:10: x = 0;  =>  x = 1;",
+        "WRONGLY LISTED fmu_core.c:10: x = 0;  =>  x = 3;: why wrongly listed"]

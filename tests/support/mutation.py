@@ -527,9 +527,7 @@ def main(argv=None):
             if not m.outcome:
                 m.outcome, m.detail = ("listed", m.proof(equivalents)) if m.proof(equivalents) else ("untested", "")
         print(summary(mutants))
-        for m in mutants:
-            if m.outcome == "survived":
-                print(f"SURVIVED {m.label()}")
+        report_failures(mutants)
         return 0
 
     builder = Builder(build_dir, work)
@@ -575,17 +573,12 @@ def main(argv=None):
     shutil.rmtree(work / "run", ignore_errors=True)
 
     print(summary(mutants))
-    survivors = [m for m in mutants if m.outcome == "survived"]
-    for m in survivors:
-        print(f"SURVIVED {m.label()}")
-    wrong = [m for m in mutants if m.outcome == "wrongly listed"]
-    for m in wrong:
-        print(f"WRONGLY LISTED {m.label()}: {m.detail}")
+    failures = report_failures(mutants)
     if args.report:
         args.report.write_text(json.dumps([dict(file=m.file, line=m.line, before=m.before, after=m.after,
                                                  outcome=m.outcome, detail=m.detail) for m in mutants], indent=1))
     print(f"{time.monotonic() - started:.0f} s")
-    return 1 if survivors or wrong or stale else 0
+    return 1 if failures or stale else 0
 
 
 def settle(groups, equivalents):
@@ -604,6 +597,14 @@ def settle(groups, equivalents):
         elif first.outcome == "killed":
             for m in listed:
                 m.outcome, m.detail = "wrongly listed", f"listed as equivalent, but {first.detail}"
+
+
+def report_failures(mutants):
+    """Print the survivors and the listed mutants a test kills; return how many there are."""
+    failures = [m for m in mutants if m.outcome in ("survived", "wrongly listed")]
+    for m in failures:
+        print(f"SURVIVED {m.label()}" if m.outcome == "survived" else f"WRONGLY LISTED {m.label()}: {m.detail}")
+    return len(failures)
 
 
 def summary(mutants):
