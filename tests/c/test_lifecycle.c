@@ -149,6 +149,11 @@ static int step(void *c, double t, double h) {
     return F3(fmi3DoStep)(c, t, h, fmi3True, &a, &b, &e, &last);
 }
 
+static int set_debug_logging(void *c, size_t n, const char *const categories[]) {
+    return version == 2 ? F2(fmi2SetDebugLogging)(c, fmi2True, n, categories)
+                        : F3(fmi3SetDebugLogging)(c, fmi3True, n, categories);
+}
+
 static double input(int k, int i) { return ((k + i) % 7) * 1.5 - 4.0; }
 
 /* ---- 1. a full simulation, every kind of call ------------------------- */
@@ -160,8 +165,7 @@ static void full_simulation(void) {
     CHECK(start(c));
     /* debug logging: every category by name */
     static const char *const every[] = { "logStatusError", "logStatusWarning", "logEvents" };
-    CHECK((version == 2 ? F2(fmi2SetDebugLogging)(c, fmi2True, 3, every)
-                        : F3(fmi3SetDebugLogging)(c, fmi3True, 3, every)) == 0);
+    CHECK(set_debug_logging(c, 3, every) == 0);
     double t = 0.0;
     for (int k = 0; k < 200; k++, t += 0.01) {
         CHECK(set_u(c, input(k, 0)) == 0);
@@ -204,8 +208,7 @@ static void full_simulation(void) {
     }
     /* an unknown (NULL) category: refused; the reset below recovers */
     static const char *const unknown[] = { "logEvents", NULL };
-    CHECK((version == 2 ? F2(fmi2SetDebugLogging)(c, fmi2True, 2, unknown)
-                        : F3(fmi3SetDebugLogging)(c, fmi3True, 2, unknown)) == fmi2Error);
+    CHECK(set_debug_logging(c, 2, unknown) == fmi2Error);
     /* reset and run again, then terminate */
     CHECK((version == 2 ? F2(fmi2Reset)(c) : F3(fmi3Reset)(c)) == 0);
     CHECK(start(c));

@@ -548,15 +548,15 @@ def main(argv=None):
             members = groups.setdefault(m.digest, [])
             members.append(m)
             first = members[0]
+            listed = m.proof(equivalents) and not args.check_listed
             if first is not m:
-                shutil.rmtree(work / "run" / str(index), ignore_errors=True)
                 if first.outcome not in ("", "listed"):  # else the first one records its group when tested
                     journal.record(m, first.outcome, f"same object code as {first.label()}")
-                return
-            if m.proof(equivalents) and not args.check_listed:
-                shutil.rmtree(work / "run" / str(index), ignore_errors=True)
+            elif listed:
                 m.outcome, m.detail = "listed", m.proof(equivalents)
-                return
+        if first is not m or listed:  # not tested: its tree goes, outside the lock
+            shutil.rmtree(work / "run" / str(index), ignore_errors=True)
+            return
         outcome, detail = test_mutant(m, index, builder, base, work, sys.executable, sanitized)
         with lock:
             m.outcome, m.detail = outcome, detail
