@@ -12,6 +12,7 @@ static int failures = 0;
 static int checks = 0;
 
 #define CHECK_EQ(actual, expected) check_eq(__FILE__, __LINE__, #actual, (double)(actual), (double)(expected))
+#define CHECK_BITS(actual, expected) check_bits(__FILE__, __LINE__, #actual, (actual), (expected))
 #define CHECK_TRUE(condition) check_eq(__FILE__, __LINE__, #condition, (condition) ? 1.0 : 0.0, 1.0)
 
 /* exact comparison; NaN equals NaN */
@@ -20,6 +21,14 @@ static void check_eq(const char *file, int line, const char *what, double actual
     if (actual == expected || (isnan(actual) && isnan(expected))) return;
     failures++;
     printf("%s:%d: %s is %.17g, expected %.17g\n", file, line, what, actual, expected);
+}
+
+/* the same bits: tells -0.0 from +0.0 */
+static void check_bits(const char *file, int line, const char *what, double actual, double expected) {
+    checks++;
+    if (memcmp(&actual, &expected, sizeof actual) == 0) return;
+    failures++;
+    printf("%s:%d: %s is %+.17g, expected %+.17g (bit for bit)\n", file, line, what, actual, expected);
 }
 
 enum { SRC_RATE_UP = 2, SRC_RATE_DOWN = 3, SRC_DURATION = 6, SRC_RATE_UP_PAR = 7, SRC_RATE_DOWN_PAR = 8,
@@ -416,6 +425,30 @@ static void test_rule6_duration(void) {
     CHECK_EQ(rl_running_time(&b.state), 259200.0);
 }
 
+/* Rule 6 compares with < and >, so -0.0 and +0.0 are equal: "y = yp if
+ * equal" keeps yp's zero; a step that ends on the target gives the target
+ * (min and max keep their first argument, u, on a tie); a u equal to a
+ * limit is its own target (uc = min(max(u, yMin), yMax) likewise). */
+static void test_signed_zeros(void) {
+    Block b;
+    RlConfig c = defaults();                  /* 1 per cycle of 1 s */
+    start(&b, &c, 0.0, 1.0);
+    CHECK_BITS(cycle(&b, -0.0), 0.0);         /* u == yp: y = yp */
+    start(&b, &c, -0.0, 1.0);
+    CHECK_BITS(cycle(&b, 0.0), -0.0);
+    start(&b, &c, -1.0, 1.0);
+    CHECK_BITS(cycle(&b, -0.0), -0.0);        /* min(u, -1 + 1 = +0.0): u */
+    start(&b, &c, 1.0, 1.0);
+    CHECK_BITS(cycle(&b, -0.0), -0.0);        /* max(u, 1 - 1 = +0.0): u */
+    c.yMin.value = 0.0;                       /* u == yMin: uc = u */
+    start(&b, &c, 1.0, 1.0);
+    CHECK_BITS(cycle(&b, -0.0), -0.0);
+    c = defaults();
+    c.yMax.value = -0.0;                      /* u == yMax: uc = u */
+    start(&b, &c, -1.0, 1.0);
+    CHECK_BITS(cycle(&b, 0.0), 0.0);
+}
+
 static void test_running_time_period_change(void) {
     Block b;
     RlConfig c = defaults();
@@ -519,15 +552,18 @@ static void test_fast_paths_equal_rules(void) {
 static void test_steady_ramp_equals_rules(void) {
     const double rates[] = { 0.0, 0.3, 1e308 };
     const double durations[] = { 0.0, 0.05, 0.3 };
-    const double periods[] = { 0.01, 0.01, 0.02, 0.02, 0.02, 0.005, 0.01, 0.01 };
-    const double inputs[][8] = { { 5.0, 5.0, 5.0, -5.0, -5.0, 5.0, 5.0, 5.0 },
-                                 { 0.1, 0.1, 0.2, 0.2, 0.2, 0.2, -0.1, -0.1 },
-                                 { 1e308, -1e308, 1e308, 1e308, 0.0, 0.0, -1e308, -1e308 },
-                                 { 1.0, NAN, 1.0, 1.0, 2.0, INFINITY, 3.0, 3.0 } };
+    enum { STEPS = 9, ROWS = 5 };
+    const double periods[STEPS] = { 0.01, 0.01, 0.02, 0.02, 0.02, 0.005, 0.005, 0.01, 0.01 };
+    const double inputs[ROWS][STEPS] = { { 5.0, 5.0, 5.0, -5.0, -5.0, 5.0, 5.0, 5.0, 5.0 },
+                                         { 0.1, 0.1, 0.2, 0.2, 0.2, 0.2, 0.2, -0.1, -0.1 },
+                                         { 1e308, -1e308, 1e308, 1e308, 0.0, 0.0, 0.0, -1e308, -1e308 },
+                                         { 1.0, NAN, 1.0, 1.0, 2.0, INFINITY, INFINITY, 3.0, 3.0 },
+                                         /* at rest while T shrinks, then a new u at that T */
+                                         { 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0 } };
     for (size_t r = 0; r < 3; r++)
     for (size_t d = 0; d < 3; d++)
     for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
-    for (size_t in = 0; in < 4; in++)
+    for (size_t in = 0; in < ROWS; in++)
     for (int repeat = 1; repeat <= 12; repeat += 11) {
         RlConfig c = defaults();
         c.rateUp.value = rates[r];
@@ -540,7 +576,7 @@ static void test_steady_ramp_equals_rules(void) {
         rules = steady;
         bool held = false; /* the FMU's fastPeriod: steady steps allowed */
         double elapsed = 0.0;
-        for (size_t k = 0; k < 8; k++) {
+        for (size_t k = 0; k < STEPS; k++) {
             if (k == 0 || periods[k] != periods[k - 1]) {
                 rl_prepare(&p, resolved(&c), periods[k]);
                 held = false;
@@ -820,6 +856,7 @@ int main(void) {
     test_rule5_configuration_error_holds();
     test_rule6_ramp();
     test_rule6_duration();
+    test_signed_zeros();
     test_running_time_period_change();
     test_fast_paths_equal_rules();
     test_steady_ramp_equals_rules();
