@@ -412,6 +412,26 @@ static void test_rule6_duration(void) {
     CHECK_EQ(cycle(&b, 100.0), 100.0);
     CHECK_EQ(rl_running_time(&b.state), 30 * 0.1); /* remains */
 
+    /* the edge of the tolerance: a runningTime of duration * (1 - 1e-9)
+     * jumps (no limit cut that step), one a bit shorter ramps; in one
+     * cycle, and in rl_run's second of two half as long */
+    c = defaults();
+    c.duration.value = 1.0;
+    const double edge = 1.0 * (1.0 - 1e-9);
+    const double shorter = nextafter(edge, 0.0);
+    start(&b, &c, 0.0, edge);
+    CHECK_EQ(cycle(&b, 5.0), 5.0);
+    CHECK_TRUE(!outputs(&b).limitingUp);
+    start(&b, &c, 0.0, shorter);
+    CHECK_EQ(cycle(&b, 5.0), shorter);        /* 1 per 1 s for one cycle */
+    CHECK_TRUE(outputs(&b).limitingUp);
+    start(&b, &c, 0.0, edge / 2);
+    rl_run(&b.state, &b.prepared, 5.0, 1, 2, edge / 2);
+    CHECK_EQ(b.state.y, 5.0);
+    start(&b, &c, 0.0, shorter / 2);
+    rl_run(&b.state, &b.prepared, 5.0, 1, 2, shorter / 2);
+    CHECK_EQ(b.state.y, shorter);
+
     /* 48 h Duration at 10 ms: the jump comes at cycle 25,920,000 exactly */
     c = defaults();
     c.rateUp.value = 1e-9;
