@@ -327,6 +327,25 @@ static void test_rule3_init_delay(void) {
     cycle(&b, 0.0);
     CHECK_EQ(cycle(&b, 500.0), 500.0);        /* ends at 30: within 1e-9 * 10 s, tracks */
     CHECK_EQ(cycle(&b, 0.0), 490.0);
+    /* the edge itself: a cycle ending at exactly initDelay + 1e-9 * T tracks */
+    c.initDelay = 0.3;
+    start(&b, &c, 0.0, 0.1);
+    const double edge = 0.3 + 1e-9 * 0.1;
+    rl_cycle(&b.state, &b.prepared, 5.0, edge);
+    CHECK_EQ(b.state.y, 5.0);
+    rl_cycle(&b.state, &b.prepared, -5.0, nextafter(edge, INFINITY));
+    CHECK_EQ(b.state.y, 4.9);
+    /* and resets runningTime (an initMode set to 3 while ramping) */
+    c.initMode = RL_INIT_INPUT;
+    start(&b, &c, 0.0, 1.0);
+    cycle(&b, 10.0);
+    cycle(&b, 10.0);
+    CHECK_EQ(rl_running_time(&b.state), 2.0);
+    c.initMode = RL_INIT_INPUT_DELAYED;
+    c.initDelay = 100.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 10.0), 10.0);
+    CHECK_EQ(rl_running_time(&b.state), 0.0);
 }
 
 static void test_rule4_invalid_previous_output(void) {
@@ -341,6 +360,17 @@ static void test_rule4_invalid_previous_output(void) {
     c.rateUp.value = -1;
     start(&b, &c, 3.0, 1.0);
     CHECK_EQ(cycle(&b, 4.0), 4.0);
+    /* an output ramped to +inf (Siemens comparison, no limit): a NaN u is
+     * not valid, the output stays; a number is passed and resets runningTime */
+    c = defaults();
+    c.passNonFinite = false;
+    c.rateUp.value = INFINITY;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, INFINITY), INFINITY);
+    CHECK_EQ(rl_running_time(&b.state), 1.0);
+    CHECK_EQ(cycle(&b, NAN), INFINITY);
+    CHECK_EQ(cycle(&b, 5.0), 5.0);
+    CHECK_EQ(rl_running_time(&b.state), 0.0);
 }
 
 static void test_rule5_configuration_error_holds(void) {
@@ -562,6 +592,17 @@ static void test_fast_paths_equal_rules(void) {
             first = last + 1;
         }
     }
+}
+
+/* rl_run of an empty range (first > last) runs no cycle */
+static void test_run_of_no_cycles(void) {
+    Block b;
+    RlConfig c = defaults();
+    start(&b, &c, 0.0, 0.5);
+    cycle(&b, 3.0);
+    const RlState before = b.state;
+    rl_run(&b.state, &b.prepared, 5.0, 3, 2, 0.5);
+    check_same_state(&b.state, &before);
 }
 
 /* The common step of the FMUs against the rules: once a cycle has run,
@@ -879,6 +920,7 @@ int main(void) {
     test_signed_zeros();
     test_running_time_period_change();
     test_fast_paths_equal_rules();
+    test_run_of_no_cycles();
     test_steady_ramp_equals_rules();
     test_status_section6();
     test_rates_by_sign();
