@@ -207,7 +207,26 @@ static void test_status_codes(void) {
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     c.duration.value = 0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
-    CHECK_TRUE(strlen(rl_status_text(0x8203)) > 0);
+    /* each status word's text, as the FMUs log it */
+    static const struct { int status; const char *text; } texts[] = {
+        { 0x0000, "no error" },
+        { 0x8200, "a rate is negative" },
+        { 0x8201, "a rate is NaN after falling back to its parameter" },
+        { 0x8202, "ratePeriod is negative or not finite" },
+        { 0x8203, "duration is negative, or NaN after falling back to its parameter" },
+        { 0x8204, "yMin is above yMax" },
+        { 0x8601, "no valid cycle configured" },
+        { 0x8000, "unknown status" },
+    };
+    for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+        const char *text = rl_status_text(texts[i].status);
+        checks++;
+        if (strcmp(text, texts[i].text) != 0) {
+            failures++;
+            printf("%s:%d: rl_status_text(0x%04X) is \"%s\", expected \"%s\"\n", __FILE__, __LINE__,
+                   (unsigned)texts[i].status, text, texts[i].text);
+        }
+    }
 }
 
 static void test_initialisation(void) {
@@ -850,6 +869,17 @@ static void test_derived_outputs(void) {
     CHECK_EQ(b.state.y, 10.0);                  /* the jump */
     CHECK_TRUE(!outputs(&b).limitingUp);
     CHECK_EQ(outputs(&b).dydt, 19.0);           /* (10 - 0.5) / 0.5 */
+    /* a leg at a rate of 0 that does not limit takes no time; the other
+     * one its own: 2 down to -3, 1.5 above 0 at 1/s */
+    c = defaults(); c.zeroRate = RL_ZERO_RATE_NO_LIMIT; c.rateDownNeg = (RlValue){ 0.0, SRC_RATE_DOWN_NEG };
+    start(&b, &c, 2.0, 0.5);
+    CHECK_EQ(cycle(&b, -3.0), 1.5);
+    CHECK_EQ(outputs(&b).remainingTime, 1.5);
+    /* a leg of no length takes no time, even at a rate of 0 that holds */
+    c = defaults(); c.rateUpNeg = (RlValue){ 0.0, SRC_RATE_UP_NEG };
+    start(&b, &c, 2.0, 0.5);
+    CHECK_EQ(cycle(&b, 5.0), 2.5);
+    CHECK_EQ(outputs(&b).remainingTime, 2.5);
     /* not finite: dydt 0, no limit flag */
     c = defaults();
     start(&b, &c, 0.0, 1.0);
