@@ -860,7 +860,30 @@ static void test_derived_outputs(void) {
     CHECK_EQ(outputs(&b).remainingTime, 0.75);  /* 1.5 / (0.5 / 0.25) */
     CHECK_EQ(outputs(&b).dydt, -2.0);
     CHECK_TRUE(outputs(&b).limitingDown);
-    /* the duration caps it */
+    /* a rate per ratePeriod of 2 s: 1 per 2 s is 0.5 per second */
+    c = defaults(); c.ratePeriod.value = 2.0;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, 3.0), 0.5);
+    CHECK_EQ(outputs(&b).remainingTime, 5.0);   /* 2.5 / 0.5 */
+    /* the duration caps it: what is left of it, when that is less */
+    c = defaults(); c.duration.value = 3.0;
+    start(&b, &c, 0.0, 0.5);
+    cycle(&b, 10.0);
+    CHECK_EQ(outputs(&b).remainingTime, 2.5);   /* min(9.5, 3 - 0.5) */
+    c.duration.value = 100.0;
+    start(&b, &c, 0.0, 0.5);
+    cycle(&b, 10.0);
+    CHECK_EQ(outputs(&b).remainingTime, 9.5);   /* min(9.5, 100 - 0.5) */
+    /* held past a duration cut below runningTime: nothing is left, 0 */
+    c = defaults(); c.duration.value = 10.0;
+    start(&b, &c, 0.0, 1.0);
+    cycle(&b, 10.0);
+    cycle(&b, 10.0);
+    c.hold = true;
+    c.duration.value = 1.5;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 10.0), 2.0);
+    CHECK_EQ(outputs(&b).remainingTime, 0.0);   /* min(8, max(0, 1.5 - 2)) */
     c = defaults(); c.duration.value = 1.0;
     start(&b, &c, 0.0, 0.5);
     cycle(&b, 10.0);
@@ -891,6 +914,40 @@ static void test_derived_outputs(void) {
 
 /* The vendor blocks have none of section 6: rl_without_section6 turns every
  * one of its features off, whatever the configuration held. */
+/* remainingTime over the legs of the way, each sign of y and uc, up and
+ * down: below 0 at the Neg rate, above at the other. Rates per 1 s: up 1,
+ * upNeg 0.5, down 2, downNeg 4; T = 0.25; y after one cycle from y0. */
+static void test_remaining_time_legs(void) {
+    static const struct { double y0, u, y, remaining; } ways[] = {
+        { -3.0, -1.0, -2.875, 3.75 },   /* up, both below 0: 1.875 / 0.5 */
+        { -3.0, -0.5, -2.875, 4.75 },   /* 2.375 / 0.5 */
+        { -3.0, 0.5, -2.875, 6.25 },    /* 2.875 / 0.5 + 0.5 / 1 */
+        { -0.5, 2.0, -0.375, 2.75 },    /* 0.375 / 0.5 + 2 / 1 */
+        { 1.0, 3.0, 1.25, 1.75 },       /* both above: 1.75 / 1 */
+        { 3.0, 1.0, 2.5, 0.75 },        /* down, both above 0: 1.5 / 2 */
+        { 3.0, 0.5, 2.5, 1.0 },         /* 2 / 2 */
+        { 3.0, -0.5, 2.5, 1.375 },      /* 2.5 / 2 + 0.5 / 4 */
+        { 0.75, -2.0, 0.25, 0.625 },    /* 0.25 / 2 + 2 / 4 */
+        { -1.0, -3.0, -2.0, 0.25 },     /* both below: 1 / 4 */
+        { -0.5, -3.0, -1.5, 0.375 },    /* 1.5 / 4 */
+        { 0.125, 2.0, 0.375, 1.625 },   /* up from above 0: 1.625 / 1 */
+        { 0.25, -3.0, -0.25, 0.6875 },  /* down from below 0: 2.75 / 4 */
+    };
+    for (size_t i = 0; i < sizeof ways / sizeof ways[0]; i++) {
+        Block b;
+        RlConfig c = defaults();
+        c.rateUp.value = 1.0;
+        c.rateUpNeg = (RlValue){ 0.5, SRC_RATE_UP_NEG };
+        c.rateDown.value = 2.0;
+        c.rateDownNeg = (RlValue){ 4.0, SRC_RATE_DOWN_NEG };
+        c.initMode = RL_INIT_VALUE;
+        c.initValue = ways[i].y0;
+        start(&b, &c, ways[i].u, 0.25);
+        CHECK_EQ(cycle(&b, ways[i].u), ways[i].y);
+        CHECK_EQ(outputs(&b).remainingTime, ways[i].remaining);
+    }
+}
+
 static void test_without_section6(void) {
     RlConfig c = defaults();
     c.rateUp = (RlValue){ 4.0, SRC_RATE_UP };
@@ -957,6 +1014,7 @@ int main(void) {
     test_output_limits();
     test_rule5b_hold();
     test_derived_outputs();
+    test_remaining_time_legs();
     test_without_section6();
     test_init_of_a_used_state();
     printf("%d passed, %d failed\n", checks - failures, failures);
