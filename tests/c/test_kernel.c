@@ -948,6 +948,81 @@ static void test_remaining_time_legs(void) {
     }
 }
 
+/* The derived outputs after each kind of cycle. Rates per cycle of 1 s:
+ * up and down 1, upNeg and downNeg 0.5, picked by the sign of yp. */
+static void test_derived_outputs_by_cycle(void) {
+    static const struct { double yp, u, y; bool limitingUp, limitingDown; } steps[] = {
+        { -2.0, -1.25, -1.5, true, false },   /* below 0: 0.5 per cycle */
+        { -0.5, 0.25, 0.0, true, false },
+        { 0.0, 0.75, 0.75, false, false },    /* 0 and above: 1 per cycle */
+        { 0.5, 1.25, 1.25, false, false },
+        { 2.0, 2.75, 2.75, false, false },
+        { 2.0, 3.0, 3.0, false, false },      /* the step ends on u: not cut */
+        { -2.0, -2.75, -2.5, false, true },
+        { -0.5, -1.25, -1.0, false, true },
+        { 0.0, -0.75, -0.75, false, false },
+        { 0.5, -0.25, -0.25, false, false },
+        { 2.0, 1.25, 1.25, false, false },
+        { 2.0, 1.0, 1.0, false, false },
+    };
+    Block b;
+    RlConfig c;
+    for (size_t i = 0; i < sizeof steps / sizeof steps[0]; i++) {
+        c = defaults();
+        c.rateUpNeg = (RlValue){ 0.5, SRC_RATE_UP_NEG };
+        c.rateDownNeg = (RlValue){ 0.5, SRC_RATE_DOWN_NEG };
+        c.initMode = RL_INIT_VALUE;
+        c.initValue = steps[i].yp;
+        start(&b, &c, steps[i].u, 1.0);
+        CHECK_EQ(cycle(&b, steps[i].u), steps[i].y);
+        CHECK_EQ(outputs(&b).limitingUp, steps[i].limitingUp);
+        CHECK_EQ(outputs(&b).limitingDown, steps[i].limitingDown);
+    }
+    /* hold and the duration jump cut no step */
+    c = defaults();
+    start(&b, &c, 2.0, 1.0);
+    c.hold = true;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, 0.0), 2.0);
+    CHECK_TRUE(!outputs(&b).limitingDown);
+    c = defaults(); c.duration.value = 1.0;
+    start(&b, &c, 10.0, 0.5);
+    CHECK_EQ(cycle(&b, 0.0), 9.5);
+    CHECK_TRUE(outputs(&b).limitingDown);
+    CHECK_EQ(cycle(&b, 0.0), 0.0);
+    CHECK_TRUE(!outputs(&b).limitingDown);
+    /* lowLimit: at yMin or below, finite */
+    c = defaults(); c.yMin.value = 1.0;
+    start(&b, &c, 3.0, 1.0);
+    CHECK_EQ(cycle(&b, 0.0), 2.0);
+    CHECK_TRUE(!outputs(&b).lowLimit);
+    CHECK_EQ(cycle(&b, 0.0), 1.0);
+    CHECK_TRUE(outputs(&b).lowLimit);
+    CHECK_EQ(cycle(&b, -INFINITY), -INFINITY);
+    CHECK_TRUE(!outputs(&b).lowLimit);
+    /* dydt after a jump of rules 1 to 4 (bypass): the jump per second */
+    c = defaults(); c.bypass = true; c.bypassValue = 8.0;
+    start(&b, &c, 1.0, 0.5);
+    CHECK_EQ(cycle(&b, 1.0), 8.0);
+    CHECK_EQ(outputs(&b).dydt, 14.0);
+    /* Siemens comparison: ramping towards +inf, remainingTime is 0 (uc not
+     * finite); at no limit the output reaches +inf, dydt 0; an output at
+     * +inf above a new yMax stays there, remainingTime 0 (y not finite) */
+    c = defaults(); c.passNonFinite = false;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, INFINITY), 1.0);
+    CHECK_EQ(outputs(&b).remainingTime, 0.0);
+    c.rateUp.value = INFINITY;
+    start(&b, &c, 0.0, 1.0);
+    CHECK_EQ(cycle(&b, INFINITY), INFINITY);
+    CHECK_EQ(outputs(&b).dydt, 0.0);
+    c.yMax.value = 5.0;
+    reconfigure(&b, &c);
+    CHECK_EQ(cycle(&b, INFINITY), INFINITY);
+    CHECK_TRUE(outputs(&b).rampActive);
+    CHECK_EQ(outputs(&b).remainingTime, 0.0);
+}
+
 static void test_without_section6(void) {
     RlConfig c = defaults();
     c.rateUp = (RlValue){ 4.0, SRC_RATE_UP };
@@ -1015,6 +1090,7 @@ int main(void) {
     test_rule5b_hold();
     test_derived_outputs();
     test_remaining_time_legs();
+    test_derived_outputs_by_cycle();
     test_without_section6();
     test_init_of_a_used_state();
     printf("%d passed, %d failed\n", checks - failures, failures);
