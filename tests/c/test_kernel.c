@@ -65,6 +65,18 @@ static RlConfig *resolved(RlConfig *c) {
     return c;
 }
 
+/* The defaults with all four rates set and the output starting at y0. */
+static RlConfig with_rates(double up, double upNeg, double down, double downNeg, double y0) {
+    RlConfig c = defaults();
+    c.rateUp.value = up;
+    c.rateUpNeg = (RlValue){ upNeg, SRC_RATE_UP_NEG };
+    c.rateDown.value = down;
+    c.rateDownNeg = (RlValue){ downNeg, SRC_RATE_DOWN_NEG };
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = y0;
+    return c;
+}
+
 typedef struct {
     RlConfig config;
     RlPrepared prepared;
@@ -718,13 +730,7 @@ static void test_status_section6(void) {
 
 static void test_rates_by_sign(void) {
     Block b;
-    RlConfig c = defaults();
-    c.rateUp.value = 2.0;
-    c.rateUpNeg = (RlValue){ 1.0, SRC_RATE_UP_NEG };
-    c.rateDown.value = 4.0;
-    c.rateDownNeg = (RlValue){ 0.5, SRC_RATE_DOWN_NEG };
-    c.initMode = RL_INIT_VALUE;
-    c.initValue = -1.0;
+    RlConfig c = with_rates(2.0, 1.0, 4.0, 0.5, -1.0);
     start(&b, &c, 3.0, 0.5);
     CHECK_TRUE(!b.prepared.plain);
     CHECK_EQ(cycle(&b, 3.0), -0.5);     /* below 0: rateUpNeg * 0.5 */
@@ -935,13 +941,7 @@ static void test_remaining_time_legs(void) {
     };
     for (size_t i = 0; i < sizeof ways / sizeof ways[0]; i++) {
         Block b;
-        RlConfig c = defaults();
-        c.rateUp.value = 1.0;
-        c.rateUpNeg = (RlValue){ 0.5, SRC_RATE_UP_NEG };
-        c.rateDown.value = 2.0;
-        c.rateDownNeg = (RlValue){ 4.0, SRC_RATE_DOWN_NEG };
-        c.initMode = RL_INIT_VALUE;
-        c.initValue = ways[i].y0;
+        RlConfig c = with_rates(1.0, 0.5, 2.0, 4.0, ways[i].y0);
         start(&b, &c, ways[i].u, 0.25);
         CHECK_EQ(cycle(&b, ways[i].u), ways[i].y);
         CHECK_EQ(outputs(&b).remainingTime, ways[i].remaining);
@@ -968,11 +968,7 @@ static void test_derived_outputs_by_cycle(void) {
     Block b;
     RlConfig c;
     for (size_t i = 0; i < sizeof steps / sizeof steps[0]; i++) {
-        c = defaults();
-        c.rateUpNeg = (RlValue){ 0.5, SRC_RATE_UP_NEG };
-        c.rateDownNeg = (RlValue){ 0.5, SRC_RATE_DOWN_NEG };
-        c.initMode = RL_INIT_VALUE;
-        c.initValue = steps[i].yp;
+        c = with_rates(1.0, 0.5, 1.0, 0.5, steps[i].yp);
         start(&b, &c, steps[i].u, 1.0);
         CHECK_EQ(cycle(&b, steps[i].u), steps[i].y);
         CHECK_EQ(outputs(&b).limitingUp, steps[i].limitingUp);
