@@ -87,8 +87,7 @@ def test_misuse_is_an_error_and_the_instance_recovers(version, misuse):
     assert call_status(fmu.step, 0.5) == 3
     assert f"not allowed in {'Error' if version == 2 else 'Terminated'}" in fmu.errors()[-1][2]
     assert fmu.get("y") == 1.0 and fmu.get("cycleTime") == 0.0 and fmu.get("zeroRate") == 1
-    api["set"](good)
-    fmu.t = t
+    fmu.restore(good, t)
     fmu.step(0.5)
     assert fmu.get("y") == 2.0
     api["free"](good)

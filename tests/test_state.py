@@ -32,8 +32,7 @@ def test_rollback_repeats_the_run(version):
     run_steps(fmu, STEPS[:7])
     state, t = api["get"](), fmu.t
     first = run_steps(fmu, STEPS[7:])
-    api["set"](state)
-    fmu.t = t
+    fmu.restore(state, t)
     assert run_steps(fmu, STEPS[7:]) == first
     api["free"](state)
     fmu.free()
@@ -53,8 +52,7 @@ def test_a_state_taken_before_the_outputs_were_read_holds_them(version):
         state = api["get"]()
         fmu.step(0.5)
         assert (fmu.get("y"), fmu.get("runningTime")) == (2.0, 1.0)
-        api["set"](state)
-        fmu.t = 0.5
+        fmu.restore(state, 0.5)
         assert (fmu.get("y"), fmu.get("runningTime"), fmu.get("time")) == (1.0, 0.5, 0.5)
         api["free"](state)
     finally:
@@ -79,8 +77,7 @@ def test_a_restored_state_has_its_own_outputs(version):
         fmu.step(1.0)
         assert (fmu.get("y"), fmu.get("remainingTime")) == (5.0, 1.25)
         fmu.step(1.0)  # y = 9, not read
-        api["set"](state)
-        fmu.t = 1.0
+        fmu.restore(state, 1.0)
         assert (fmu.get("y"), fmu.get("remainingTime")) == (1.0, 9.0)
         assert math.isnan(fmu.get("rateUp"))  # the state's input: not connected
         fmu.step(1.0)
@@ -229,16 +226,14 @@ def test_bad_serialized_state_is_refused_and_the_instance_recovers(version, dama
     data = bytes(api["serialize"](good))
     t = fmu.t
     expected = run_steps(fmu, STEPS[5:9])
-    api["set"](good)
-    fmu.t = t
+    fmu.restore(good, t)
     assert call_status(api["deserialize"], BAD_BYTES[damage](data)) == 3
     errors = fmu.errors()
     assert len(errors) == 1 and "deserialize" in errors[0][2].lower(), errors
     assert REASONS[damage] in errors[0][2], errors
     # refused until recovery, as the standard says; a good state recovers it
     assert call_status(fmu.step, 0.25) == 3
-    api["set"](good)
-    fmu.t = t
+    fmu.restore(good, t)
     assert run_steps(fmu, STEPS[5:9]) == expected
     api["free"](good)
     fmu.free()
