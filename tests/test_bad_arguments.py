@@ -11,8 +11,8 @@ from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYP
                        fmi2CallbackLoggerTYPE)
 from fmpy.fmi3 import fmi3LogMessageCallback
 
-from support.fmu_driver import Instance, call_status
-from test_conformance import NOT_INSTANCE_CALLS, exported_functions
+from support.fmu_driver import STATE_FUNCTIONS, Instance, call_status, state_api
+from test_conformance import NOT_INSTANCE_CALLS, exported_functions, raw
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -201,7 +201,9 @@ def test_fmi3_instantiation_refusals_name_the_first_problem():
         token = fmu.md.instantiationToken.encode()
         cases = [
             ((b"", b"wrong", True, 1), "instanceName is missing"),
+            ((None, token, False, 0), "instanceName is missing"),
             ((b"a", b"wrong", True, 1), "the instantiationToken does not match this FMU's model description"),
+            ((b"a", None, False, 0), "the instantiationToken does not match this FMU's model description"),
             ((b"a", token, True, 1), "this FMU has no Event Mode (hasEventMode = false)"),
             ((b"a", token, False, 1), "this FMU provides no intermediate update"),
         ]
@@ -232,18 +234,32 @@ def test_fmi2_instantiation_refusals_name_the_first_problem():
         instantiate = fmi2_instantiate_function(fmu.fmu.dll)
         messages = []
         callbacks = fmi2CallbackFunctions()
-        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((s, c, m)))
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((n, s, c, m)))
         callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         guid = fmu.md.guid.encode()
         cases = [((b"", 0, b"wrong"), "instanceName is missing"),
+                 ((None, 1, guid), "instanceName is missing"),
                  ((b"a", 0, b"wrong"), "this FMU supports Co-Simulation only"),
-                 ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description")]
+                 ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description"),
+                 ((b"a", 1, None), "the GUID does not match this FMU's model description")]
         for (name, kind, given), reason in cases:
             messages.clear()
             assert instantiate(name, kind, given, None, byref(callbacks), 0, 0) is None
-            assert messages == [(3, b"logStatusError", reason.encode())], (reason, messages)
+            # a missing name is logged as "?"
+            assert messages == [(b"?" if name is None else name, 3, b"logStatusError", reason.encode())], (reason, messages)
         assert instantiate(b"a", 1, guid, None, None, 0, 0) is None  # no callbacks: nothing to allocate with
+        for missing in ("allocateMemory", "freeMemory"):  # half a memory manager: nothing allocated
+            partial = fmi2CallbackFunctions()
+            partial.logger = callbacks.logger
+            partial.allocateMemory = callbacks.allocateMemory if missing == "freeMemory" else \
+                fmi2CallbackAllocateMemoryTYPE()
+            partial.freeMemory = callbacks.freeMemory if missing == "allocateMemory" else fmi2CallbackFreeMemoryTYPE()
+            assert instantiate(b"a", 1, guid, None, byref(partial), 0, 0) is None, missing
+        silent = fmi2CallbackFunctions()  # no logger: refused, nothing called
+        silent.allocateMemory, silent.freeMemory = callbacks.allocateMemory, callbacks.freeMemory
+        messages.clear()
+        assert instantiate(b"a", 1, b"wrong", None, byref(silent), 0, 0) is None and messages == []
     finally:
         fmu.free()
 
@@ -303,11 +319,14 @@ def test_fmi3_accessors_of_types_without_variables_refuse_every_value_reference(
             else:
                 function.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t]
             function.restype = c_int
-            for vrs, message in (([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
-                                 ([u, u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
-                                 ([999, u], "unknown value reference 999")):
+            cases = [([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                     ([u, u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                     ([999, u], "unknown value reference 999")]
+            if kind == "Binary":
+                cases.append(([u], "the valueSizes array is NULL"))
+            for number, (vrs, message) in enumerate(cases):
                 array = (c_uint * len(vrs))(*vrs)
-                args = (sizes, buffer) if kind == "Binary" else (buffer,)
+                args = ((sizes if number < 3 else None), buffer) if kind == "Binary" else (buffer,)
                 assert function(c, array, len(vrs), *args, len(vrs)) == 3, (name, vrs)
                 assert fmu.errors()[-1][2] == f"{name}: {message}", (name, vrs)
                 fmu.fmu.reset()
@@ -383,20 +402,28 @@ def test_a_null_array_is_refused_naming_which_one(version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_a_foreign_fmu_state_is_refused_by_every_state_function(version):
-    """Its size, serializing it and freeing it: an error naming the function,
-    nothing written or freed, no crash (setting one: test_misuse.py)."""
+    """Its size, serializing it, getting or deserializing into it and freeing
+    it: an error naming the function, nothing written or freed, no crash
+    (setting one: test_misuse.py)."""
     fmu = Instance("RateLimiter", version)
     try:
         fmu.start()
         c, dll = fmu.fmu.component, fmu.fmu.dll
         junk = ctypes.create_string_buffer(b"\x5a" * 4096)
         foreign = ctypes.cast(junk, c_void_p)
-        names = {2: ("fmi2SerializedFMUstateSize", "fmi2SerializeFMUstate", "fmi2FreeFMUstate"),
-                 3: ("fmi3SerializedFMUStateSize", "fmi3SerializeFMUState", "fmi3FreeFMUState")}[version]
+        names = [STATE_FUNCTIONS[version][which] for which in ("size", "serialize", "get", "deserialize")]
+        names.append(f"fmi{version}FreeFMU{'s' if version == 2 else 'S'}tate")
+        api = state_api(fmu)
+        good = api["get"]()
+        data = bytes(api["serialize"](good))
+        api["free"](good)
         size, out = c_size_t(7), ctypes.create_string_buffer(4096)
         calls = {names[0]: ([c_void_p, c_void_p, c_void_p], (c, foreign, byref(size))),
                  names[1]: ([c_void_p, c_void_p, c_void_p, c_size_t], (c, foreign, out, 4096)),
-                 names[2]: ([c_void_p, c_void_p], (c, byref(foreign)))}
+                 # given a state to fill, it must be one of this FMU's
+                 names[2]: ([c_void_p, c_void_p], (c, byref(foreign))),
+                 names[3]: ([c_void_p, c_char_p, c_size_t, c_void_p], (c, data, len(data), byref(foreign))),
+                 names[4]: ([c_void_p, c_void_p], (c, byref(foreign)))}
         for name, (argtypes, args) in calls.items():
             function = getattr(dll, name)
             function.argtypes, function.restype = argtypes, c_int
@@ -437,5 +464,219 @@ def test_set_debug_logging_refuses_a_null_category_array_and_escapes_a_bad_name(
         long_name = "x" * 1000  # the reason is cut at 399 characters (docs/fmi.md)
         assert function(fmu.fmu.component, 1, 1, (c_char_p * 1)(long_name.encode())) == 3
         assert fmu.errors()[-1][2] == f"{name}: " + f'unknown log category "{long_name}"'[:399]
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_serializing_into_a_short_byte_array_is_refused_and_writes_nothing(version):
+    """One byte short: an error giving both sizes, not a write past the end;
+    exactly the size: fine."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        api = state_api(fmu)
+        state = api["get"]()
+        c, name = fmu.fmu.component, STATE_FUNCTIONS[version]["serialize"]
+        size = c_size_t()
+        assert raw(fmu, STATE_FUNCTIONS[version]["size"], [c_void_p, c_void_p, c_void_p], c, state, byref(size)) == 0
+        n = size.value
+        out = ctypes.create_string_buffer(b"\xa5" * (n + 8), n + 8)
+        assert raw(fmu, name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, out, n - 1) == 3
+        assert fmu.errors()[-1][2] == f"{name}: the byte array has {n - 1} bytes; the state needs {n}"
+        assert out.raw == b"\xa5" * (n + 8)
+        fmu.fmu.reset()
+        assert raw(fmu, name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, out, n) == 0
+        assert out.raw[:n] == bytes(api["serialize"](state)) and out.raw[n:] == b"\xa5" * 8
+        api["free"](state)
+    finally:
+        fmu.free()
+
+
+def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
+    """The importer's allocateMemory refuses the state (FMI 2 keeps FMU
+    states in the importer's memory): getting or deserializing one is an
+    error saying so, the pointer stays NULL, the instance runs on after a
+    reset."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        refuse, live, messages = [False], set(), []
+
+        def allocate(count, size):
+            if refuse[0]:
+                return None
+            block = calloc(count, size)
+            live.add(block)
+            return block
+
+        def release(block):
+            live.discard(block)
+            free(block)
+
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((s, m.decode())))
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(allocate)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(release)
+        dll = fmu.fmu.dll
+        c = fmi2_instantiate_function(dll)(b"a", 1, fmu.md.guid.encode(), None, byref(callbacks), 0, 1)
+        assert c
+        held = set(live)  # the instance and its name
+        state = c_void_p()
+        assert raw(fmu, "fmi2GetFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0
+        data = ctypes.create_string_buffer(4096)
+        size = c_size_t()
+        assert raw(fmu, "fmi2SerializedFMUstateSize", [c_void_p, c_void_p, c_void_p], c, state, byref(size)) == 0
+        assert raw(fmu, "fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], c, state, data,
+                   size.value) == 0
+        assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and live == held
+        refuse[0] = True
+        for name, argtypes, args in (("fmi2GetFMUstate", [c_void_p, c_void_p], ()),
+                                     ("fmi2DeSerializeFMUstate", [c_void_p, c_void_p, c_size_t, c_void_p],
+                                      (data, size.value))):
+            messages.clear()
+            empty = c_void_p()
+            assert raw(fmu, name, argtypes, c, *args, byref(empty)) == 3
+            assert messages == [(3, f"{name}: out of memory")] and empty.value is None and live == held
+            assert raw(fmu, "fmi2Reset", [c_void_p], c) == 0
+        refuse[0] = False
+        assert raw(fmu, "fmi2GetFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and state.value
+        assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and live == held
+        release_instance = dll.fmi2FreeInstance
+        release_instance.argtypes, release_instance.restype = [c_void_p], None
+        release_instance(c)
+        assert live == set()
+    finally:
+        fmu.free()
+
+
+def test_fmi2_status_queries_answer_only_what_this_fmu_has():
+    """fmi2GetXXXStatus: the last successful time (fmi2LastSuccessfulTime = 2)
+    and 'terminated' (fmi2Terminated = 3, always false: the FMU never stops a
+    run) are answered; every other kind is fmi2Discard (nothing asynchronous
+    here: doStep never returns fmi2Pending). A NULL value pointer for an
+    answered kind is an error, not a write through NULL."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        fmu.start(rateUpPar=2.0)
+        fmu.set(u=5.0)
+        fmu.step(0.5)
+        fmu.step(0.25)
+        c = fmu.fmu.component
+        real, flag, integer = c_double(-1.0), c_int(7), c_int(7)
+        text = c_char_p(b"untouched")
+        query = [c_void_p, c_int, c_void_p]
+        for kind in range(4):
+            answered_real, answered_flag = kind == 2, kind == 3
+            assert raw(fmu, "fmi2GetRealStatus", query, c, kind, byref(real)) == (0 if answered_real else 2), kind
+            assert raw(fmu, "fmi2GetBooleanStatus", query, c, kind, byref(flag)) == (0 if answered_flag else 2), kind
+            for name, value in (("fmi2GetStatus", integer), ("fmi2GetIntegerStatus", integer),
+                                ("fmi2GetStringStatus", text)):
+                assert raw(fmu, name, query, c, kind, byref(value)) == 2, (name, kind)
+        assert real.value == 0.75 and flag.value == 0 and integer.value == 7 and text.value == b"untouched"
+        assert fmu.messages == []
+        for name, kind in (("fmi2GetRealStatus", 2), ("fmi2GetBooleanStatus", 3)):
+            fmu.fmu.reset()
+            fmu.start(rateUpPar=2.0)
+            fmu.set(u=5.0)
+            fmu.step(0.5)
+            assert raw(fmu, name, query, c, kind, None) == 3
+            assert fmu.errors()[-1][2] == f"{name}: the value pointer is NULL"
+            assert fmu.get("y") == 1.0  # the last good values
+    finally:
+        fmu.free()
+
+
+def test_the_version_functions_name_the_standard():
+    fmu2, fmu3 = Instance("RateLimiter", 2), Instance("RateLimiter", 3)
+    try:
+        for fmu, name, expected in ((fmu2, "fmi2GetTypesPlatform", b"default"), (fmu2, "fmi2GetVersion", b"2.0"),
+                                    (fmu3, "fmi3GetVersion", b"3.0")):
+            function = getattr(fmu.fmu.dll, name)
+            function.argtypes, function.restype = [], c_char_p
+            assert function() == expected, name
+    finally:
+        fmu2.free()
+        fmu3.free()
+
+
+def test_fmi3_a_step_with_a_null_output_pointer_is_refused_and_the_time_stays():
+    """Each of fmi3DoStep's four output pointers NULL in turn: an error
+    naming the function, the time and outputs stay at the last good step."""
+    fmu = Instance("RateLimiter", 3)
+    try:
+        for missing in range(4):
+            fmu.start(rateUpPar=2.0)
+            fmu.set(u=5.0)
+            fmu.step(0.5)
+            flags, when = (c_bool * 3)(), c_double()
+            outputs = [byref(flags, 0), byref(flags, 1), byref(flags, 2), byref(when)]
+            outputs[missing] = None
+            assert raw(fmu, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4,
+                       fmu.fmu.component, 0.5, 0.5, True, *outputs) == 3, missing
+            assert fmu.errors()[-1][2] == "fmi3DoStep: an output argument pointer is NULL", missing
+            assert (fmu.get("time"), fmu.get("y")) == (0.5, 1.0), missing
+            fmu.fmu.reset()
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("interface", ["ModelExchange", "ScheduledExecution"])
+def test_fmi3_other_interfaces_are_refused_with_a_reason(interface):
+    """Co-Simulation only: no instance; the reason goes to the logger when
+    logging is on, and nothing is called otherwise."""
+    fmu = Instance("RateLimiter", 3)
+    try:
+        function = getattr(fmu.fmu.dll, f"fmi3Instantiate{interface}")
+        function.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_void_p, fmi3LogMessageCallback] + \
+            [c_void_p] * (3 if interface == "ScheduledExecution" else 0)
+        function.restype = c_void_p
+        messages = []
+        log = fmi3LogMessageCallback(lambda env, status, category, message: messages.append((status, category, message)))
+        extra = [None] * (3 if interface == "ScheduledExecution" else 0)
+        token = fmu.md.instantiationToken.encode()
+        assert function(b"a", token, None, False, True, None, log, *extra) is None
+        assert messages == [(3, b"logStatusError", b"this FMU supports Co-Simulation only")]
+        messages.clear()
+        assert function(b"a", token, None, False, False, None, log, *extra) is None
+        assert function(b"a", token, None, False, True, None, fmi3LogMessageCallback(), *extra) is None
+        assert messages == []
+    finally:
+        fmu.free()
+
+
+def test_fmi2_string_accessors_refuse_every_value_reference():
+    """No variable is a String: any value reference is refused, naming the
+    variable's own type, or as unknown."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        fmu.start()
+        c, u = fmu.fmu.component, fmu.vr("u")
+        texts = (c_char_p * 2)(b"a", b"b")
+        for access in ("Get", "Set"):
+            name = f"fmi2{access}String"
+            for vrs, message in (([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                                 ([999], "unknown value reference 999")):
+                array = (c_uint * len(vrs))(*vrs)
+                assert raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, array, len(vrs), texts) == 3
+                assert fmu.errors()[-1][2] == f"{name}: {message}", (name, vrs)
+                fmu.fmu.reset()
+                fmu.start()
+        assert texts[0] == b"a" and fmu.get("u") == 0.0
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_freeing_through_a_null_pointer_or_a_null_state_does_nothing(version):
+    """FMI: freeing a NULL state is a no-op; a NULL pointer to one too."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        name = f"fmi{version}FreeFMU{'s' if version == 2 else 'S'}tate"
+        empty = c_void_p()
+        assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, None) == 0
+        assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, byref(empty)) == 0
+        assert fmu.messages == []
+        fmu.step(0.5)
     finally:
         fmu.free()

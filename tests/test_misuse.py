@@ -7,7 +7,7 @@ import math
 import pytest
 from fmpy.fmi2 import FMU2Slave
 
-from support.fmu_driver import Instance, call_status, state_api, unzipped
+from support.fmu_driver import STATE_FUNCTIONS, Instance, call_status, state_api, unzipped
 
 
 def set_raw(fmu, vr, value, kind="Real"):
@@ -39,6 +39,27 @@ def foreign_state(fmu):
     return call_status(state_api(fmu)["set"], ctypes.cast(junk, ctypes.c_void_p))
 
 
+def null_in_state_call(fmu, case):
+    """An FMU-state function given NULL where a pointer belongs; every other argument good."""
+    api = state_api(fmu)
+    state = api["get"]()
+    data = bytes(api["serialize"](state))
+    size = ctypes.c_size_t()
+    p, n = ctypes.c_void_p, ctypes.c_size_t
+    calls = {"get": ("get", [p, p], (None,)),
+             "set": ("set", [p, p], (None,)),
+             "size of NULL": ("size", [p, p, p], (None, ctypes.byref(size))),
+             "size pointer": ("size", [p, p, p], (state, None)),
+             "byte array": ("serialize", [p, p, p, n], (state, None, len(data))),
+             "deserialize": ("deserialize", [p, ctypes.c_char_p, n, p], (data, len(data), None))}
+    which, argtypes, args = calls[case]
+    function = getattr(fmu.fmu.dll, STATE_FUNCTIONS[fmu.version][which])
+    function.argtypes, function.restype = argtypes, ctypes.c_int
+    status = function(fmu.fmu.component, *args)
+    api["free"](state)
+    return status
+
+
 # name: (misuse, words the log message must contain)
 MISUSES = {
     "step size zero": (lambda f: call_status(f.fmu.doStep, f.t, 0.0),
@@ -63,6 +84,13 @@ MISUSES = {
     "null arrays": (null_arrays, "NULL"),
     "call in the wrong state": (lambda f: call_status(f.fmu.exitInitializationMode), "not allowed in Step Mode"),
     "foreign FMU state": (foreign_state, "not an FMU state"),
+    "FMU state pointer NULL (get)": (lambda f: null_in_state_call(f, "get"), ": the FMU state pointer is NULL"),
+    "FMU state pointer NULL (deserialize)": (lambda f: null_in_state_call(f, "deserialize"),
+                                             ": the FMU state pointer is NULL"),
+    "FMU state NULL (set)": (lambda f: null_in_state_call(f, "set"), ": the FMU state is NULL"),
+    "FMU state NULL (serialized size)": (lambda f: null_in_state_call(f, "size of NULL"), ": the FMU state is NULL"),
+    "size pointer NULL": (lambda f: null_in_state_call(f, "size pointer"), ": the size pointer is NULL"),
+    "byte array NULL": (lambda f: null_in_state_call(f, "byte array"), ": the byte array is NULL"),
 }
 
 

@@ -6,11 +6,11 @@ import struct
 import sys
 import zlib
 
-from ctypes import byref, c_int, c_size_t, c_void_p
+from ctypes import byref, c_char_p, c_int, c_size_t, c_void_p
 
 import pytest
 
-from support.fmu_driver import MODELS, TESTS, Instance, call_status, run_steps, state_api
+from support.fmu_driver import MODELS, STATE_FUNCTIONS, TESTS, Instance, call_status, run_steps, state_api
 from support.process import run as run_bounded
 
 # inputs and step sizes of a run: ramps, a change, NaN, sub-cycling steps
@@ -166,6 +166,8 @@ def values_end(d):
 
 
 BLOCK = 8 + 8 + 8 + 1 + 8 + 8 + 8  # y, uPrevious, yPrevious, decided, runCycles, runPeriod, runBase
+MODE_OFFSET = -12  # mode, reported status, CRC at the end
+ERROR_MODE = 16  # FMI 2's Error state, as the core numbers its modes
 
 BAD_BYTES = {
     "truncated": lambda d: d[: len(d) // 2],
@@ -175,7 +177,7 @@ BAD_BYTES = {
     "foreign magic": lambda d: b"XXXX" + d[4:],
     "future version": lambda d: reseal(d[:4] + struct.pack("<I", 99) + d[8:]),
     "another model": lambda d: reseal(d[:8] + struct.pack("<I", 0x12345678) + d[12:]),
-    "invalid mode": lambda d: reseal(d[:-12] + struct.pack("<I", 12345) + d[-8:]),
+    "invalid mode": lambda d: value_at(d, len(d) + MODE_OFFSET, struct.pack("<I", 12345)),
     # checksums right, values impossible (found by the fuzzer: a NaN enumeration)
     "enumeration NaN": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", float("nan"))),  # zeroRate
     "boolean 2": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", 2.0)),  # bypass
@@ -196,6 +198,20 @@ BAD_BYTES = {
     "running cycle count 2^53 + 1": lambda d: value_at(d, values_end(d) + 25, struct.pack("<Q", (1 << 53) + 1)),
     "enumeration below its range": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", 0.0)),  # zeroRate
     "enumeration above its range": lambda d: value_at(d, 20 + 8 * 12, struct.pack("<d", 3.0)),
+    # the header's own edges: 16 bytes (magic, version, model, payload size), read, then refused by size;
+    # fewer, or the magic alone, refused before any field past the bytes given is read
+    "header alone": lambda d: d[:16],
+    "header one byte short": lambda d: d[:15],
+    "magic alone": lambda d: d[:4],
+    "payload size wrong, resealed": lambda d: value_at(d, 12, struct.pack("<I", struct.unpack_from("<I", d, 12)[0] + 8)),
+    "boolean -1": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", -1.0)),  # bypass
+    "boolean one half": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", 0.5)),
+    "integer -2^31 - 1": lambda d: value_at(d, 20 + 8 * 21, struct.pack("<d", -2147483649.0)),
+    "time infinite": lambda d: value_at(d, values_end(d) + BLOCK + 8, struct.pack("<d", float("inf"))),
+    "running time period infinite": lambda d: value_at(d, values_end(d) + 33, struct.pack("<d", float("inf"))),
+    "running time base infinite": lambda d: value_at(d, values_end(d) + 41, struct.pack("<d", float("inf"))),
+    # the variable count (after the header) disagrees with the model; size and CRC right
+    "variable count one more": lambda d: value_at(d, 16, struct.pack("<I", struct.unpack_from("<I", d, 16)[0] + 1)),
 }
 
 
@@ -213,7 +229,78 @@ REASONS = {
     "running cycle count 2^53 + 1": "impossible time or cycle count",
     "enumeration below its range": "impossible value 0 for zeroRate",
     "enumeration above its range": "impossible value 3 for zeroRate",
+    "variable count one more": "wrong number of variables",
+    "header alone": "16 bytes; expected", "header one byte short": "(15 bytes, no header)",
+    "magic alone": "(4 bytes, no header)", "payload size wrong, resealed": "bytes; expected",
+    "boolean -1": "impossible value -1 for bypass", "boolean one half": "impossible value 0.5 for bypass",
+    "integer -2^31 - 1": "impossible value -2.14748e+09 for status", "time infinite": "impossible time",
+    "running time period infinite": "impossible time", "running time base infinite": "impossible time",
 }
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_state_is_got_or_deserialized_into_an_existing_one_in_place(version):
+    """Given a state it returned before, getting or deserializing overwrites
+    that state and returns the same pointer (FMI 2.0 section 2.1.8, FMI 3.0
+    section 2.2.6.4: "typically reuses the memory of this FMUstate")."""
+    fmu = started(version)
+    api = state_api(fmu)
+    c, dll = fmu.fmu.component, fmu.fmu.dll
+    run_steps(fmu, STEPS[:4])
+    got, deserialized = api["get"](), api["get"]()
+    run_steps(fmu, STEPS[4:8])
+    t = fmu.t
+    get, deserialize = (getattr(dll, STATE_FUNCTIONS[version][name]) for name in ("get", "deserialize"))
+    get.argtypes, get.restype = [c_void_p, c_void_p], c_int
+    deserialize.argtypes, deserialize.restype = [c_void_p, c_char_p, c_size_t, c_void_p], c_int
+    handle = c_void_p(got.value)
+    assert get(c, byref(handle)) == 0 and handle.value == got.value
+    data = bytes(api["serialize"](got))  # at t now
+    handle = c_void_p(deserialized.value)
+    assert deserialize(c, data, len(data), byref(handle)) == 0 and handle.value == deserialized.value
+    expected = run_steps(fmu, STEPS[8:12])
+    for state in (got, deserialized):
+        fmu.restore(state, t)  # a state still at the earlier time would refuse the step at t
+        assert run_steps(fmu, STEPS[8:12]) == expected
+        api["free"](state)
+    assert not fmu.errors()
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_state_taken_after_an_error_carries_the_error_mode_fmi2_only(version):
+    """FMI 2 may get, serialize and set a state in its Error state: the
+    instance set to it is in Error (a step is refused, the last good values
+    are read), and reset recovers it. FMI 3 has no Error state (an error
+    leads to Terminated), so bytes claiming one are refused."""
+    fmu = started(version)
+    api = state_api(fmu)
+    fmu.set(u=10.0)
+    fmu.step(0.5)  # 3 per s: y = 1.5
+    assert call_status(fmu.fmu.doStep, fmu.t + 1.0, 0.5) == 3
+    data = bytes(api["serialize"](api["get"]()))
+    error_mode = struct.unpack_from("<I", data, len(data) + MODE_OFFSET)[0]
+    assert error_mode == (ERROR_MODE if version == 2 else 8)
+    fresh = Instance("RateLimiter", version, name="fresh")
+    try:
+        fresh_api = state_api(fresh)
+        if version == 3:
+            claimed = value_at(data, len(data) + MODE_OFFSET, struct.pack("<I", ERROR_MODE))
+            assert call_status(fresh_api["deserialize"], claimed) == 3
+            assert "invalid mode 16" in fresh.errors()[-1][2]
+            fresh.fmu.reset()
+        fresh.restore(fresh_api["deserialize"](data), 0.5)
+        assert fresh.get("y") == 1.5
+        assert call_status(fresh.step, 0.5) == 3
+        assert f"not allowed in {'Error' if version == 2 else 'Terminated'}" in fresh.errors()[-1][2]
+        fresh.fmu.reset()
+        fresh.start(rateUpPar=2.0)
+        fresh.set(u=1.0)
+        fresh.step(0.25)
+        assert fresh.get("y") == 0.5
+    finally:
+        fresh.release()
+    fmu.free()
 
 
 @pytest.mark.parametrize("version", [2, 3])

@@ -178,6 +178,13 @@ def state_api(fmu):
             "serialize": f.serializeFMUState, "deserialize": f.deserializeFMUState}
 
 
+# the FMU-state functions' exported names, for calls through ctypes
+STATE_FUNCTIONS = {2: {"get": "fmi2GetFMUstate", "set": "fmi2SetFMUstate", "size": "fmi2SerializedFMUstateSize",
+                       "serialize": "fmi2SerializeFMUstate", "deserialize": "fmi2DeSerializeFMUstate"},
+                   3: {"get": "fmi3GetFMUState", "set": "fmi3SetFMUState", "size": "fmi3SerializedFMUStateSize",
+                       "serialize": "fmi3SerializeFMUState", "deserialize": "fmi3DeserializeFMUState"}}
+
+
 def run_steps(fmu, steps, names=STATE_OUTPUTS):
     """Set inputs, step, and record the outputs as exact hex floats."""
     trace = []
