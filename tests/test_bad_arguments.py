@@ -84,21 +84,36 @@ def test_duplicate_value_references_take_the_last_value(version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_stop_time_before_start_time_is_refused(version):
+    """A stop time before the start time is refused; one equal to it (an
+    experiment of no length) is not, nor one that is not defined."""
     fmu = Instance("RateLimiter", version)
     try:
         c, dll = fmu.fmu.component, fmu.fmu.dll
         if version == 2:
+            name = "fmi2SetupExperiment"
             setup = dll.fmi2SetupExperiment
             setup.argtypes, setup.restype = [c_void_p, c_int, c_double, c_double, c_int, c_double], c_int
-            assert setup(c, 0, 0.0, 10.0, 1, 5.0) == 3
+            begin = lambda start, defined, stop: setup(c, 0, 0.0, start, defined, stop)  # noqa: E731
         else:
+            name = "fmi3EnterInitializationMode"
             enter = dll.fmi3EnterInitializationMode
             enter.argtypes, enter.restype = [c_void_p, c_bool, c_double, c_double, c_bool, c_double], c_int
-            assert enter(c, False, 0.0, 10.0, True, 5.0) == 3
-        assert "stopTime" in fmu.errors()[-1][2]
+            begin = lambda start, defined, stop: enter(c, False, 0.0, start, defined, stop)  # noqa: E731
+        assert begin(10.0, True, 5.0) == 3
+        assert fmu.errors()[-1][2] == f"{name}: stopTime 5 is before startTime 10"
         fmu.fmu.reset()  # the standard's way on from an error
         fmu.start(start_time=10.0)
         fmu.step(0.5)
+        for stop, defined in ((10.0, True), (5.0, False)):
+            fmu.fmu.reset()
+            assert begin(10.0, defined, stop) == 0, (stop, defined)
+            if version == 2:
+                fmu.fmu.enterInitializationMode()
+            fmu.fmu.exitInitializationMode()
+            fmu.t = 10.0
+            fmu.step(0.5)
+            assert fmu.get("time") == 10.5
+        assert not fmu.errors()[1:]
     finally:
         fmu.free()
 

@@ -269,3 +269,24 @@ def test_calls_after_an_error_are_refused_until_reset(version):
         assert fmu.get("y") == pytest.approx(0.1)
     finally:
         fmu.free()
+
+
+def test_fmi3_a_step_reports_no_event_no_stop_no_early_return_and_its_end():
+    """fmi3DoStep's outputs (FMI 3.0 section 4.2.3): this FMU has no events,
+    never asks to stop and never returns early, so the three flags are
+    false and lastSuccessfulTime is the end of the step; on the first step,
+    a repeated step size (the common step's fast path) and a new one."""
+    fmu = Instance("RateLimiter", 3)
+    try:
+        fmu.start(rateUpPar=2.0, cycleTime=0.1)
+        do_step = fmu.fmu.dll.fmi3DoStep
+        do_step.argtypes, do_step.restype = [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4, c_int
+        t = 0.0
+        for h in (0.5, 0.5, 0.5, 0.25, 1.0):
+            flags, when = (c_bool * 3)(True, True, True), c_double(-1.0)
+            assert do_step(fmu.fmu.component, t, h, True, ctypes.byref(flags, 0), ctypes.byref(flags, 1),
+                           ctypes.byref(flags, 2), ctypes.byref(when)) == 0
+            t += h
+            assert list(flags) == [False, False, False] and when.value == t, (h, list(flags), when.value)
+    finally:
+        fmu.free()
