@@ -695,3 +695,26 @@ def test_freeing_through_a_null_pointer_or_a_null_state_does_nothing(version):
         fmu.step(0.5)
     finally:
         fmu.free()
+
+
+def test_fmi2_any_boolean_other_than_false_is_true():
+    """fmi2Boolean is an int: 2 or -1 set as a Boolean is true (the block
+    passes u through), one value or two at once, and reads back as
+    fmi2True (1)."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        c, bypass = fmu.fmu.component, fmu.vr("bypass")
+        function = [c_void_p, c_void_p, c_size_t, c_void_p]
+        for values in ([2], [-1], [0, 7]):
+            fmu.fmu.reset()
+            fmu.start(rateUpPar=1.0)
+            fmu.set(u=5.0)
+            vrs = (c_uint * len(values))(*([bypass] * len(values)))
+            assert raw(fmu, "fmi2SetBoolean", function, c, vrs, len(values), (c_int * len(values))(*values)) == 0
+            fmu.step(0.5)
+            read = (c_int * 2)(9, 9)
+            assert raw(fmu, "fmi2GetBoolean", function, c, (c_uint * 2)(bypass, bypass), 2, read) == 0
+            assert list(read) == [1, 1] and fmu.get("y") == 5.0, values
+        assert fmu.messages == []
+    finally:
+        fmu.free()
