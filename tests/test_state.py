@@ -212,6 +212,15 @@ BAD_BYTES = {
     "running time base infinite": lambda d: value_at(d, values_end(d) + 41, struct.pack("<d", float("inf"))),
     # the variable count (after the header) disagrees with the model; size and CRC right
     "variable count one more": lambda d: value_at(d, 16, struct.pack("<I", struct.unpack_from("<I", d, 16)[0] + 1)),
+    "variable count one fewer": lambda d: value_at(d, 16, struct.pack("<I", struct.unpack_from("<I", d, 16)[0] - 1)),
+    # each header field and the checksum wrong by one either way: every one is compared whole, for equality
+    "magic's last byte wrong, resealed": lambda d: reseal(d[:3] + b"X" + d[4:]),
+    "older version": lambda d: reseal(d[:4] + struct.pack("<I", struct.unpack_from("<I", d, 4)[0] - 1) + d[8:]),
+    "model one below": lambda d: value_at(d, 8, struct.pack("<I", (struct.unpack_from("<I", d, 8)[0] - 1) % 2**32)),
+    "model one above": lambda d: value_at(d, 8, struct.pack("<I", (struct.unpack_from("<I", d, 8)[0] + 1) % 2**32)),
+    "payload size short, resealed": lambda d: value_at(d, 12, struct.pack("<I", struct.unpack_from("<I", d, 12)[0] - 8)),
+    "checksum one more": lambda d: d[:-4] + struct.pack("<I", (zlib.crc32(d[:-4]) + 1) % 2**32),
+    "checksum one less": lambda d: d[:-4] + struct.pack("<I", (zlib.crc32(d[:-4]) - 1) % 2**32),
 }
 
 
@@ -229,7 +238,10 @@ REASONS = {
     "running cycle count 2^53 + 1": "impossible time or cycle count",
     "enumeration below its range": "impossible value 0 for zeroRate",
     "enumeration above its range": "impossible value 3 for zeroRate",
-    "variable count one more": "wrong number of variables",
+    "variable count one more": "wrong number of variables", "variable count one fewer": "wrong number of variables",
+    "magic's last byte wrong, resealed": "no header", "older version": "format version 1",
+    "model one below": "another model", "model one above": "another model",
+    "payload size short, resealed": "bytes; expected", "checksum one more": "checksum", "checksum one less": "checksum",
     "header alone": "16 bytes; expected", "header one byte short": "(15 bytes, no header)",
     "magic alone": "(4 bytes, no header)", "payload size wrong, resealed": "bytes; expected",
     "boolean -1": "impossible value -1 for bypass", "boolean one half": "impossible value 0.5 for bypass",
@@ -265,6 +277,34 @@ def test_a_state_is_got_or_deserialized_into_an_existing_one_in_place(version):
         api["free"](state)
     assert not fmu.errors()
     fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_the_reported_status_travels_with_the_state(version):
+    """A status word is logged once, when it changes (SPEC section 5). A
+    state carries what was reported: an instance set to a serialized state
+    whose error status was already reported steps with fmi*OK and logs
+    nothing; from a state taken before, the same error is reported as the
+    run leaves Initialization Mode."""
+    fmu = Instance("RateLimiter", version)
+    api = state_api(fmu)
+    fmu.enter_initialization()
+    before = bytes(api["serialize"](api["get"]()))  # nothing reported yet
+    fmu.set(rateUpPar=-1.0)
+    fmu.fmu.exitInitializationMode()  # reports 16#8200 (a warning)
+    assert fmu.raw_step(0.5) == 0
+    after = bytes(api["serialize"](api["get"]()))
+    fmu.free()
+    for data, t, logged in ((after, 0.5, []), (before, 0.0, ["status 16#8200"])):
+        fresh = Instance("RateLimiter", version, name="fresh")
+        fresh_api = state_api(fresh)
+        fresh.restore(fresh_api["deserialize"](data), t)
+        if t == 0.0:
+            fresh.set(rateUpPar=-1.0)
+            fresh.fmu.exitInitializationMode()
+        assert fresh.raw_step(0.5) == 0
+        assert [m[2][:14] for m in fresh.messages] == logged
+        fresh.free()
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -316,7 +356,7 @@ def test_bad_serialized_state_is_refused_and_the_instance_recovers(version, dama
     fmu.restore(good, t)
     assert call_status(api["deserialize"], BAD_BYTES[damage](data)) == 3
     errors = fmu.errors()
-    assert len(errors) == 1 and "deserialize" in errors[0][2].lower(), errors
+    assert len(errors) == 1 and errors[0][2].startswith(f"{STATE_FUNCTIONS[version]['deserialize']}: "), errors
     assert REASONS[damage] in errors[0][2], errors
     # refused until recovery, as the standard says; a good state recovers it
     assert call_status(fmu.step, 0.25) == 3
