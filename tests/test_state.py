@@ -213,6 +213,13 @@ BAD_BYTES = {
     # the variable count (after the header) disagrees with the model; size and CRC right
     "variable count one more": lambda d: value_at(d, 16, struct.pack("<I", struct.unpack_from("<I", d, 16)[0] + 1)),
     "variable count one fewer": lambda d: value_at(d, 16, struct.pack("<I", struct.unpack_from("<I", d, 16)[0] - 1)),
+    # modes: none, two at once, a negative int
+    "mode 0": lambda d: value_at(d, len(d) + MODE_OFFSET, struct.pack("<I", 0)),
+    "mode 3": lambda d: value_at(d, len(d) + MODE_OFFSET, struct.pack("<I", 3)),
+    "mode -1": lambda d: value_at(d, len(d) + MODE_OFFSET, struct.pack("<I", 0xFFFFFFFF)),
+    # running time fields just below 0 (above -1)
+    "running time period -0.5": lambda d: value_at(d, values_end(d) + 33, struct.pack("<d", -0.5)),
+    "running time base -0.5": lambda d: value_at(d, values_end(d) + 41, struct.pack("<d", -0.5)),
     # each header field and the checksum wrong by one either way: every one is compared whole, for equality
     "magic's last byte wrong, resealed": lambda d: reseal(d[:3] + b"X" + d[4:]),
     "older version": lambda d: reseal(d[:4] + struct.pack("<I", struct.unpack_from("<I", d, 4)[0] - 1) + d[8:]),
@@ -238,6 +245,8 @@ REASONS = {
     "running cycle count 2^53 + 1": "impossible time or cycle count",
     "enumeration below its range": "impossible value 0 for zeroRate",
     "enumeration above its range": "impossible value 3 for zeroRate",
+    "mode 0": "invalid mode 0", "mode 3": "invalid mode 3", "mode -1": "invalid mode -1",
+    "running time period -0.5": "impossible time", "running time base -0.5": "impossible time",
     "variable count one more": "wrong number of variables", "variable count one fewer": "wrong number of variables",
     "magic's last byte wrong, resealed": "no header", "older version": "format version 1",
     "model one below": "another model", "model one above": "another model",
@@ -388,14 +397,39 @@ def test_values_at_the_ends_of_their_range_in_a_state_are_accepted(version, name
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_cycle_counts_of_two_to_the_53_in_a_state_are_accepted(version):
+def test_counts_and_running_time_at_the_ends_of_their_range_in_a_state_are_accepted(version):
+    """Cycle counts up to 2^53 (exact in a double); the running time's period
+    and base from 0 to the largest finite double."""
     fmu = started(version)
     api = state_api(fmu)
     data = bytes(api["serialize"](api["get"]()))
-    for offset in (values_end(data) + BLOCK + 16, values_end(data) + 25):  # cycles, running cycles
-        state = api["deserialize"](value_at(data, offset, struct.pack("<Q", 1 << 53)))
+    ends = [(values_end(data) + BLOCK + 16, struct.pack("<Q", 1 << 53)),  # cycles
+            (values_end(data) + 25, struct.pack("<Q", 1 << 53))]  # running cycles
+    ends += [(values_end(data) + offset, struct.pack("<d", value))  # running period, base
+             for offset in (33, 41) for value in (0.0, sys.float_info.max)]
+    for offset, packed in ends:
+        state = api["deserialize"](value_at(data, offset, packed))
         api["free"](state)
     assert not fmu.errors()
+    fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_state_taken_in_terminated_is_accepted_and_restores_terminated(version):
+    fmu = started(version)
+    api = state_api(fmu)
+    fmu.set(u=1.0)
+    fmu.step(0.5)
+    fmu.fmu.terminate()
+    data = bytes(api["serialize"](api["get"]()))
+    fresh = Instance("RateLimiter", version, name="fresh")
+    try:
+        fresh.restore(state_api(fresh)["deserialize"](data), 0.5)
+        assert fresh.get("y") == fmu.get("y") and fresh.get("time") == 0.5
+        assert call_status(fresh.step, 0.5) == 3
+        assert fresh.errors()[-1][2].endswith("not allowed in Terminated")
+    finally:
+        fresh.release()
     fmu.free()
 
 
