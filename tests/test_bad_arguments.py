@@ -718,3 +718,41 @@ def test_fmi2_any_boolean_other_than_false_is_true():
         assert fmu.messages == []
     finally:
         fmu.free()
+
+
+def test_fmi2_a_freed_state_whose_memory_is_still_there_is_refused():
+    """FMI 2 states live in the importer's memory. An importer whose
+    freeMemory keeps the block (a pool) and that uses a state after freeing
+    it gets an error, not a state: freeing marks the state as no longer
+    one. Setting it, serializing it and freeing it again are refused."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        kept, messages = [], []
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((s, m.decode())))
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(kept.append)  # released at the end
+        dll = fmu.fmu.dll
+        c = fmi2_instantiate_function(dll)(b"a", 1, fmu.md.guid.encode(), None, byref(callbacks), 0, 0)
+        state = c_void_p()
+        assert raw(fmu, "fmi2GetFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0
+        stale = c_void_p(state.value)
+        assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0
+        assert state.value is None and kept == [stale.value]
+        out, size = ctypes.create_string_buffer(4096), c_size_t()
+        for name, argtypes, args in (("fmi2SetFMUstate", [c_void_p, c_void_p], (stale,)),
+                                     ("fmi2SerializedFMUstateSize", [c_void_p, c_void_p, c_void_p], (stale, byref(size))),
+                                     ("fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], (stale, out, 4096)),
+                                     ("fmi2FreeFMUstate", [c_void_p, c_void_p], (byref(stale),))):
+            messages.clear()
+            assert raw(fmu, name, argtypes, c, *args) == 3, name
+            assert messages == [(3, f"{name}: not an FMU state of this FMU")], name
+            assert raw(fmu, "fmi2Reset", [c_void_p], c) == 0
+        assert len(kept) == 1  # not freed twice
+        release_instance = dll.fmi2FreeInstance
+        release_instance.argtypes, release_instance.restype = [c_void_p], None
+        release_instance(c)
+        for block in kept:
+            free(block)
+    finally:
+        fmu.free()
