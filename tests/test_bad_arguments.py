@@ -219,6 +219,9 @@ def test_fmi3_instantiation_refusals_name_the_first_problem():
             ((None, token, False, 0), "instanceName is missing"),
             ((b"a", b"wrong", True, 1), "the instantiationToken does not match this FMU's model description"),
             ((b"a", None, False, 0), "the instantiationToken does not match this FMU's model description"),
+            # compared whole: one character more or less does not match either
+            ((b"a", token + b"0", False, 0), "the instantiationToken does not match this FMU's model description"),
+            ((b"a", token[:-1], False, 0), "the instantiationToken does not match this FMU's model description"),
             ((b"a", token, True, 1), "this FMU has no Event Mode (hasEventMode = false)"),
             ((b"a", token, False, 1), "this FMU provides no intermediate update"),
         ]
@@ -257,7 +260,10 @@ def test_fmi2_instantiation_refusals_name_the_first_problem():
                  ((None, 1, guid), "instanceName is missing"),
                  ((b"a", 0, b"wrong"), "this FMU supports Co-Simulation only"),
                  ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description"),
-                 ((b"a", 1, None), "the GUID does not match this FMU's model description")]
+                 ((b"a", 1, None), "the GUID does not match this FMU's model description"),
+                 ((b"a", 1, guid + b"0"), "the GUID does not match this FMU's model description"),
+                 ((b"a", 1, guid[:-1]), "the GUID does not match this FMU's model description"),
+                 ((b"a", 2, guid), "this FMU supports Co-Simulation only")]  # not an fmi2Type at all
         for (name, kind, given), reason in cases:
             messages.clear()
             assert instantiate(name, kind, given, None, byref(callbacks), 0, 0) is None
