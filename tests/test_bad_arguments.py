@@ -705,8 +705,8 @@ def test_freeing_through_a_null_pointer_or_a_null_state_does_nothing(version):
 
 def test_fmi2_any_boolean_other_than_false_is_true():
     """fmi2Boolean is an int: 2 or -1 set as a Boolean is true (the block
-    passes u through), one value or two at once, and reads back as
-    fmi2True (1)."""
+    passes u through), one value or two at once, reads back as fmi2True
+    (1), and is kept as true in an FMU state."""
     fmu = Instance("RateLimiter", 2)
     try:
         c, bypass = fmu.fmu.component, fmu.vr("bypass")
@@ -721,6 +721,11 @@ def test_fmi2_any_boolean_other_than_false_is_true():
             read = (c_int * 2)(9, 9)
             assert raw(fmu, "fmi2GetBoolean", function, c, (c_uint * 2)(bypass, bypass), 2, read) == 0
             assert list(read) == [1, 1] and fmu.get("y") == 5.0, values
+            # stored as true itself: a state holding it deserializes (only 0 and 1 are possible there)
+            api = state_api(fmu)
+            state = api["get"]()
+            api["free"](api["deserialize"](bytes(api["serialize"](state))))
+            api["free"](state)
         assert fmu.messages == []
     finally:
         fmu.free()
@@ -760,5 +765,41 @@ def test_fmi2_a_freed_state_whose_memory_is_still_there_is_refused():
         release_instance(c)
         for block in kept:
             free(block)
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("logging_on", [1, 0])
+def test_fmi2_the_logger_gets_the_name_and_environment_given_and_only_what_loggingon_allows(logging_on):
+    """The logger is called with the componentEnvironment and the instance
+    name given to fmi2Instantiate (a copy: the importer's string may change
+    after the call). With loggingOn = fmi2False only warnings and errors
+    are logged: the status cleared (an event) is not."""
+    fmu = Instance("RateLimiter", 2)
+    try:
+        messages = []
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((e, n, s, c.decode())))
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        callbacks.componentEnvironment = 0x5EED
+        name = ctypes.create_string_buffer(b"pump 1")
+        dll = fmu.fmu.dll
+        c = fmi2_instantiate_function(dll)(name, 1, fmu.md.guid.encode(), None, byref(callbacks), 0, logging_on)
+        name.value = b"other"
+        rate = (c_uint * 1)(fmu.vr("rateUpPar"))
+        set_real = [c_void_p, c_void_p, c_size_t, c_void_p]
+        assert raw(fmu, "fmi2SetReal", set_real, c, rate, 1, (c_double * 1)(-1.0)) == 0
+        assert raw(fmu, "fmi2EnterInitializationMode", [c_void_p], c) == 0
+        assert raw(fmu, "fmi2ExitInitializationMode", [c_void_p], c) == 1  # status 16#8200: a warning
+        assert raw(fmu, "fmi2SetReal", set_real, c, rate, 1, (c_double * 1)(1.0)) == 0
+        assert raw(fmu, "fmi2DoStep", [c_void_p, c_double, c_double, c_int], c, 0.0, 0.5, 1) == 0  # cleared
+        assert raw(fmu, "fmi2ExitInitializationMode", [c_void_p], c) == 3  # not in Step Mode: an error
+        expected = [(0x5EED, b"pump 1", 1, "logStatusWarning"), (0x5EED, b"pump 1", 0, "logEvents"),
+                    (0x5EED, b"pump 1", 3, "logStatusError")]
+        assert messages == (expected if logging_on else [expected[0], expected[2]])
+        release_instance = dll.fmi2FreeInstance
+        release_instance.argtypes, release_instance.restype = [c_void_p], None
+        release_instance(c)
     finally:
         fmu.free()
