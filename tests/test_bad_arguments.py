@@ -200,14 +200,17 @@ def test_a_start_time_that_is_not_finite_is_refused_naming_the_function(version,
 
 # ---- instantiation: refusals, and an importer without a logger ----
 
-def fmi3_instantiate(dll, name, token, event_mode=False, n_required=0, logging=True, log=None):
+def fmi3_instantiate(dll, name, token, event_mode=False, n_required=0, logging=True, log=None, environment=None):
+    """log: a Python function, or an fmi3LogMessageCallback the caller keeps alive for the instance's life."""
     instantiate = dll.fmi3InstantiateCoSimulation
     instantiate.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_bool, c_bool, c_void_p, c_size_t,
                             c_void_p, fmi3LogMessageCallback, c_void_p]
     instantiate.restype = c_void_p
     required = (c_uint * 1)(1)
-    return instantiate(name, token, None, False, logging, event_mode, False, required, n_required, None,
-                       fmi3LogMessageCallback(log) if log else fmi3LogMessageCallback(), None)
+    if not isinstance(log, fmi3LogMessageCallback):
+        log = fmi3LogMessageCallback(log) if log else fmi3LogMessageCallback()
+    return instantiate(name, token, None, False, logging, event_mode, False, required, n_required, environment,
+                       log, None)
 
 
 def test_fmi3_instantiation_refusals_name_the_first_problem():
@@ -799,6 +802,40 @@ def test_fmi2_the_logger_gets_the_name_and_environment_given_and_only_what_loggi
                     (0x5EED, b"pump 1", 3, "logStatusError")]
         assert messages == (expected if logging_on else [expected[0], expected[2]])
         release_instance = dll.fmi2FreeInstance
+        release_instance.argtypes, release_instance.restype = [c_void_p], None
+        release_instance(c)
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("logging_on", [True, False])
+def test_fmi3_the_logger_gets_the_environment_given_and_nothing_when_logging_is_off(logging_on):
+    """fmi3LogMessageCallback gets the instanceEnvironment given to
+    fmi3InstantiateCoSimulation. With loggingOn = false the FMU logs
+    nothing at all (FMI 3 has no categories that are always on): the
+    statuses say what happened."""
+    fmu = Instance("RateLimiter", 3)
+    try:
+        messages = []
+        log = fmi3LogMessageCallback(lambda env, status, category, message: messages.append(
+            (env, status, category.decode())))
+        dll = fmu.fmu.dll
+        c = fmi3_instantiate(dll, b"pump 1", fmu.md.instantiationToken.encode(), logging=logging_on, log=log,
+                             environment=0x5EED)
+        rate = (c_uint * 1)(fmu.vr("rateUpPar"))
+        set_float = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t]
+        assert raw(fmu, "fmi3SetFloat64", set_float, c, rate, 1, (c_double * 1)(-1.0), 1) == 0
+        assert raw(fmu, "fmi3EnterInitializationMode", [c_void_p, c_bool, c_double, c_double, c_bool, c_double],
+                   c, False, 0.0, 0.0, False, 0.0) == 0
+        assert raw(fmu, "fmi3ExitInitializationMode", [c_void_p], c) == 1  # status 16#8200: a warning
+        assert raw(fmu, "fmi3SetFloat64", set_float, c, rate, 1, (c_double * 1)(1.0), 1) == 0
+        flags, when = (c_bool * 3)(), c_double()
+        assert raw(fmu, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4, c, 0.0, 0.5, True,
+                   byref(flags, 0), byref(flags, 1), byref(flags, 2), byref(when)) == 0  # cleared: an event
+        assert raw(fmu, "fmi3ExitInitializationMode", [c_void_p], c) == 3  # not in Step Mode: an error
+        expected = [(0x5EED, 1, "logStatusWarning"), (0x5EED, 0, "logEvents"), (0x5EED, 3, "logStatusError")]
+        assert messages == (expected if logging_on else [])
+        release_instance = dll.fmi3FreeInstance
         release_instance.argtypes, release_instance.restype = [c_void_p], None
         release_instance(c)
     finally:
