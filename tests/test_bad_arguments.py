@@ -840,3 +840,34 @@ def test_fmi3_the_logger_gets_the_environment_given_and_nothing_when_logging_is_
         release_instance(c)
     finally:
         fmu.free()
+
+
+ALL_ACCESSOR_TYPES = {2: ("Real", "Integer", "Boolean", "String"),
+                      3: ("Float64", "Int32", "Int64", "Boolean") + NO_VARIABLES}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_zero_values_with_arrays_given_reads_and_writes_nothing(version):
+    """nvr = 0 with real arrays (the first entry an unknown value reference):
+    every getter and setter returns OK without looking at them."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        c = fmu.fmu.component
+        vrs = (c_uint * 1)(999)
+        buffer = ctypes.create_string_buffer(b"\x5a" * 64, 64)
+        sizes = (c_size_t * 1)(7)
+        for kind in ALL_ACCESSOR_TYPES[version]:
+            for access in ("Get", "Set"):
+                name = f"fmi{version}{access}{kind}"
+                if kind == "Binary":
+                    args = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], (c, vrs, 0, sizes, buffer, 0)
+                elif version == 3:
+                    args = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], (c, vrs, 0, buffer, 0)
+                else:
+                    args = [c_void_p, c_void_p, c_size_t, c_void_p], (c, vrs, 0, buffer)
+                assert raw(fmu, name, args[0], *args[1]) == 0, name
+        assert buffer.raw == b"\x5a" * 64 and sizes[0] == 7 and fmu.messages == []
+        fmu.step(0.5)
+    finally:
+        fmu.free()
