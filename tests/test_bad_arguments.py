@@ -589,7 +589,7 @@ def test_fmi2_status_queries_answer_only_what_this_fmu_has():
         real, flag, integer = c_double(-1.0), c_int(7), c_int(7)
         text = c_char_p(b"untouched")
         query = [c_void_p, c_int, c_void_p]
-        for kind in range(4):
+        for kind in (0, 1, 2, 3, 4, 99, -1):  # the four fmi2StatusKinds, and numbers that are none
             answered_real, answered_flag = kind == 2, kind == 3
             assert raw(fmu, "fmi2GetRealStatus", query, c, kind, byref(real)) == (0 if answered_real else 2), kind
             assert raw(fmu, "fmi2GetBooleanStatus", query, c, kind, byref(flag)) == (0 if answered_flag else 2), kind
