@@ -8,7 +8,10 @@
  * 2. <instantiations> instantiate/free cycles: afterwards as many blocks
  *    are live as before (FMI 2 memory callbacks and an interposed malloc);
  * 3. <instances> instances alive at once, each stepped with its own input,
- *    each output checked against a run of one instance alone.
+ *    each output checked against a run of one instance alone;
+ * 4. out of memory: each allocation of an instantiation, of an FMU state
+ *    and of a deserialized one refused in turn: no instance or state, an
+ *    error, no crash, nothing held, and the instance runs on after a reset.
  * Exit 0 when every check passes. */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -25,6 +28,11 @@
 
 static long liveBlocks; /* allocated minus freed, from the FMU's side */
 static int counting;
+static long failCountdown; /* > 0: the FMU's allocation that many from now is refused */
+
+static int refuse_allocation(void) {
+    return failCountdown > 0 && --failCountdown == 0;
+}
 
 #if defined(__SANITIZE_ADDRESS__)
 /* ASan owns malloc: the FMU's own blocks are not counted here, and
@@ -38,12 +46,14 @@ extern void *__libc_realloc(void *pointer, size_t size);
 extern void __libc_free(void *pointer);
 
 void *malloc(size_t size) {
+    if (counting && refuse_allocation()) return NULL;
     void *p = __libc_malloc(size);
     if (counting && p) liveBlocks++;
     return p;
 }
 
 void *calloc(size_t count, size_t size) {
+    if (counting && refuse_allocation()) return NULL;
     void *p = __libc_calloc(count, size);
     if (counting && p) liveBlocks++;
     return p;
@@ -64,6 +74,7 @@ void free(void *pointer) {
 static long callbackBlocks;
 
 static void *allocate(size_t count, size_t size) {
+    if (refuse_allocation()) return NULL;
     void *p = LIBC(calloc)(count, size);
     if (p) callbackBlocks++;
     return p;
@@ -277,6 +288,82 @@ static void many_instances(int n) {
     printf("instances alive at once %d, mismatches %d\n", n, mismatches);
 }
 
+/* ---- 4. out of memory --------------------------------------------------- */
+
+static int get_state(void *c, void **state) {
+    return version == 2 ? (int)F2(fmi2GetFMUstate)(c, state) : (int)F3(fmi3GetFMUState)(c, state);
+}
+
+static int free_state(void *c, void **state) {
+    return version == 2 ? (int)F2(fmi2FreeFMUstate)(c, state) : (int)F3(fmi3FreeFMUState)(c, state);
+}
+
+static int reset(void *c) {
+    return version == 2 ? (int)F2(fmi2Reset)(c) : (int)F3(fmi3Reset)(c);
+}
+
+/* Whether this program's malloc is the one the FMU gets: not under ASan or
+ * valgrind, which bring their own (called through a volatile pointer, so
+ * that the compiler cannot assume what malloc returns). */
+static int malloc_is_ours(void) {
+    void *(*volatile allocator)(size_t) = malloc;
+    failCountdown = 1;
+    void *p = allocator(16);
+    failCountdown = 0;
+    free(p);
+    return p == NULL;
+}
+
+static void out_of_memory(void) {
+    if (version == 3 && !malloc_is_ours()) { /* FMI 3 allocates with malloc */
+        printf("out of memory: not checked for FMI 3 here (malloc belongs to ASan or valgrind)\n");
+        return;
+    }
+    const long blocks = liveBlocks, callbackLive = callbackBlocks;
+    /* instantiation: FMI 2 allocates the instance and its name, FMI 3 one block */
+    const long allocations = version == 2 ? 2 : 1;
+    for (long n = 1; n <= allocations; n++) {
+        failCountdown = n;
+        CHECK(instantiate("no memory") == NULL);
+        CHECK(failCountdown == 0);
+        CHECK(liveBlocks == blocks && callbackBlocks == callbackLive);
+    }
+    failCountdown = 0;
+    void *c = instantiate("states");
+    CHECK(c != NULL);
+    if (!c) return;
+    CHECK(start(c));
+    CHECK(step(c, 0.0, 0.1) == 0);
+    void *state = NULL;
+    size_t size = 0;
+    CHECK(get_state(c, &state) == 0);
+    CHECK((version == 2 ? (int)F2(fmi2SerializedFMUstateSize)(c, state, &size)
+                        : (int)F3(fmi3SerializedFMUStateSize)(c, state, &size)) == 0);
+    unsigned char *bytes = LIBC(malloc)(size);
+    CHECK((version == 2 ? (int)F2(fmi2SerializeFMUstate)(c, state, (fmi2Byte *)bytes, size)
+                        : (int)F3(fmi3SerializeFMUState)(c, state, bytes, size)) == 0);
+    CHECK(free_state(c, &state) == 0);
+    const double y = get_y(c);
+    for (int deserializing = 0; deserializing <= 1; deserializing++) {
+        void *refused = NULL;
+        failCountdown = 1;
+        const int status = !deserializing ? get_state(c, &refused)
+                           : version == 2 ? (int)F2(fmi2DeSerializeFMUstate)(c, (const fmi2Byte *)bytes, size, &refused)
+                                          : (int)F3(fmi3DeserializeFMUState)(c, bytes, size, &refused);
+        CHECK(status == 3 && refused == NULL && failCountdown == 0);
+        failCountdown = 0;
+        CHECK(get_y(c) == y); /* the last good values, readable after the error */
+        CHECK(reset(c) == 0);
+        CHECK(start(c));
+        CHECK(step(c, 0.0, 0.1) == 0);
+    }
+    LIBC(free)(bytes);
+    release(c);
+    CHECK(liveBlocks == blocks && callbackBlocks == callbackLive);
+    printf("out of memory: %ld instantiation and 2 FMU-state allocations refused, live blocks after %ld (before %ld)\n",
+           allocations, liveBlocks + callbackBlocks, blocks + callbackLive);
+}
+
 /* The attribute value after `after` in the model description, from `from`. */
 static const char *attribute(const char *text, const char *from, const char *after, char *out, size_t size) {
     const char *p = from ? strstr(text, from) : text;
@@ -330,6 +417,7 @@ int main(int argc, char **argv) {
     full_simulation();
     instantiate_free(atol(argv[3]));
     many_instances(atoi(argv[4]));
+    out_of_memory();
     counting = 0;
     dlclose(library); /* so that memcheck sees every block freed */
     printf("FMI %d: %s (%d log messages)\n", version, failures ? "FAILED" : "passed", messages);
