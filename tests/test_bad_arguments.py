@@ -34,34 +34,49 @@ def test_null_instance_is_refused_by_every_function(version):
         fmu.free()
 
 
-def test_fmi3_nvalues_must_match_the_scalars():
+@pytest.mark.parametrize("access", ["Get", "Set"])
+def test_fmi3_nvalues_must_match_the_scalars(access):
+    """Every variable is a scalar: nValues must equal nvr, more or fewer is
+    an error saying both, with nothing read or written."""
     fmu = Instance("RateLimiter", 3)
     try:
         fmu.start()
         c, dll = fmu.fmu.component, fmu.fmu.dll
-        get = dll.fmi3GetFloat64
-        get.argtypes, get.restype = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c_int
-        vr = (c_uint * 1)(fmu.vr("y"))
-        values = (c_double * 2)()
-        assert get(c, vr, 0, None, 0) == 0  # nothing asked, nothing given: fine
-        assert get(c, vr, 1, values, 1) == 0
-        assert get(c, vr, 1, values, 2) == 3
-        assert "nValues" in fmu.errors()[-1][2]
+        name = f"fmi3{access}Float64"
+        function = getattr(dll, name)
+        function.argtypes, function.restype = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c_int
+        vr = (c_uint * 2)(fmu.vr("y" if access == "Get" else "u"), fmu.vr("y" if access == "Get" else "u"))
+        values = (c_double * 2)(7.0, 7.0)
+        assert function(c, vr, 0, None, 0) == 0  # nothing asked, nothing given: fine
+        for nvr, n_values in ((1, 2), (1, 0), (2, 1), (2, 3)):
+            assert function(c, vr, nvr, values, n_values) == 3, (nvr, n_values)
+            assert fmu.errors()[-1][2] == f"{name}: nValues = {n_values}, but the {nvr} variables are scalars"
+            fmu.fmu.reset()
+            fmu.start()
+        assert list(values) == [7.0, 7.0] and fmu.get("u") == 0.0
+        assert function(c, vr, 1, values, 1) == 0
     finally:
         fmu.free()
 
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_zero_values_with_null_arrays_is_fine(version):
+    """nvr = 0 with every array NULL (FMI 3's valueSizes of Binary too): every getter and setter is OK."""
     fmu = Instance("RateLimiter", version)
     try:
         fmu.start()
-        c, dll = fmu.fmu.component, fmu.fmu.dll
-        for name in ("SetReal", "GetReal") if version == 2 else ("SetFloat64", "GetFloat64"):
-            function = getattr(dll, f"fmi{version}{name}")
-            n = 4 if version == 2 else 5
-            function.argtypes, function.restype = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t][:n], c_int
-            assert function(*([c, None, 0, None, 0][:n])) == 0, name
+        c = fmu.fmu.component
+        for kind in ALL_ACCESSOR_TYPES[version]:
+            for access in ("Get", "Set"):
+                name = f"fmi{version}{access}{kind}"
+                if version == 2:
+                    argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p], (None,)
+                elif kind == "Binary":  # valueSizes and values
+                    argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], (None, None, 0)
+                else:
+                    argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], (None, 0)
+                assert raw(fmu, name, argtypes, c, None, 0, *args) == 0, name
+        assert fmu.messages == []
         fmu.step(0.1)
     finally:
         fmu.free()
