@@ -48,7 +48,7 @@ def test_fmi3_nvalues_must_match_the_scalars(access):
         vr = (c_uint * 2)(fmu.vr("y" if access == "Get" else "u"), fmu.vr("y" if access == "Get" else "u"))
         values = (c_double * 2)(7.0, 7.0)
         assert function(c, vr, 0, None, 0) == 0  # nothing asked, nothing given: fine
-        for nvr, n_values in ((1, 2), (1, 0), (2, 1), (2, 3)):
+        for nvr, n_values in ((1, 2), (1, 0), (2, 1), (2, 3), (0, 1)):
             assert function(c, vr, nvr, values, n_values) == 3, (nvr, n_values)
             assert fmu.errors()[-1][2] == f"{name}: nValues = {n_values}, but the {nvr} variables are scalars"
             fmu.fmu.reset()
