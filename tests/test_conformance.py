@@ -317,14 +317,18 @@ def test_calls_after_an_error_are_refused_until_reset(version):
         fmu.free()
 
 
-def test_fmi3_a_step_reports_no_event_no_stop_no_early_return_and_its_end():
+@pytest.mark.parametrize("cycle_time", [0.0, 0.1])
+def test_fmi3_a_step_reports_no_event_no_stop_no_early_return_and_its_end(cycle_time):
     """fmi3DoStep's outputs (FMI 3.0 section 4.2.3): this FMU has no events,
     never asks to stop and never returns early, so the three flags are
     false and lastSuccessfulTime is the end of the step; on the first step,
-    a repeated step size (the common step's fast path) and a new one."""
+    a repeated step size (with cycleTime 0 the common step's fast path) and
+    a new one. Then a step from a point that is not the FMU's time is
+    refused, even one whose size is the FMU's time and whose point is the
+    last step size."""
     fmu = Instance("RateLimiter", 3)
     try:
-        fmu.start(rateUpPar=2.0, cycleTime=0.1)
+        fmu.start(rateUpPar=2.0, cycleTime=cycle_time)
         do_step = fmu.fmu.dll.fmi3DoStep
         do_step.argtypes, do_step.restype = [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4, c_int
         t = 0.0
@@ -334,5 +338,8 @@ def test_fmi3_a_step_reports_no_event_no_stop_no_early_return_and_its_end():
                            ctypes.byref(flags, 2), ctypes.byref(when)) == 0
             t += h
             assert list(flags) == [False, False, False] and when.value == t, (h, list(flags), when.value)
+        assert do_step(fmu.fmu.component, 1.0, t, True, ctypes.byref(flags, 0), ctypes.byref(flags, 1),
+                       ctypes.byref(flags, 2), ctypes.byref(when)) == 3
+        assert "currentCommunicationPoint" in fmu.errors()[-1][2] and fmu.get("time") == t
     finally:
         fmu.free()
