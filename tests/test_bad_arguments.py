@@ -375,6 +375,30 @@ def test_fmi3_accessors_of_types_without_variables_refuse_every_value_reference(
         fmu.free()
 
 
+class ImporterMemory:
+    """FMI 2 memory callbacks that keep count of the blocks live and refuse an allocation when refuse()
+    says so (called after the allocation is counted in calls)."""
+
+    def __init__(self, logger=lambda e, n, s, c, m: None):
+        self.live, self.calls, self.refuse = set(), [], lambda: False
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(self._allocate)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(self._release)
+
+    def _allocate(self, count, size):
+        self.calls.append(size)
+        if self.refuse():
+            return None
+        block = calloc(count, size)
+        self.live.add(block)
+        return block
+
+    def _release(self, block):
+        self.live.discard(block)
+        free(block)
+
+
 def test_fmi2_instantiation_with_memory_refused_returns_null_and_frees_what_it_got():
     """The importer's allocateMemory fails on its first call (the instance)
     or its second (the name): no instance, nothing held, no crash."""
@@ -382,26 +406,10 @@ def test_fmi2_instantiation_with_memory_refused_returns_null_and_frees_what_it_g
     try:
         instantiate = fmi2_instantiate_function(fmu.fmu.dll)
         for failing in (1, 2):
-            live, calls = set(), []
-
-            def allocate(count, size):
-                calls.append(size)
-                if len(calls) == failing:
-                    return None
-                block = calloc(count, size)
-                live.add(block)
-                return block
-
-            def release(block):
-                live.discard(block)
-                free(block)
-
-            callbacks = fmi2CallbackFunctions()
-            callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: None)
-            callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(allocate)
-            callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(release)
-            assert instantiate(b"a", 1, fmu.md.guid.encode(), None, byref(callbacks), 0, 0) is None, failing
-            assert len(calls) == 2 and live == set(), (failing, calls, live)
+            memory = ImporterMemory()
+            memory.refuse = lambda: len(memory.calls) == failing
+            assert instantiate(b"a", 1, fmu.md.guid.encode(), None, byref(memory.callbacks), 0, 0) is None, failing
+            assert len(memory.calls) == 2 and memory.live == set(), (failing, memory.calls, memory.live)
     finally:
         fmu.free()
 
@@ -539,25 +547,11 @@ def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
     reset."""
     fmu = Instance("RateLimiter", 2)
     try:
-        refuse, live, messages = [False], set(), []
-
-        def allocate(count, size):
-            if refuse[0]:
-                return None
-            block = calloc(count, size)
-            live.add(block)
-            return block
-
-        def release(block):
-            live.discard(block)
-            free(block)
-
-        callbacks = fmi2CallbackFunctions()
-        callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append((s, m.decode())))
-        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(allocate)
-        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(release)
+        messages = []
+        memory = ImporterMemory(lambda e, n, s, c, m: messages.append((s, m.decode())))
+        live = memory.live
         dll = fmu.fmu.dll
-        c = fmi2_instantiate_function(dll)(b"a", 1, fmu.md.guid.encode(), None, byref(callbacks), 0, 1)
+        c = fmi2_instantiate_function(dll)(b"a", 1, fmu.md.guid.encode(), None, byref(memory.callbacks), 0, 1)
         assert c
         held = set(live)  # the instance and its name
         state = c_void_p()
@@ -568,7 +562,7 @@ def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
         assert raw(fmu, "fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], c, state, data,
                    size.value) == 0
         assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and live == held
-        refuse[0] = True
+        memory.refuse = lambda: True
         for name, argtypes, args in (("fmi2GetFMUstate", [c_void_p, c_void_p], ()),
                                      ("fmi2DeSerializeFMUstate", [c_void_p, c_void_p, c_size_t, c_void_p],
                                       (data, size.value))):
@@ -577,7 +571,7 @@ def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
             assert raw(fmu, name, argtypes, c, *args, byref(empty)) == 3
             assert messages == [(3, f"{name}: out of memory")] and empty.value is None and live == held
             assert raw(fmu, "fmi2Reset", [c_void_p], c) == 0
-        refuse[0] = False
+        memory.refuse = lambda: False
         assert raw(fmu, "fmi2GetFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and state.value
         assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and live == held
         release_instance = dll.fmi2FreeInstance
