@@ -375,6 +375,13 @@ def test_fmi3_accessors_of_types_without_variables_refuse_every_value_reference(
         fmu.free()
 
 
+def free_instance(fmu, c):
+    """fmi*FreeInstance of an instance made by hand beside fmu's, from fmu's library (still loaded)."""
+    function = getattr(fmu.fmu.dll, f"fmi{fmu.version}FreeInstance")
+    function.argtypes, function.restype = [c_void_p], None
+    function(c)
+
+
 class ImporterMemory:
     """FMI 2 memory callbacks that keep count of the blocks live and refuse an allocation when refuse()
     says so (called after the allocation is counted in calls)."""
@@ -458,8 +465,7 @@ def test_a_foreign_fmu_state_is_refused_by_every_state_function(version):
         c, dll = fmu.fmu.component, fmu.fmu.dll
         junk = ctypes.create_string_buffer(b"\x5a" * 4096)
         foreign = ctypes.cast(junk, c_void_p)
-        names = [STATE_FUNCTIONS[version][which] for which in ("size", "serialize", "get", "deserialize")]
-        names.append(f"fmi{version}FreeFMU{'s' if version == 2 else 'S'}tate")
+        names = [STATE_FUNCTIONS[version][which] for which in ("size", "serialize", "get", "deserialize", "free")]
         api = state_api(fmu)
         good = api["get"]()
         data = bytes(api["serialize"](good))
@@ -574,9 +580,7 @@ def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
         memory.refuse = lambda: False
         assert raw(fmu, "fmi2GetFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and state.value
         assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and live == held
-        release_instance = dll.fmi2FreeInstance
-        release_instance.argtypes, release_instance.restype = [c_void_p], None
-        release_instance(c)
+        free_instance(fmu, c)
         assert live == set()
     finally:
         fmu.free()
@@ -705,7 +709,7 @@ def test_freeing_through_a_null_pointer_or_a_null_state_does_nothing(version):
     fmu = Instance("RateLimiter", version)
     try:
         fmu.start()
-        name = f"fmi{version}FreeFMU{'s' if version == 2 else 'S'}tate"
+        name = STATE_FUNCTIONS[version]["free"]
         empty = c_void_p()
         assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, None) == 0
         assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, byref(empty)) == 0
@@ -772,9 +776,7 @@ def test_fmi2_a_freed_state_whose_memory_is_still_there_is_refused():
             assert messages == [(3, f"{name}: not an FMU state of this FMU")], name
             assert raw(fmu, "fmi2Reset", [c_void_p], c) == 0
         assert len(kept) == 1  # not freed twice
-        release_instance = dll.fmi2FreeInstance
-        release_instance.argtypes, release_instance.restype = [c_void_p], None
-        release_instance(c)
+        free_instance(fmu, c)
         for block in kept:
             free(block)
     finally:
@@ -810,9 +812,7 @@ def test_fmi2_the_logger_gets_the_name_and_environment_given_and_only_what_loggi
         expected = [(0x5EED, b"pump 1", 1, "logStatusWarning"), (0x5EED, b"pump 1", 0, "logEvents"),
                     (0x5EED, b"pump 1", 3, "logStatusError")]
         assert messages == (expected if logging_on else [expected[0], expected[2]])
-        release_instance = dll.fmi2FreeInstance
-        release_instance.argtypes, release_instance.restype = [c_void_p], None
-        release_instance(c)
+        free_instance(fmu, c)
     finally:
         fmu.free()
 
@@ -844,9 +844,7 @@ def test_fmi3_the_logger_gets_the_environment_given_and_nothing_when_logging_is_
         assert raw(fmu, "fmi3ExitInitializationMode", [c_void_p], c) == 3  # not in Step Mode: an error
         expected = [(0x5EED, 1, "logStatusWarning"), (0x5EED, 0, "logEvents"), (0x5EED, 3, "logStatusError")]
         assert messages == (expected if logging_on else [])
-        release_instance = dll.fmi3FreeInstance
-        release_instance.argtypes, release_instance.restype = [c_void_p], None
-        release_instance(c)
+        free_instance(fmu, c)
     finally:
         fmu.free()
 

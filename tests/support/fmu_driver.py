@@ -180,9 +180,11 @@ def state_api(fmu):
 
 # the FMU-state functions' exported names, for calls through ctypes
 STATE_FUNCTIONS = {2: {"get": "fmi2GetFMUstate", "set": "fmi2SetFMUstate", "size": "fmi2SerializedFMUstateSize",
-                       "serialize": "fmi2SerializeFMUstate", "deserialize": "fmi2DeSerializeFMUstate"},
+                       "serialize": "fmi2SerializeFMUstate", "deserialize": "fmi2DeSerializeFMUstate",
+                       "free": "fmi2FreeFMUstate"},
                    3: {"get": "fmi3GetFMUState", "set": "fmi3SetFMUState", "size": "fmi3SerializedFMUStateSize",
-                       "serialize": "fmi3SerializeFMUState", "deserialize": "fmi3DeserializeFMUState"}}
+                       "serialize": "fmi3SerializeFMUState", "deserialize": "fmi3DeserializeFMUState",
+                       "free": "fmi3FreeFMUState"}}
 
 
 def run_steps(fmu, steps, names=STATE_OUTPUTS):
