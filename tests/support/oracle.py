@@ -1,25 +1,57 @@
 """An independent model of the rate limiter, written from SPEC sections 2,
-3, 6 and 7 (not from the C code), to check the FMUs against.
+3, 6, 7 and 8 (not from the C code), to check the FMUs against.
 
 The oracle speaks the unified block's variable names. It follows the
 project's documented conventions where the contract leaves room:
 runningTime is counted in whole cycles (cycles * T, with the sum started
 afresh when T changes), and time comparisons use a relative 1e-9.
+
+Arithmetic (SPEC section 8): LREAL computes in Python floats (binary64).
+REAL rounds every value that enters a cycle and the result of every
+operation of the signal path to binary32 with f32, in the order the
+contract writes it. f32 of one +, -, * or / of two binary32 values computed
+in binary64 is that operation correctly rounded in binary32: binary64 has
+more than twice binary32's precision plus two bits, so the double rounding
+is innocuous (test_oracle.py checks it against numpy's float32 scalars).
 """
 import functools
 import hashlib
 import json
 import math
 import os
+import struct
 from dataclasses import dataclass
 from pathlib import Path
 
 TOL = 1e-9
 
+LREAL, REAL = 1, 2  # the values of RateLimiter's `arithmetic`
+_BINARY32 = struct.Struct("<f")
+
+
+def f32(x):
+    """x rounded to binary32 (to nearest, ties to even), as a Python float;
+    beyond the largest binary32 it is an infinity, NaN stays NaN."""
+    try:
+        return _BINARY32.unpack(_BINARY32.pack(x))[0]
+    except OverflowError:  # struct refuses what rounds to an infinity
+        return math.copysign(math.inf, x)
+
+
+def f64(x):
+    return x
+
+
+def time_ms(seconds):
+    """A TIME pin set in seconds: whole milliseconds, seconds * 1000 in
+    binary64 rounded to nearest, ties to even (Python's round of a float is
+    exact and ties to even, as C's nearbyint), used as ms / 1000."""
+    return round(seconds * 1000.0) / 1000.0
+
 PARAMETER_DEFAULTS = {
     "rateUpPar": 1.0, "rateDownPar": 1.0, "bypassValuePar": math.nan, "durationPar": 0.0,
     "ratePeriod": 1.0, "zeroRate": 1, "cycleTime": 0.0, "initMode": 2, "initValue": 0.0, "initDelay": 0.0,
-    "yMaxPar": math.inf, "yMinPar": -math.inf,
+    "yMaxPar": math.inf, "yMinPar": -math.inf, "arithmetic": LREAL,
 }
 INPUT_DEFAULTS = {
     "u": 0.0, "rateUp": math.nan, "rateDown": math.nan, "bypass": False, "bypassValue": math.nan,
@@ -46,7 +78,8 @@ class RateLimiterOracle:
     non-finite input: no rule 1, u is only compared with the output.
     `neg_fallback=False`: a NaN Neg rate is not replaced by the other rate
     (LGF_LimRateOfChangeAdvancedCI: a NaN rate is 16#8201).
-    `limit_initial=False`: the initial output is not limited (ibid.)."""
+    `limit_initial=False`: the initial output is not limited (ibid.).
+    The arithmetic is the value `arithmetic` (LREAL or REAL, fixed)."""
 
     def __init__(self, vr, start=None, start_time=0.0, compare_only=False, neg_fallback=True, limit_initial=True):
         self.vr = vr
@@ -55,11 +88,14 @@ class RateLimiterOracle:
         self.values.update(start or {})
         self.compare_only = compare_only
         self.neg_fallback = neg_fallback
+        # every value entering the signal path, and every operation of it, goes through real
+        self.real = f32 if self.values["arithmetic"] == REAL else f64
+        self.resolved = {}  # of the values as they are: emptied whenever they change
         self.t0 = start_time
         self.time = start_time
         self.cycles_done = 0
-        u = self.values["u"]
-        y = self.values["initValue"] if self.values["initMode"] == 1 else u
+        u = self.real(self.values["u"])
+        y = self.real(self.values["initValue"]) if self.values["initMode"] == 1 else u
         # section 6: limited if y is finite and yMin <= yMax (a NaN limit: none)
         low, high = self.limits()
         if limit_initial and finite(y) and low <= high:
@@ -77,10 +113,27 @@ class RateLimiterOracle:
 
     # -- rule 0 and the status table -------------------------------------
     def resolve(self, name):
+        """The input, or its parameter when it is NaN, as it enters the
+        signal path (rates, limits, bypass value)."""
+        known = self.resolved.get(name)
+        if known is None:
+            value = self.values[name]
+            if math.isnan(value):
+                known = Resolved(self.real(self.values[name + "Par"]), name + "Par")
+            else:
+                known = Resolved(self.real(value), name)
+            self.resolved[name] = known
+        return known
+
+    def resolve_time(self, name):
+        """duration: time bookkeeping, binary64 in either arithmetic."""
         value = self.values[name]
         if math.isnan(value):
             return Resolved(self.values[name + "Par"], name + "Par")
         return Resolved(value, name)
+
+    def rate_period(self):
+        return self.real(self.values["ratePeriod"])
 
     def resolve_neg(self, name):
         """rateUpNeg / rateDownNeg: NaN falls back to the resolved rateUp /
@@ -88,7 +141,7 @@ class RateLimiterOracle:
         value = self.values[name]
         if math.isnan(value) and self.neg_fallback:
             return self.resolve(name[:-3])
-        return Resolved(value, name)
+        return Resolved(self.real(value), name)
 
     def rates(self):
         return (self.resolve("rateUp"), self.resolve("rateDown"), self.resolve_neg("rateUpNeg"),
@@ -101,8 +154,8 @@ class RateLimiterOracle:
 
     def evaluate_status(self):
         rates = self.rates()
-        period = self.values["ratePeriod"]
-        duration = self.resolve("duration")
+        period = self.rate_period()
+        duration = self.resolve_time("duration")
         cycle = self.values["cycleTime"]
         for rate in rates:                       # rateUp, rateDown, rateUpNeg, rateDownNeg
             if rate.value < 0:
@@ -124,8 +177,9 @@ class RateLimiterOracle:
     def per_cycle_limit(self, rate, T):
         if rate == 0:
             return math.inf if self.values["zeroRate"] == 2 else 0.0
-        period = self.values["ratePeriod"]
-        return rate * T / period if period > 0 else rate
+        period = self.rate_period()
+        real = self.real
+        return real(real(rate * real(T)) / period) if period > 0 else rate
 
     @property
     def running_time(self):
@@ -148,9 +202,9 @@ class RateLimiterOracle:
     # -- one cycle (rules 1 to 6) ------------------------------------------
     def cycle(self, T, elapsed):
         v = self.values
-        u = v["u"]
+        real = self.real
+        u = real(v["u"])
         yp = self.y
-        self.status, self.culprit = self.evaluate_status()
         self.yp, self.T = yp, T
         self.jumped = False
         decided_by = "1-5"
@@ -185,36 +239,40 @@ class RateLimiterOracle:
                 self.running_reset()
             if yp != uc:
                 self.running_add(T)
-            duration = self.resolve("duration").value
+            duration = self.resolve_time("duration").value
             if duration > 0 and self.running_time >= duration * (1 - TOL):
                 y = uc
                 self.jumped = True
             elif uc > yp:
-                y = min(uc, yp + max_up)
+                y = min(uc, real(yp + max_up))
             elif uc < yp:
-                y = max(uc, yp - max_down)
+                y = max(uc, real(yp - max_down))
             else:
                 y = yp
         self.decided_by = decided_by
         self.y = y
         self.u_prev = u
-        # the outputs are those of the last cycle run (SPEC section 2)
-        self.last = self.evaluate_outputs()
 
     # -- SPEC section 2: a communication step --------------------------------
     def do_step(self, t, h, inputs=None):
         """Set the inputs (held for the whole step), then run every cycle
         whose end lies in (t, t+h]."""
         self.values.update(inputs or {})
+        self.resolved = {}
+        # evaluated every cycle from the values, which a step holds
+        self.status, self.culprit = self.evaluate_status()
         end = t + h
         c = self.values["cycleTime"]
         if finite(c) and c > 0:
             last = math.floor((end - self.t0) / c + TOL)
             for n in range(self.cycles_done + 1, last + 1):
                 self.cycle(c, n * c)
+            if last > self.cycles_done:
+                self.last = self.evaluate_outputs()  # the outputs are those of the last cycle run (SPEC section 2)
             self.cycles_done = max(self.cycles_done, last)
         else:
             self.cycle(h, end - self.t0)
+            self.last = self.evaluate_outputs()
         self.time = end
         return self.outputs()
 
@@ -229,7 +287,7 @@ class RateLimiterOracle:
         else:
             legs = [(min(y, 0.0) - uc, down_neg.value) if uc < 0 else (0.0, down_neg.value),
                     (y - max(uc, 0.0), down.value) if y > 0 else (0.0, down.value)]
-        period = self.values["ratePeriod"]
+        period = self.rate_period()
         total = 0.0
         for length, rate in legs:
             if length <= 0:
@@ -240,7 +298,7 @@ class RateLimiterOracle:
             per_second = rate / period if period > 0 else rate / self.T
             # IEEE division, as the PLC's: a rate per second that underflows to 0 never arrives
             total += length / per_second if per_second != 0 else math.inf
-        duration = self.resolve("duration").value
+        duration = self.resolve_time("duration").value
         if duration > 0:
             total = min(total, max(0.0, duration - self.running_time))
         return total
@@ -256,6 +314,7 @@ class RateLimiterOracle:
         by_rule_6 = self.decided_by == "6"
         ramped = by_rule_6 and not self.jumped
         max_up, max_down = self.rates_used
+        real = self.real
         remaining = 0.0
         if self.decided_by in ("6", "5b") and y != uc and finite(y) and finite(uc):
             remaining = self.remaining_time(y, uc)
@@ -266,9 +325,9 @@ class RateLimiterOracle:
             "error": error,
             "status": self.status,
             "subFunctionStatus": self.vr[self.culprit] if error else 0,
-            "dydt": (y - yp) / self.T if self.decided_by and finite(y) and finite(yp) else 0.0,
-            "limitingUp": ramped and yp + max_up < uc,
-            "limitingDown": ramped and yp - max_down > uc,
+            "dydt": real(real(y - yp) / real(self.T)) if self.decided_by and finite(y) and finite(yp) else 0.0,
+            "limitingUp": ramped and real(yp + max_up) < uc,
+            "limitingDown": ramped and real(yp - max_down) > uc,
             "highLimit": finite(y) and y >= high,
             "lowLimit": finite(y) and y <= low,
             "remainingTime": remaining,
