@@ -1,0 +1,98 @@
+"""Recordings as controllers' recorders export them, read into one
+normalised, columnar Recording (recordings.model) whatever the recorder.
+
+The format is recognised from the content, in this order (the first that
+fits reads the file):
+
+  ASAM MDF4                              mdf.py
+  Beckhoff TwinCAT Scope View CSV        twincat.py
+  WinCC data log CSV                     vendors.py
+  Niagara history export (one point)     vendors.py
+  CODESYS 2.3 trace (ASCII file)         vendors.py
+  tables: TIA Portal trace CSV, CODESYS V3 export, plain CSV/TSV   tables.py
+
+A file none of them fits is a TraceError that says, for each, why not.
+"""
+import os
+
+from ..traces import InputError, TraceError
+from . import mdf, tables, text as texts, twincat, vendors
+from .matching import Plan, last_component, plan
+from .model import Channel, Recording
+from .timebase import OFF_CYCLE, normalise
+
+TEXT_FORMATS = (
+    ("Beckhoff TwinCAT Scope View CSV", twincat.sniff, twincat.read),
+    ("WinCC data log CSV", vendors.sniff_wincc, vendors.read_wincc),
+    ("Niagara history export", vendors.sniff_niagara, vendors.read_niagara),
+    ("CODESYS 2.3 trace (ASCII file)", vendors.sniff_codesys23, vendors.read_codesys23),
+    ("table (TIA Portal trace CSV, CODESYS V3 export, CSV/TSV)", tables.sniff, tables.read),
+)
+FORMAT_NAMES = ("ASAM MDF4",) + tuple(name for name, _, _ in TEXT_FORMATS)
+
+__all__ = ["Channel", "FORMAT_NAMES", "OFF_CYCLE", "Plan", "Recording", "is_recording", "last_component",
+           "normalise", "plan", "read_file", "read_recording"]
+
+
+def read_file(path):
+    """The Recording of one exported file."""
+    try:
+        with open(path, "rb") as file:
+            head = file.read(64)
+    except OSError as error:
+        raise TraceError(path, 0, 0, error.strerror or str(error)) from None
+    if mdf.sniff(head) is None:
+        return mdf.read(path)
+    text = texts.read(path)
+    if not text.text.strip():
+        raise TraceError(path, 0, 0, "empty file")
+    reasons = [f"ASAM MDF4: {mdf.sniff(head)}"]
+    for name, sniff, read in TEXT_FORMATS:
+        why = sniff(text)
+        if why is None:
+            return read(text)
+        reasons.append(f"{name}: {why}")
+    raise TraceError(path, 0, 0, "no known recording format; tried " + "; ".join(reasons))
+
+
+def _files(paths):
+    files = []
+    for path in paths:
+        path = os.fspath(path)
+        if os.path.isdir(path):
+            inside = sorted(os.path.join(path, n) for n in os.listdir(path)
+                            if not n.startswith(".") and os.path.isfile(os.path.join(path, n)))
+            if not inside:
+                raise InputError(f"{path}: an empty folder")
+            files.extend(inside)
+        elif os.path.exists(path):
+            files.append(path)
+        else:
+            raise InputError(f"{path}: no such file or folder")
+    return files
+
+
+def read_recording(paths):
+    """A list of Recordings of the files and folders given: each file is
+    one recording, except single-point histories (Niagara), which together
+    make one (given as their files or as their folder)."""
+    recordings, points = [], []
+    for path in _files([paths] if isinstance(paths, (str, os.PathLike)) else paths):
+        recording = read_file(path)
+        (points if recording.format == "Niagara history export" else recordings).append(recording)
+    if points:
+        recordings.append(vendors.merge(points))
+    return recordings
+
+
+def is_recording(path):
+    """Whether a path given to compare is a recording (a file, or a folder
+    without cases of the cross-check layout: no *_ref.csv in it)."""
+    if os.path.isfile(path):
+        return True
+    if os.path.isdir(path):
+        for _, _, names in os.walk(path):
+            if any(n.endswith("_ref.csv") for n in names):
+                return False
+        return True
+    return False

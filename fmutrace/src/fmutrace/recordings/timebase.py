@@ -1,0 +1,223 @@
+"""Time as recorders stamp it, made seconds from the recording's first
+sample, and matched to the cycles of the FMU's step.
+
+Units: s, ms, us, ns (a number per sample), FILETIME (100 ns ticks since
+1601, TwinCAT's full time stamps), OLE days (WinCC's Time_ms: days since
+30 Dec 1899 times 1e6), date strings (ISO 8601, 24.03.2014 10:42:55.123,
+22-Sep-26 09:00:01.250 AM UTC, ...), and cycle counts (times the step).
+Integer stamps are subtracted as integers first, so FILETIME's 1.3e17
+ticks lose no resolution.
+
+A stamp belongs to the nearest cycle end; one further than OFF_CYCLE of a
+cycle from it is reported (recorders' clocks and printed decimals are
+not exact, a stamp that far off means another clock or another step).
+"""
+import re
+from datetime import datetime, timedelta, timezone
+
+import numpy as np
+
+from ..traces import InputError, TraceError
+from .model import TIME_FACTORS
+
+OFF_CYCLE = 0.1          # a stamp more than this fraction of a cycle from a cycle end is reported
+MAX_STEPS = 200_000_000    # more steps than this (23 days of 10 ms cycles) is a misread unit
+MAX_SPARSE = 1000          # and so are samples this many steps apart on average (unless --time-unit says so)
+MAX_SPAN = 366 * 86400.0   # and so is a recording over a year long
+SNAP = 1e-3                # an interval between stamps this close to a shorter decimal is that decimal
+UNIT_WORDS = {"s": "s", "sec": "s", "seconds": "s", "ms": "ms", "msec": "ms", "us": "us", "µs": "us",
+              "μs": "us", "usec": "us", "ns": "ns", "cycle": "cycles", "cycles": "cycles"}
+UNIT_NAMES = {"s": "seconds", "ms": "milliseconds", "us": "microseconds", "ns": "nanoseconds",
+              "cycles": "cycle counts", "FILETIME": "FILETIME (100 ns ticks since 1601)",
+              "OLE days": "OLE days (days since 30 Dec 1899, times 1e6)", "date": "dates and times"}
+_UNIT_IN_NAME = re.compile(r"(?:[\[(]\s*([^\])]+?)\s*[\])]|[_/ ](ms|us|µs|ns|s)\s*$)", re.IGNORECASE)
+
+
+def unit_in_name(name):
+    """The time unit a column's name states ('Time [ms]', 'Zeit (ms)',
+    'Time_ms', 'time/s'), or None."""
+    match = _UNIT_IN_NAME.search(name)
+    if not match:
+        return None
+    word = (match.group(1) or match.group(2)).strip()
+    return UNIT_WORDS.get(word) or UNIT_WORDS.get(word.lower())
+
+
+# -- date strings ---------------------------------------------------------------
+_MONTHS = {m: i + 1 for i, m in enumerate(("jan", "feb", "mar", "apr", "may", "jun", "jul", "aug", "sep", "oct",
+                                          "nov", "dec"))}
+_MONTHS.update({"mär": 3, "mrz": 3, "mai": 5, "okt": 10, "dez": 12})
+_DATE_FORMS = [
+    # 2026-11-20T14:03:11.125+01:00, 2026-11-20 14:03:11,125
+    re.compile(r"^(?P<Y>\d{4})-(?P<m>\d{1,2})-(?P<d>\d{1,2})[T ](?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+               r"(?:[.,](?P<f>\d+))?\s*(?P<z>Z|[+-]\d{2}:?\d{2})?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"),
+    # 24.03.2014 10:42:55.123 (WinCC), 20/11/2026 14:03:11
+    re.compile(r"^(?P<d>\d{1,2})[./](?P<m>\d{1,2})[./](?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+               r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"),
+    # 22-Sep-26 09:00:01.250 AM UTC (Niagara)
+    re.compile(r"^(?P<d>\d{1,2})-(?P<b>[A-Za-zä]{3})-(?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+               r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<z>[+-]\d{2}:?\d{2}))?"
+               r"(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"),
+]
+
+
+def looks_like_date(text):
+    return any(form.match(text.strip()) for form in _DATE_FORMS)
+
+
+def parse_date(text):
+    """A date string as integer nanoseconds since 1970 (local times and
+    named zones other than UTC/GMT/Z taken as they read: only differences
+    matter here); None if it is no date form known."""
+    text = text.strip()
+    for form in _DATE_FORMS:
+        match = form.match(text)
+        if match:
+            break
+    else:
+        return None
+    g = match.groupdict()
+    year = int(g["Y"])
+    if year < 100:
+        year += 2000
+    month = _MONTHS.get(g["b"].lower()) if g.get("b") else int(g["m"])
+    if month is None:
+        return None
+    hour = int(g["H"])
+    if g.get("ap"):
+        hour = hour % 12 + (12 if g["ap"].lower() == "pm" else 0)
+    try:
+        moment = datetime(year, month, int(g["d"]), hour, int(g["M"]), int(g["S"]), tzinfo=timezone.utc)
+    except ValueError:
+        return None
+    zone = g.get("z")
+    if zone and zone != "Z":
+        sign = -1 if zone[0] == "-" else 1
+        digits = zone[1:].replace(":", "")
+        moment -= sign * timedelta(hours=int(digits[:2]), minutes=int(digits[2:]))
+    fraction = g.get("f") or ""
+    nanoseconds = int((fraction + "000000000")[:9]) if fraction else 0
+    return (int((moment - datetime(1970, 1, 1, tzinfo=timezone.utc)).total_seconds()) * 1_000_000_000
+            + nanoseconds)
+
+
+def dates(cells, text, line_of, column, name):
+    """A column of date strings as int64 nanoseconds; the first that is no
+    date is a TraceError at its place."""
+    out = np.empty(len(cells), dtype=np.int64)
+    for i, cell in enumerate(cells):
+        value = parse_date(cell)
+        if value is None:
+            raise text.error(line_of(i), column, f"{cell.strip()!r} in column {name!r} is not a date and time "
+                                                 "(e.g. 2026-11-20 14:03:11.125 or 20.11.2026 14:03:11.125)")
+        out[i] = value
+    return out
+
+
+# -- seconds from the first sample -------------------------------------------------
+def normalise(recording, time_unit=None, step_size=None, default_step=None):
+    """Set every channel's times (seconds from the recording's first
+    sample, over all channels) and the recording's step_size: step_size if
+    given, else the sample time the file declares, else the finest interval
+    between its time stamps (the recorder sampled every cycle), else
+    default_step (the FMU's) for cycle counts. time_unit overrides the
+    recording's. Refuses a recording whose length in steps is absurd,
+    naming the unit it assumed."""
+    if time_unit:
+        if recording.time_unit in ("date", "OLE days") and time_unit != recording.time_unit:
+            raise InputError(f"{recording.label}: its time stamps are {UNIT_NAMES[recording.time_unit]}: "
+                             f"--time-unit {time_unit} does not apply")
+        recording.time_unit, recording.time_source = time_unit, "--time-unit"
+    unit = recording.time_unit
+    channels = [c for c in recording.channels if len(c.stamps)]
+    if not channels:
+        raise TraceError(recording.label, 0, 0, "no samples: the recording holds no channel with values")
+    if unit == "cycles":
+        step = step_size or recording.sample_time or default_step
+        if not step:
+            raise InputError(f"{recording.label}: its time is a cycle count: give the cycle time with --step-size")
+        recording.step_size = step
+        recording.step_source = ("--step-size" if step_size else "the recording's sample time"
+                                 if recording.sample_time else "the FMU's default step size")
+    origin = min(_first(c.stamps, c.unit or unit) for c in channels)
+    for channel in recording.channels:
+        channel_unit = channel.unit or unit
+        relative = _minus(channel.stamps, origin, channel_unit)
+        if channel_unit == "cycles":
+            channel.times = relative * recording.step_size
+        elif channel_unit == "date":
+            channel.times = relative * 1e-9
+        else:
+            channel.times = relative * TIME_FACTORS[channel_unit]
+    span = max(float(c.times[-1]) for c in channels)
+    assumed = (f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit])
+    if span > MAX_SPAN:
+        raise InputError(f"{recording.label}: with its time read as {assumed}, the recording would span "
+                         f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give --time-unit "
+                         "(s, ms, us, ns, cycles, filetime)")
+    if unit != "cycles":
+        if step_size:
+            recording.step_size, recording.step_source = step_size, "--step-size"
+        elif recording.sample_time:
+            recording.step_size, recording.step_source = recording.sample_time, "the recording's sample time"
+        else:
+            step = finest_interval(channels)
+            if step is None:
+                if not default_step:
+                    raise InputError(f"{recording.label}: one sample per channel tells no cycle time: give "
+                                     "--step-size")
+                step, source = default_step, "the FMU's default step size"
+            else:
+                source = "the finest interval between its time stamps"
+            recording.step_size, recording.step_source = step, source
+    steps = span / recording.step_size
+    samples = max(len(c.times) for c in channels)
+    if steps > MAX_STEPS or (steps > MAX_SPARSE * samples and recording.time_source != "--time-unit"):
+        raise InputError(f"{recording.label}: with its time read as {assumed} and a step of "
+                         f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
+                         f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit (s, ms, us, ns, cycles, "
+                         "filetime)")
+    return recording
+
+
+def _first(stamps, unit):
+    return stamps[0] if unit not in ("s", "ms", "us", "ns", "OLE days") else float(stamps[0])
+
+
+def _minus(stamps, origin, unit):
+    """stamps - origin as float64, exactly for integer stamps."""
+    if stamps.dtype.kind in "iu":
+        return (stamps - np.int64(origin)).astype(np.float64)
+    if stamps.dtype.kind == "M":
+        return (stamps - origin).astype("timedelta64[ns]").astype(np.int64).astype(np.float64)
+    return stamps.astype(np.float64) - float(origin)
+
+
+def finest_interval(channels):
+    """The smallest of the channels' typical (median) positive intervals
+    between samples, in seconds; None if no channel has two samples."""
+    best = None
+    for channel in channels:
+        steps = np.diff(channel.times)
+        steps = steps[steps > 0]
+        if len(steps):
+            typical = float(np.median(steps))
+            best = typical if best is None else min(best, typical)
+    if best is None:
+        return None
+    # clocks and printed stamps are not exact: a median of 0.2499985 s is a 250 ms cycle (the shortest
+    # decimal within SNAP of it)
+    for digits in range(1, 16):
+        rounded = float(f"{best:.{digits}g}")
+        if abs(rounded - best) <= SNAP * best:
+            return rounded
+    return best
+
+
+def cycles(channel, step):
+    """(cycle index of each sample, indices of samples whose stamp is off
+    its cycle end by more than OFF_CYCLE of a cycle)."""
+    exact = channel.times / step
+    index = np.rint(exact).astype(np.int64)
+    off = np.flatnonzero(np.abs(exact - index) > OFF_CYCLE)
+    return index, off
