@@ -143,7 +143,7 @@ def worker_peaks(fmu, folders_root, jobs, report):
             LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             Client(cluster) as client:
         campaign = fmutrace.compare(fmu, folders_root, report=report, plots="failed",
-                                    scheduler=cluster.scheduler_address, shared_files=True, timeout=3600)
+                                    scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=3600)
         if not campaign.passed:
             raise SystemExit(campaign.summary()[:3000])
         peaks = client.run(peak_megabytes)

@@ -38,12 +38,12 @@ def test_lifecycle_harness_under_emulation():
     assert "FMI 3: passed" in done.stdout
 
 
-@pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.id for s in SCENARIOS])
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.name for s in SCENARIOS])
 def test_scenario_gives_the_same_bits_on_aarch64(scenario, tmp_path):
     stage = BUILD_DIR / "stage" / "fmi3" / scenario.model
     md = read_model_description(str(stage / "modelDescription.xml"))
     text = script(scenario, md)
-    native, emulated = (run_script(platform, stage, scenario.model, md.guid, text, tmp_path, f"{scenario.id} on {platform}")
+    native, emulated = (run_script(platform, stage, scenario.model, md.guid, text, tmp_path, f"{scenario.name} on {platform}")
                         for platform in ("x86_64-linux", "aarch64-linux"))
     o = scenario.options
     assert len(native) == (round((o["StopTime"] - o["StartTime"]) / o["StepSize"]) + 1) * len(scenario.outputs)
@@ -53,7 +53,7 @@ def test_scenario_gives_the_same_bits_on_aarch64(scenario, tmp_path):
 def test_the_harness_gives_the_reference(tmp_path):
     """run_trace's numbers are the FMU's: a scenario through it on x86_64
     gives its hand-worked reference."""
-    scenario = next(s for s in SCENARIOS if s.id == "RateLimiter/asymmetric")
+    scenario = next(s for s in SCENARIOS if s.name == "RateLimiter/asymmetric")
     stage = BUILD_DIR / "stage" / "fmi3" / "RateLimiter"
     md = read_model_description(str(stage / "modelDescription.xml"))
     lines = run_script("x86_64-linux", stage, "RateLimiter", md.guid, script(scenario, md), tmp_path, "run_trace")
@@ -64,7 +64,7 @@ def test_the_harness_gives_the_reference(tmp_path):
 @pytest.mark.parametrize("name", ["RateLimiter/asymmetric", "RateLimiter/duration_jump", "Ramp/ttime_tuned_in_run",
                                   "LGF_LimRateOfChangeAdvancedCI/inverted_limits", "RateLimit/duration_48h"])
 def test_a_state_serialized_on_one_platform_continues_on_the_other(name, saved_on, restored_on, tmp_path):
-    scenario = next(s for s in SCENARIOS if s.id == name)
+    scenario = next(s for s in SCENARIOS if s.name == name)
     stage = BUILD_DIR / "stage" / "fmi3" / scenario.model
     md = read_model_description(str(stage / "modelDescription.xml"))
     first, second, whole_script = halves(scenario, md, "state.bin")

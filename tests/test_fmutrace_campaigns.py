@@ -187,7 +187,7 @@ def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
     report = tmp_path / "killed"
     result = {}
     campaign = threading.Thread(target=lambda: result.setdefault("campaign", fmutrace.compare(
-        fmus, cases, report=report, scheduler=cluster, timeout=600, plots="all")))
+        fmus, cases, report=report, scheduler=cluster, cluster_timeout=600, plots="all")))
     campaign.start()
     wait_for(lambda: (report / "results.jsonl").exists() and len(journal_keys(report)) >= 3, "three finished cases")
     with Client(cluster, timeout=WAIT) as client:
@@ -223,11 +223,11 @@ def faulty_cases(root, values):
 def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, jobs, tmp_path):
     """On workers the batch that holds it kills its worker, is run again
     case by case in child processes, and only the crashing case fails; in
-    one process (with --timeout, which runs the cases in a child) the
+    one process (with --case-timeout, which runs the cases in a child) the
     same."""
     cases = faulty_cases(tmp_path / "cases", [1, 2, 13, 4, 5, 6])
     args = ["compare", FAULTY[version], cases, "--report", tmp_path / "report", "--jobs", jobs]
-    code, out, err = finish(start(args + (["--timeout", 60] if jobs == 1 else [])))
+    code, out, err = finish(start(args + (["--case-timeout", 60] if jobs == 1 else [])))
     assert code == 1, out + err
     assert f"ERROR  case_13 on Faulty (FMI {version})\n      the simulation's process was {CRASH} while running " \
            "this case" in out
@@ -239,7 +239,7 @@ def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, 
 def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     cases = faulty_cases(tmp_path / "cases", [1, 17, 3, 13, 5])
     started = time.monotonic()
-    code, out, err = finish(start(["compare", FAULTY[3], cases, "--jobs", jobs, "--timeout", 3]))
+    code, out, err = finish(start(["compare", FAULTY[3], cases, "--jobs", jobs, "--case-timeout", 3]))
     assert code == 1, out + err
     assert "ERROR  case_17 on Faulty (FMI 3)\n      stopped after the per-case timeout of 3 s" in out
     assert f"ERROR  case_13 on Faulty (FMI 3)\n      the simulation's process was {CRASH}" in out

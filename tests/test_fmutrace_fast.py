@@ -54,7 +54,7 @@ def test_every_reference_scenario_bit_for_bit(version):
         o = s.options
         fast, plain = both(s.model, version, o["StartTime"], o["StopTime"], o["StepSize"], s.inputs, s.start_values,
                            s.outputs, o["RelTol"])
-        assert same_bits(fast, plain), s.id
+        assert same_bits(fast, plain), s.name
     # the fast loop ran (not only fmpy's): all but the off-grid scenarios
     assert sum(x.fast_runs for x in r.values()) - fast_before >= len(SCENARIOS) - 4
 

@@ -22,8 +22,7 @@ from fmpy.util import read_csv
 
 from support.fmu_driver import BUILD_DIR, TESTS
 from support.process import run as run_bounded
-from fmutrace import Tolerance
-from fmutrace.comparison import compare as compare_traces
+from fmutrace import Tolerance, compare_traces
 from support.scenarios import discover, fmu_path
 
 SCENARIOS = discover()
@@ -43,13 +42,13 @@ def run(importer, scenario, version, tmp_path):
     out = tmp_path / "result.csv"
     process = run_bounded([sys.executable, "-m", "support.importers", importer, str(scenario.folder),
                            str(fmu_path(BUILD_DIR, scenario.model, version)), str(out)],
-                          timeout=300, what=f"{scenario.id} through {importer} (FMI {version})", cwd=TESTS)
+                          timeout=300, what=f"{scenario.name} through {importer} (FMI {version})", cwd=TESTS)
     assert process.returncode == 0, process.stderr[-3000:]
     return np.atleast_1d(read_csv(str(out))), process.stdout + process.stderr
 
 
 @pytest.mark.parametrize("importer,version", IMPORTERS, ids=[f"{i}-fmi{v}" for i, v in IMPORTERS])
-@pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.id for s in SCENARIOS])
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.name for s in SCENARIOS])
 def test_scenario_through_importer(importer, version, scenario, tmp_path):
     result, log = run(importer, scenario, version, tmp_path)
     reference = scenario.reference

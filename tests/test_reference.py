@@ -21,11 +21,11 @@ def test_enough_hand_worked_scenarios(model, least):
     scenarios = [s for s in SCENARIOS if s.model == model]
     assert len(scenarios) >= least
     for s in scenarios:
-        assert s.description, f"{s.id} has no README.md"
+        assert s.description, f"{s.name} has no README.md"
 
 
 @pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.id)
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
 def test_fmu_matches_reference(scenario, version):
     result = simulate(scenario, fmu_file(scenario.model, version))
     problems = compare(scenario, result)
@@ -55,7 +55,7 @@ def inputs_at(scenario, t, booleans):
             for name in scenario.inputs.dtype.names[1:]}
 
 
-@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.id)
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
 def test_oracle_matches_reference(scenario):
     md = read_model_description(unzipped(scenario.model, 2))
     vr = {v.name: v.valueReference for v in md.modelVariables}

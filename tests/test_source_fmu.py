@@ -42,7 +42,7 @@ def test_compiled_source_fmu_matches_shipped_binary(model, version, tmp_path):
         a = simulate(scenario, shipped)
         b = simulate(scenario, source_only)
         for name in a.dtype.names:
-            assert np.array_equal(a[name], b[name], equal_nan=True), (scenario.id, name)
+            assert np.array_equal(a[name], b[name], equal_nan=True), (scenario.name, name)
 
 
 @pytest.mark.parametrize("portable", [False, True], ids=["hints", "no-hints"])

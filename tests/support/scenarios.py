@@ -4,8 +4,7 @@ import math
 from functools import lru_cache
 from pathlib import Path
 
-from fmutrace import Fmu, Tolerance, load_case
-from fmutrace.comparison import compare as compare_traces
+from fmutrace import Exact, Fmu, compare_traces, load_case
 from fmutrace.simulation import run_fmpy
 
 from support.fmu_driver import BUILD_DIR
@@ -45,7 +44,7 @@ def simulate(scenario, fmu):
 def compare(scenario, result, reference=None):
     """Where result differs from the reference (or the rows of it given),
     bit for bit, as readable lines (none: the same)."""
-    return compare_traces(result, scenario.reference if reference is None else reference, Tolerance()).messages()
+    return compare_traces(result, scenario.reference if reference is None else reference, Exact()).messages()
 
 
 def same(value, expected):

@@ -6,15 +6,17 @@ with fmpy and report where they differ from references.
     campaign = fmutrace.compare("RateLimiter.fmu", "my_traces/", report="report/")
     assert campaign.passed, campaign.summary()
 """
-__version__ = "0.2.0"
+__version__ = "0.2.0"  # the package's version (pyproject.toml reads it from here)
 
-from .campaign import CampaignResult, CaseOutcome, compare
+from .campaign import compare
 from .cases import Case, find_cases, load_case
-from .comparison import Comparison, Deviation, Tolerance
+from .comparison import Comparison, Deviation, Exact, Mode, Tolerance, Tube, compare_traces, comparison_mode
+from .errors import ExitStatus, InputError, SimulationError, TraceError
 from .fmu import Fmu
-from .simulation import SimulationError, simulate
-from .traces import InputError, TraceError, read_trace, write_trace
+from .outcome import CampaignResult, CaseOutcome, Status
+from .simulation import simulate
+from .traces import read_trace, write_trace
 
-__all__ = ["CampaignResult", "Case", "CaseOutcome", "Comparison", "Deviation", "Fmu", "InputError",
-           "SimulationError", "Tolerance", "TraceError", "compare", "find_cases", "load_case", "read_trace",
-           "simulate", "write_trace"]
+__all__ = ["CampaignResult", "Case", "CaseOutcome", "Comparison", "Deviation", "Exact", "ExitStatus", "Fmu",
+           "InputError", "Mode", "SimulationError", "Status", "Tolerance", "TraceError", "Tube", "compare",
+           "compare_traces", "comparison_mode", "find_cases", "load_case", "read_trace", "simulate", "write_trace"]

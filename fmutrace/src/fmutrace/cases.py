@@ -13,11 +13,14 @@ an InputError naming the file, line and column.
 """
 import os
 from array import array
+from os import PathLike
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from .traces import InputError, TraceError, _lines, _split, parse_number, read_text, read_trace
+from .errors import InputError, TraceError
+from .fmu import Fmu
+from .traces import data_lines, parse_number, read_text, read_trace, split_cells
 
 OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
 FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
@@ -35,10 +38,6 @@ class Case:
     description: str = ""
 
     @property
-    def id(self):
-        return self.name
-
-    @property
     def outputs(self):
         """The reference's signals: what is recorded and compared."""
         return [n for n in self.reference.dtype.names if n != "time"]
@@ -46,8 +45,8 @@ class Case:
 
 def read_options(path, text, reference, fmu):
     options = {"RelTol": 1e-6}
-    for number, line in _lines(text or ""):
-        cells = _split(line, ",")
+    for number, line in data_lines(text or ""):
+        cells = split_cells(line, ",")
         if len(cells) != 2:
             raise TraceError(path, number, 1, f"expected 'Name,value', found {line.strip()!r}")
         key, literal = cells
@@ -77,8 +76,8 @@ def read_start_values(path, text, fmu):
     """The start values of a "name,value" file, each checked against the
     FMU's variable (type, range)."""
     values = {}
-    for number, line in _lines(text or ""):
-        cells = _split(line, "," if line.count(",") else ";")
+    for number, line in data_lines(text or ""):
+        cells = split_cells(line, "," if line.count(",") else ";")
         if len(cells) != 2:
             raise TraceError(path, number, 1, f"expected 'name,value', found {line.strip()!r}")
         name, literal = cells
@@ -106,7 +105,7 @@ def case_texts(folder, model):
     return texts
 
 
-def load_case(folder, fmu, name=None, texts=None):
+def load_case(folder: str | PathLike, fmu: Fmu, name: str | None = None, texts: dict | None = None) -> Case:
     """The case in folder for fmu's model, checked against the FMU; the
     files' texts may be given (texts from case_texts), else they are read."""
     folder = Path(folder)
@@ -166,7 +165,7 @@ class CaseList(Sequence):
         return os.path.join(root, name if kind == self.RELATIVE else name[len(root_name) + 1:]), name
 
 
-def find_cases(paths, model):
+def find_cases(paths: Sequence[str | PathLike], model: str) -> "CaseList":
     """[(folder, name)] of the cases of model under paths, each a case
     folder itself or a folder searched recursively (through linked folders
     too, each folder once), sorted by name: the folder's path below the one

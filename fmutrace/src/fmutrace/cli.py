@@ -3,18 +3,20 @@
   fmutrace run FMU [--input IN.csv] [--set NAME=VALUE]... [-o OUT.csv] ...
   fmutrace compare FMU... CASE... [--report DIR] [--rel-tol R] ...
 
-Exit status: 0 success (compare: every case passes), 1 a case differs or
-the simulation failed, 2 a usage or input error (a case with bad files is
-reported and the other cases run).
+Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
+simulation, 2 bad input); compare's is its worst case's.
 """
 import argparse
 import sys
 
 from . import __version__
 from .campaign import compare
+from .errors import ExitStatus, InputError, SimulationError
 from .fmu import is_fmu_file
-from .simulation import SimulationError, simulate
-from .traces import InputError, write_trace
+from .outcome import Status
+from .simulation import simulate
+from .traces import write_trace
+from .worker import PLOT_ALL_UP_TO, PLOTS
 
 EXAMPLES = """examples:
   fmutrace run build/fmi3/RateLimiter.fmu --input u.csv --set rateUpPar=2 --step-size 0.1 -o y.csv
@@ -91,10 +93,11 @@ def parser():
     cmp.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
     cmp.add_argument("--shared-files", action="store_true", help="the scheduler's workers see the case folders at "
                      "the same paths (else they are sent the files)")
-    cmp.add_argument("--plots", choices=("all", "failed", "none"), default="all",
-                     help="which cases get a plot in the report (default: all)")
-    cmp.add_argument("--timeout", type=_non_negative, metavar="S", help="seconds a case may run: one over it is "
-                     "stopped and reported (the cases then run in child processes)")
+    cmp.add_argument("--plots", choices=PLOTS, help="which cases get a plot and a result CSV in the report "
+                     f"(default: all for up to {PLOT_ALL_UP_TO} cases, else the failed ones)")
+    cmp.add_argument("--case-timeout", type=_non_negative, metavar="S", help="seconds a case may run: one over it "
+                     "is stopped and reported (the cases then run in child processes)")
+    cmp.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
     cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
     cmp.add_argument("--resume", action="store_true", help="take the cases the report's journal holds from it and "
                      "run the others (after a stopped campaign; needs --report)")
@@ -110,7 +113,7 @@ def run_command(args, out):
         print(f"{len(result)} samples of {len(result.dtype.names) - 1} signals written to {args.out}", file=out)
     else:
         write_trace(out, result)
-    return 0
+    return ExitStatus.SUCCESS
 
 
 def compare_command(args, out):
@@ -125,9 +128,9 @@ def compare_command(args, out):
     result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
                      scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
-                     timeout=args.cluster_timeout, case_timeout=args.timeout, resume=args.resume)
+                     case_timeout=args.case_timeout, cluster_timeout=args.cluster_timeout, resume=args.resume)
     for o in result.failed(results=False):
-        if o.status == "invalid":
+        if o.status == Status.INVALID:
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
             continue
         print(f"{o.status.upper()}  {o.case} on {o.fmu}", file=out)
@@ -148,10 +151,10 @@ def main(argv=None, out=None):
         return (run_command if args.command == "run" else compare_command)(args, out)
     except InputError as error:
         print(f"fmutrace: error: {error}", file=sys.stderr)
-        return 2
+        return error.exit_code
     except SimulationError as error:
         print(f"fmutrace: {error}", file=sys.stderr)
-        return 1
+        return error.exit_code
 
 
 if __name__ == "__main__":

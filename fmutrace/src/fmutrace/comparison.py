@@ -1,4 +1,4 @@
-"""A result against its reference, signal by signal, in one of three modes:
+"""A result against its reference, signal by signal, in a comparison mode:
 
 exact      every value bit for bit (any NaN matches any NaN)
 tolerance  |result - reference| <= abs_tol + rel_tol * |reference|
@@ -10,49 +10,38 @@ tube       the reference drawn as a polyline (a repeated time is a
            samples inside the reference's time range are checked). For
            traces sampled at other instants than the FMU's steps.
 
+A mode is an object (Exact, Tolerance, Tube) that gives each signal's
+Band: the samples compared and the bounds each must lie in. The verdict,
+the report's plot and its wording ask the mode; a new mode is a new class
+here.
+
 In the exact and tolerance modes each reference sample is compared with
-the result's sample at the same time (times within a relative 1e-9, they
-are communication points); at a repeated time the reference's last row,
-the value from that instant on, is the one compared. A reference sample
-without a result sample at its time fails.
+the result's sample at the same time: times match within 1e-9 s, or
+within 1e-9 of |t| beyond |t| = 1 s (they are communication points, sums
+of steps); at a repeated time the reference's last row, the value from
+that instant on, is the one compared. A reference sample without a
+result sample at its time fails.
 """
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
-TIME_MATCH = 1e-9
+from .errors import InputError
+
+TIME_MATCH = 1e-9  # seconds below |t| = 1 s, relative above
 
 
 @dataclass(frozen=True)
-class Tolerance:
-    rel_tol: float = 0.0
-    abs_tol: float = 0.0
-    tube_time: float = None
-    tube_value: float = None
-
-    def __post_init__(self):
-        for name in ("rel_tol", "abs_tol", "tube_time", "tube_value"):
-            value = getattr(self, name)
-            if value is not None and not (value >= 0 and math.isfinite(value)):
-                raise ValueError(f"{name.replace('_', '-')} must be a finite number >= 0, not {value!r}")
-        if (self.tube_time is None) != (self.tube_value is None):
-            raise ValueError("a tube needs both its time and its value tolerance (--tube-time and --tube-value)")
-        if self.tube_time is not None and (self.rel_tol or self.abs_tol):
-            raise ValueError("choose a tube or a relative/absolute tolerance, not both")
-
-    @property
-    def mode(self):
-        if self.tube_time is not None:
-            return "tube"
-        return "tolerance" if (self.rel_tol or self.abs_tol) else "exact"
-
-    def describe(self):
-        if self.mode == "tube":
-            return f"tube of {self.tube_time:g} s and {self.tube_value:g}"
-        if self.mode == "tolerance":
-            return f"relative tolerance {self.rel_tol:g}, absolute tolerance {self.abs_tol:g}"
-        return "exact (bit for bit)"
+class Band:
+    """One signal's compared samples and the band each must lie in."""
+    times: np.ndarray
+    values: np.ndarray     # the result's, as float64
+    lower: np.ndarray
+    upper: np.ndarray
+    ok: np.ndarray         # the sample passes
+    deviation: np.ndarray  # what the report plots under the signals
 
 
 @dataclass
@@ -73,7 +62,9 @@ class Deviation:
     largest_at: float = None
     note: str = ""
 
-    def describe(self):
+    NUMBERS: ClassVar[tuple] = ("time", "value", "lower", "upper", "excess", "largest_excess", "largest_at")
+
+    def describe(self) -> str:
         if self.passed:
             return f"{self.name}: {self.compared} samples within the band"
         if self.note:
@@ -83,35 +74,172 @@ class Deviation:
                 f"off by {self.excess:.6g}; {self.failed} of {self.compared} samples outside, "
                 f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}")
 
-    def as_dict(self):
-        """For JSON: the fields that have a value."""
-        return {k: _json_number(v) for k, v in vars(self).items() if v is not None and v != ""}
+    def to_json(self) -> dict:
+        """The fields that have a value; NaN and infinities as "nan", "inf", "-inf" (JSON has none)."""
+        return {k: repr(v) if isinstance(v, float) and not math.isfinite(v) else v
+                for k, v in vars(self).items() if v is not None and v != ""}
 
-
-def _json_number(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return repr(value)  # JSON has no NaN or infinity: "nan", "inf", "-inf"
-    return value
+    @classmethod
+    def from_json(cls, entry: dict) -> "Deviation":
+        return cls(**{k: float(v) if k in cls.NUMBERS and isinstance(v, str) else v for k, v in entry.items()})
 
 
 @dataclass
 class Comparison:
-    deviations: list = field(default_factory=list)
+    deviations: list = field(default_factory=list)  # of Deviation, one per signal
     problem: str = ""  # the whole result failed (no samples, simulation error)
+    bands: dict = field(default_factory=dict, repr=False)  # name -> Band, for a plot
 
     @property
-    def passed(self):
+    def passed(self) -> bool:
         return not self.problem and all(d.passed for d in self.deviations)
 
-    def messages(self):
+    def messages(self) -> list:
         if self.problem:
             return [self.problem]
         return [d.describe() for d in self.deviations if not d.passed]
 
 
-def _same_bits(a, b):
-    both_nan = np.isnan(a) & np.isnan(b)
-    return (a.view(np.uint64) == b.view(np.uint64)) | both_nan
+class Mode:
+    """How a result is judged against a reference (a frozen dataclass of
+    its settings)."""
+
+    name: ClassVar[str]               # in results.json
+    fills_band: ClassVar[bool]        # the plot draws the band (else the reference is it)
+    reference_line: ClassVar[dict]    # how the plot draws the reference (matplotlib)
+    deviation_label: ClassVar[str]    # what the plot's last axis shows
+
+    def settings(self) -> dict:
+        """The arguments of comparison_mode that make this mode."""
+        return dict(vars(self))
+
+    def describe(self) -> str:
+        raise NotImplementedError
+
+    def bands(self, result, reference, names) -> tuple:
+        """({name: Band}, problem): problem names what the result lacks ("" if nothing)."""
+        raise NotImplementedError
+
+
+class _Pointwise(Mode):
+    """Each reference sample against the result's at its time."""
+
+    fills_band = False
+    reference_line = {"drawstyle": "steps-post", "color": "0.6", "linewidth": 4}
+    deviation_label = "result - ref"
+
+    def bounds(self, values, expected):
+        """(lower, upper, ok) of the result's values against the expected ones."""
+        raise NotImplementedError
+
+    def bands(self, result, reference, names):
+        index = _aligned(result["time"], reference["time"])
+        use = index >= 0
+        times = reference["time"][use]
+        bands = {}
+        for name in names:
+            expected = reference[name][use].astype(np.float64)
+            values = result[name][index[use]].astype(np.float64)
+            lower, upper, ok = self.bounds(values, expected)
+            with np.errstate(invalid="ignore", over="ignore"):
+                bands[name] = Band(times, values, lower, upper, ok, values - expected)
+        absent = np.flatnonzero(index == -1)
+        if not len(absent):
+            return bands, ""
+        return bands, (f"the result has no sample at t={float(reference['time'][absent[0]])!r} "
+                       f"({len(absent)} reference times without one)")
+
+
+@dataclass(frozen=True)
+class Exact(_Pointwise):
+    name: ClassVar[str] = "exact"
+
+    def describe(self):
+        return "exact (bit for bit)"
+
+    def bounds(self, values, expected):
+        both_nan = np.isnan(values) & np.isnan(expected)
+        return expected, expected, (values.view(np.uint64) == expected.view(np.uint64)) | both_nan
+
+
+@dataclass(frozen=True)
+class Tolerance(_Pointwise):
+    rel_tol: float = 0.0
+    abs_tol: float = 0.0
+
+    name: ClassVar[str] = "tolerance"
+
+    def __post_init__(self):
+        _check_widths(self, rel_tol="rel-tol", abs_tol="abs-tol")
+
+    def describe(self):
+        return f"relative tolerance {self.rel_tol:g}, absolute tolerance {self.abs_tol:g}"
+
+    def bounds(self, values, expected):
+        with np.errstate(invalid="ignore"):
+            allowed = self.abs_tol + self.rel_tol * np.abs(expected)
+            lower, upper = expected - allowed, expected + allowed
+            ok = ((values >= lower) & (values <= upper)) | (np.isnan(values) & np.isnan(expected)) | \
+                (values == expected)  # an infinity equal to its reference (its band is NaN)
+        return lower, upper, ok
+
+
+@dataclass(frozen=True)
+class Tube(Mode):
+    time: float
+    value: float
+
+    name: ClassVar[str] = "tube"
+    fills_band = True
+    reference_line = {"color": "0.5", "linewidth": 1}
+    deviation_label = "outside the tube"
+
+    def __post_init__(self):
+        _check_widths(self, time="tube-time", value="tube-value")
+
+    def settings(self):
+        return {"tube_time": self.time, "tube_value": self.value}
+
+    def describe(self):
+        return f"tube of {self.time:g} s and {self.value:g}"
+
+    def bands(self, result, reference, names):
+        bands = {}
+        for name in names:
+            lower, upper = tube_bounds(reference["time"], reference[name].astype(np.float64), result["time"],
+                                       self.time, self.value)
+            inside = ~np.isnan(lower)  # the samples inside the reference's time range
+            values, lower, upper = result[name].astype(np.float64)[inside], lower[inside], upper[inside]
+            with np.errstate(invalid="ignore"):
+                ok = (values >= lower) & (values <= upper)
+                outside = np.where(values > upper, values - upper, np.where(values < lower, values - lower, 0.0))
+            bands[name] = Band(result["time"][inside], values, lower, upper, ok, outside)
+        return bands, ""
+
+
+def _check_widths(mode, **options):
+    """Every width a finite number >= 0; options: field -> the command's option."""
+    for name, option in options.items():
+        value = getattr(mode, name)
+        if not (value >= 0 and math.isfinite(value)):
+            raise InputError(f"{option} must be a finite number >= 0, not {value!r}")
+
+
+EXACT = Exact()
+
+
+def comparison_mode(rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float = None,
+                    tube_value: float = None) -> Mode:
+    """The mode the command's options (and compare's arguments of the same
+    names) choose: a tube, a tolerance, else exact. InputError if they do
+    not make one."""
+    if (tube_time is None) != (tube_value is None):
+        raise InputError("a tube needs both its time and its value tolerance (--tube-time and --tube-value)")
+    if tube_time is not None:
+        if rel_tol or abs_tol:
+            raise InputError("choose a tube or a relative/absolute tolerance, not both")
+        return Tube(tube_time, tube_value)
+    return Tolerance(rel_tol, abs_tol) if (rel_tol or abs_tol) else EXACT
 
 
 def _aligned(result_time, reference_time):
@@ -130,9 +258,11 @@ def _aligned(result_time, reference_time):
     return np.where(last, best, -2)
 
 
-def _verdict(name, times, values, lower, upper, ok):
+def _verdict(name, band):
+    ok = band.ok
     deviation = Deviation(name, bool(ok.all()), compared=len(ok), failed=int((~ok).sum()))
     if not deviation.passed:
+        times, values, lower, upper = band.times, band.values, band.lower, band.upper
         with np.errstate(invalid="ignore"):
             excess = np.where(values > upper, values - upper, lower - values)
         excess = np.where(np.isnan(excess), np.inf, excess)
@@ -144,22 +274,6 @@ def _verdict(name, times, values, lower, upper, ok):
         deviation.excess = float(excess[first])
         deviation.largest_excess, deviation.largest_at = float(excess[worst]), float(times[worst])
     return deviation
-
-
-def _pointwise(name, result, reference, tolerance, index):
-    use = index >= 0
-    times = reference["time"][use]
-    expected = reference[name][use].astype(np.float64)
-    values = result[name][index[use]].astype(np.float64)
-    if tolerance.mode == "exact":
-        ok = _same_bits(values, expected)
-        lower = upper = expected
-    else:
-        with np.errstate(invalid="ignore"):
-            allowed = tolerance.abs_tol + tolerance.rel_tol * np.abs(expected)
-            lower, upper = expected - allowed, expected + allowed
-            ok = ((values >= lower) & (values <= upper)) | (np.isnan(values) & np.isnan(expected)) | (values == expected)
-    return _verdict(name, times, values, lower, upper, ok)
 
 
 def _polyline_at(times, values, at):
@@ -195,18 +309,7 @@ def tube_bounds(reference_time, reference_values, times, tube_time, tube_value):
     return lower, upper
 
 
-def _tube(name, result, reference, tolerance):
-    reference_values = reference[name].astype(np.float64)
-    times = result["time"]
-    values = result[name].astype(np.float64)
-    lower, upper = tube_bounds(reference["time"], reference_values, times, tolerance.tube_time, tolerance.tube_value)
-    inside = ~np.isnan(lower)
-    with np.errstate(invalid="ignore"):
-        ok = (values[inside] >= lower[inside]) & (values[inside] <= upper[inside])
-    return _verdict(name, times[inside], values[inside], lower[inside], upper[inside], ok)
-
-
-def compare(result, reference, tolerance=Tolerance()):
+def compare_traces(result, reference, mode: Mode = EXACT) -> Comparison:
     """The Comparison of a result (structured array with 'time') with a
     reference, for every signal of the reference."""
     names = [n for n in reference.dtype.names if n != "time"]
@@ -215,13 +318,5 @@ def compare(result, reference, tolerance=Tolerance()):
         return Comparison(problem=f"the result has no signal {', '.join(missing)}")
     if len(result) == 0:
         return Comparison(problem="the result has no samples")
-    if tolerance.mode == "tube":
-        return Comparison([_tube(name, result, reference, tolerance) for name in names])
-    index = _aligned(result["time"], reference["time"])
-    deviations = [_pointwise(name, result, reference, tolerance, index) for name in names]
-    absent = np.flatnonzero(index == -1)
-    if len(absent):
-        t = float(reference["time"][absent[0]])
-        return Comparison(deviations, problem=f"the result has no sample at t={t!r} "
-                                              f"({len(absent)} reference times without one)")
-    return Comparison(deviations)
+    bands, problem = mode.bands(result, reference, names)
+    return Comparison([_verdict(name, band) for name, band in bands.items()], problem, bands)

@@ -11,14 +11,15 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from .traces import BOOLEAN_WORDS, InputError
+from .errors import InputError
+from .traces import BOOLEAN_WORDS
 
 INTEGER_RANGES = {
     "Integer": (-2**31, 2**31 - 1), "Int8": (-2**7, 2**7 - 1), "UInt8": (0, 2**8 - 1),
     "Int16": (-2**15, 2**15 - 1), "UInt16": (0, 2**16 - 1), "Int32": (-2**31, 2**31 - 1),
     "UInt32": (0, 2**32 - 1), "Int64": (-2**63, 2**63 - 1), "UInt64": (0, 2**64 - 1),
 }
-REAL_TYPES = ("Real", "Float32", "Float64")
+REAL_TYPES = ("Real", "Float32", "Float64")  # FMI 2 and FMI 3 floating-point types
 
 
 class Fmu:

@@ -21,6 +21,9 @@ import threading
 import time
 from pathlib import Path
 
+from .outcome import CaseOutcome, Status
+from .worker import run_cases
+
 HEADER = struct.Struct("!Q")
 CHILD = "import sys, fmutrace.isolated; sys.exit(fmutrace.isolated.main())"
 
@@ -49,7 +52,7 @@ def _reader(stream, out):
         out.put(None)
 
 
-def run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout, outcome_class, on_outcome=None):
+def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_outcome=None):
     """[outcome] of items [(folder, name, texts)], the cases in a child
     process; a crash or a case over case_timeout seconds (None: no bound)
     fails that case only. on_outcome(outcome), if given, hears of each as
@@ -62,7 +65,7 @@ def run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout,
         said = tempfile.TemporaryFile()  # the child's last words, if it dies
         child = subprocess.Popen([sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                  stderr=said, env=environment)
-        child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, tolerance, plots)))
+        child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, mode, plots)))
         child.stdin.close()
         arrived = queue.Queue()
         threading.Thread(target=_reader, args=(child.stdout, arrived), daemon=True).start()
@@ -73,20 +76,20 @@ def run_isolated(items, fmu_bytes, path, labels, tolerance, plots, case_timeout,
             except queue.Empty:
                 child.kill()
                 child.wait()
-                outcome = outcome_class(name, **labels, status="error",
+                outcome = CaseOutcome(name, **labels, status=Status.ERROR,
                                         messages=[f"stopped after the per-case timeout of {case_timeout:g} s"],
                                         seconds=time.monotonic() - started)
             if outcome is None:  # the child died running this case
                 code = child.wait()
                 cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
-                outcome = outcome_class(name, **labels, status="error",
+                outcome = CaseOutcome(name, **labels, status=Status.ERROR,
                                         messages=[f"the simulation's process was {cause} while running this case"
                                                   + _last_words(said)],
                                         seconds=time.monotonic() - started)
             outcomes.append(outcome)
             if on_outcome:
                 on_outcome(outcome)
-            if outcome.status == "error" and child.poll() is not None:
+            if outcome.status == Status.ERROR and child.poll() is not None:
                 remaining = remaining[index + 1:]
                 break
         else:
@@ -100,12 +103,8 @@ def main():
     out = os.fdopen(os.dup(1), "wb")
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes
-    items, fmu_bytes, path, labels, tolerance, plots = pickle.loads(sys.stdin.buffer.read())
-    from .campaign import run_one, worker_fmu
-
-    runner, fmu = worker_fmu(fmu_bytes, path)
-    for folder, name, texts in items:
-        data = pickle.dumps(run_one(folder, name, texts, runner, fmu, labels, tolerance, plots))
+    for outcome in run_cases(*pickle.loads(sys.stdin.buffer.read())):
+        data = pickle.dumps(outcome)
         out.write(HEADER.pack(len(data)) + data)
         out.flush()
     return 0

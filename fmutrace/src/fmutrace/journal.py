@@ -14,11 +14,12 @@ import json
 import os
 from pathlib import Path
 
-from .comparison import Deviation
-from .traces import InputError
+from .comparison import Mode
+from .errors import InputError
+from .outcome import CaseOutcome, Outcomes
+from .traces import read_trace
 
 JOURNAL = "results.jsonl"
-NUMBERS = ("time", "value", "lower", "upper", "excess", "largest_excess", "largest_at")  # "nan", "inf" in JSON
 LOCK = ".fmutrace.lock"
 
 
@@ -52,8 +53,9 @@ class ReportLock:
             self.file.close()
 
 
-def campaign_key(fmu_bytes, tolerance, plots):
-    return {"tolerance": {k: v for k, v in vars(tolerance).items() if v is not None}, "plots": plots,
+def campaign_key(fmu_bytes: dict, mode: Mode, plots: str) -> dict:
+    """What makes a campaign the same campaign: its FMUs (by content), comparison and plots."""
+    return {"mode": mode.name, "tolerance": mode.settings(), "plots": plots,
             "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values())}
 
 
@@ -123,11 +125,41 @@ def _parse(line):
         return None  # cut short by a kill
 
 
-def outcome_from(entry, outcome_class, fmu_folder):
-    """A CaseOutcome from its journal entry."""
-    return outcome_class(
-        case=entry["case"], fmu=entry["fmu"], fmu_file=entry["fmu_file"], fmu_folder=fmu_folder,
-        status=entry["status"], messages=entry["messages"],
-        deviations=[Deviation(**{k: float(v) if k in NUMBERS and isinstance(v, str) else v for k, v in d.items()})
-                    for d in entry["signals"]],
-        seconds=entry["seconds"], csv=entry.get("result_csv", ""), plot=entry.get("plot", ""))
+class JournaledOutcomes(Outcomes):
+    """The outcomes of a campaign with a report folder, read from its
+    journal when asked: the client keeps where each case's line starts (8
+    bytes a case), so its memory does not grow with the campaign. A case
+    with a result CSV in the report gets its result read from it (bit for
+    bit the one written); light() leaves the results out."""
+
+    def __init__(self, report_dir, journal_path, offsets, fmu_folders):
+        self.report_dir, self.path = Path(report_dir), Path(journal_path)
+        self.offsets, self.fmu_folders = offsets, fmu_folders
+
+    def __len__(self):
+        return len(self.offsets)
+
+    def _outcome(self, journal, offset, results=True):
+        journal.seek(offset)
+        entry = json.loads(journal.readline())
+        outcome = CaseOutcome.from_json(entry, self.fmu_folders[entry["fmu_file"]])
+        if results and outcome.csv:
+            outcome.result = read_trace(self.report_dir / outcome.csv)
+        return outcome
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        with open(self.path, "rb") as journal:
+            return self._outcome(journal, self.offsets[index])
+
+    def _outcomes(self, results):
+        with open(self.path, "rb") as journal:
+            for offset in self.offsets:
+                yield self._outcome(journal, offset, results)
+
+    def __iter__(self):
+        return self._outcomes(results=True)
+
+    def light(self):
+        return self._outcomes(results=False)

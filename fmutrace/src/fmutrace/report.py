@@ -2,83 +2,18 @@
 case), summary.md, results.json and, when asked, JUnit XML; and each
 case's result as <case>_out.csv."""
 import html
-import io
 import json
 import os
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
-import numpy as np
-
-from .comparison import tube_bounds
+from .outcome import CampaignResult, CaseOutcome, Status
 from .traces import write_trace
 
 RESULTS_FORMAT = 1
 
 
-def plot_case(case, result, tolerance, label):
-    """PNG bytes: the inputs, each compared signal (reference and result;
-    the tube's band in tube mode) and the deviation."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    names = case.outputs
-    has_inputs = case.inputs is not None
-    rows = len(names) + 1 + has_inputs
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(8, 1.6 * rows + 0.6), squeeze=False)
-    for ax in axes[:, 0]:
-        ax.tick_params(labelsize=7)
-    axes = list(axes[:, 0])
-    if has_inputs:
-        ax = axes.pop(0)
-        stop = case.options["StopTime"]
-        for name in case.inputs.dtype.names[1:]:
-            ax.step(np.append(case.inputs["time"], stop), np.append(case.inputs[name], case.inputs[name][-1]),
-                    where="post", label=f"input {name}")
-        ax.legend(loc="best", fontsize=7)
-    deviation_axis = axes.pop()
-    ref = case.reference
-    for ax, name in zip(axes, names):
-        if tolerance.mode == "tube":
-            lower, upper = tube_bounds(ref["time"], ref[name].astype(float), result["time"], tolerance.tube_time,
-                                       tolerance.tube_value)
-            ax.fill_between(result["time"], lower, upper, color="0.85", step=None, label="tube")
-            ax.plot(ref["time"], ref[name], color="0.5", linewidth=1, label=f"{name} reference")
-        else:
-            ax.step(ref["time"], ref[name], where="post", color="0.6", linewidth=4, label=f"{name} reference")
-        ax.step(result["time"], result[name], where="post", color="C1", linewidth=1.2, marker=".", markersize=3,
-                label=f"{name} {label}")
-        ax.legend(loc="best", fontsize=7)
-        if tolerance.mode == "tube":
-            with np.errstate(invalid="ignore"):
-                value = result[name].astype(float)
-                off = np.where(value > upper, value - upper, np.where(value < lower, value - lower, 0.0))
-            deviation_axis.plot(result["time"], off, drawstyle="steps-post", label=name)
-        else:
-            at = np.searchsorted(result["time"], ref["time"]).clip(0, len(result) - 1)
-            with np.errstate(invalid="ignore"):
-                deviation_axis.plot(ref["time"], result[name][at].astype(float) - ref[name].astype(float),
-                                    drawstyle="steps-post", label=name)
-    deviation_axis.set_ylabel("outside the tube" if tolerance.mode == "tube" else "result - ref", fontsize=7)
-    deviation_axis.legend(loc="best", fontsize=7)
-    deviation_axis.set_xlabel("time [s]")
-    title = f"{case.name} on {label}" + (f": {case.description}" if case.description else "")
-    fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize=9)
-    height = 1.6 * rows + 0.6  # fixed margins: tight_layout would cost more than the rest of the plot
-    fig.subplots_adjust(left=0.1, right=0.98, top=1 - 0.45 / height, bottom=0.45 / height, hspace=0.12)
-    stream = io.BytesIO()
-    fig.savefig(stream, dpi=80, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return stream.getvalue()
-
-
-def light(cases):
-    """The outcomes, without their results where they must be read (a journaled campaign's)."""
-    return cases.light() if hasattr(cases, "light") else iter(cases)
-
-
-def write_case_files(outcome, report_dir):
+def write_case_files(outcome: CaseOutcome, report_dir):
     """<fmu folder>/<case>_out.csv and .png; their paths into outcome."""
     if outcome.result is None and not outcome.png:
         return
@@ -92,12 +27,12 @@ def write_case_files(outcome, report_dir):
         outcome.plot = os.path.relpath(f"{stem}.png", report_dir)
 
 
-def write_results_json(campaign, path):
+def write_results_json(campaign: CampaignResult, path):
     """results.json, a case at a time (a campaign's cases may not fit in memory at once)."""
     head = {
         "format": RESULTS_FORMAT,
-        "mode": campaign.tolerance.mode,
-        "tolerance": {k: v for k, v in vars(campaign.tolerance).items() if v is not None},
+        "mode": campaign.mode.name,
+        "tolerance": campaign.mode.settings(),
         "passed": campaign.passed,
         "counts": campaign.counts(),
         "where": campaign.where,
@@ -105,48 +40,38 @@ def write_results_json(campaign, path):
     }
     with open(path, "w") as out:
         out.write(json.dumps(head)[:-1] + ', "cases": [')
-        for n, o in enumerate(light(campaign.cases)):
-            out.write(("," if n else "") + "\n" + json.dumps(case_json(o)))
+        for n, o in enumerate(campaign.cases.light()):
+            out.write(("," if n else "") + "\n" + json.dumps(o.to_json()))
         out.write("\n]}\n")
 
 
-def case_json(o):
-    entry = {"case": o.case, "fmu": o.fmu, "fmu_file": o.fmu_file, "status": o.status, "messages": o.messages,
-             "seconds": round(o.seconds, 4), "signals": [d.as_dict() for d in o.deviations]}
-    if o.csv:
-        entry["result_csv"] = o.csv
-    if o.plot:
-        entry["plot"] = o.plot
-    return entry
-
-
-def write_junit(campaign, path):
+def write_junit(campaign: CampaignResult, path):
     """JUnit XML: a test suite per FMU, a test case per case; a suite's
     totals first (one pass over the cases), then its cases (one pass per FMU)."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     counts = campaign.counts()
     suites = {}  # fmu -> [tests, failures, errors, seconds]
-    for o in light(campaign.cases):
+    for o in campaign.cases.light():
         totals = suites.setdefault(o.fmu, [0, 0, 0, 0.0])
         totals[0] += 1
-        totals[1] += o.status == "fail"
-        totals[2] += o.status in ("error", "invalid")
+        totals[1] += o.status == Status.FAIL
+        totals[2] += o.status in (Status.ERROR, Status.INVALID)
         totals[3] += o.seconds
     with open(path, "w") as out:
         out.write("<?xml version='1.0' encoding='utf-8'?>\n")
-        out.write(f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts["fail"]}" '
-                  f'errors="{counts["error"] + counts["invalid"]}" time="{campaign.seconds:.3f}">\n')
+        out.write(f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts[Status.FAIL]}" '
+                  f'errors="{counts[Status.ERROR] + counts[Status.INVALID]}" time="{campaign.seconds:.3f}">\n')
         for fmu, (tests, failures, errors, seconds) in suites.items():
             out.write(f'  <testsuite name={quoteattr(fmu)} tests="{tests}" failures="{failures}" errors="{errors}" '
                       f'time="{seconds:.3f}">\n')
-            for o in light(campaign.cases):
+            for o in campaign.cases.light():
                 if o.fmu != fmu:
                     continue
                 case = f'    <testcase name={quoteattr(o.case)} classname={quoteattr(fmu)} time="{o.seconds:.3f}"'
-                if o.status == "pass":
+                if o.passed:
                     out.write(case + " />\n")
                     continue
-                kind = "failure" if o.status == "fail" else "error"
+                kind = "failure" if o.status == Status.FAIL else "error"
                 message = o.messages[0] if o.messages else o.status
                 out.write(f"{case}>\n      <{kind} message={quoteattr(message)}>{escape(chr(10).join(o.messages))}"
                           f"</{kind}>\n    </testcase>\n")
@@ -158,14 +83,14 @@ def _verdict(o):
     return "pass" if o.passed else f"{o.status.upper()}: " + "; ".join(o.messages[:3])
 
 
-def write_report(campaign, report_dir):
+def write_report(campaign: CampaignResult, report_dir):
     """index.html, summary.md and results.json into report_dir, a case at
     a time (the case files are written as the cases finish)."""
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     headline = campaign.headline()
     with open(report_dir / "summary.md", "w") as summary, open(report_dir / "index.html", "w") as page:
-        summary.write("\n".join(["# fmutrace", "", headline, "", f"Comparison: {campaign.tolerance.describe()}.", "",
+        summary.write("\n".join(["# fmutrace", "", headline, "", f"Comparison: {campaign.mode.describe()}.", "",
                                  "| case | FMU | result | seconds | plot |", "|---|---|---|---|---|"]) + "\n")
         page.write(f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
@@ -173,10 +98,10 @@ def write_report(campaign, report_dir):
 td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}}tr.pass td:nth-child(3){{color:#176617}}
 tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</style>
 </head><body>
-<h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.tolerance.describe())}.</p>
+<h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.mode.describe())}.</p>
 <table><tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
 """)
-        for o in light(campaign.cases):
+        for o in campaign.cases.light():
             verdict = _verdict(o)
             summary.write(f"| {o.case} | {o.fmu} | {verdict.replace('|', '/')} | {o.seconds:.2f} | "
                           + (f"[png]({o.plot})" if o.plot else "") + " |\n")

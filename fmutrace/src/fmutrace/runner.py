@@ -40,8 +40,8 @@ import numpy as np
 from fmpy.simulation import apply_start_values, instantiate_fmu, settable_in_initialization_mode, \
     settable_in_instantiated
 
-from .fmu import unpacked
-from .simulation import _held_to, run_fmpy
+from .fmu import REAL_TYPES, unpacked
+from .simulation import held_to, run_fmpy
 
 # per FMI type: the C type's dtype (fmpy's Input tables and getters) and the
 # recorded column's dtype (fmpy's Recorder)
@@ -50,7 +50,6 @@ FMI3_TYPES = {t: (d, d) for t, d in (("Float32", np.float32), ("Float64", np.flo
                                      ("UInt8", np.uint8), ("Int16", np.int16), ("UInt16", np.uint16),
                                      ("Int32", np.int32), ("UInt32", np.uint32), ("Int64", np.int64),
                                      ("UInt64", np.uint64), ("Boolean", np.bool_))}
-REAL_TYPES = ("Real", "Float32", "Float64")
 
 
 def discrete_rows(t, times, after_event):
@@ -250,7 +249,7 @@ class Runner:
     def run(self, start, stop, step, inputs, start_values, outputs, relative_tolerance=None):
         """The trace's result, as fmpy.simulate_fmu(..., output_interval=step)
         returns it (a structured array). SimulationError if the FMU fails."""
-        inputs = _held_to(inputs, stop)  # as run_fmpy gives them to fmpy
+        inputs = held_to(inputs, stop)  # as run_fmpy gives them to fmpy
         if self.fast_path_problem(start, stop, step, inputs, outputs) is None:
             with contextlib.redirect_stdout(io.StringIO()):  # what fmpy's default logger prints
                 result = self._fast(start, stop, step, inputs, start_values, outputs, relative_tolerance)

@@ -8,20 +8,18 @@ the outputs at t + h.
 import contextlib
 import io
 import math
+from os import PathLike
 from pathlib import Path
 
 import numpy as np
 from fmpy import simulate_fmu
 
+from .errors import InputError, SimulationError
 from .fmu import Fmu
-from .traces import InputError, read_trace
+from .traces import read_trace
 
 
-class SimulationError(RuntimeError):
-    """The FMU failed (an FMI error status, a crash of the call)."""
-
-
-def _held_to(inputs, stop_time):
+def held_to(inputs, stop_time):
     """fmpy needs two input samples: a single row is held until stop_time
     by a copy there (the same signal)."""
     if inputs is None or len(inputs) != 1:
@@ -52,7 +50,7 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
                 stop_time=stop_time,
                 output_interval=step_size,
                 relative_tolerance=relative_tolerance,
-                input=_held_to(inputs, stop_time),
+                input=held_to(inputs, stop_time),
                 start_values=dict(start_values),
                 output=list(outputs),
                 fmi_type="CoSimulation",
@@ -90,8 +88,10 @@ def every_nth(result, start_time, step_size, output_interval):
     return result[steps % n == 0]
 
 
-def simulate(fmu, input=None, start_values=None, start_time=None, stop_time=None, step_size=None,
-             output_interval=None, outputs=None):
+def simulate(fmu: str | PathLike | Fmu, input: str | PathLike | np.ndarray | None = None,
+             start_values: dict | None = None, start_time: float | None = None, stop_time: float | None = None,
+             step_size: float | None = None, output_interval: float | None = None,
+             outputs: list[str] | None = None) -> np.ndarray:
     """Simulate an FMI 2 or FMI 3 co-simulation FMU on input signals.
 
     fmu              path of the .fmu file

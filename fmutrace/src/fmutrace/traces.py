@@ -15,39 +15,26 @@ sample. Accepted, without options:
 - blank lines, lines starting with ``#``, a missing or extra trailing
   newline.
 
-Anything else raises :class:`TraceError`, which names the file, the line
-and the column.
+Anything else raises a TraceError, which names the file, the line and
+the column.
 """
 import csv
 import io
 import math
 import re
 import warnings
+from collections.abc import Callable
+from os import PathLike
+from typing import TextIO
 
 import numpy as np
+
+from .errors import TraceError
 
 TIME_NAMES = ("time", "t", "Time")
 UNUSUAL_LINE_BREAKS = "\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
 _LINE_BREAK = re.compile("\r\n|[\n\r" + UNUSUAL_LINE_BREAKS + "]")  # where str.splitlines() splits
 BOOLEAN_WORDS = {"true": 1.0, "false": 0.0}
-
-
-class InputError(ValueError):
-    """Bad input that no simulation can mend (exit code 2)."""
-
-
-class TraceError(InputError):
-    """Bad input: the file, the line and column (1-based, 0 if none) and
-    what is wrong. str() is the message users see."""
-
-    def __init__(self, path, line, column, message):
-        self.path, self.line, self.column, self.message = str(path), line, column, message
-        where = str(path)
-        if line:
-            where += f", line {line}"
-        if column:
-            where += f", column {column}"
-        super().__init__(f"{where}: {message}")
 
 
 def read_text(path):
@@ -61,7 +48,7 @@ def read_text(path):
         raise TraceError(path, 0, 0, error.strerror or str(error)) from None
 
 
-def _lines(text):
+def data_lines(text):
     """(line number, text) of the lines that hold data or the header, split
     as str.splitlines() splits them, one at a time (a reader that needs only
     the header does not split the rest)."""
@@ -86,7 +73,8 @@ def _separator(header):
     return ";" if counts[";"] > counts[","] else ","
 
 
-def _split(line, separator):
+def split_cells(line, separator):
+    """The cells of a line, unquoted and stripped."""
     return [cell.strip() for cell in next(csv.reader([line], delimiter=separator, skipinitialspace=True))]
 
 
@@ -104,7 +92,8 @@ def parse_number(text, decimal_comma=False):
         return None
 
 
-def read_trace(path, known=None, text=None):
+def read_trace(path: str | PathLike, known: Callable[[str], str | None] | None = None,
+               text: str | None = None) -> np.ndarray:
     """The trace in path (or its text, given) as a structured array with
     'time' first.
 
@@ -113,13 +102,13 @@ def read_trace(path, known=None, text=None):
     that is not allowed is a TraceError at its place in the header.
     """
     text = read_text(path) if text is None else text.removeprefix("\ufeff")
-    lines = _lines(text)
+    lines = data_lines(text)
     try:
         header_line, header = next(lines)
     except StopIteration:
         raise TraceError(path, 0, 0, "empty file: no header line and no samples") from None
     separator = _separator(header)
-    names = _split(header, separator)
+    names = split_cells(header, separator)
     time_columns = [i for i, n in enumerate(names) if n in TIME_NAMES]
     if not time_columns:
         raise TraceError(path, header_line, 1, f"no time column: one of the columns must be named "
@@ -181,7 +170,7 @@ def _read_rows(path, lines, names, order, time_index, separator, dtype, header_l
     rows = []
     previous_time = -math.inf
     for number, line in lines:
-        cells = _split(line, separator)
+        cells = split_cells(line, separator)
         if len(cells) != len(names):
             raise TraceError(path, number, min(len(cells), len(names)) + 1,
                              f"{len(cells)} cells, the header has {len(names)} columns")
@@ -217,7 +206,7 @@ def format_number(value):
     return repr(value)
 
 
-def write_trace(path, trace):
+def write_trace(path: str | PathLike | TextIO, trace: np.ndarray) -> None:
     """The structured array as CSV into a file name or a text stream:
     'time' first, names quoted, numbers that read back bit for bit,
     Booleans as 0/1."""

@@ -1,0 +1,227 @@
+"""Where a campaign's cases run, behind one interface: an Executor takes
+the cases to do and calls finished(i, outcome) as each one ends.
+
+InProcess       one after the other in this process
+ChildProcesses  one after the other in child processes (a per-case
+                timeout: a case that hangs is stopped by killing its process)
+Dask            in batches on Dask workers: a local cluster of worker
+                processes, or a distributed scheduler's
+
+A Dask task carries a batch of cases and the FMU's bytes (sent once to
+every worker) and returns the outcomes with their results and plots, so
+workers need the same Python packages (fmutrace itself is uploaded to
+them) but no shared file system; the report is written by the caller.
+"""
+import logging
+import os
+import tempfile
+import time
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from .cases import case_texts
+from .comparison import Mode
+from .isolated import run_isolated
+from .outcome import CaseOutcome, Status
+from .runner import Runner
+from .worker import run_case, run_cases
+
+BATCH_CASES = 256              # cases per Dask task at most
+BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
+BATCH_ATTEMPTS = 3             # a batch lost with its worker is sent again, so many times in all
+# Dask keeps its last messages for its developers (distributed.admin.low-level-log-length, 1000): a
+# message that sends a batch keeps the batch's cases, so a campaign's client (and a local cluster's
+# scheduler, in its process) would grow with the first 1000 batches. A few are enough here.
+SHORT_LOGS = {"distributed.admin.low-level-log-length": 16}
+# no statistical profiler in the workers (its history grows with the campaign's length)
+LOCAL_CLUSTER = {"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}
+
+
+@dataclass(frozen=True)
+class Work:
+    """What every case of a campaign is run with."""
+    fmu_bytes: dict            # FMU path -> the file's bytes
+    labels: dict               # FMU path -> the CaseOutcome fields that name the FMU
+    mode: Mode
+    plots: str                 # "all", "failed" or "none"
+    case_timeout: float = None
+
+
+class Executor:
+    where = ""  # for the headline: "1 process", "Dask, 2 workers (local processes)", ...
+
+    def run(self, todo, work: Work, finished):
+        """Run todo, (i, fmu, folder, name) of each case; finished(i, outcome) as each ends."""
+        raise NotImplementedError
+
+
+class InProcess(Executor):
+    where = "1 process"
+
+    def run(self, todo, work, finished):
+        runners = {}
+        try:
+            for i, fmu, folder, name in todo:
+                if fmu.path not in runners:
+                    runners[fmu.path] = Runner(work.fmu_bytes[fmu.path])
+                finished(i, run_case(folder, name, None, runners[fmu.path], fmu, work.labels[fmu.path], work.mode,
+                                     work.plots))
+        finally:
+            for runner in runners.values():
+                runner.close()
+
+
+class ChildProcesses(Executor):
+    where = "1 process at a time (isolated)"
+
+    def run(self, todo, work, finished):
+        by_fmu = {}
+        for i, fmu, folder, name in todo:
+            by_fmu.setdefault(fmu, []).append((i, folder, name))
+        for fmu, cases in by_fmu.items():
+            arrived = iter(cases)
+            run_isolated([(str(folder), name, None) for _, folder, name in cases], work.fmu_bytes[fmu.path],
+                         str(fmu.path), work.labels[fmu.path], work.mode, work.plots, work.case_timeout,
+                         on_outcome=lambda outcome: finished(next(arrived)[0], outcome))
+
+
+def run_batch(items, fmu_bytes, path, labels, mode, plots, isolate, case_timeout):
+    """A Dask task: the outcomes of the cases [(folder, name, texts or
+    None)] of one FMU, run in this worker, or (isolate) in child processes
+    of it."""
+    if isolate:
+        return run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout)
+    return list(run_cases(items, fmu_bytes, path, labels, mode, plots))
+
+
+class Dask(Executor):
+    """The cases in batches on Dask workers, at most a few batches per
+    worker in flight (the client's memory stays flat). Workers of a local
+    cluster (scheduler None: jobs processes), or of a scheduler's that see
+    the same files (shared_files), read the cases themselves; others get
+    the files' texts. cluster_timeout bounds the wait for the cluster."""
+
+    def __init__(self, jobs: int, scheduler: str = None, shared_files: bool = False, cluster_timeout: float = None):
+        self.jobs, self.scheduler, self.shared_files, self.cluster_timeout = jobs, scheduler, shared_files, \
+            cluster_timeout
+
+    def run(self, todo, work, finished):
+        import dask
+        from dask.distributed import Client, LocalCluster
+
+        cluster = None
+        with dask.config.set(SHORT_LOGS):
+            if self.scheduler:
+                client = Client(self.scheduler, timeout=self.cluster_timeout or 60)
+            else:
+                # a task whose worker dies is not tried on others: the batch is run isolated instead (below)
+                # (silent: a worker's death is reported by the campaign)
+                with dask.config.set(LOCAL_CLUSTER):
+                    cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, silence_logs=logging.CRITICAL)
+                client = Client(cluster)
+        try:
+            workers = self._run(client, todo, work, finished)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        self.where = f"Dask, {workers} workers" + (f" at {self.scheduler}" if self.scheduler else " (local processes)")
+
+    def _run(self, client, todo, work, finished):
+        from dask.distributed import as_completed
+
+        client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
+        workers = len(client.scheduler_info()["workers"])
+        shared = {path: client.scatter(data, broadcast=True) for path, data in work.fmu_bytes.items()}
+        # about 8 batches per worker; at most BATCH_CASES cases each (a task's cost is a few milliseconds)
+        size = max(1, min(BATCH_CASES, -(-len(todo) // (8 * workers))))
+        batches = _batches(todo, size, ship_texts=bool(self.scheduler) and not self.shared_files)
+        in_flight = as_completed()
+        submitted = {}  # future -> (fmu, batch, isolated, attempt)
+
+        def submit(fmu, batch, isolated, attempt):
+            items = [(folder, name, texts) for _, folder, name, texts in batch]
+            future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), work.labels[fmu.path],
+                                   work.mode, work.plots, isolated, work.case_timeout, pure=False)
+            submitted[future] = fmu, batch, isolated, attempt
+            in_flight.add(future)
+
+        def submit_next():
+            for fmu, batch in batches:  # with a per-case timeout every batch runs isolated: a hang needs a process
+                submit(fmu, batch, work.case_timeout is not None, 1)  # to kill
+                return
+
+        for _ in range(3 * workers):
+            submit_next()
+        timeout = self.cluster_timeout
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while in_flight.count():
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+            future = next(in_flight) if remaining is None else _next_within(in_flight, remaining, timeout)
+            fmu, batch, isolated, attempt = submitted.pop(future)
+            try:
+                outcomes = future.result()
+            except Exception as error:  # its worker died (an FMU crashed it?), or the result was lost with a worker
+                if attempt < BATCH_ATTEMPTS:
+                    # the FMU's bytes again too: the copies may have gone with the workers
+                    shared[fmu.path] = client.scatter(work.fmu_bytes[fmu.path], broadcast=True)
+                    submit(fmu, batch, True, attempt + 1)  # isolated: a crashing case fails alone
+                    continue
+                outcomes = [CaseOutcome(name, **work.labels[fmu.path], status=Status.ERROR,
+                                        messages=[f"lost with its Dask worker {attempt} times: {type(error).__name__}: "
+                                                  f"{error}"]) for _, _, name, _ in batch]
+            for (i, _, _, _), outcome in zip(batch, outcomes):
+                finished(i, outcome)
+            del outcomes
+            submit_next()
+        return workers
+
+
+def executor_for(cases: int, jobs: int = None, scheduler: str = None, shared_files: bool = False,
+                 case_timeout: float = None, cluster_timeout: float = None) -> Executor:
+    """The executor compare's options choose for so many cases."""
+    if jobs is None:  # a local cluster takes seconds to start: worth it for many cases only
+        jobs = os.cpu_count() if cases >= 20 else 1
+    if scheduler is None and jobs <= 1:
+        return InProcess() if case_timeout is None else ChildProcesses()
+    return Dask(jobs, scheduler, shared_files, cluster_timeout)
+
+
+def package_zip():
+    """fmutrace as a zip (for Dask's upload_file), made once per process."""
+    target = Path(tempfile.gettempdir()) / f"fmutrace-package-{os.getpid()}.zip"
+    if not target.exists():
+        package = Path(__file__).resolve().parent
+        with zipfile.ZipFile(target, "w") as z:
+            for source in sorted(package.glob("*.py")):
+                z.write(source, f"fmutrace/{source.name}")
+    return target
+
+
+def _batches(todo, size, ship_texts):
+    """Consecutive runs of one FMU's cases, [(fmu, [(i, folder, name, texts)])]:
+    at most size cases, and with their files' texts (ship_texts) at most
+    BATCH_TEXT_BYTES of them, so that a worker's queue stays small."""
+    batch, current, volume = [], None, 0
+    for i, fmu, folder, name in todo:
+        texts = case_texts(folder, fmu.model) if ship_texts else None
+        if batch and (fmu is not current or len(batch) == size or volume >= BATCH_TEXT_BYTES):
+            yield current, batch
+            batch, volume = [], 0
+        current = fmu
+        volume += sum(map(len, texts.values())) if texts else 0
+        batch.append((i, str(folder), name, texts))
+    if batch:
+        yield current, batch
+
+
+def _next_within(in_flight, seconds, timeout):
+    """The next finished future, or TimeoutError once the campaign's bound is up."""
+    deadline = time.monotonic() + seconds
+    while not in_flight.has_ready():
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"the cluster did not finish the campaign within {timeout} s")
+        time.sleep(0.01)
+    return next(in_flight)

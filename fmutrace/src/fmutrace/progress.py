@@ -1,0 +1,34 @@
+"""A campaign's progress bar on a terminal."""
+import sys
+import time
+
+
+class Progress:
+    """A progress bar on a terminal, from the moment a campaign has taken
+    a few seconds; nothing when the stream is not a terminal."""
+
+    AFTER_SECONDS = 2.0
+
+    def __init__(self, total: int, stream=None):
+        self.total, self.stream = total, stream or sys.stderr
+        self.enabled = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.started = time.monotonic()
+        self.shown = False
+
+    def update(self, done: int, failed: int):
+        elapsed = time.monotonic() - self.started
+        if not self.enabled or (elapsed < self.AFTER_SECONDS and done < self.total):
+            return
+        if not self.shown and done == self.total:
+            return
+        width = 30
+        filled = width * done // max(1, self.total)
+        self.stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{self.total} cases, "
+                          f"{failed} failing, {elapsed:.0f} s ")
+        self.stream.flush()
+        self.shown = True
+
+    def close(self):
+        if self.shown:
+            self.stream.write("\n")
+            self.stream.flush()

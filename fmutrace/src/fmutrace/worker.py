@@ -1,0 +1,70 @@
+"""One case on one FMU, where the work happens (this process, a child
+process or a Dask worker): read and checked, simulated, compared, plotted
+if asked."""
+import hashlib
+import time
+
+from .cases import load_case
+from .comparison import Comparison, Mode, compare_traces
+from .errors import InputError, SimulationError
+from .fmu import Fmu
+from .outcome import CaseOutcome, Status
+from .plot import plot_case
+from .runner import Runner
+
+PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV
+PLOT_ALL_UP_TO = 500               # the default: all for campaigns up to so many cases, else the failed ones
+
+
+def default_plots(cases: int) -> str:
+    return "all" if cases <= PLOT_ALL_UP_TO else "failed"
+
+
+def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: Mode, plots: str) -> CaseOutcome:
+    """The case in folder (its files' texts given, or None: read them);
+    labels: the CaseOutcome fields that name the FMU."""
+    started = time.perf_counter()
+    outcome = CaseOutcome(name, **labels)
+    try:
+        case = load_case(folder, fmu, name, texts)
+    except InputError as error:
+        outcome.status, outcome.messages = Status.INVALID, [str(error)]
+        outcome.seconds = time.perf_counter() - started
+        return outcome
+    try:
+        o = case.options
+        result = runner.run(o["StartTime"], o["StopTime"], o["StepSize"], case.inputs, case.start_values,
+                            case.outputs, o["RelTol"])
+        comparison = compare_traces(result, case.reference, mode)
+        outcome.status = Status.PASS if comparison.passed else Status.FAIL
+    except SimulationError as error:
+        result, outcome.status = None, Status.ERROR
+        comparison = Comparison(problem=str(error))
+    outcome.deviations = [d for d in comparison.deviations if not d.passed]  # a passing signal says nothing more
+    outcome.messages = comparison.messages()
+    if result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
+        outcome.result = result
+        outcome.png = plot_case(case, result, comparison, mode, labels["fmu"])
+    outcome.seconds = time.perf_counter() - started
+    return outcome
+
+
+_fmus = {}  # the FMU's content hash -> (Runner, Fmu), kept from task to task in a worker process
+
+
+def worker_fmu(fmu_bytes: bytes, path: str) -> tuple:
+    """The Runner (one instance, reused) and the Fmu of these bytes in this
+    process."""
+    key = hashlib.sha256(fmu_bytes).hexdigest()
+    if key not in _fmus:
+        runner = Runner(fmu_bytes)
+        _fmus[key] = runner, Fmu(path, runner.md)
+    return _fmus[key]
+
+
+def run_cases(items, fmu_bytes: bytes, path: str, labels: dict, mode: Mode, plots: str):
+    """The outcomes of the cases [(folder, name, texts or None)] of one FMU
+    in this process, as they finish."""
+    runner, fmu = worker_fmu(fmu_bytes, path)
+    for folder, name, texts in items:
+        yield run_case(folder, name, texts, runner, fmu, labels, mode, plots)
