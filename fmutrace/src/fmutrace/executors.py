@@ -195,8 +195,8 @@ def package_zip():
     if not target.exists():
         package = Path(__file__).resolve().parent
         with zipfile.ZipFile(target, "w") as z:
-            for source in sorted(package.glob("*.py")):
-                z.write(source, f"fmutrace/{source.name}")
+            for source in sorted(package.rglob("*.py")):  # its subpackages too
+                z.write(source, f"fmutrace/{source.relative_to(package).as_posix()}")
     return target
 
 

@@ -15,7 +15,7 @@ A file none of them fits is a TraceError that says, for each, why not.
 """
 import os
 
-from ..traces import InputError, TraceError
+from ..errors import InputError, TraceError
 from . import mdf, tables, text as texts, twincat, vendors
 from .matching import Plan, last_component, plan
 from .model import Channel, Recording

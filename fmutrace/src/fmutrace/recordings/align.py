@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..traces import InputError
+from ..errors import InputError
 from .timebase import OFF_CYCLE, cycles
 
 TIMINGS = ("cycle", "fmi")

@@ -18,7 +18,7 @@ import re
 
 import numpy as np
 
-from ..traces import TraceError
+from ..errors import TraceError
 
 SEPARATORS = ("\t", ";", ",", " ")
 BOOLEANS = {"true": 1.0, "false": 0.0}
