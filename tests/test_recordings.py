@@ -205,7 +205,8 @@ def test_a_stamp_off_its_cycle_is_reported_and_two_on_one_cycle_refused(tmp_path
     assert any("u: 1 of its 4 time stamps are more than 0.1 of a cycle" in n and "line 4: t=0.023" in n
                for n in aligned.notes)
     recording = normalise(read_recording(path)[0], step_size=0.02)
-    with pytest.raises(InputError, match=r"line 4: samples of u at t=0.0100004 s and t=0.023 s fall on the same cycle of 0.02 s"):
+    with pytest.raises(InputError, match=r"line 4: samples of u at t=0.0100004 s and t=0.023 s fall on the same "
+                                         r"cycle of 0.02 s"):
         align(recording, plan(recording, variables, "M"))
 
 
@@ -294,7 +295,8 @@ def test_two_channels_meaning_one_variable_are_refused(tmp_path):
     path = tmp_path / "twice.csv"
     path.write_text("time,MAIN.a.value,MAIN.b.value,delayedValue\n0,1,2,0\n")
     recording = read_recording(path)[0]
-    with pytest.raises(InputError, match=r"'MAIN.a.value' .* and 'MAIN.b.value' .* both mean value: .*--map"):
+    with pytest.raises(InputError, match=r"'MAIN.a.value' \(column 2 of .*twice.csv\) and 'MAIN.b.value' "
+                                         r"\(column 3 of .* both mean value: .*--map"):
         plan(recording, SIEMENS_VARIABLES, "M")
 
 
@@ -338,3 +340,13 @@ def test_a_recording_is_columnar():
         assert isinstance(c.values, np.ndarray) and c.values.dtype == np.float64
         assert isinstance(c.times, np.ndarray) and c.times.dtype == np.float64
     assert math.isfinite(sum(float(c.values.sum()) for c in recording.channels))
+
+
+def test_a_table_of_absolute_time_stamps(tmp_path):
+    path = tmp_path / "dates.csv"
+    path.write_text("Timestamp;u;y\n2026-11-20T14:00:00.000+01:00;0;0\n2026-11-20T14:00:00.250+01:00;2;0,25\n"
+                    "2026-11-20T13:00:00.500Z;2;0,5\n")
+    recording = read_one(path)
+    assert (recording.time_unit, recording.step_size) == ("date", 0.25)
+    assert channel(recording, "y").times.tolist() == [0.0, 0.25, 0.5]
+    assert channel(recording, "y").values.tolist() == [0.0, 0.25, 0.5]

@@ -22,6 +22,8 @@ from .fmu import Fmu
 from .journal import Journal, JournaledOutcomes, ReportLock, campaign_key, case_key
 from .outcome import CampaignResult, KeptOutcomes, Status
 from .progress import Progress
+from .recordings import is_recording
+from .recordings.case import RecordingOptions, recording_paths
 from .report import write_case_files, write_junit, write_report
 from .worker import PLOTS, default_plots
 
@@ -33,13 +35,17 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
             tube_value: float | None = None, junit: str | PathLike | None = None, jobs: int | None = None,
             scheduler: str | None = None, shared_files: bool = False, plots: str | None = None,
             case_timeout: float | None = None, cluster_timeout: float | None = None, resume: bool = False,
-            progress: TextIO | None = None) -> CampaignResult:
+            progress: TextIO | None = None, step_size: float | None = None, maps: Iterable = (),
+            start_values: dict | None = None, time_unit: str | None = None,
+            timing: str = "cycle") -> CampaignResult:
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
     cases       a case folder or a folder of them (searched recursively),
                 or a list; a case belongs to the FMU whose model name its
-                files carry (<Model>_ref.csv)
+                files carry (<Model>_ref.csv). A file (or a folder without
+                cases) is a recording as a recorder exports it
+                (docs/recordings.md): it is run on every FMU
     report      folder for index.html, summary.md, results.json, the
                 results and plots (None: no files)
     mode        a comparison mode (fmutrace.Exact(), Tolerance(rel_tol,
@@ -61,6 +67,15 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
                 from it, run the others (after a campaign was stopped)
     progress    the stream of the progress bar (default: standard error;
                 drawn on a terminal only)
+    step_size   recordings: the PLC's cycle (default: the recording's
+                sample time, else its finest interval between samples)
+    maps        recordings: (VARIABLE, CHANNEL) pairs, or {VARIABLE: CHANNEL}
+    start_values  recordings: {name: value} of the FMU's start values
+    time_unit   recordings: s, ms, us, ns, cycles or filetime, instead of
+                the recording's own
+    timing      recordings: 'cycle' (a row is one cycle's input and
+                output, as recorders write it) or 'fmi' (a row's output is
+                the output at its time, as fmpy writes it)
 
     Returns a CampaignResult (.passed, .cases, .summary(), .exit_code).
     Raises InputError for a bad FMU, folder or option; a case whose files
@@ -74,13 +89,15 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
     if not fmu_paths or not case_paths:
         raise InputError("give at least one FMU and one case folder")
     loaded = [Fmu(path) for path in fmu_paths]
+    recording = RecordingOptions(step_size, time_unit, timing, tuple(dict(maps).items()),
+                                 tuple((start_values or {}).items()))
     work = plan(loaded, case_paths)
     plots = (plots or default_plots(len(work))) if report else "none"
     folders = _report_folders(loaded)
     job = Work(fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
                labels={f.path: {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]}
                        for f in loaded},
-               mode=mode, plots=plots, case_timeout=case_timeout)
+               mode=mode, plots=plots, case_timeout=case_timeout, recording=recording)
     executor = executor_for(len(work), jobs, scheduler, shared_files, case_timeout, cluster_timeout)
 
     started = time.perf_counter()
@@ -92,7 +109,8 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
         lock = ReportLock(report)
     try:
         if report:
-            journal = Journal(report, campaign_key(job.fmu_bytes, mode, plots), resume)
+            journal = Journal(report, campaign_key(job.fmu_bytes, mode, plots, recording.settings()
+                                                   if any(is_recording(p) for p in case_paths) else None), resume)
         if journal and journal.done:
             indices = array("q")
             for i, (fmu, folder, name) in enumerate(work):
@@ -192,12 +210,31 @@ class Todo:
 
 
 def plan(fmus, paths):
-    """A Plan of every FMU's cases under paths (InputError for an FMU
-    without any)."""
+    """A Plan of every FMU's cases under the case folders among paths,
+    and of the recordings among them (every FMU's too); InputError for an
+    FMU with neither."""
+    folders = [p for p in paths if not is_recording(p)]
+    recordings = RecordingList(recording_paths([p for p in paths if is_recording(p)]))
     parts = []
     for fmu in fmus:
-        found = find_cases(paths, fmu.model)
-        if not found:
+        found = find_cases(folders, fmu.model)
+        if not found and not recordings:
             raise InputError(f"no case of {fmu.label} (no {fmu.model}_ref.csv) under {', '.join(map(str, paths))}")
-        parts.append((fmu, found))
+        parts += [(fmu, found)] * bool(found) + [(fmu, recordings)] * bool(recordings)
     return Plan(parts)
+
+
+class RecordingList(Sequence):
+    """(path, name) of each recording, as a CaseList gives its cases."""
+
+    def __init__(self, items):
+        self.items = items
+
+    def __len__(self):
+        return len(self.items)
+
+    def __getitem__(self, index):
+        return self.items[index]
+
+    def text(self, index):
+        return self.items[index]

@@ -14,6 +14,9 @@ from .campaign import compare
 from .errors import ExitStatus, InputError, SimulationError
 from .fmu import is_fmu_file
 from .outcome import Status
+from .recordings import is_recording
+from .recordings.align import TIMINGS
+from .recordings.case import TIME_UNITS
 from .simulation import simulate
 from .traces import write_trace
 from .worker import PLOT_ALL_UP_TO, PLOTS
@@ -21,6 +24,7 @@ from .worker import PLOT_ALL_UP_TO, PLOTS
 EXAMPLES = """examples:
   fmutrace run build/fmi3/RateLimiter.fmu --input u.csv --set rateUpPar=2 --step-size 0.1 -o y.csv
   fmutrace compare build/fmi3/RateLimiter.fmu my_traces/ --report report/
+  fmutrace compare build/fmi3/LGF_LimRateOfChangeCI.fmu LGF_Ramp.csv     (a TwinCAT Scope export, say)
   fmutrace compare build/fmi2/*.fmu build/fmi3/*.fmu tests/scenarios --jobs 2 --junit junit.xml
 """
 
@@ -39,6 +43,13 @@ def _non_negative(text):
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not value >= 0:
         raise argparse.ArgumentTypeError(f"{text} must be >= 0")
+    return value
+
+
+def _positive(text):
+    value = _non_negative(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text} must be greater than 0")
     return value
 
 
@@ -73,13 +84,16 @@ def parser():
                      "default: the outputs)")
     run.add_argument("-o", dest="out", metavar="OUT.csv", help="result file (default: standard output)")
 
-    cmp = commands.add_parser("compare", help="replay cases and compare with their references",
+    cmp = commands.add_parser("compare", help="replay cases and recordings and compare with their references",
                               description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
                               "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
-                              "model and compare with the reference. Exact (bit for bit) unless a tolerance "
-                              "or a tube is given.")
-    cmp.add_argument("paths", nargs="+", metavar="FMU|CASE", help=".fmu files, then case folders or folders "
-                     "holding them (searched recursively)")
+                              "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
+                              "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF4, WinCC data logs, "
+                              "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
+                              "Exact (bit for bit) unless a tolerance or a tube is given.")
+    cmp.add_argument("paths", nargs="+", metavar="FMU|CASE|RECORDING", help=".fmu files, then case folders or "
+                     "folders holding them (searched recursively), or recordings (files, or a folder of one "
+                     "recording's files)")
     cmp.add_argument("--report", metavar="DIR", help="write index.html, summary.md, results.json, the results "
                      "and plots here")
     cmp.add_argument("--rel-tol", type=_non_negative, default=0.0, metavar="R")
@@ -101,6 +115,19 @@ def parser():
     cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
     cmp.add_argument("--resume", action="store_true", help="take the cases the report's journal holds from it and "
                      "run the others (after a stopped campaign; needs --report)")
+    rec = cmp.add_argument_group("recordings", "how recordings are read (docs/recordings.md)")
+    rec.add_argument("--step-size", type=_positive, metavar="H", help="the PLC's cycle in seconds (default: the "
+                     "recording's sample time, else its finest interval between samples)")
+    rec.add_argument("--map", metavar="VARIABLE=CHANNEL", action="append", type=_assignment, default=[],
+                     help="the channel that is the FMU's variable (repeatable; default: the channel whose name's "
+                     "last component is the variable's name)")
+    rec.add_argument("--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[],
+                     help="a start value of the FMU (repeatable)")
+    rec.add_argument("--time-unit", choices=TIME_UNITS, help="the unit of the recording's time stamps (default: "
+                     "what the export says, else seconds)")
+    rec.add_argument("--timing", choices=TIMINGS, default="cycle", help="cycle (default): a row is the input a "
+                     "cycle read and the output it produced, as recorders write it; fmi: a row's output is the "
+                     "output at its time, as fmpy and FMI cross-check files write it")
     return main
 
 
@@ -128,10 +155,14 @@ def compare_command(args, out):
     result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
                      tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
                      scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
-                     case_timeout=args.case_timeout, cluster_timeout=args.cluster_timeout, resume=args.resume)
-    for o in result.failed(results=False):
+                     case_timeout=args.case_timeout, cluster_timeout=args.cluster_timeout, resume=args.resume,
+                     step_size=args.step_size, maps=args.map, start_values=dict(args.set), time_unit=args.time_unit,
+                     timing=args.timing)
+    for o in result.failed(results=False) if not any(map(is_recording, cases)) else result.cases.light():
         if o.status == Status.INVALID:
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
+            continue
+        if o.passed and not o.messages:
             continue
         print(f"{o.status.upper()}  {o.case} on {o.fmu}", file=out)
         for message in o.messages[:10]:

@@ -24,6 +24,8 @@ from .cases import case_texts
 from .comparison import Mode
 from .isolated import run_isolated
 from .outcome import CaseOutcome, Status
+from .recordings import is_recording
+from .recordings.case import RecordingOptions
 from .runner import Runner
 from .worker import run_case, run_cases
 
@@ -46,6 +48,7 @@ class Work:
     mode: Mode
     plots: str                 # "all", "failed" or "none"
     case_timeout: float = None
+    recording: RecordingOptions = None  # how recordings are read (None: with their own settings)
 
 
 class Executor:
@@ -66,7 +69,7 @@ class InProcess(Executor):
                 if fmu.path not in runners:
                     runners[fmu.path] = Runner(work.fmu_bytes[fmu.path])
                 finished(i, run_case(folder, name, None, runners[fmu.path], fmu, work.labels[fmu.path], work.mode,
-                                     work.plots))
+                                     work.plots, work.recording))
         finally:
             for runner in runners.values():
                 runner.close()
@@ -83,16 +86,17 @@ class ChildProcesses(Executor):
             arrived = iter(cases)
             run_isolated([(str(folder), name, None) for _, folder, name in cases], work.fmu_bytes[fmu.path],
                          str(fmu.path), work.labels[fmu.path], work.mode, work.plots, work.case_timeout,
+                         recording=work.recording,
                          on_outcome=lambda outcome: finished(next(arrived)[0], outcome))
 
 
-def run_batch(items, fmu_bytes, path, labels, mode, plots, isolate, case_timeout):
+def run_batch(items, fmu_bytes, path, labels, mode, plots, isolate, case_timeout, recording=None):
     """A Dask task: the outcomes of the cases [(folder, name, texts or
     None)] of one FMU, run in this worker, or (isolate) in child processes
     of it."""
     if isolate:
-        return run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout)
-    return list(run_cases(items, fmu_bytes, path, labels, mode, plots))
+        return run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, recording=recording)
+    return list(run_cases(items, fmu_bytes, path, labels, mode, plots, recording))
 
 
 class Dask(Executor):
@@ -144,7 +148,7 @@ class Dask(Executor):
         def submit(fmu, batch, isolated, attempt):
             items = [(folder, name, texts) for _, folder, name, texts in batch]
             future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), work.labels[fmu.path],
-                                   work.mode, work.plots, isolated, work.case_timeout, pure=False)
+                                   work.mode, work.plots, isolated, work.case_timeout, work.recording, pure=False)
             submitted[future] = fmu, batch, isolated, attempt
             in_flight.add(future)
 
@@ -206,7 +210,7 @@ def _batches(todo, size, ship_texts):
     BATCH_TEXT_BYTES of them, so that a worker's queue stays small."""
     batch, current, volume = [], None, 0
     for i, fmu, folder, name in todo:
-        texts = case_texts(folder, fmu.model) if ship_texts else None
+        texts = case_texts(folder, fmu.model) if ship_texts and not is_recording(folder) else None
         if batch and (fmu is not current or len(batch) == size or volume >= BATCH_TEXT_BYTES):
             yield current, batch
             batch, volume = [], 0

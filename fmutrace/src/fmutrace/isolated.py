@@ -52,7 +52,7 @@ def _reader(stream, out):
         out.put(None)
 
 
-def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_outcome=None):
+def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_outcome=None, recording=None):
     """[outcome] of items [(folder, name, texts)], the cases in a child
     process; a crash or a case over case_timeout seconds (None: no bound)
     fails that case only. on_outcome(outcome), if given, hears of each as
@@ -65,7 +65,7 @@ def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_o
         said = tempfile.TemporaryFile()  # the child's last words, if it dies
         child = subprocess.Popen([sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                  stderr=said, env=environment)
-        child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, mode, plots)))
+        child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, mode, plots, recording)))
         child.stdin.close()
         arrived = queue.Queue()
         threading.Thread(target=_reader, args=(child.stdout, arrived), daemon=True).start()

@@ -53,10 +53,14 @@ class ReportLock:
             self.file.close()
 
 
-def campaign_key(fmu_bytes: dict, mode: Mode, plots: str) -> dict:
-    """What makes a campaign the same campaign: its FMUs (by content), comparison and plots."""
-    return {"mode": mode.name, "tolerance": mode.settings(), "plots": plots,
-            "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values())}
+def campaign_key(fmu_bytes: dict, mode: Mode, plots: str, recordings: dict | None = None) -> dict:
+    """What makes a campaign the same campaign: its FMUs (by content), comparison, plots and how
+    recordings are read."""
+    key = {"mode": mode.name, "tolerance": mode.settings(), "plots": plots,
+           "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values())}
+    if recordings:
+        key["recordings"] = recordings
+    return key
 
 
 def case_key(fmu_file, folder):

@@ -10,6 +10,8 @@ from .errors import InputError, SimulationError
 from .fmu import Fmu
 from .outcome import CaseOutcome, Status
 from .plot import plot_case
+from .recordings import is_recording
+from .recordings.case import RecordedCase, RecordingOptions, recorded_case
 from .runner import Runner
 
 PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV
@@ -20,13 +22,18 @@ def default_plots(cases: int) -> str:
     return "all" if cases <= PLOT_ALL_UP_TO else "failed"
 
 
-def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: Mode, plots: str) -> CaseOutcome:
-    """The case in folder (its files' texts given, or None: read them);
-    labels: the CaseOutcome fields that name the FMU."""
+def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: Mode, plots: str,
+             recording: RecordingOptions = None) -> CaseOutcome:
+    """The case in folder (its files' texts given, or None: read them), or
+    the recording there (read with recording's options); labels: the
+    CaseOutcome fields that name the FMU."""
     started = time.perf_counter()
     outcome = CaseOutcome(name, **labels)
     try:
-        case = load_case(folder, fmu, name, texts)
+        if is_recording(folder):
+            case = recorded_case(str(folder), fmu, name, recording or RecordingOptions())
+        else:
+            case = load_case(folder, fmu, name, texts)
     except InputError as error:
         outcome.status, outcome.messages = Status.INVALID, [str(error)]
         outcome.seconds = time.perf_counter() - started
@@ -35,13 +42,16 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
         o = case.options
         result = runner.run(o["StartTime"], o["StopTime"], o["StepSize"], case.inputs, case.start_values,
                             case.outputs, o["RelTol"])
-        comparison = compare_traces(result, case.reference, mode)
+        comparison = case.compare(result, mode) if isinstance(case, RecordedCase) else \
+            compare_traces(result, case.reference, mode)
         outcome.status = Status.PASS if comparison.passed else Status.FAIL
     except SimulationError as error:
         result, outcome.status = None, Status.ERROR
         comparison = Comparison(problem=str(error))
     outcome.deviations = [d for d in comparison.deviations if not d.passed]  # a passing signal says nothing more
     outcome.messages = comparison.messages()
+    if isinstance(case, RecordedCase):  # what was read, matched and assumed, pass or fail
+        outcome.messages += [case.description] + (case.explain(comparison) if not comparison.passed else case.notes)
     if result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
         outcome.result = result
         outcome.png = plot_case(case, result, comparison, mode, labels["fmu"])
@@ -62,9 +72,10 @@ def worker_fmu(fmu_bytes: bytes, path: str) -> tuple:
     return _fmus[key]
 
 
-def run_cases(items, fmu_bytes: bytes, path: str, labels: dict, mode: Mode, plots: str):
+def run_cases(items, fmu_bytes: bytes, path: str, labels: dict, mode: Mode, plots: str,
+              recording: RecordingOptions = None):
     """The outcomes of the cases [(folder, name, texts or None)] of one FMU
     in this process, as they finish."""
     runner, fmu = worker_fmu(fmu_bytes, path)
     for folder, name, texts in items:
-        yield run_case(folder, name, texts, runner, fmu, labels, mode, plots)
+        yield run_case(folder, name, texts, runner, fmu, labels, mode, plots, recording)

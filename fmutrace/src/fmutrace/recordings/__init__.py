@@ -88,7 +88,8 @@ def read_recording(paths):
 def is_recording(path):
     """Whether a path given to compare is a recording (a file, or a folder
     without cases of the cross-check layout: no *_ref.csv in it)."""
-    if os.path.isfile(path):
+    path = os.fspath(path)
+    if os.path.isfile(path) or (os.pathsep in path and all(os.path.isfile(p) for p in path.split(os.pathsep))):
         return True
     if os.path.isdir(path):
         for _, _, names in os.walk(path):

@@ -45,7 +45,8 @@ def _cycles_of(channel, step, notes):
     index, off = cycles(channel, step)
     if len(off):
         i = int(off[0])
-        notes.append(f"{channel.name}: {len(off)} of its {len(index)} time stamps are more than {OFF_CYCLE:g} of a cycle "
+        notes.append(f"{channel.name}: {len(off)} of its {len(index)} time stamps are more than {OFF_CYCLE:g} "
+                     "of a cycle "
                      f"({OFF_CYCLE * step:g} s) off a cycle end, matched to the nearest one; the first at "
                      f"{channel.where(i)}: t={float(channel.times[i]):.9g} s, {float(channel.times[i] / step):.3f} "
                      "cycles: is the step size the recorder's cycle?")

@@ -48,6 +48,10 @@ class Plan:
         return lines
 
 
+def _column(channel):
+    return f" (column {channel.column} of {channel.file})" if channel.column else f" (in {channel.file})"
+
+
 def _pair(variable, channel):
     return variable if channel.name == variable else f"{variable} <- {channel.name}"
 
@@ -112,8 +116,8 @@ def plan(recording, variables, label, maps=()):
             if any(v == variable for v, _ in maps):
                 result.ignored.append((channel, f"{variable} is mapped to {other.name!r}"))
                 continue
-            raise InputError(f"{recording.label}: channels {other.name!r} ({other.where(0)}) and {channel.name!r} "
-                             f"({channel.where(0)}) both mean {variable}: say which with --map {variable}=CHANNEL")
+            raise InputError(f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
+                             f"{_column(channel)} both mean {variable}: say which with --map {variable}=CHANNEL")
         taken[variable] = channel
     for variable, channel in taken.items():
         role, why = _role(variables[variable])

@@ -25,7 +25,7 @@ CYCLE_WORDS = ("cycle", "cycles", "zyklus")
 HEADER_SCAN = 200  # lines searched for the header
 
 
-def _bare(name):
+def bare_name(name):
     """A column name without its unit, in lower case: 'Time [ms]' -> 'time'."""
     name = texts.unquote(name).strip().strip('"').lower()
     for opener in ("[", "("):
@@ -38,16 +38,16 @@ def _bare(name):
 
 
 def is_time_name(name):
-    return _bare(name) in TIME_WORDS
+    return bare_name(name) in TIME_WORDS
 
 
 def is_index_name(name):
-    return _bare(name) in INDEX_WORDS
+    return bare_name(name) in INDEX_WORDS
 
 
 def _is_value(cell):
     cell = cell.strip()
-    return bool(cell) and (texts._cell_value(cell) is not None or timebase.looks_like_date(cell))
+    return bool(cell) and (texts.cell_value(cell) is not None or timebase.looks_like_date(cell))
 
 
 def find_header(text):
@@ -126,7 +126,7 @@ def read(text):
             unit, source = "cycles", f"column {time_name!r} counts samples"
         elif unit:
             source = f"column {time_name!r} says so"
-        elif _bare(time_name) in CYCLE_WORDS:
+        elif bare_name(time_name) in CYCLE_WORDS:
             unit, source = "cycles", f"column {time_name!r}"
         else:
             unit, source = "s", f"assumed: column {time_name!r} names no unit"

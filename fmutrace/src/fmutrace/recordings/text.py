@@ -133,7 +133,7 @@ def unquote(name):
     return name
 
 
-def _cell_value(text):
+def cell_value(text):
     """One cell as a float, or None."""
     cell = text.strip()
     if not cell:
@@ -151,7 +151,7 @@ def _cell_value(text):
         return -value if sign == "-" else value
     typed = _TYPED.match(cell)
     if typed and "#" not in typed.group(1):
-        return _cell_value(typed.group(1))
+        return cell_value(typed.group(1))
     if "," in cell:  # a decimal comma (a comma-separated file has it only in a quoted cell)
         if "." in cell or cell.count(",") > 1:
             return None
@@ -175,7 +175,7 @@ def numbers(cells, decimal_comma, where):
         pass
     out = np.empty(len(array), dtype=np.float64)
     for i, cell in enumerate(array):
-        value = _cell_value(str(cell))
+        value = cell_value(str(cell))
         if value is None:
             error = where(i)
             raise error(repr(str(cell).strip()))

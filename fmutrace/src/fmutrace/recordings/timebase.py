@@ -22,7 +22,7 @@ from .model import TIME_FACTORS
 
 OFF_CYCLE = 0.1          # a stamp more than this fraction of a cycle from a cycle end is reported
 MAX_STEPS = 200_000_000    # more steps than this (23 days of 10 ms cycles) is a misread unit
-MAX_SPARSE = 1000          # and so are samples this many steps apart on average (unless --time-unit says so)
+MAX_SPARSE = 100           # and so are samples this many steps apart on average (unless --time-unit says so)
 MAX_SPAN = 366 * 86400.0   # and so is a recording over a year long
 SNAP = 1e-3                # an interval between stamps this close to a shorter decimal is that decimal
 UNIT_WORDS = {"s": "s", "sec": "s", "seconds": "s", "ms": "ms", "msec": "ms", "us": "us", "µs": "us",
@@ -175,8 +175,8 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
     if steps > MAX_STEPS or (steps > MAX_SPARSE * samples and recording.time_source != "--time-unit"):
         raise InputError(f"{recording.label}: with its time read as {assumed} and a step of "
                          f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
-                         f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit (s, ms, us, ns, cycles, "
-                         "filetime)")
+                         f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit "
+                         "(s, ms, us, ns, cycles, filetime)")
     return recording
 
 

@@ -85,7 +85,7 @@ def read(text):
         for j in columns:
             literal = prop("SampleTime[ms]", j) or prop("SampleTime", j)
             if literal:
-                value = texts._cell_value(literal)
+                value = texts.cell_value(literal)
                 if value is None or not value > 0:
                     raise text.error(header.get("SampleTime[ms]", (0,))[0], j + 1,
                                      f"SampleTime[ms] {literal!r} is not a positive number")
@@ -102,7 +102,7 @@ def read(text):
             row_stamps = np.arange(len(rows), dtype=np.float64)
             for j in columns:
                 k = rows_columns[columns.index(j)] if no_time else j
-                ms = texts._cell_value(prop("SampleTime[ms]", j))
+                ms = texts.cell_value(prop("SampleTime[ms]", j))
                 channels.append(grids.channel_from(text, table[:, k], lines, row_stamps * ms, np.ones(len(rows), bool),
                                                    k + 1, prop("Name", j), decimal_comma, prop("SymbolName", j)))
             continue

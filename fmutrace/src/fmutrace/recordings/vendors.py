@@ -30,7 +30,7 @@ from . import grid as grids
 from . import text as texts
 from . import timebase
 from .model import Channel, Recording
-from .tables import CYCLE_WORDS, _bare
+from .tables import CYCLE_WORDS, bare_name
 
 
 # -- CODESYS 2.3 -----------------------------------------------------------------------
@@ -64,7 +64,7 @@ def read_codesys23(text):
     table = grids.grid(rows, len(names))
     stamps = grids.numeric_stamps(text, table[:, 0], lines, 1, names[0], True)
     grids.check_increasing(text, stamps, lines, 1, names[0])
-    cycles = _bare(names[0]) in CYCLE_WORDS
+    cycles = bare_name(names[0]) in CYCLE_WORDS
     everywhere = np.ones(len(rows), dtype=bool)
     channels = [grids.channel_from(text, table[:, j], lines, stamps, everywhere, j + 1, names[j], True)
                 for j in range(1, len(names))]
@@ -148,7 +148,7 @@ HISTORY_KEYS = ("history", "history id", "historyid", "history name", "point", "
 def _niagara_header(text):
     for i, line in enumerate(text.lines[:20]):
         separator = texts.sniff_separator(line)
-        names = [_bare(n) for n in texts.split(line, separator)]
+        names = [bare_name(n) for n in texts.split(line, separator)]
         if len(names) >= 4 and tuple(names[:4]) == NIAGARA_COLUMNS:
             return i, separator
     return None, "no header Timestamp, Trend Flags, Status, Value (one Niagara history per file)"
