@@ -100,6 +100,7 @@ FFI.cdef("\n".join(
     + ["int fmi2DoStep(void *, double, double, int);",
        "int fmi3DoStep(void *, double, double, bool, bool *, bool *, bool *, double *);"]))
 
+STEPS_PER_CHUNK = 1 << 17  # steps run between two result chunks (a long run's memory: its pointers, its rows)
 KEPT_SHAPES = 8  # grids and output arrays kept for traces of so many shapes (memory stays flat)
 
 
@@ -121,6 +122,103 @@ def _value_references(variables):
 def _close(a, b):
     """math.isclose elementwise (relative 1e-9)."""
     return np.abs(a - b) <= 1e-9 * np.maximum(np.abs(a), np.abs(b))
+
+
+class FastLoopFailed(Exception):
+    """The fast loop cannot give fmpy's result (a call failed, or the inputs need fmpy)."""
+
+
+@contextlib.contextmanager
+def _quiet():
+    """What fmpy's default logger prints (the FMU's messages) goes nowhere."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        yield
+
+
+class _InputRows:
+    """The rows of an input table that fmpy applies at consecutive steps,
+    the table read chunk by chunk. discrete_rows gives a step's row from
+    a window of the table when the window starts before the step (or at
+    the table's first row) and reaches past it, not only close to it (or to
+    the table's last row): the window keeps the rows from the one before
+    the last step's on, and grows by chunks until it reaches the next
+    steps. Per FMI type the values of the rows that change, as fmpy
+    converts them."""
+
+    def __init__(self, chunks, runner, start, stop, step):
+        self.chunks, self.runner, self.grid = chunks, runner, (start, stop, step)
+        self.table, self.offset, self.done = None, 0, False  # offset: the window's first row in the table
+        self.last_row = None  # the row set at the last step
+        self.setters = None   # (function, value references, count, dtype, names) per FMI type
+
+    def _read(self):
+        chunk = next(self.chunks, None)
+        if chunk is None:
+            self.done = True
+            return
+        if self.setters is None:
+            r, groups = self.runner, {}
+            for name in sorted(chunk.dtype.names[1:], key=r.order.get):
+                v = r.variables[name]
+                groups.setdefault(v.type, []).append(v)
+            self.setters = []
+            for variables in groups.values():
+                kind = r._kind(variables[0])
+                self.setters.append((r._set[kind], _value_references(variables), len(variables), r.types[kind][0],
+                                     [v.name for v in variables]))
+        self.table = chunk if self.table is None else np.concatenate([self.table, chunk])
+        problem = self.runner.event_problem(*self.grid, self.table)
+        if problem:
+            raise FastLoopFailed(problem)
+
+    def _reach(self, time):
+        while not self.done and (self.table is None or not (self.table["time"][-1] > time and
+                                                            not _close(time, self.table["time"][-1]))):
+            self._read()
+        if self.table is None or not len(self.table):
+            raise FastLoopFailed("no input rows")
+
+    def _setter(self, rows):
+        """set_inputs(j): sets the values of the table's rows[j] (global indices)."""
+        fmi3, component = self.runner.fmi3, self.runner._component
+        calls = []
+        for function, vrs, count, dtype, names in self.setters:
+            table = np.asarray(np.stack([self.table[name] for name in names]), dtype=dtype)  # fmpy's conversion
+            values = np.ascontiguousarray(table[:, rows - self.offset].T)
+            calls.append((function, vrs, count, values, _row_pointers(values)))
+
+        def set_inputs(row):
+            status = 0
+            for function, vrs, count, _, pointers in calls:
+                status |= function(component, vrs, count, pointers[row], count) if fmi3 else \
+                    function(component, vrs, count, pointers[row])
+            return status
+        return set_inputs
+
+    def first(self, start):
+        """set_inputs for the initialization (its argument 0): the row before the first event at start."""
+        self._reach(start)
+        row = discrete_rows(self.table["time"], np.array([start]), after_event=False) + self.offset
+        return self._setter(row)
+
+    def steps(self, times):
+        """(set_at, set_inputs) of steps at times: set_at[k] the argument of
+        set_inputs before step k, None where the row stays the one set."""
+        self._reach(times[-1])
+        t = self.table["time"]
+        rows = discrete_rows(t, times, after_event=True) + self.offset
+        changed = np.empty(len(rows), dtype=bool)
+        changed[0] = self.last_row is None or rows[0] != self.last_row
+        changed[1:] = rows[1:] != rows[:-1]
+        at = np.flatnonzero(changed)
+        set_at = [None] * len(times)
+        for j, k in enumerate(at.tolist()):
+            set_at[k] = j
+        set_inputs = self._setter(rows[at])
+        self.last_row = rows[-1]
+        keep = max(int(np.searchsorted(t, times[-1])) - 1, 0)
+        self.table, self.offset = self.table[keep:], self.offset + keep
+        return set_at, set_inputs
 
 
 _LOOPS = {}
@@ -226,17 +324,26 @@ class Runner:
     def fast_path_problem(self, start, stop, step, inputs, outputs):
         """Why the fast loop would not give fmpy's result for this trace
         (None if it would); see the module's docstring."""
+        names = inputs.dtype.names[1:] if inputs is not None else ()
+        return self.static_problem(start, stop, step, names, outputs) or \
+            (self.event_problem(start, stop, step, inputs) if inputs is not None else None)
+
+    def static_problem(self, start, stop, step, input_names, outputs):
+        """fast_path_problem's reasons that the names and the grid alone give."""
         n = round((stop - start) / step)
         if n < 1 or not math.isclose(start + n * step, stop):
             return "the stop time is not a whole number of steps from the start"
         if any(self.variables[name].shape for name in outputs):
             return "an array variable"
-        if inputs is None:
-            return None
-        for name in inputs.dtype.names[1:]:
+        for name in input_names:
             v = self.variables[name]
             if v.shape or (v.type in REAL_TYPES and v.variability not in ("discrete", "tunable")):
                 return f"{name} is a continuous input (fmpy interpolates it)"
+        return None
+
+    def event_problem(self, start, stop, step, inputs):
+        """fast_path_problem's reason that an input table (or a run of its
+        consecutive rows) gives: an input event between communication points."""
         if self.variable_step:
             events = input_events(inputs)
             events = events[(events > start) & (events < stop) & ~_close(events, start) & ~_close(events, stop)]
@@ -251,24 +358,51 @@ class Runner:
         returns it (a structured array). SimulationError if the FMU fails."""
         inputs = held_to(inputs, stop)  # as run_fmpy gives them to fmpy
         if self.fast_path_problem(start, stop, step, inputs, outputs) is None:
-            with contextlib.redirect_stdout(io.StringIO()):  # what fmpy's default logger prints
-                result = self._fast(start, stop, step, inputs, start_values, outputs, relative_tolerance)
-            if result is not None:
+            try:
+                chunks = list(self._fast(start, stop, step, None if inputs is None else iter([inputs]), start_values,
+                                         outputs, relative_tolerance, STEPS_PER_CHUNK))
                 self.fast_runs += 1
-                return result
-            self._drop_instance()  # a call failed: fmpy tells the story on an instance of its own
+                return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+            except FastLoopFailed:
+                self._drop_instance()  # a call failed: fmpy tells the story on an instance of its own
         self.fmpy_runs += 1
         return run_fmpy(self.folder, self.md, start_time=start, stop_time=stop, step_size=step, inputs=inputs,
                         start_values=start_values, outputs=outputs, relative_tolerance=relative_tolerance)
 
-    def _grid(self, start, step, n):
-        """fmpy's communication points, start + (n_steps + 1) * output_interval,
-        and the step sizes it passes (next point - time)."""
-        key = (start, step, n)
-        if key not in self._grids:
+    def run_chunks(self, start, stop, step, input_chunks, input_names, start_values, outputs,
+                   relative_tolerance=None, steps_per_chunk=STEPS_PER_CHUNK):
+        """The result of run() in consecutive structured arrays (the first
+        holds the start time's row too), the instance kept from chunk to
+        chunk: the same bits as run() gives (a test checks it), in memory
+        that does not grow with the length. input_chunks: consecutive
+        structured arrays of the input table (two rows at least in all),
+        or None. FastLoopFailed where run() would go through fmpy (before
+        the first chunk when the names or the grid say so)."""
+        problem = self.static_problem(start, stop, step, input_names, outputs)
+        if problem:
+            raise FastLoopFailed(problem)
+        self.fast_runs += 1
+        try:
+            yield from self._fast(start, stop, step, input_chunks, start_values, outputs, relative_tolerance,
+                                  steps_per_chunk)
+        except FastLoopFailed:
+            self._drop_instance()
+            raise
+
+    def _grid(self, start, step, k, m):
+        """fmpy's communication points from step k on for m steps,
+        start + (n_steps + 1) * output_interval, as an array, and the step
+        times and sizes it passes (next point - time) as lists."""
+        key = (start, step, m)
+        if k or key not in self._grids:
+            times = start + np.arange(k, k + m + 1, dtype=np.float64) * step
+            if k == 0:
+                times[0] = start
+            grid = times, times[:-1].tolist(), (times[1:] - times[:-1]).tolist()
+            if k:
+                return grid  # a long run's later chunks: not kept
             _forget_oldest(self._grids)
-            times = np.concatenate(([start], start + np.arange(1, n + 1, dtype=np.float64) * step))
-            self._grids[key] = times, times[:-1].tolist(), (times[1:] - times[:-1]).tolist()
+            self._grids[key] = grid
         return self._grids[key]
 
     def _buffer(self, kind, count, n):
@@ -289,91 +423,83 @@ class Runner:
             groups.setdefault(self._kind(v), []).append(v)
         return groups
 
-    def _fast(self, start, stop, step, inputs, start_values, outputs, tolerance):
-        fmu = self._instance()
+    def _fast(self, start, stop, step, input_chunks, start_values, outputs, tolerance, steps_per_chunk):
+        """The fast loop's result chunk by chunk (see run_chunks);
+        FastLoopFailed as soon as a call fails or the inputs need fmpy."""
+        with _quiet():
+            fmu = self._instance()
         n = round((stop - start) / step)
-        times, step_times, step_sizes = self._grid(start, step, n)
+        size = min(n, steps_per_chunk)
         component = self._component
+        fmi3 = self.fmi3
+        inputs = _InputRows(input_chunks, self, start, stop, step) if input_chunks is not None else None
 
-        # inputs: per FMI type (fmpy's grouping, by the variable's type) the values at the steps where a row changes
-        setters = []
-        changes = np.array([0])
-        if inputs is not None:
-            t = inputs["time"]
-            rows = discrete_rows(t, times[:-1], after_event=True)
-            first = discrete_rows(t, times[:1], after_event=False)
-            changes = np.concatenate(([0], np.flatnonzero(rows[1:] != rows[:-1]) + 1))
-            groups = {}
-            for name in sorted(inputs.dtype.names[1:], key=self.order.get):
-                v = self.variables[name]
-                groups.setdefault(v.type, []).append(v)
-            for variables in groups.values():
-                kind = self._kind(variables[0])
-                table = np.asarray(np.stack([inputs[v.name] for v in variables]),
-                                   dtype=self.types[kind][0])  # fmpy's conversion
-                values = np.ascontiguousarray(np.concatenate([table[:, first], table[:, rows[changes]]], axis=1).T)
-                setters.append((self._set[kind], _value_references(variables), len(variables), values,
-                                _row_pointers(values)))
-
-        # outputs: per FMI type in the recorder's order, into the kept arrays
+        # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
         getters, columns = [], [("time", np.float64)]
         groups = self._groups([name for name in outputs if name != "time"])
         for kind in self.types:
             if kind in groups:
                 variables = groups[kind]
-                values, pointers = self._buffer(kind, len(variables), n)
+                values, pointers = self._buffer(kind, len(variables), size)
                 getters.append((self._get[kind], _value_references(variables), len(variables), pointers, values,
                                 variables, kind))
                 columns += [(v.name, self.types[kind][1]) for v in variables]
-        fmi3 = self.fmi3
 
-        def set_inputs(row):
+        def result(rows, times):
+            chunk = np.empty(len(times), dtype=columns)
+            chunk["time"] = times
+            for _, _, _, _, values, variables, kind in getters:
+                for i, v in enumerate(variables):
+                    chunk[v.name] = values[rows, i] != 0 if kind == "Boolean" and not fmi3 else values[rows, i]
+            return chunk
+
+        with _quiet():
+            first = inputs.first(start) if inputs is not None else None
+            try:
+                if fmi3:
+                    remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
+                    fmu.enterInitializationMode(tolerance=tolerance, startTime=start, stopTime=stop)
+                else:
+                    fmu.setupExperiment(tolerance=tolerance, startTime=start, stopTime=stop)
+                    remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
+                    fmu.enterInitializationMode()
+                remaining = apply_start_values(fmu, self.md, remaining, settable=settable_in_initialization_mode)
+                if remaining or (first is not None and first(0) > 1):
+                    raise FastLoopFailed("a start value or an input was refused")
+                fmu.exitInitializationMode()
+            except FastLoopFailed:
+                raise
+            except Exception as error:  # fmpy's calls raise on an error status
+                raise FastLoopFailed(str(error)) from None
             status = 0
-            for function, vrs, count, _, pointers in setters:
-                status |= function(component, vrs, count, pointers[row], count) if fmi3 else \
-                    function(component, vrs, count, pointers[row])
-            return status
+            for function, vrs, count, pointers, _, _, _ in getters:
+                status |= function(component, vrs, count, pointers[0], count) if fmi3 else \
+                    function(component, vrs, count, pointers[0])
+            if status > 1:
+                raise FastLoopFailed("a getter failed")
+        pending = result(slice(0, 1), [start])  # the start's row goes out with the first chunk
 
-        try:
-            if fmi3:
-                remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
-                fmu.enterInitializationMode(tolerance=tolerance, startTime=start, stopTime=stop)
-            else:
-                fmu.setupExperiment(tolerance=tolerance, startTime=start, stopTime=stop)
-                remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
-                fmu.enterInitializationMode()
-            remaining = apply_start_values(fmu, self.md, remaining, settable=settable_in_initialization_mode)
-            if remaining or set_inputs(0) > 1:
-                return None
-            fmu.exitInitializationMode()
-        except Exception:  # fmpy's calls raise on an error status
-            return None
-
-        status = 0
-        for function, vrs, count, pointers, _, _, _ in getters:
-            status |= function(component, vrs, count, pointers[0], count) if fmi3 else \
-                function(component, vrs, count, pointers[0])
-        if status > 1:
-            return None
-        set_at = [None] * n  # the row of the setters' values to set before step k (None: no change)
-        if setters:
-            for row, k in enumerate(changes.tolist(), start=1):
-                set_at[k] = row
         loop = _step_loop(fmi3, len(getters))
         getter_arguments = [(function, vrs, count) for function, vrs, count, _, _, _, _ in getters]
-        rows = [pointers[1:] for _, _, _, pointers, _, _, _ in getters]
         flags = (self._flags, self._flags + 1, self._flags + 2, self._stop_flags, self._last_time) if fmi3 else ()
-        if not loop(self._do_step, component, step_times, step_sizes, set_at, set_inputs, getter_arguments, rows,
-                    flags):
-            return None
-        try:
-            fmu.terminate()
-        except Exception:
-            return None
-
-        result = np.empty(n + 1, dtype=columns)
-        result["time"] = times
-        for _, _, _, _, values, variables, kind in getters:
-            for i, v in enumerate(variables):
-                result[v.name] = values[:, i] != 0 if kind == "Boolean" and not self.fmi3 else values[:, i]
-        return result
+        for k in range(0, n, size):
+            m = min(size, n - k)
+            times, step_times, step_sizes = self._grid(start, step, k, m)
+            with _quiet():
+                if inputs is not None:
+                    set_at, set_inputs = inputs.steps(times[:-1])
+                else:
+                    set_at, set_inputs = [None] * m, None
+                rows = [pointers[1:m + 1] for _, _, _, pointers, _, _, _ in getters]
+                if not loop(self._do_step, component, step_times, step_sizes, set_at, set_inputs, getter_arguments,
+                            rows, flags):
+                    raise FastLoopFailed("a step failed")
+            chunk = result(slice(1, m + 1), times[1:])
+            if pending is not None:
+                chunk, pending = np.concatenate([pending, chunk]), None
+            yield chunk
+        with _quiet():
+            try:
+                fmu.terminate()
+            except Exception as error:
+                raise FastLoopFailed(str(error)) from None

@@ -23,7 +23,7 @@ import io
 import math
 import re
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from os import PathLike
 from typing import TextIO
 
@@ -193,6 +193,70 @@ def _read_rows(path, lines, names, order, time_index, separator, dtype, header_l
     return np.array(rows, dtype=dtype)
 
 
+CHUNK_BYTES = 1 << 24  # of CSV text per chunk of trace_chunks
+
+
+def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None = None,
+                 chunk_bytes: int = CHUNK_BYTES) -> Iterator[np.ndarray]:
+    """The trace in path as consecutive structured arrays ('time' first) of
+    about chunk_bytes of text each, read by pyarrow's CSV reader: memory
+    stays flat in the file's length. For the plain dialect (',' separated
+    numbers, a header of names); any other file, or one whose values or
+    times read_trace would refuse, raises NotPlain at the chunk where that
+    shows, and read_trace reads or explains it. Both readers convert a
+    number correctly rounded: the same bits (a test checks it)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
+    try:
+        with open(path, encoding="utf-8-sig") as file:
+            header = file.readline()
+    except (OSError, UnicodeDecodeError) as error:
+        raise NotPlain(str(error)) from None
+    if _separator(header) != "," or header.lstrip().startswith("#"):
+        raise NotPlain("not the plain dialect")
+    names = split_cells(header, ",")
+    times = [i for i, n in enumerate(names) if n in TIME_NAMES]
+    if len(times) != 1 or len(set(names)) != len(names) or not all(names) or \
+            (known is not None and any(known(n) for i, n in enumerate(names) if i != times[0])):
+        raise NotPlain("the header needs read_trace's explanation")
+    order = [names[times[0]]] + [n for i, n in enumerate(names) if i != times[0]]
+    dtype = [("time", np.float64)] + [(n, np.float64) for n in order[1:]]
+    try:
+        reader = pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=chunk_bytes, column_names=names,
+                                                                    skip_rows=1),
+                               parse_options=pcsv.ParseOptions(delimiter=",", quote_char=False),
+                               convert_options=pcsv.ConvertOptions(column_types={n: pa.float64() for n in names},
+                                                                   null_values=[], strings_can_be_null=False))
+    except (pa.ArrowInvalid, OSError) as error:
+        raise NotPlain(str(error)) from None
+    previous = -math.inf
+    rows = 0
+    while True:
+        try:
+            batch = reader.read_next_batch()
+        except StopIteration:
+            break
+        except pa.ArrowInvalid as error:
+            raise NotPlain(str(error)) from None
+        chunk = np.empty(batch.num_rows, dtype=dtype)
+        for (field, _), name in zip(dtype, order):
+            chunk[field] = batch.column(names.index(name)).to_numpy()
+        t = chunk["time"]
+        if len(t) and not (np.isfinite(t).all() and t[0] >= previous and (np.diff(t) >= 0).all()):
+            raise NotPlain("a time read_trace would refuse")
+        if len(t):
+            previous = t[-1]
+        rows += len(t)
+        yield chunk
+    if not rows:
+        raise NotPlain("no samples")
+
+
+class NotPlain(Exception):
+    """trace_chunks cannot read the file: read_trace reads or explains it."""
+
+
 def format_number(value):
     """The shortest text that reads back as the same double (so a trace
     written and read again is bit for bit the same)."""
@@ -206,15 +270,36 @@ def format_number(value):
     return repr(value)
 
 
+WRITE_ROWS = 1 << 16  # rows formatted at a time by write_trace
+
+
 def write_trace(path: str | PathLike | TextIO, trace: np.ndarray) -> None:
     """The structured array as CSV into a file name or a text stream:
     'time' first, names quoted, numbers that read back bit for bit,
-    Booleans as 0/1."""
+    Booleans as 0/1. Formatted a block of rows at a time by pyarrow's
+    writer (the shortest text that reads back as the same double)."""
     if not hasattr(path, "write"):
         with open(path, "w", newline="\n") as out:
             return write_trace(out, trace)
-    names = trace.dtype.names
-    path.write(",".join(f'"{name}"' for name in names) + "\n")
-    columns = [trace[name].astype(np.float64) for name in names]
-    for i in range(len(trace)):
-        path.write(",".join(format_number(column[i]) for column in columns) + "\n")
+    writer = TraceWriter(path, trace.dtype.names)
+    writer.write(trace)
+
+
+class TraceWriter:
+    """A trace written block by block (a long result as it is made), in
+    write_trace's format."""
+
+    def __init__(self, out: TextIO, names):
+        self.out, self.names = out, list(names)
+        out.write(",".join(f'"{name}"' for name in self.names) + "\n")
+
+    def write(self, trace: np.ndarray):
+        import pyarrow as pa
+        import pyarrow.csv as pcsv
+
+        for begin in range(0, len(trace), WRITE_ROWS):
+            block = trace[begin:begin + WRITE_ROWS]
+            table = pa.table({name: np.asarray(block[name], dtype=np.float64) for name in self.names})
+            data = io.BytesIO()
+            pcsv.write_csv(table, data, write_options=pcsv.WriteOptions(include_header=False, quoting_style="none"))
+            self.out.write(data.getvalue().decode("ascii"))
