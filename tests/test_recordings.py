@@ -350,3 +350,46 @@ def test_a_table_of_absolute_time_stamps(tmp_path):
     assert (recording.time_unit, recording.step_size) == ("date", 0.25)
     assert channel(recording, "y").times.tolist() == [0.0, 0.25, 0.5]
     assert channel(recording, "y").values.tolist() == [0.0, 0.25, 0.5]
+
+
+def test_twincat_without_time_columns_takes_the_time_from_the_sample_time(tmp_path):
+    """Timelines 'None', ',' as the separator (so a decimal point): row k is at k * SampleTime."""
+    path = tmp_path / "none.csv"
+    path.write_text("Name,Scope\nFile,none.csv\n\n\nName,value,delayedValue\nData-Type,REAL64,REAL64\n"
+                    "SampleTime[ms],250,250\nSymbolName,MAIN.fbRamp.value,MAIN.fbRamp.delayedValue\n\n"
+                    "0,0\n3.5,1\n3.5,2\n")
+    recording = read_one(path)
+    assert (recording.format, recording.time_unit) == ("Beckhoff TwinCAT Scope View CSV export", "ms")
+    assert channel(recording, "value").times.tolist() == [0.0, 0.25, 0.5]
+    assert channel(recording, "delayedValue").values.tolist() == [0.0, 1.0, 2.0]
+
+
+def test_codesys23_with_a_time_column_in_milliseconds(tmp_path):
+    path = tmp_path / "trace.txt"
+    path.write_text("Ramp trace\nD:\\PROJECTS\\RAMP.PRO\nTime PLC_PRG.u PLC_PRG.y\n0 0 0\n250 2 0.25\n500 2 0.5\n")
+    recording = read_one(path)
+    assert (recording.time_unit, recording.step_size) == ("ms", 0.25)
+    assert channel(recording, "y").values.tolist() == [0.0, 0.25, 0.5]
+
+
+@pytest.mark.parametrize("body", [
+    "0;1,5;TRUE\n0,25; 2 ;FALSE\n0,5;3;16#00FF\n",          # blanks around cells, decimal commas, literals
+    "0\t1\t2\n1\t\t3\nEOF\n\n",                                # an empty cell, the EOF tag, trailing blank lines
+])
+def test_the_one_split_of_a_plain_body_equals_the_line_by_line_reading(tmp_path, body):
+    from fmutrace.recordings import grid, text as texts
+    separator = ";" if ";" in body else "\t"
+    path = tmp_path / "t.csv"
+    path.write_text(f"time{separator}a{separator}b\n" + body)
+    decoded = texts.read(path)
+    cells, lines = grid.uniform_table(decoded, 1, separator, 3)
+    rows, numbers = grid.body(decoded, 1, separator)
+    assert cells.tolist() == grid.grid(rows, 3).tolist() and lines.tolist() == numbers.tolist()
+
+
+@pytest.mark.parametrize("body", ['0;"1";2\n', "0;1;2\n\n1;2;3\n", "0;1\n", "0;1;2;3\n"])
+def test_bodies_the_one_split_cannot_read_go_line_by_line(tmp_path, body):
+    from fmutrace.recordings import grid, text as texts
+    path = tmp_path / "t.csv"
+    path.write_text("time;a;b\n" + body)
+    assert grid.uniform_table(texts.read(path), 1, ";", 3) is None

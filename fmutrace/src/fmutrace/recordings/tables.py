@@ -98,13 +98,17 @@ def read(text):
         if name in seen:
             raise text.error(header_line, i + 1, f"column {name!r} again (first in column {seen[name] + 1})")
         seen[name] = i
-    rows, lines = grids.body(text, index + 1, separator)
-    if not rows:
-        raise text.error(header_line, 0, "no samples: the table has a header line only")
-    for row, line in zip(rows, lines):
-        if len(row) > len(names):
-            raise text.error(int(line), len(names) + 1, f"{len(row)} cells, the header has {len(names)} columns")
-    table = grids.grid(rows, len(names))
+    fast = grids.uniform_table(text, index + 1, separator, len(names))
+    if fast:
+        table, lines = fast
+    else:
+        rows, lines = grids.body(text, index + 1, separator)
+        if not rows:
+            raise text.error(header_line, 0, "no samples: the table has a header line only")
+        for row, line in zip(rows, lines):
+            if len(row) > len(names):
+                raise text.error(int(line), len(names) + 1, f"{len(row)} cells, the header has {len(names)} columns")
+        table = grids.grid(rows, len(names))
     decimal_comma = separator != ","
     time_column = time_columns[0] if time_columns else (index_columns[0] if index_columns else None)
     if time_column is None:

@@ -167,10 +167,11 @@ def numbers(cells, decimal_comma, where):
     (line, column, name) of cell i for the error: the first cell that is
     no value is a TraceError naming it."""
     array = np.asarray(cells, dtype=object) if not isinstance(cells, np.ndarray) else cells
+    strings = array if array.dtype.kind == "U" else array.astype(str)
     try:
         if decimal_comma:
-            return np.char.replace(array.astype(str), ",", ".").astype(np.float64)
-        return array.astype(str).astype(np.float64)
+            return np.char.replace(strings, ",", ".").astype(np.float64)
+        return strings.astype(np.float64)
     except ValueError:
         pass
     out = np.empty(len(array), dtype=np.float64)
