@@ -393,3 +393,20 @@ def test_bodies_the_one_split_cannot_read_go_line_by_line(tmp_path, body):
     path = tmp_path / "t.csv"
     path.write_text("time;a;b\n" + body)
     assert grid.uniform_table(texts.read(path), 1, ";", 3) is None
+
+
+def test_twincat_sample_time_with_a_decimal_comma_in_a_comma_separated_export(tmp_path):
+    """Scope View writes 'SampleTime[ms],0,2' in a ',' export (a decimal comma the separator splits):
+    one channel's group of two cells is one number; where that cannot be told, the row is named."""
+    head = "Name,Scope\nFile,x.csv\n\n\n"
+    path = tmp_path / "comma.csv"
+    path.write_text(head + "Name,fast,Name,slow,other\nSampleTime[ms],0,2,SampleTime[ms],1,1\n"
+                           "SymbolName,MAIN.fast,SymbolName,MAIN.slow,MAIN.other\n\n0,1,0,5,6\n0.2,2\n0.4,3\n")
+    recording = read_one(path)
+    assert recording.sample_time == 0.0002
+    assert channel(recording, "fast").times.tolist() == [0.0, 0.0002, 0.0004]
+    assert channel(recording, "slow").values.tolist() == [5.0]
+    path.write_text(head + "Name,fast,Name,slow,other\nSampleTime[ms],0,2,SampleTime[ms],1,1,5\n\n0,1,0,5,6\n")
+    with pytest.raises(TraceError, match=r"line 6, column 4: the row 'SampleTime\[ms\]' has 3 cells for 2 channels "
+                                         r"\(a decimal comma, ',' separating\?\)"):
+        read_file(path)

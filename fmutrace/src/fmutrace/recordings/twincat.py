@@ -47,6 +47,32 @@ def sniff(text):
     return why if found is None else None
 
 
+def _realigned(text, line, key, cells, name_cells, key_columns, separator):
+    """A property row with more cells than the Name row: Scope View writes
+    a decimal comma in SampleTime[ms] even with ',' as the separator
+    ('SampleTime[ms],0,2,SampleTime[ms],1'). Where a group of one channel
+    got more cells than it has channels, they are one number; any other
+    misfit cannot be told apart and is an error at the row."""
+    starts = [j for j, c in enumerate(cells) if c == key]
+    if len(starts) != len(key_columns):
+        raise text.error(line, 0, f"the row {key!r} has {len(starts)} groups, the Name row {len(key_columns)}")
+    fixed = []
+    bounds = key_columns + [len(name_cells)]
+    for g, start in enumerate(starts):
+        slots = bounds[g + 1] - bounds[g] - 1
+        end = starts[g + 1] if g + 1 < len(starts) else len(cells)
+        values = cells[start + 1:end]
+        if len(values) != slots:
+            if slots != 1 or not all(v.strip().lstrip("-").isdigit() for v in values):
+                why = "a name with blanks, blanks separating" if separator == " " else \
+                    "a decimal comma, ',' separating" if separator == "," else "a separator inside a name"
+                raise text.error(line, start + 1, f"the row {key!r} has {len(values)} cells for {slots} channels "
+                                                  f"({why}?): export with another separator")
+            values = [",".join(values)]
+        fixed += [key] + values
+    return fixed
+
+
 def read(text):
     start, separator = _find(text)
     if start is None:
@@ -59,6 +85,9 @@ def read(text):
         index += 1
     name_line, name_cells = header["Name"]
     key_columns = [j for j, c in enumerate(name_cells) if c == "Name"]
+    for key, (line, cells) in list(header.items()):
+        if len(cells) != len(name_cells):
+            header[key] = (line, _realigned(text, line, key, cells, name_cells, key_columns, separator))
     rows, lines = grids.body(text, index, separator if separator != " " else " ")
     if not rows:
         raise text.error(name_line, 0, "no samples: the export has its header only")
