@@ -202,3 +202,14 @@ def test_set_gives_the_fmus_start_values(tmp_path):
     assert done.returncode == 1 and "y leaves the band first at t=0.5: 0.25, expected 0.5" in done.stdout
     said = compare(RATE_LIMITER[3], path, "--set", "rateUpPar=fast").stderr
     assert "rateUpPar is a Float64: 'fast' is not a number" in said
+
+
+def test_recordings_on_every_executor_and_niagara_histories_given_as_files(tmp_path):
+    histories = sorted((SAMPLES / "niagara_siemens").iterdir())
+    for options in (["--jobs", "2", "--report", tmp_path / "report"], ["--case-timeout", "120"]):
+        done = compare(SIEMENS[3], SAMPLES / "twincat_siemens.csv", *histories, *options)
+        assert done.returncode == 0, done.stdout + done.stderr
+        assert "2 of 2 cases pass" in done.stdout and "PASS  niagara_siemens on" in done.stdout
+    resumed = compare(SIEMENS[3], SAMPLES / "twincat_siemens.csv", *histories, "--report", tmp_path / "report",
+                      "--resume")
+    assert resumed.returncode == 0 and "on the journal" in resumed.stdout
