@@ -12,7 +12,7 @@ import numpy as np
 from ..cases import Case
 from ..comparison import Comparison, compare_traces
 from ..errors import InputError
-from . import read_recording, vendors
+from . import read_recording, text as texts, vendors
 from .align import TIMINGS, align
 from .matching import plan
 from .timebase import UNIT_NAMES, normalise
@@ -105,7 +105,6 @@ def _is_single_point(path):
             head = file.read(4096)
     except OSError:
         return False
-    from . import text as texts
     try:
         decoded, _ = texts.decode(path, head)
     except InputError:

@@ -15,7 +15,6 @@ class Channel:
     column: int = 0             # 1-based column of its values in a text file, 0 in MDF4
     lines: np.ndarray = None    # line of each sample in a text file (int64), else None
     symbol: str = ""            # a fuller name the recorder gives too (TwinCAT's SymbolName)
-    unit: str = None            # the time unit of its stamps when the recorder says it per channel
     times: np.ndarray = None    # seconds from the recording's first sample (normalise())
 
     def where(self, index):

@@ -139,16 +139,10 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
         recording.step_size = step
         recording.step_source = ("--step-size" if step_size else "the recording's sample time"
                                  if recording.sample_time else "the FMU's default step size")
-    origin = min(_first(c.stamps, c.unit or unit) for c in channels)
+    origin = min(c.stamps[0] for c in channels)
+    factor = recording.step_size if unit == "cycles" else 1e-9 if unit == "date" else TIME_FACTORS[unit]
     for channel in recording.channels:
-        channel_unit = channel.unit or unit
-        relative = _minus(channel.stamps, origin, channel_unit)
-        if channel_unit == "cycles":
-            channel.times = relative * recording.step_size
-        elif channel_unit == "date":
-            channel.times = relative * 1e-9
-        else:
-            channel.times = relative * TIME_FACTORS[channel_unit]
+        channel.times = _minus(channel.stamps, origin) * factor
     span = max(float(c.times[-1]) for c in channels)
     assumed = (f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit])
     if span > MAX_SPAN:
@@ -180,11 +174,7 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
     return recording
 
 
-def _first(stamps, unit):
-    return stamps[0] if unit not in ("s", "ms", "us", "ns", "OLE days") else float(stamps[0])
-
-
-def _minus(stamps, origin, unit):
+def _minus(stamps, origin):
     """stamps - origin as float64, exactly for integer stamps."""
     if stamps.dtype.kind in "iu":
         return (stamps - np.int64(origin)).astype(np.float64)
