@@ -213,3 +213,13 @@ def test_recordings_on_every_executor_and_niagara_histories_given_as_files(tmp_p
     resumed = compare(SIEMENS[3], SAMPLES / "twincat_siemens.csv", *histories, "--report", tmp_path / "report",
                       "--resume")
     assert resumed.returncode == 0 and "on the journal" in resumed.stdout
+
+
+def test_the_readmes_recording_command_passes():
+    from support.fmu_driver import REPO
+    [line] = [line for line in (REPO / "README.md").read_text().splitlines()
+              if line.startswith("build/venv/bin/fmutrace compare") and "tests/recordings/" in line]
+    command, fmu, recording = line.split()[1:]
+    assert command == "compare"
+    done = compare(BUILD_DIR / Path(fmu).relative_to("build"), REPO / recording)
+    assert done.returncode == 0, done.stdout + done.stderr
