@@ -136,15 +136,15 @@ def load_case(folder: str | PathLike, fmu: Fmu, name: str | None = None, texts: 
 
 class CaseList(Sequence):
     """(folder, name) of each case, sorted by name, kept compact for
-    campaigns of many cases: a case costs its name's text and three bytes
-    (which folder searched, and how its name was made); the folder is
-    made again when asked for."""
+    campaigns of many cases: a case costs its name's text and two bytes
+    (which folder searched); its folder, the one searched joined with the
+    name, is made again when asked for. The few cases whose folder is not
+    that (a case folder given itself, a name prefixed) keep it as text."""
 
-    RELATIVE, ROOT, PREFIXED = 0, 1, 2  # name = path below the root; the root's own name; root name / path
-
-    def __init__(self, roots, names, root_of, kinds):
-        self.roots = roots  # [(path, its name)]
-        self.names, self.root_of, self.kinds = names, root_of, kinds
+    def __init__(self, roots, names, root_of, folders):
+        self.roots = roots                           # the folders searched, as text
+        self.names, self.root_of = names, root_of    # per case: its name, the index of its root
+        self.folders = folders                       # case index -> folder, where it is not root/name
 
     def __len__(self):
         return len(self.names)
@@ -158,40 +158,39 @@ class CaseList(Sequence):
     def text(self, index):
         """(folder, name) with the folder as text: Path interns every part
         of a path for good, a campaign of many cases must not."""
-        name, kind = self.names[index], self.kinds[index]
-        root, root_name = self.roots[self.root_of[index]]
-        if kind == self.ROOT:
-            return root, name
-        return os.path.join(root, name if kind == self.RELATIVE else name[len(root_name) + 1:]), name
+        name = self.names[index]
+        folder = self.folders.get(index % len(self.names))  # (a negative index counts from the end)
+        return (os.path.join(self.roots[self.root_of[index]], name) if folder is None else folder), name
 
 
-def find_cases(paths: Sequence[str | PathLike], model: str) -> "CaseList":
+def find_cases(paths: Sequence[str | PathLike], model: str) -> CaseList:
     """[(folder, name)] of the cases of model under paths, each a case
     folder itself or a folder searched recursively (through linked folders
     too, each folder once), sorted by name: the folder's path below the one
     searched (its own name for a case folder given itself). A CaseList."""
     target = f"{model}_ref.csv"
     seen = set()
-    names, root_of, kinds, roots = [], array("H"), array("b"), []
+    names, root_of, folders, roots = [], array("H"), {}, []
     taken = set() if len(paths) > 1 else None  # names: only folders searched together can give one twice
     for path in paths:
         root = os.fspath(path)
         if not os.path.isdir(root):
             raise InputError(f"{path}: no such folder")
         root_name = os.path.basename(os.path.realpath(root))
-        roots.append((root, root_name))
+        roots.append(root)
         for relative in _walk(root, "", target, seen):
-            name, kind = (relative, CaseList.RELATIVE) if relative else (root_name, CaseList.ROOT)
+            name = relative or root_name
             if taken is not None:
                 if name in taken:  # the same name below two folders given
-                    name, kind = f"{root_name}/{name}", CaseList.PREFIXED if relative else CaseList.ROOT
+                    name = f"{root_name}/{name}"
                 taken.add(name)
+            if name != relative:  # its folder is not root/name
+                folders[len(names)] = os.path.join(root, relative) if relative else root
             names.append(name)
             root_of.append(len(roots) - 1)
-            kinds.append(kind)
     order = sorted(range(len(names)), key=names.__getitem__)
     return CaseList(roots, [names[i] for i in order], array("H", (root_of[i] for i in order)),
-                    array("b", (kinds[i] for i in order)))
+                    {new: folders[old] for new, old in enumerate(order) if old in folders})
 
 
 def _walk(folder, relative, file_name, seen):

@@ -32,6 +32,7 @@ scenario and on random traces.
 """
 import contextlib
 import io
+import itertools
 import math
 from ctypes import c_void_p
 
@@ -221,44 +222,32 @@ class _InputRows:
         return set_at, set_inputs
 
 
-_LOOPS = {}
+def _steps_fmi2(do_step, component, times, sizes, set_at, set_inputs, getters):
+    """Per step: the inputs where they change, doStep, one get per output
+    type into the step's row; False as soon as a call fails."""
+    for t, h, row, k in zip(times, sizes, set_at, itertools.count()):
+        if row is not None and set_inputs(row) > 1:
+            return False
+        status = do_step(component, t, h, 1)
+        for get, vrs, n, rows in getters:
+            status |= get(component, vrs, n, rows[k])
+        if status > 1:
+            return False
+    return True
 
 
-def _step_loop(fmi3, outputs):
-    """The step loop for an FMI version and a number of output types: per
-    step the inputs where they change, doStep and one get per type, into
-    the next row; False as soon as a call fails or an FMI 3 step asks to
-    stop. Written out per shape
-    (Python source made here once per shape): an inner loop over the
-    getters would cost as much as a call."""
-    key = (fmi3, outputs)
-    if key not in _LOOPS:
-        names = [f"g{i}" for i in range(outputs)]
-        unpack = "".join(f"    ({name}, {name}_vrs, {name}_n), = getters[{i}:{i + 1}]\n" for i, name in enumerate(names))
-        rows = "".join(f", {name}_row" for name in names)
-        row_lists = "".join(f", rows[{i}]" for i in range(outputs))
-        if fmi3:
-            calls = "".join(f" | {name}(component, {name}_vrs, {name}_n, {name}_row, {name}_n)" for name in names)
-            step = "do_step(component, t, h, True, event, terminate, early, last)"
-            check = "status > 1 or stop[0]"
-            unpack += "    event, terminate, early, stop, last = flags\n"
-        else:
-            calls = "".join(f" | {name}(component, {name}_vrs, {name}_n, {name}_row)" for name in names)
-            step = "do_step(component, t, h, 1)"
-            check = "status > 1"
-        source = (f"def loop(do_step, component, times, sizes, set_at, set_inputs, getters, rows, flags):\n"
-                  f"{unpack}"
-                  f"    for t, h, row{rows} in zip(times, sizes, set_at{row_lists}):\n"
-                  f"        if row is not None and set_inputs(row) > 1:\n"
-                  f"            return False\n"
-                  f"        status = {step}{calls}\n"
-                  f"        if {check}:\n"
-                  f"            return False\n"
-                  f"    return True\n")
-        namespace = {}
-        exec(compile(source, f"<fmutrace step loop {key}>", "exec"), namespace)
-        _LOOPS[key] = namespace["loop"]
-    return _LOOPS[key]
+def _steps_fmi3(do_step, component, times, sizes, set_at, set_inputs, getters, flags):
+    """_steps_fmi2 for FMI 3; False also when a step asks to terminate or returns early."""
+    event, terminate, early, last = flags
+    for t, h, row, k in zip(times, sizes, set_at, itertools.count()):
+        if row is not None and set_inputs(row) > 1:
+            return False
+        status = do_step(component, t, h, True, event, terminate, early, last)
+        for get, vrs, n, rows in getters:
+            status |= get(component, vrs, n, rows[k], n)
+        if status > 1 or terminate[0] or early[0]:
+            return False
+    return True
 
 
 class Runner:
@@ -291,9 +280,8 @@ class Runner:
             component = self.fmu.component
             self._component = FFI.cast("void *", component.value if isinstance(component, c_void_p) else component)
             if self.fmi3:
-                self._flags = FFI.new("bool[4]")  # eventHandlingNeeded, terminateSimulation, earlyReturn, (pad)
-                self._stop_flags = FFI.cast("uint16_t *", self._flags + 1)  # terminate or early return: one read
-                self._last_time = FFI.new("double *")
+                flags = FFI.new("bool[3]")  # eventHandlingNeeded, terminateSimulation, earlyReturn
+                self._step_flags = flags, flags + 1, flags + 2, FFI.new("double *")  # and lastSuccessfulTime
             self.fresh = True
         elif not self.fresh:
             try:
@@ -479,9 +467,6 @@ class Runner:
                 raise FastLoopFailed("a getter failed")
         pending = result(slice(0, 1), [start])  # the start's row goes out with the first chunk
 
-        loop = _step_loop(fmi3, len(getters))
-        getter_arguments = [(function, vrs, count) for function, vrs, count, _, _, _, _ in getters]
-        flags = (self._flags, self._flags + 1, self._flags + 2, self._stop_flags, self._last_time) if fmi3 else ()
         for k in range(0, n, size):
             m = min(size, n - k)
             times, step_times, step_sizes = self._grid(start, step, k, m)
@@ -490,9 +475,12 @@ class Runner:
                     set_at, set_inputs = inputs.steps(times[:-1])
                 else:
                     set_at, set_inputs = [None] * m, None
-                rows = [pointers[1:m + 1] for _, _, _, pointers, _, _, _ in getters]
-                if not loop(self._do_step, component, step_times, step_sizes, set_at, set_inputs, getter_arguments,
-                            rows, flags):
+                step_getters = [(function, vrs, count, pointers[1:m + 1])
+                                for function, vrs, count, pointers, _, _, _ in getters]
+                if not (_steps_fmi3(self._do_step, component, step_times, step_sizes, set_at, set_inputs,
+                                    step_getters, self._step_flags) if fmi3 else
+                        _steps_fmi2(self._do_step, component, step_times, step_sizes, set_at, set_inputs,
+                                    step_getters)):
                     raise FastLoopFailed("a step failed")
             chunk = result(slice(1, m + 1), times[1:])
             if pending is not None:
