@@ -105,6 +105,25 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
     assert code == 0 and "on the journal" in out  # all done: nothing runs
 
 
+def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp_path):
+    """The command's default is the documented one: a plot and a result CSV
+    for every case up to 500 (test_fmutrace.py's report test: every case
+    plotted), the failing ones beyond. Two of 501 cases differ at t = 0.4."""
+    cases = pass_through_cases(tmp_path / "cases", 501)
+    for k in (7, 300):
+        reference = cases / f"case_{k:02d}" / "PassThrough_ref.csv"
+        reference.write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k + 1}\n")
+    report = tmp_path / "report"
+    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report]))
+    assert code == 1, out + err
+    assert "499 of 501 cases pass, 2 differ" in out
+    failing = ["PassThrough-fmi3/case_07", "PassThrough-fmi3/case_300"]
+    assert sorted(str(p.relative_to(report)) for p in report.rglob("*.png")) == [f"{c}.png" for c in failing]
+    assert sorted(str(p.relative_to(report)) for p in report.rglob("*_out.csv")) == [f"{c}_out.csv" for c in failing]
+    assert [c["case"] for c in json.loads((report / "results.json").read_text())["cases"] if "plot" in c] == \
+        ["case_07", "case_300"]
+
+
 def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 6)
     report = tmp_path / "report"

@@ -61,15 +61,21 @@ def data_lines(text):
             yield number, line
 
 
-def _separator(header):
-    """',' or ';': the one that occurs outside quotes in the header."""
-    counts = {",": 0, ";": 0}
+def counts_outside_quotes(line, characters):
+    """{character: how often it occurs in line outside double quotes}."""
+    counts = dict.fromkeys(characters, 0)
     quoted = False
-    for char in header:
+    for char in line:
         if char == '"':
             quoted = not quoted
         elif not quoted and char in counts:
             counts[char] += 1
+    return counts
+
+
+def _separator(header):
+    """',' or ';': the one that occurs outside quotes in the header."""
+    counts = counts_outside_quotes(header, ",;")
     return ";" if counts[";"] > counts[","] else ","
 
 

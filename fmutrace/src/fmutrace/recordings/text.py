@@ -19,6 +19,7 @@ import re
 import numpy as np
 
 from ..errors import TraceError
+from ..traces import counts_outside_quotes
 
 SEPARATORS = ("\t", ";", ",", " ")
 BOOLEANS = {"true": 1.0, "false": 0.0}
@@ -113,13 +114,7 @@ def _unquote_cell(cell):
 def sniff_separator(line):
     """The separator of a header line: tab, ';' or ',' (the most frequent
     one outside quotes), else blanks."""
-    counts = dict.fromkeys(SEPARATORS[:3], 0)
-    quoted = False
-    for char in line:
-        if char == '"':
-            quoted = not quoted
-        elif not quoted and char in counts:
-            counts[char] += 1
+    counts = counts_outside_quotes(line, SEPARATORS[:3])
     best = max(counts, key=counts.get)
     return best if counts[best] else " "
 
