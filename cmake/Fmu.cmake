@@ -1,11 +1,13 @@
 # add_fmu(<Model> <2|3>): build/fmi<2|3>/<Model>.fmu from the model's TOML
-# file, its mapping fmu_src/models/<Model>.c, the kernel and the shared glue.
+# file and its sources (cmake/FmuSources.cmake).
 # The .fmu is a zip made by CMake alone, with fixed time stamps; the host
 # tool zip_normalize (cmake/zip_normalize.c) then fixes what libarchive takes
 # from the file system (access/change times, owner, umask), so that the same
 # sources give the same bytes on any machine and for any user.
 # A fixture passes its own TOML, C sources (relative to the source tree) and
 # output folder: add_fmu(<Model> <2|3> TOML t SOURCES a.c ... OUTPUT_DIR d).
+
+include(${CMAKE_CURRENT_LIST_DIR}/FmuSources.cmake)
 
 add_custom_target(fmus ALL)
 
@@ -21,7 +23,8 @@ function(add_fmu model version)
   set(stage ${CMAKE_BINARY_DIR}/stage/fmi${version}/${model})
   set(toml ${CMAKE_SOURCE_DIR}/modelDescription/${model}.toml)
   set(header ${gen}/${model}_variables.h)
-  set(sources ${CORE_SOURCES} ${CORE_HEADERS} fmu_src/fmi${version}_glue.c fmu_src/models/${model}.c)
+  fmu_sources(sources ${model} ${version})
+  list(APPEND sources ${FMU_HEADERS})
   set(out_dir ${CMAKE_BINARY_DIR}/fmi${version})
   if(ARG_TOML)
     set(toml ${CMAKE_SOURCE_DIR}/${ARG_TOML})

@@ -36,8 +36,6 @@ set(FUZZ_MAX_LEN_deserialize 600)
 set(FUZZ_MAX_LEN_calls 1024)
 if(FUZZ_CLANG)
   message(STATUS "Fuzzers built with ${FUZZ_CLANG}")
-  set(fuzz_core ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c ${CMAKE_SOURCE_DIR}/fmu_src/fmu_core.c
-                ${CMAKE_SOURCE_DIR}/fmu_src/fmi2_glue.c ${CMAKE_SOURCE_DIR}/fmu_src/fmi3_glue.c)
   set(fuzz_binaries)
   # each target on the unified block and on the Siemens advanced block
   foreach(model RateLimiter LGF_LimRateOfChangeAdvancedCI)
@@ -46,7 +44,14 @@ if(FUZZ_CLANG)
     else()
       set(suffix "_${model}")
     endif()
-    set(fuzz_sources ${fuzz_core} ${CMAKE_SOURCE_DIR}/fmu_src/models/${model}.c)
+    # both versions' sources: a fuzzer drives both glues
+    fmu_sources(fmi2_sources ${model} 2)
+    fmu_sources(fmi3_sources ${model} 3)
+    set(fuzz_sources ${fmi2_sources} ${fmi3_sources})
+    list(REMOVE_DUPLICATES fuzz_sources)
+    list(TRANSFORM fuzz_sources PREPEND ${CMAKE_SOURCE_DIR}/)
+    set(fuzz_headers ${FMU_HEADERS})
+    list(TRANSFORM fuzz_headers PREPEND ${CMAKE_SOURCE_DIR}/)
     foreach(target IN LISTS FUZZ_TARGETS)
       set(binary ${CMAKE_BINARY_DIR}/fuzz/fuzz_${target}${suffix})
       add_custom_command(
@@ -55,7 +60,7 @@ if(FUZZ_CLANG)
                 -ffp-contract=off -I${CMAKE_SOURCE_DIR}/fmu_src -I${CMAKE_BINARY_DIR}/gen/${model}
                 -DMODEL_VARIABLES=${model}_variables.h
                 -I${FMI_HEADERS_DIR} ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} -lm -o ${binary}
-        DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} ${CORE_HEADERS}
+        DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_${target}.c ${fuzz_sources} ${fuzz_headers}
                 ${CMAKE_BINARY_DIR}/gen/${model}/${model}_variables.h
         COMMENT "Building the fuzzer fuzz_${target}${suffix}")
       list(APPEND fuzz_binaries ${binary})

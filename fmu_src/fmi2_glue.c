@@ -50,6 +50,7 @@
 typedef struct {
     FmuInstance base; /* first: an fmi2Component is an FmuInstance */
     fmi2CallbackFunctions functions;
+    const char *instanceName; /* a copy, for the logger */
 } Fmi2Instance;
 
 /* Errors and warnings are logged even with loggingOn = false: a failed call
@@ -70,7 +71,7 @@ typedef struct {
 
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
     const Fmi2Instance *g = (const Fmi2Instance *)instance;
-    g->functions.logger(g->functions.componentEnvironment, instance->instanceName, (fmi2Status)status, category, message);
+    g->functions.logger(g->functions.componentEnvironment, g->instanceName, (fmi2Status)status, category, message);
 }
 
 /* FMU states live in the importer's memory */
@@ -117,7 +118,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     }
     strcpy(name, instanceName);
     g->functions = *functions;
-    g->base.instanceName = name;
+    g->instanceName = name;
     g->base.environment = functions->componentEnvironment;
     g->base.logFunction = functions->logger ? log_to_importer : NULL;
     g->base.logCategories = (loggingOn ? LOG_ALL : 0) | ALWAYS_LOGGED;
@@ -132,7 +133,7 @@ void fmi2FreeInstance(fmi2Component c) {
     Fmi2Instance *g = c;
     if (!g) return;
     const fmi2CallbackFreeMemory release = g->functions.freeMemory;
-    release((void *)g->base.instanceName);
+    release((void *)g->instanceName);
     release(g);
 }
 

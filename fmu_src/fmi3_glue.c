@@ -64,7 +64,6 @@
 typedef struct {
     FmuInstance base; /* first: an fmi3Instance is an FmuInstance */
     fmi3LogMessageCallback logMessage;
-    char name[];
 } Fmi3Instance;
 
 #define BEGIN(name)                                                           \
@@ -121,11 +120,9 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", reason);
         return NULL;
     }
-    Fmi3Instance *g = calloc(1, sizeof *g + strlen(instanceName) + 1);
+    Fmi3Instance *g = calloc(1, sizeof *g);
     if (!g) return NULL;
-    strcpy(g->name, instanceName);
     g->logMessage = logMessage;
-    g->base.instanceName = g->name;
     g->base.environment = instanceEnvironment;
     g->base.logFunction = logMessage ? log_to_importer : NULL;
     g->base.logCategories = loggingOn ? LOG_ALL : 0;
@@ -304,42 +301,22 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
 
 /* ---- Co-Simulation -------------------------------------------------------- */
 
-/* The outputs of fmi3DoStep: no events, no early return. */
-static inline void step_outputs(const FmuInstance *I, fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
-                                fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    *eventHandlingNeeded = fmi3False;
-    *terminateSimulation = fmi3False;
-    *earlyReturn = fmi3False;
-    *lastSuccessfulTime = I->core.time;
-}
-
-/* Every step but the common one. Its parameters are fmi3DoStep's, so that
- * the common step's way out to it is a jump with every argument in place. */
-FMU_KEEP_SIGNATURE static fmi3Status general_step(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h,
-                                             fmi3Boolean noSetFMUStatePriorToCurrentPoint,
-                                             fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
-                                             fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    (void)noSetFMUStatePriorToCurrentPoint;
-    FmuInstance *I = (FmuInstance *)instance;
-    if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
-        return (fmi3Status)fmu_error(I, "fmi3DoStep", "an output argument pointer is NULL");
-    }
-    const FmuStatus status = fmu_do_step_general(I, "fmi3DoStep", t, h);
-    step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
-    return (fmi3Status)status;
-}
-
+/* The step of both versions (fmu_do_step); its outputs: no events, no
+ * early return. */
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
+    (void)noSetFMUStatePriorToCurrentPoint;
     BEGIN(DoStep);
-    if (eventHandlingNeeded && terminateSimulation && earlyReturn && lastSuccessfulTime &&
-        fmu_step_fast(I, currentCommunicationPoint, communicationStepSize)) {
-        step_outputs(I, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
-        return fmi3OK;
+    if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
+        return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
     }
-    return general_step(instance, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentPoint,
-                        eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime);
+    *eventHandlingNeeded = fmi3False;
+    *terminateSimulation = fmi3False;
+    *earlyReturn = fmi3False;
+    const FmuStatus status = fmu_do_step(I, FN, currentCommunicationPoint, communicationStepSize);
+    *lastSuccessfulTime = I->core.time;
+    return (fmi3Status)status;
 }
 
 /* ---- not provided --------------------------------------------------------- */

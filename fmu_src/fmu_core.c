@@ -53,11 +53,21 @@ void fmu_reset(FmuInstance *instance) {
     core->mode = MODE_INSTANTIATED;
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
-    instance->prepareDue = true;
+    /* the start values are the outputs until Initialization Mode */
+    instance->outputsStale = FMU_FRESH;
+    fmu_invalidate(instance);
+}
+
+/* configure() sets prepareDue and cycleTime, so that neither needs setting
+ * here: configDirty guarantees a configure before the next cycle (a step
+ * configures first; Initialization Mode's outputs and its end initialize
+ * the block, which configures). */
+void fmu_invalidate(FmuInstance *instance) {
     instance->configDirty = true;
     instance->fastPeriod = NAN;
-    instance->outputsStale = FMU_FRESH;
-    instance->cycleTime = 0.0;
+    if (instance->core.mode == MODE_INITIALIZATION) {
+        instance->outputsStale = FMU_STALE_ALL;
+    }
 }
 
 static void log_message(FmuInstance *instance, FmuStatus status, const char *fmt, va_list args) {
@@ -126,7 +136,7 @@ FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const voi
 }
 
 /* Why fmu_check_get or fmu_check_set refused a value reference. */
-FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set) {
+FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value) {
     const ModelDefinition *model = instance->model;
     if (vr >= model->count) {
         return fmu_error(instance, function, "unknown value reference %u", vr);
@@ -136,9 +146,7 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
         return fmu_error(instance, function, "%s (value reference %u) is %s variable, which %s cannot access",
                          v->name, vr, type_name(v->type), function);
     }
-    if (!set) {
-        return fmu_error(instance, function, "%s cannot be read", v->name);
-    }
+    /* a get is refused only for the two reasons above (fmu_readable): a set from here */
     if (v->causality == FMU_OUTPUT || v->causality == FMU_INDEPENDENT) {
         return fmu_error(instance, function, "%s is an %s and cannot be set", v->name,
                          v->causality == FMU_OUTPUT ? "output" : "independent variable");
@@ -154,7 +162,7 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
 static void publish(FmuInstance *instance, bool block) {
     instance->core.values[0] = instance->core.time; /* the independent variable */
     if (block) {
-        instance->model->publish(&instance->core.block, &instance->prepared, instance->core.values);
+        instance->model->publish(&instance->core.block, &instance->prepared, instance->modelMode, instance->core.values);
     }
     instance->outputsStale = FMU_FRESH;
 }
@@ -166,7 +174,7 @@ FMU_NOINLINE static void configure(FmuInstance *instance) {
     if (instance->outputsStale == FMU_STALE_ALL) {
         publish(instance, true);
     }
-    instance->model->configure(instance->core.values, &instance->prepared.config);
+    instance->modelMode = instance->model->configure(instance->core.values, &instance->prepared.config);
     const double c = instance->prepared.config.cycleTime.value;
     instance->cycleTime = c > 0 && isfinite(c) ? c : 0.0;
     instance->prepareDue = true;
@@ -180,8 +188,12 @@ FMU_NOINLINE static void prepare(FmuInstance *instance, double period) {
     rl_prepare(&instance->prepared, &config, period);
     instance->prepareDue = false;
     /* the status is known from here; the block's outputs after a cycle */
-    if (instance->model->publishStatus) {
-        instance->model->publishStatus(&instance->prepared, instance->core.values);
+    const FmuStatusOutputs *outputs = instance->model->statusOutputs;
+    if (outputs) {
+        const int status = instance->prepared.status;
+        instance->core.values[outputs->errorVr] = rl_status_is_error(status);
+        instance->core.values[outputs->statusVr] = status;
+        instance->core.values[outputs->causeVr] = rl_status_is_error(status) ? instance->prepared.statusSource : 0;
     }
 }
 
@@ -221,9 +233,7 @@ FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, doub
 
 FmuStatus fmu_enter_initialization(FmuInstance *instance) {
     instance->core.mode = MODE_INITIALIZATION;
-    instance->configDirty = true;
-    instance->fastPeriod = NAN;
-    instance->outputsStale = FMU_STALE_ALL;
+    fmu_invalidate(instance);
     return FMU_OK;
 }
 
@@ -231,7 +241,7 @@ FmuStatus fmu_enter_initialization(FmuInstance *instance) {
 FMU_NOINLINE static FmuStatus log_status(FmuInstance *instance) {
     const RlPrepared *p = &instance->prepared;
     instance->core.reportedStatus = p->status;
-    if (p->status >= 0x8000) {
+    if (rl_status_is_error(p->status)) {
         const FmuVariable *cause = &instance->model->variables[p->statusSource];
         fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds",
                 (unsigned)p->status, rl_status_text(p->status), cause->name, instance->core.values[p->statusSource]);
@@ -328,12 +338,10 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
 /* Make a restored core the current one. */
 static void restore(FmuInstance *instance, const FmuCore *state) {
     instance->core = *state;
-    instance->configDirty = true;
-    instance->fastPeriod = NAN;
-    instance->prepareDue = true;
-    /* the outputs are the state's; one taken in Initialization Mode
-     * initializes again on a get */
-    instance->outputsStale = state->mode == MODE_INITIALIZATION ? FMU_STALE_ALL : FMU_FRESH;
+    /* the outputs are the state's (snapshot published them); one taken in
+     * Initialization Mode initializes again on a get */
+    instance->outputsStale = FMU_FRESH;
+    fmu_invalidate(instance);
 }
 
 /* ---- serialization ---------------------------------------------------- */

@@ -1,7 +1,7 @@
 /* FMI-version independent part of every FMU: variable access, the cycle
  * scheduler (SPEC section 2), FMU states and their serialization, logging.
- * fmi2_glue.c and fmi3_glue.c map the FMI C APIs onto it; a model file
- * (models/<Model>.c) maps its variables onto the kernel. */
+ * fmi2_glue.c and fmi3_glue.c map the FMI C APIs onto it; a model
+ * (model.h, models/<Model>.c) maps its variables onto the kernel. */
 #ifndef FMU_CORE_H
 #define FMU_CORE_H
 
@@ -12,7 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "rate_limiter.h"
+#include "model.h"
 
 /* Compiler hints, portable: GCC and clang read them, any other compiler
  * (MSVC compiling the source FMU) gets nothing; FMU_PORTABLE forces that
@@ -24,26 +24,6 @@
 #define FMU_NOINLINE
 #define FMU_COLD
 #endif
-/* keep every parameter of a function (no clone with fewer): GCC's noipa */
-#if defined(__GNUC__) && !defined(__clang__) && !defined(FMU_PORTABLE)
-#define FMU_KEEP_SIGNATURE __attribute__((noipa))
-#else
-#define FMU_KEEP_SIGNATURE FMU_NOINLINE
-#endif
-
-typedef enum { FMU_REAL, FMU_INTEGER, FMU_BOOLEAN, FMU_ENUMERATION, FMU_UNSUPPORTED_TYPE } FmuType;
-typedef enum { FMU_INDEPENDENT, FMU_PARAMETER, FMU_INPUT, FMU_OUTPUT } FmuCausality;
-typedef enum { FMU_CONTINUOUS, FMU_DISCRETE, FMU_FIXED, FMU_TUNABLE } FmuVariability;
-
-/* One row of a model's variable table (generated from its TOML file). */
-typedef struct {
-    const char *name;
-    FmuType type;
-    FmuCausality causality;
-    FmuVariability variability;
-    double start;
-    double min, max;
-} FmuVariable;
 
 /* Same numbering as fmi2Status and fmi3Status. */
 typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } FmuStatus;
@@ -58,9 +38,6 @@ typedef enum {
     MODE_ERROR          = 1 << 4
 } FmuMode;
 
-/* Variables per model, at most (the generated header checks its model). */
-#define FMU_MAX_VARIABLES 40
-
 /* A step that would run more cycles than this is refused (no endless loop
  * on a tiny cycleTime or a huge step). */
 #define FMU_MAX_CYCLES_PER_STEP 100000000.0
@@ -68,35 +45,6 @@ typedef enum {
 /* Log categories (bits); names in fmu_log_category_names. */
 enum { LOG_ERROR = 1, LOG_WARNING = 2, LOG_EVENTS = 4, LOG_ALL = 7 };
 extern const char *const fmu_log_category_names[3];
-
-/* What a model file provides: its variables and the mapping to the kernel.
- * Value reference 0 is the independent variable time (generate.py). */
-typedef struct {
-    const char *identifier;
-    const char *token;
-    const FmuVariable *variables;
-    unsigned count;
-    unsigned inputVr;  /* the cycle input u */
-    unsigned outputVr; /* the output y: the block's state y */
-    void (*configure)(const double *values, RlConfig *config);
-    /* outputs of the block's state (and of what the configuration of its
-     * last cycle derives from it), and (NULL: none) of the status */
-    void (*publish)(const RlState *block, const RlPrepared *prepared, double *values);
-    void (*publishStatus)(const RlPrepared *prepared, double *values);
-} ModelDefinition;
-
-extern const ModelDefinition fmuModel;
-
-/* For the Siemens LGF models: cycleTime (the OB interval) counts only when
- * callOB is a cyclic interrupt OB, 30..38 or 123 and above; else there is
- * no valid cycle, and callOB is the cause. */
-static inline RlValue fmu_siemens_cycle(double callOB, int callOBVr, double cycleTime, int cycleTimeVr) {
-    const bool cyclic = (callOB >= 30 && callOB <= 38) || callOB >= 123;
-    RlValue cycle;
-    cycle.value = cyclic ? cycleTime : NAN;
-    cycle.source = cyclic ? cycleTimeVr : callOBVr;
-    return cycle;
-}
 
 /* What a step changed since the outputs were last published: the time
  * only (a step that ran no cycle), or the block too. */
@@ -122,6 +70,7 @@ struct FmuInstance {
      * from the values at the next step (configure), prepared before a
      * cycle runs (prepareDue) */
     RlPrepared prepared;
+    int modelMode;          /* the model's own, from the same configure */
     bool configDirty;       /* a parameter or input other than u changed */
     unsigned char outputsStale; /* FMU_STALE_*: what changed since the outputs were published */
     bool prepareDue;        /* the configuration changed: prepare before the next cycle */
@@ -140,7 +89,6 @@ struct FmuInstance {
     FmuLogFunction *logFunction;
     int logCategories;      /* enabled categories */
     int errorMode;          /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
-    const char *instanceName;
     void *environment;      /* the importer's instance environment */
     /* memory for FMU states, as the importer provides it (FMI 2) or not */
     void *(*allocate)(FmuInstance *instance, size_t size);
@@ -149,6 +97,13 @@ struct FmuInstance {
 
 void fmu_init_instance(FmuInstance *instance);
 void fmu_reset(FmuInstance *instance);
+
+/* The values or the mode changed other than by a new u (a set, a reset, a
+ * restored state, Initialization Mode entered): what the core derived from
+ * them is void. The configuration is taken again before the next cycle,
+ * the common step waits for a general one, and in Initialization Mode the
+ * outputs follow the values. */
+void fmu_invalidate(FmuInstance *instance);
 
 void fmu_log(FmuInstance *instance, FmuStatus status, const char *fmt, ...);
 
@@ -168,7 +123,7 @@ FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt
 /* A call in a mode its function's state table does not allow. */
 FMU_COLD FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
 FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr);
-FMU_COLD FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value, bool set);
+FMU_COLD FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value);
 /* Publish the outputs (Initialization Mode: initialize the block first). */
 void fmu_refresh_outputs(FmuInstance *instance);
 
@@ -189,7 +144,7 @@ static inline bool fmu_readable(const FmuInstance *instance, int typeMask, unsig
 }
 
 static inline FmuStatus fmu_check_get(FmuInstance *instance, const char *function, int typeMask, unsigned vr) {
-    return fmu_readable(instance, typeMask, vr) ? FMU_OK : fmu_access_error(instance, function, typeMask, vr, 0.0, false);
+    return fmu_readable(instance, typeMask, vr) ? FMU_OK : fmu_access_error(instance, function, typeMask, vr, 0.0);
 }
 
 /* Outputs and time are published when read, not after every step: a step
@@ -228,7 +183,7 @@ static inline bool fmu_settable(const FmuInstance *instance, int typeMask, unsig
 static inline FmuStatus fmu_check_set(FmuInstance *instance, const char *function, int typeMask, unsigned vr,
                                       double value) {
     return fmu_settable(instance, typeMask, vr, value) ? FMU_OK
-                                                       : fmu_access_error(instance, function, typeMask, vr, value, true);
+                                                       : fmu_access_error(instance, function, typeMask, vr, value);
 }
 
 /* fmu_set of u as a Real: nothing to check. */
@@ -240,13 +195,11 @@ static inline void fmu_set_input(FmuInstance *instance, double value) {
 }
 
 static inline void fmu_set(FmuInstance *instance, unsigned vr, double value) {
-    instance->core.values[vr] = value;
-    if (vr != instance->inputVr) {
-        instance->configDirty = true;
-        instance->fastPeriod = NAN;
-    }
-    if (instance->core.mode == MODE_INITIALIZATION) {
-        instance->outputsStale = FMU_STALE_ALL;
+    if (vr == instance->inputVr) {
+        fmu_set_input(instance, value);
+    } else {
+        instance->core.values[vr] = value;
+        fmu_invalidate(instance);
     }
 }
 
@@ -255,7 +208,7 @@ static inline void fmu_set(FmuInstance *instance, unsigned vr, double value) {
  * no table lookup. */
 static inline bool fmu_get_one(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double *value) {
     if (!(typeMask == TYPE_BIT(FMU_REAL) && vr == instance->outputVr) && !fmu_readable(instance, typeMask, vr)) {
-        fmu_access_error(instance, function, typeMask, vr, 0.0, false);
+        fmu_access_error(instance, function, typeMask, vr, 0.0);
         return false;
     }
     *value = fmu_get(instance, vr);
@@ -268,7 +221,7 @@ static inline bool fmu_set_one(FmuInstance *instance, const char *function, int 
         return true;
     }
     if (!fmu_settable(instance, typeMask, vr, value)) {
-        fmu_access_error(instance, function, typeMask, vr, value, true);
+        fmu_access_error(instance, function, typeMask, vr, value);
         return false;
     }
     fmu_set(instance, vr, value);
@@ -304,6 +257,8 @@ static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
 /* Any step, with every check and the status report. */
 FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h);
 
+/* The step of both FMI versions: the common one if it applies, else the
+ * general one. */
 static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function, double t, double h) {
     return fmu_step_fast(instance, t, h) ? FMU_OK : fmu_do_step_general(instance, function, t, h);
 }

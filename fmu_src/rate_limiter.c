@@ -21,7 +21,6 @@ void rl_without_section6(RlConfig *c) {
     c->yMax = c->yMin = (RlValue){ NAN, 0 };
     c->hold = false;
     c->limitInitialOutput = false;
-    c->modelMode = 0;
 }
 
 int rl_status(const RlConfig *c, int *source) {
@@ -79,7 +78,7 @@ void rl_prepare(RlPrepared *p, const RlConfig *c, double period) {
      * init, 5 error hold, 5b hold, and any new one) and everything that
      * makes rule 6 ramp otherwise (output limits, other limits below 0)
      * must clear it here. */
-    p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && p->status < 0x8000 && !c->hold &&
+    p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && !rl_status_is_error(p->status) && !c->hold &&
                p->yLow == -INFINITY && p->yHigh == INFINITY && p->maxUpNeg == p->maxUp &&
                p->maxDownNeg == p->maxDown;
     p->durationLimited = c->duration.value > 0;
@@ -122,7 +121,7 @@ void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
     } else if (!isfinite(s->y) && isfinite(u)) {
         y = u;
         running_reset(s);
-    } else if (p->status >= 0x8000) {
+    } else if (rl_status_is_error(p->status)) {
         y = s->y;
     } else if (c->hold) {
         /* rule 5b: y and runningTime as they are */

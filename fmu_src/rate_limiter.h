@@ -8,9 +8,10 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-/* Status words (Siemens convention: 0x8000 and above are errors). */
+/* Status words (Siemens convention: RL_STATUS_ERROR and above are errors). */
 enum {
     RL_STATUS_OK                = 0x0000,
+    RL_STATUS_ERROR             = 0x8000, /* the first error word */
     RL_STATUS_RATE_NEGATIVE     = 0x8200,
     RL_STATUS_RATE_NAN          = 0x8201,
     RL_STATUS_RATE_PERIOD       = 0x8202,
@@ -59,7 +60,6 @@ typedef struct {
      * only compared with the output, so NaN holds and +-inf ramps. */
     bool passNonFinite;
     bool limitInitialOutput;   /* the initial output within [yMin, yMax] */
-    int modelMode;             /* the model's own, kept with its cycle's configuration */
 } RlConfig;
 
 /* Per-configuration values derived once, not every cycle. */
@@ -92,6 +92,11 @@ typedef struct {
     double runPeriod;
     double runBase;
 } RlState;
+
+/* An error status: the block holds its output (rule 5). */
+static inline bool rl_status_is_error(int status) {
+    return status >= RL_STATUS_ERROR;
+}
 
 /* Rule 0: an "or Par" input that is NaN falls back to its parameter. */
 RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource);

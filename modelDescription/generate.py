@@ -20,12 +20,12 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 GENERATION_TOOL = "rate-limiter-fmus modelDescription/generate.py"
-CORE_HEADER = Path(__file__).resolve().parent.parent / "fmu_src" / "fmu_core.h"
+MODEL_HEADER = Path(__file__).resolve().parent.parent / "fmu_src" / "model.h"
 
 
 def max_variables():
     """The size of the core's variable table (FMU_MAX_VARIABLES)."""
-    return int(re.search(r"#define FMU_MAX_VARIABLES (\d+)", CORE_HEADER.read_text()).group(1))
+    return int(re.search(r"#define FMU_MAX_VARIABLES (\d+)", MODEL_HEADER.read_text()).group(1))
 
 TYPES = {"Real", "Integer", "Boolean", "Enumeration"}
 CAUSALITIES = {"independent", "parameter", "input", "output"}
@@ -63,7 +63,7 @@ def load(path):
         sys.exit(f"{path}: value reference 0 must be the independent variable time (the core publishes it there)")
     if len(variables) > max_variables():
         sys.exit(f"{path}: {len(variables)} variables; the core's table holds {max_variables()} "
-                 f"(FMU_MAX_VARIABLES in {CORE_HEADER.name})")
+                 f"(FMU_MAX_VARIABLES in {MODEL_HEADER.name})")
     return model
 
 
@@ -223,7 +223,7 @@ def c_header(model, instantiation_token, toml_name):
 #define {guard}
 
 #include <math.h>
-#include "fmu_core.h"
+#include "model.h"
 
 #define MODEL_IDENTIFIER "{identifier}"
 #define MODEL_TOKEN "{instantiation_token}"
@@ -241,6 +241,11 @@ typedef char modelTimeIsValueReference0[VR_time == 0 ? 1 : -1];
 static const FmuVariable modelVariables[MODEL_VARIABLE_COUNT] = {{
 {table}
 }};
+
+/* the table's part of the model's definition (model.h): fmuModel starts
+ * with MODEL_TABLE, then the mapping */
+#define MODEL_TABLE .identifier = MODEL_IDENTIFIER, .token = MODEL_TOKEN, \
+    .variables = modelVariables, .count = MODEL_VARIABLE_COUNT
 
 #endif
 """

@@ -3,10 +3,11 @@
  * manOp, enDefaultOutValue and track (first match wins), each of which
  * sets the output as a bypass does; the output starts at 0, not limited. */
 #include "LGF_LimRateOfChangeAdvancedCI_variables.h"
+#include "siemens.h"
 
 enum { MODE_RAMP, MODE_RESET, MODE_MANUAL, MODE_DEFAULT, MODE_TRACK };
 
-static void configure(const double *v, RlConfig *c) {
+static int configure(const double *v, RlConfig *c) {
     c->rateUp = (RlValue){ v[VR_setPosUpRateLim], VR_setPosUpRateLim };
     c->rateDown = (RlValue){ v[VR_setPosDownRateLim], VR_setPosDownRateLim };
     /* named by the output's magnitude: negUp falls below 0, negDown rises */
@@ -17,38 +18,40 @@ static void configure(const double *v, RlConfig *c) {
     c->yMin = (RlValue){ v[VR_setLowLim], VR_setLowLim };
     c->hold = false;
     c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = fmu_siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
+    c->cycleTime = siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
+    int mode;
     if (v[VR_reset] != 0) {
-        c->modelMode = MODE_RESET;
+        mode = MODE_RESET;
         c->bypassValue = v[VR_enDefaultOutValue] != 0 ? v[VR_defaultOutValue] : 0.0;
     } else if (v[VR_manOp] != 0) {
-        c->modelMode = MODE_MANUAL;
+        mode = MODE_MANUAL;
         c->bypassValue = v[VR_manualValue];
     } else if (v[VR_enDefaultOutValue] != 0) {
-        c->modelMode = MODE_DEFAULT;
+        mode = MODE_DEFAULT;
         c->bypassValue = v[VR_defaultOutValue];
     } else if (v[VR_track] != 0) {
-        c->modelMode = MODE_TRACK;
+        mode = MODE_TRACK;
         c->bypassValue = v[VR_autoValue];
     } else {
-        c->modelMode = MODE_RAMP;
+        mode = MODE_RAMP;
         c->bypassValue = NAN;
     }
-    c->bypass = c->modelMode != MODE_RAMP;
+    c->bypass = mode != MODE_RAMP;
     c->zeroRate = RL_ZERO_RATE_HOLD;
     c->initMode = RL_INIT_VALUE;
     c->initValue = 0.0;
     c->initDelay = 0.0;
     c->passNonFinite = false;
     c->limitInitialOutput = false;
+    return mode;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     RlOutputs o;
     rl_outputs(block, prepared, &o);
     /* the quadrant of the output the rate was picked by */
     const bool negative = block->yPrevious < 0;
-    const bool reset = prepared->config.modelMode == MODE_RESET;
+    const bool reset = modelMode == MODE_RESET;
     v[VR_outputValue] = block->y;
     v[VR_posUpRateLim] = o.limitingUp && !negative;
     v[VR_posDownRateLim] = o.limitingDown && !negative;
@@ -58,20 +61,11 @@ static void publish(const RlState *block, const RlPrepared *prepared, double *v)
     v[VR_lowLim] = o.lowLimit && !reset;
 }
 
-static void publish_status(const RlPrepared *p, double *v) {
-    v[VR_error] = p->status >= 0x8000;
-    v[VR_status] = p->status;
-    v[VR_subfunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
-}
+static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subfunctionStatus };
 
 const ModelDefinition fmuModel = {
-    .identifier = MODEL_IDENTIFIER,
-    .token = MODEL_TOKEN,
-    .variables = modelVariables,
-    .count = MODEL_VARIABLE_COUNT,
-    .inputVr = VR_autoValue,
-    .outputVr = VR_outputValue,
-    .configure = configure,
-    .publish = publish,
-    .publishStatus = publish_status,
+    MODEL_TABLE,
+    .inputVr = VR_autoValue, .outputVr = VR_outputValue,
+    .configure = configure, .publish = publish,
+    .statusOutputs = &statusOutputs,
 };

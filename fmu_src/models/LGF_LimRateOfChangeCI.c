@@ -2,12 +2,13 @@
  * both directions (0 holds), enDefaultOutValue as the bypass, output from 0,
  * a NaN value compared rather than passed, callOB validated. */
 #include "LGF_LimRateOfChangeCI_variables.h"
+#include "siemens.h"
 
-static void configure(const double *v, RlConfig *c) {
+static int configure(const double *v, RlConfig *c) {
     c->rateUp = c->rateDown = (RlValue){ v[VR_setChangeRate], VR_setChangeRate };
     c->ratePeriod = (RlValue){ 1.0, VR_setChangeRate };
     c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = fmu_siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
+    c->cycleTime = siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     c->bypass = v[VR_enDefaultOutValue] != 0;
     c->bypassValue = v[VR_defaultOutValue];
     c->zeroRate = RL_ZERO_RATE_HOLD;
@@ -16,27 +17,20 @@ static void configure(const double *v, RlConfig *c) {
     c->initDelay = 0.0;
     c->passNonFinite = false;
     rl_without_section6(c);
+    return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     (void)prepared;
+    (void)modelMode;
     v[VR_delayedValue] = block->y;
 }
 
-static void publish_status(const RlPrepared *p, double *v) {
-    v[VR_error] = p->status >= 0x8000;
-    v[VR_status] = p->status;
-    v[VR_subFunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
-}
+static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };
 
 const ModelDefinition fmuModel = {
-    .identifier = MODEL_IDENTIFIER,
-    .token = MODEL_TOKEN,
-    .variables = modelVariables,
-    .count = MODEL_VARIABLE_COUNT,
-    .inputVr = VR_value,
-    .outputVr = VR_delayedValue,
-    .configure = configure,
-    .publish = publish,
-    .publishStatus = publish_status,
+    MODEL_TABLE,
+    .inputVr = VR_value, .outputVr = VR_delayedValue,
+    .configure = configure, .publish = publish,
+    .statusOutputs = &statusOutputs,
 };

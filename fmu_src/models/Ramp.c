@@ -3,7 +3,7 @@
  * tInitDelay are the kernel's init modes. */
 #include "Ramp_variables.h"
 
-static void configure(const double *v, RlConfig *c) {
+static int configure(const double *v, RlConfig *c) {
     c->rateUp = c->rateDown = (RlValue){ v[VR_rVariation], VR_rVariation };
     c->ratePeriod = (RlValue){ v[VR_tTime], VR_tTime };
     c->duration = (RlValue){ 0.0, 0 };
@@ -16,9 +16,11 @@ static void configure(const double *v, RlConfig *c) {
     c->initDelay = v[VR_tInitDelay];
     c->passNonFinite = true;
     rl_without_section6(c);
+    return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+    (void)modelMode;
     v[VR_rOut] = block->y;
     RlOutputs o;
     rl_outputs(block, prepared, &o);
@@ -26,13 +28,7 @@ static void publish(const RlState *block, const RlPrepared *prepared, double *v)
 }
 
 const ModelDefinition fmuModel = {
-    .identifier = MODEL_IDENTIFIER,
-    .token = MODEL_TOKEN,
-    .variables = modelVariables,
-    .count = MODEL_VARIABLE_COUNT,
-    .inputVr = VR_rIn,
-    .outputVr = VR_rOut,
-    .configure = configure,
-    .publish = publish,
-    .publishStatus = NULL,
+    MODEL_TABLE,
+    .inputVr = VR_rIn, .outputVr = VR_rOut,
+    .configure = configure, .publish = publish,
 };

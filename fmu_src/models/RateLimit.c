@@ -5,7 +5,7 @@
 
 #define DURATION_MAX 259200.0
 
-static void configure(const double *v, RlConfig *c) {
+static int configure(const double *v, RlConfig *c) {
     c->rateUp = rl_resolve(v[VR_UpRate], VR_UpRate, v[VR_UpRatePar], VR_UpRatePar);
     c->rateDown = rl_resolve(v[VR_DownRate], VR_DownRate, v[VR_DownRatePar], VR_DownRatePar);
     c->ratePeriod = (RlValue){ 1.0, VR_UpRatePar };
@@ -23,22 +23,18 @@ static void configure(const double *v, RlConfig *c) {
     c->initDelay = 0.0;
     c->passNonFinite = true;
     rl_without_section6(c);
+    return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     (void)prepared;
+    (void)modelMode;
     v[VR_Out] = block->y;
     v[VR_RunningTime] = rl_running_time(block);
 }
 
 const ModelDefinition fmuModel = {
-    .identifier = MODEL_IDENTIFIER,
-    .token = MODEL_TOKEN,
-    .variables = modelVariables,
-    .count = MODEL_VARIABLE_COUNT,
-    .inputVr = VR_In,
-    .outputVr = VR_Out,
-    .configure = configure,
-    .publish = publish,
-    .publishStatus = NULL,
+    MODEL_TABLE,
+    .inputVr = VR_In, .outputVr = VR_Out,
+    .configure = configure, .publish = publish,
 };

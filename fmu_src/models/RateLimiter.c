@@ -2,7 +2,7 @@
  * of its variables onto the kernel. */
 #include "RateLimiter_variables.h"
 
-static void configure(const double *v, RlConfig *c) {
+static int configure(const double *v, RlConfig *c) {
     c->rateUp = rl_resolve(v[VR_rateUp], VR_rateUp, v[VR_rateUpPar], VR_rateUpPar);
     c->rateDown = rl_resolve(v[VR_rateDown], VR_rateDown, v[VR_rateDownPar], VR_rateDownPar);
     c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);
@@ -21,10 +21,11 @@ static void configure(const double *v, RlConfig *c) {
     c->initDelay = v[VR_initDelay];
     c->passNonFinite = true;
     c->limitInitialOutput = true;
-    c->modelMode = 0;
+    return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, double *v) {
+static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+    (void)modelMode;
     RlOutputs o;
     rl_outputs(block, prepared, &o);
     v[VR_y] = block->y;
@@ -38,20 +39,11 @@ static void publish(const RlState *block, const RlPrepared *prepared, double *v)
     v[VR_remainingTime] = o.remainingTime;
 }
 
-static void publish_status(const RlPrepared *p, double *v) {
-    v[VR_error] = p->status >= 0x8000;
-    v[VR_status] = p->status;
-    v[VR_subFunctionStatus] = p->status >= 0x8000 ? p->statusSource : 0;
-}
+static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };
 
 const ModelDefinition fmuModel = {
-    .identifier = MODEL_IDENTIFIER,
-    .token = MODEL_TOKEN,
-    .variables = modelVariables,
-    .count = MODEL_VARIABLE_COUNT,
-    .inputVr = VR_u,
-    .outputVr = VR_y,
-    .configure = configure,
-    .publish = publish,
-    .publishStatus = publish_status,
+    MODEL_TABLE,
+    .inputVr = VR_u, .outputVr = VR_y,
+    .configure = configure, .publish = publish,
+    .statusOutputs = &statusOutputs,
 };
