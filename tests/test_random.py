@@ -150,15 +150,18 @@ def test_outputs_in_initialization_mode_follow_what_is_set(version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("start,run,start_time", [
+@pytest.mark.parametrize("model,start,run,start_time", [
     # cycles of 1 s in steps of 0.5 s: a cycle ends every other step
-    ({"cycleTime": 1.0, "u": 0.0}, [(0.5, {"u": 10.0})] * 6, 0.0),
+    ("RateLimiter", {"cycleTime": 1.0, "u": 0.0}, [(0.5, {"u": 10.0})] * 6, 0.0),
     # the initial delay counts from the start time (one cycle per step)
-    ({"initMode": 3, "initDelay": 1.0, "u": 0.0},
+    ("RateLimiter", {"initMode": 3, "initDelay": 1.0, "u": 0.0},
      [(0.5, {"u": 5.0}), (0.5, {"u": 2.0}), (0.5, {"u": 8.0}), (0.5, {"u": -1.0})], 10.0),
+    # track follows autoValue when autoValue (the cycle input) is all that changes
+    ("LGF_LimRateOfChangeAdvancedCI", {"track": True},
+     [(0.05, {}), (0.05, {"autoValue": 1.0}), (0.1, {"autoValue": -3.0}), (0.1, {"track": False})], 0.0),
 ])
-def test_directed_runs_agree_with_oracle(version, start, run, start_time):
-    run_against_oracle("RateLimiter", version, start, run, start_time=start_time)
+def test_directed_runs_agree_with_oracle(version, model, start, run, start_time):
+    run_against_oracle(model, version, start, run, start_time=start_time)
 
 
 @pytest.mark.parametrize("version", [2, 3])

@@ -31,7 +31,7 @@ static int configure(const double *v, RlConfig *c) {
         c->bypassValue = v[VR_defaultOutValue];
     } else if (v[VR_track] != 0) {
         mode = MODE_TRACK;
-        c->bypassValue = v[VR_autoValue];
+        c->bypassValue = NAN; /* the output is u itself, autoValue, in every cycle */
     } else {
         mode = MODE_RAMP;
         c->bypassValue = NAN;
