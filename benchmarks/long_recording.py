@@ -69,7 +69,7 @@ def write_case(folder, cycles):
     write_columns(folder / f"{MODEL}_in.csv", {"time": time[:-1], "u": u})
     write_columns(folder / f"{MODEL}_ref.csv", {"time": time, "y": y})
     (folder / f"{MODEL}_start.csv").write_text("rateUpPar,100\nrateDownPar,100\n")
-    (folder / f"{MODEL}_ref.opt").write_text(f"StartTime,0\nStopTime,{time[-1]!r}\nStepSize,{STEP!r}\n")
+    (folder / f"{MODEL}_ref.opt").write_text(f"StartTime,0\nStopTime,{float(time[-1])!r}\nStepSize,{STEP!r}\n")
     (folder / "README.md").write_text(f"# {cycles} cycles of 10 ms: a random walk the limiter passes on\n")
 
 

@@ -7,12 +7,14 @@ Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
 simulation, 2 bad input); compare's is its worst case's.
 """
 import argparse
+import contextlib
 import sys
 
 from . import __version__
 from .campaign import compare
 from .errors import ExitStatus, InputError, SimulationError
-from .fmu import is_fmu_file
+from .fmu import Fmu, is_fmu_file
+from .longcase import simulate_long
 from .outcome import Status
 from .recordings import is_recording
 from .recordings.align import TIMINGS
@@ -132,6 +134,15 @@ def parser():
 
 
 def run_command(args, out):
+    if args.input and args.output_interval is None:  # a long input runs chunk by chunk, written as it goes
+        with open(args.out, "w", newline="\n") if args.out else contextlib.nullcontext(out) as stream:
+            written = simulate_long(args.fmu, args.input, stream, dict(args.set), args.start_time, args.stop_time,
+                                    args.step_size, args.output)
+        if written is not None:
+            if args.out:
+                print(f"{written} samples of {len(args.output or Fmu(args.fmu).outputs)} signals written to "
+                      f"{args.out}", file=out)
+            return ExitStatus.SUCCESS
     result = simulate(args.fmu, input=args.input, start_values=dict(args.set), start_time=args.start_time,
                       stop_time=args.stop_time, step_size=args.step_size, output_interval=args.output_interval,
                       outputs=args.output)

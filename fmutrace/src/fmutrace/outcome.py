@@ -36,6 +36,7 @@ class CaseOutcome:
     seconds: float = 0.0
     result: object = None    # structured array
     png: bytes = b""
+    result_path: str = ""    # a long case's result, in a file of its own (the report moves it in)
     csv: str = ""            # paths in the report folder
     plot: str = ""
 

@@ -1,53 +1,184 @@
 """A case's figure for the report: its inputs, each compared signal
 (reference, result, and the band where the mode draws one) and the
-deviation, as PNG bytes."""
+deviation, as PNG bytes; for a failing case beside it the same zoomed on
+the first deviation.
+
+A line of millions of samples is drawn decimated to what the figure can
+show: per pixel column the first and last sample and the smallest and
+largest value (Envelope), so the picture is the same and its cost does
+not grow with the length. A long case fills its envelopes chunk by chunk."""
 import io
 
 import numpy as np
 
 from .comparison import Comparison, Mode
 
+WIDTH_INCHES, DPI = 8.0, 80
+COLUMNS = 600        # pixel columns of an axis (the figure is 640 pixels wide)
+ZOOM_SAMPLES = 40    # compared samples each side of the first deviation in the zoom
+
+
+class Envelope:
+    """A line over [t0, t1] decimated to COLUMNS pixel columns: per column
+    the first and the last sample and the smallest and the largest value
+    (NaN ignored), filled from consecutive chunks of (times, values)."""
+
+    def __init__(self, t0: float, t1: float, columns: int = COLUMNS):
+        self.t0, self.span, self.columns = float(t0), max(float(t1) - float(t0), 1e-300), columns
+        self.first_t = np.full(columns, np.nan)
+        self.first_v = np.full(columns, np.nan)
+        self.last_t = np.full(columns, np.nan)
+        self.last_v = np.full(columns, np.nan)
+        self.low = np.full(columns, np.nan)
+        self.high = np.full(columns, np.nan)
+
+    def add(self, times, values):
+        """Samples in time order, after those added before."""
+        if not len(times):
+            return
+        values = np.asarray(values, dtype=np.float64)
+        column = np.clip(((times - self.t0) / self.span * self.columns).astype(np.int64), 0, self.columns - 1)
+        starts = np.flatnonzero(np.concatenate(([True], column[1:] != column[:-1])))
+        ends = np.concatenate((starts[1:], [len(times)])) - 1
+        c = column[starts]
+        with np.errstate(invalid="ignore"):
+            low, high = np.fmin.reduceat(values, starts), np.fmax.reduceat(values, starts)
+        new = np.isnan(self.first_t[c])
+        self.first_t[c[new]], self.first_v[c[new]] = times[starts[new]], values[starts[new]]
+        self.last_t[c], self.last_v[c] = times[ends], values[ends]
+        self.low[c], self.high[c] = np.fmin(self.low[c], low), np.fmax(self.high[c], high)
+
+    def line(self):
+        """(times, values) to draw: per filled column its first sample, its
+        range at its middle, its last sample."""
+        filled = ~np.isnan(self.first_t)
+        middle = (self.first_t + self.last_t) / 2
+        times = np.stack([self.first_t, middle, middle, self.last_t], axis=1)[filled].ravel()
+        values = np.stack([self.first_v, self.low, self.high, self.last_v], axis=1)[filled].ravel()
+        return times, values
+
+
+def decimated(times, values, t0=None, t1=None):
+    """(times, values) of a whole line, decimated when it has more samples
+    than its pixel columns can show."""
+    if len(times) <= 4 * COLUMNS:
+        return times, values
+    envelope = Envelope(times[0] if t0 is None else t0, times[-1] if t1 is None else t1)
+    envelope.add(times, values)
+    return envelope.line()
+
+
+class Figure:
+    """What a case's figure shows, each line already decimated:
+    inputs [(name, times, values)], signals [(name, (ref times, values),
+    (result times, values), band or None)], deviations [(name, times,
+    values)], and zoom: None, or the same three around the first
+    deviation (full resolution)."""
+
+    def __init__(self, title, inputs, signals, deviations, zoom=None):
+        self.title, self.inputs, self.signals, self.deviations, self.zoom = title, inputs, signals, deviations, zoom
+
+
+def case_figure(case, result, comparison: Comparison, label: str) -> Figure:
+    """The Figure of a case run in memory."""
+    title = f"{case.name} on {label}" + (f": {case.description}" if case.description else "")
+    stop = case.options["StopTime"]
+    inputs = []
+    if case.inputs is not None:
+        for name in case.inputs.dtype.names[1:]:
+            inputs.append((name, *decimated(np.append(case.inputs["time"], stop),
+                                            np.append(case.inputs[name], case.inputs[name][-1]))))
+    ref = case.reference
+    signals, deviations = [], []
+    for name in case.outputs:
+        band = comparison.bands.get(name)
+        shown_band = None
+        if band is not None and len(band.times) > 4 * COLUMNS:
+            lower, upper = decimated(band.times, band.lower), decimated(band.times, band.upper)
+            shown_band = (lower[0], lower[1], upper[1])
+        elif band is not None:
+            shown_band = (band.times, band.lower, band.upper)
+        signals.append((name, decimated(ref["time"], ref[name]), decimated(result["time"], result[name]),
+                        shown_band))
+        if band is not None:
+            deviations.append((name, *decimated(band.times, band.deviation)))
+    return Figure(title, inputs, signals, deviations, zoom_of(comparison))
+
+
+def zoom_of(comparison: Comparison):
+    """The zoom on the first deviation of a failing comparison (None if it
+    passes): (its time, [(name, times, result, lower, upper, deviation)] of
+    every signal's compared samples around it)."""
+    failing = [d for d in comparison.deviations if not d.passed and d.time is not None]
+    if not failing:
+        return None
+    first = min(failing, key=lambda d: d.time)
+    lines = []
+    for name, band in comparison.bands.items():
+        k = int(np.searchsorted(band.times, first.time))
+        window = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
+        lines.append((name, band.times[window], band.values[window], band.lower[window], band.upper[window],
+                      band.deviation[window]))
+    return first.time, lines
+
 
 def plot_case(case, result, comparison: Comparison, mode: Mode, label: str) -> bytes:
+    return draw(case_figure(case, result, comparison, label), mode, label)
+
+
+def draw(figure: Figure, mode: Mode, label: str) -> bytes:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = case.outputs
-    has_inputs = case.inputs is not None
-    rows = len(names) + 1 + has_inputs
+    has_inputs = bool(figure.inputs)
+    rows = len(figure.signals) + 1 + has_inputs
     height = 1.6 * rows + 0.6
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(8, height), squeeze=False)
-    for ax in axes[:, 0]:
+    columns = 2 if figure.zoom else 1
+    fig, grid = plt.subplots(rows, columns, sharex="col", figsize=(WIDTH_INCHES * (1 + 0.45 * (columns - 1)), height),
+                             squeeze=False, width_ratios=[1, 0.45][:columns])
+    for ax in grid.ravel():
         ax.tick_params(labelsize=7)
-    axes = list(axes[:, 0])
+    axes = list(grid[:, 0])
     if has_inputs:
         ax = axes.pop(0)
-        stop = case.options["StopTime"]
-        for name in case.inputs.dtype.names[1:]:
-            ax.step(np.append(case.inputs["time"], stop), np.append(case.inputs[name], case.inputs[name][-1]),
-                    where="post", label=f"input {name}")
+        for name, times, values in figure.inputs:
+            ax.step(times, values, where="post", label=f"input {name}")
         ax.legend(loc="best", fontsize=7)
     deviation_axis = axes.pop()
-    ref = case.reference
-    for ax, name in zip(axes, names):
-        band = comparison.bands.get(name)
+    many = max((len(r[0]) for _, _, r, _ in figure.signals), default=0) > COLUMNS
+    for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals):
         if band is not None and mode.fills_band:
-            ax.fill_between(band.times, band.lower, band.upper, color="0.85", label=mode.name)
-        ax.plot(ref["time"], ref[name], **mode.reference_line, label=f"{name} reference")
-        ax.step(result["time"], result[name], where="post", color="C1", linewidth=1.2, marker=".", markersize=3,
+            ax.fill_between(band[0], band[1], band[2], color="0.85", label=mode.name)
+        ax.plot(ref_t, ref_v, **mode.reference_line, label=f"{name} reference")
+        ax.step(res_t, res_v, where="post", color="C1", linewidth=1.2, marker="" if many else ".", markersize=3,
                 label=f"{name} {label}")
         ax.legend(loc="best", fontsize=7)
-        if band is not None:
-            deviation_axis.plot(band.times, band.deviation, drawstyle="steps-post", label=name)
+    for name, times, values in figure.deviations:
+        deviation_axis.plot(times, values, drawstyle="steps-post", label=name)
     deviation_axis.set_ylabel(mode.deviation_label, fontsize=7)
     deviation_axis.legend(loc="best", fontsize=7)
     deviation_axis.set_xlabel("time [s]")
-    title = f"{case.name} on {label}" + (f": {case.description}" if case.description else "")
+    if figure.zoom:
+        at, lines = figure.zoom
+        zoom_axes = list(grid[:, 1])
+        if has_inputs:
+            zoom_axes.pop(0).set_axis_off()
+        zoom_deviation = zoom_axes.pop()
+        for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines):
+            ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
+            ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=name)
+            ax.axvline(at, color="C3", linewidth=0.8)
+            zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=name)
+        zoom_axes and zoom_axes[0].set_title(f"zoom: first deviation at t={at!r}", fontsize=8)
+        zoom_deviation.axvline(at, color="C3", linewidth=0.8)
+        zoom_deviation.set_xlabel("time [s]")
+    title = figure.title
     fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize=9)
     # fixed margins: tight_layout would cost more than the rest of the plot
-    fig.subplots_adjust(left=0.1, right=0.98, top=1 - 0.45 / height, bottom=0.45 / height, hspace=0.12)
+    fig.subplots_adjust(left=0.1 / (1 + 0.45 * (columns - 1)), right=0.98, top=1 - 0.45 / height,
+                        bottom=0.45 / height, hspace=0.12, wspace=0.18)
     stream = io.BytesIO()
-    fig.savefig(stream, dpi=80, format="png", metadata={"Software": None})
+    fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
     plt.close(fig)
     return stream.getvalue()

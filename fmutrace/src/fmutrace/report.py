@@ -4,6 +4,7 @@ case's result as <case>_out.csv."""
 import html
 import json
 import os
+import shutil
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
@@ -15,12 +16,15 @@ RESULTS_FORMAT = 1
 
 def write_case_files(outcome: CaseOutcome, report_dir):
     """<fmu folder>/<case>_out.csv and .png; their paths into outcome."""
-    if outcome.result is None and not outcome.png:
+    if outcome.result is None and not outcome.png and not outcome.result_path:
         return
     stem = Path(report_dir) / outcome.fmu_folder / outcome.case
     stem.parent.mkdir(parents=True, exist_ok=True)
     if outcome.result is not None:
         write_trace(f"{stem}_out.csv", outcome.result)
+        outcome.csv = os.path.relpath(f"{stem}_out.csv", report_dir)
+    elif outcome.result_path:
+        shutil.move(outcome.result_path, f"{stem}_out.csv")
         outcome.csv = os.path.relpath(f"{stem}_out.csv", report_dir)
     if outcome.png:
         Path(f"{stem}.png").write_bytes(outcome.png)
@@ -94,12 +98,13 @@ def write_report(campaign: CampaignResult, report_dir):
                                  "| case | FMU | result | seconds | plot |", "|---|---|---|---|---|"]) + "\n")
         page.write(f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
-<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}
-td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top}}tr.pass td:nth-child(3){{color:#176617}}
-tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:480px}}</style>
+<style>body{{font-family:sans-serif;margin:1em 2em}}table{{border-collapse:collapse;width:100%;table-layout:fixed}}
+td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top;overflow-wrap:anywhere}}tr.pass td:nth-child(3){{color:#176617}}
+tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:100%;height:auto}}</style>
 </head><body>
 <h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.mode.describe())}.</p>
-<table><tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
+<table><colgroup><col style="width:16%"><col style="width:10%"><col style="width:28%"><col style="width:6%"><col style="width:40%"></colgroup>
+<tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
 """)
         for o in campaign.cases.light():
             verdict = _verdict(o)

@@ -199,7 +199,7 @@ def _read_rows(path, lines, names, order, time_index, separator, dtype, header_l
     return np.array(rows, dtype=dtype)
 
 
-CHUNK_BYTES = 1 << 24  # of CSV text per chunk of trace_chunks
+CHUNK_BYTES = 1 << 22  # of CSV text per chunk of trace_chunks
 
 
 def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None = None,
@@ -228,26 +228,24 @@ def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None
         raise NotPlain("the header needs read_trace's explanation")
     order = [names[times[0]]] + [n for i, n in enumerate(names) if i != times[0]]
     dtype = [("time", np.float64)] + [(n, np.float64) for n in order[1:]]
-    try:
-        reader = pcsv.open_csv(path, read_options=pcsv.ReadOptions(block_size=chunk_bytes, column_names=names,
-                                                                    skip_rows=1),
-                               parse_options=pcsv.ParseOptions(delimiter=",", quote_char=False),
-                               convert_options=pcsv.ConvertOptions(column_types={n: pa.float64() for n in names},
-                                                                   null_values=[], strings_can_be_null=False))
-    except (pa.ArrowInvalid, OSError) as error:
-        raise NotPlain(str(error)) from None
+    convert = pcsv.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
+                                  strings_can_be_null=False)
+    parse = pcsv.ParseOptions(delimiter=",", quote_char=False)
     previous = -math.inf
     rows = 0
-    while True:
+    # blocks of whole lines cut here, each parsed by itself: pyarrow's own streaming reader holds on to
+    # memory that grows with the file (measured: 80 MB at 360,000 rows, 240 MB at 17,280,000)
+    for block in _line_blocks(path, chunk_bytes):
         try:
-            batch = reader.read_next_batch()
-        except StopIteration:
-            break
+            table = pcsv.read_csv(io.BytesIO(block), read_options=pcsv.ReadOptions(column_names=names,
+                                                                                     use_threads=True),
+                                  parse_options=parse, convert_options=convert)
         except pa.ArrowInvalid as error:
             raise NotPlain(str(error)) from None
-        chunk = np.empty(batch.num_rows, dtype=dtype)
+        chunk = np.empty(table.num_rows, dtype=dtype)
         for (field, _), name in zip(dtype, order):
-            chunk[field] = batch.column(names.index(name)).to_numpy()
+            chunk[field] = table.column(name).to_numpy()
+        del table
         t = chunk["time"]
         if len(t) and not (np.isfinite(t).all() and t[0] >= previous and (np.diff(t) >= 0).all()):
             raise NotPlain("a time read_trace would refuse")
@@ -257,6 +255,27 @@ def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None
         yield chunk
     if not rows:
         raise NotPlain("no samples")
+
+
+def _line_blocks(path, size):
+    """The file's bytes after its header line in blocks of about size, each ending at a line's end."""
+    with open(path, "rb") as file:
+        file.readline()
+        rest = b""
+        while True:
+            data = file.read(size)
+            if not data:
+                break
+            data = rest + data
+            cut = data.rfind(b"\n") + 1
+            if cut == 0:
+                rest = data
+                continue
+            block, rest = data[:cut], data[cut:]
+            if block.strip():
+                yield block
+        if rest.strip():
+            yield rest
 
 
 class NotPlain(Exception):

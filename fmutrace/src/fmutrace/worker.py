@@ -2,12 +2,15 @@
 process or a Dask worker): read and checked, simulated, compared, plotted
 if asked."""
 import hashlib
+import os
+import tempfile
 import time
 
 from .cases import load_case
 from .comparison import Comparison, Mode, compare_traces
 from .errors import InputError, SimulationError
 from .fmu import Fmu
+from .longcase import is_long, run_long_case
 from .outcome import CaseOutcome, Status
 from .plot import plot_case
 from .recordings import is_recording
@@ -28,6 +31,15 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
     the recording there (read with recording's options); labels: the
     CaseOutcome fields that name the FMU."""
     started = time.perf_counter()
+    if not is_recording(folder) and is_long(folder, fmu.model, texts):
+        result_file = _result_file() if plots != "none" else None
+        long = run_long_case(folder, name, runner, fmu, labels, mode, plots, result_file=result_file)
+        if result_file and (long is None or not long.png):  # a result file only with the case's plot
+            os.unlink(result_file)
+        elif long is not None:
+            long.result_path = result_file
+        if long is not None:
+            return long
     outcome = CaseOutcome(name, **labels)
     try:
         if is_recording(folder):
@@ -57,6 +69,14 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
         outcome.png = plot_case(case, result, comparison, mode, labels["fmu"])
     outcome.seconds = time.perf_counter() - started
     return outcome
+
+
+def _result_file():
+    """A new file for a long case's result, written as it is made (the report takes it)."""
+    handle, path = tempfile.mkstemp(prefix="fmutrace-", suffix="_out.csv")
+    os.close(handle)
+    os.chmod(path, 0o644)  # as the report's other files (mkstemp makes it private)
+    return path
 
 
 _fmus = {}  # the FMU's content hash -> (Runner, Fmu), kept from task to task in a worker process

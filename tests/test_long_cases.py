@@ -1,0 +1,108 @@
+"""A long case run chunk by chunk (fmutrace.longcase) gives the in-memory
+path's outcome (worker.run_case), bit for bit: status, messages and every
+failing signal's deviation, on every reference scenario (in chunks of a
+few steps and a few rows, so every boundary case occurs) and on
+references made to fail (one ulp off, a sample the result lacks, a
+repeated time), exact and with a tolerance. `fmutrace run` on a long
+input writes what it writes on a short one."""
+import shutil
+
+import numpy as np
+import pytest
+
+from fmutrace import Exact, Tolerance, read_trace, write_trace
+from fmutrace.longcase import run_long_case, simulate_long
+from fmutrace.simulation import simulate
+from fmutrace.worker import run_case, worker_fmu
+from support.scenarios import SCENARIO_ROOT, fmu_path
+from support.fmu_driver import BUILD_DIR
+
+FOLDERS = sorted(p.parent for p in SCENARIO_ROOT.glob("*/*/*_ref.csv"))
+MODES = [Exact(), Tolerance(rel_tol=1e-12, abs_tol=0.0)]
+
+
+def outcomes(folder, version, mode, steps, chunk_bytes):
+    path = fmu_path(BUILD_DIR, folder.parent.name, version)
+    runner, fmu = worker_fmu(path.read_bytes(), str(path))
+    labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
+    whole = run_case(folder, folder.name, None, runner, fmu, labels, mode, "none")
+    long = run_long_case(folder, folder.name, runner, fmu, labels, mode, "none", steps_per_chunk=steps,
+                         chunk_bytes=chunk_bytes)
+    return whole, long
+
+
+def same(whole, long):
+    assert long.status == whole.status
+    assert long.messages == whole.messages
+    assert [d.to_json() for d in long.deviations] == [d.to_json() for d in whole.deviations]
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("steps,chunk_bytes", [(1, 8), (4, 40), (1000, 1 << 20)])
+def test_every_reference_scenario_chunked_as_in_memory(version, steps, chunk_bytes):
+    taken = 0
+    for folder in FOLDERS:
+        whole, long = outcomes(folder, version, MODES[0], steps, chunk_bytes)
+        if long is not None:
+            same(whole, long)
+            taken += 1
+    # the others take the in-memory path: one input row, inputs off the grid, words for Booleans
+    assert taken >= 3 * len(FOLDERS) // 4
+
+
+def failing_copy(tmp_path, how):
+    source = SCENARIO_ROOT / "RateLimiter" / "step_up"
+    folder = tmp_path / "RateLimiter" / how
+    shutil.copytree(source, folder)
+    ref = read_trace(folder / "RateLimiter_ref.csv")
+    if how == "ulp":
+        ref["y"][5] = np.nextafter(ref["y"][5], np.inf)
+        ref["y"][9] = ref["y"][9] + 0.5
+    elif how == "absent":
+        ref["time"][7] = ref["time"][7] + 0.2
+    elif how == "repeated":
+        ref = np.concatenate([ref[:4], ref[3:4], ref[4:]])
+        ref["y"][3] = 99.0  # the first of two rows at one time: not compared
+    write_trace(folder / "RateLimiter_ref.csv", ref)
+    return folder
+
+
+@pytest.mark.parametrize("how", ["ulp", "absent", "repeated"])
+@pytest.mark.parametrize("mode", MODES, ids=["exact", "tolerance"])
+def test_failing_references_chunked_as_in_memory(how, mode, tmp_path):
+    folder = failing_copy(tmp_path, how)
+    for steps, chunk_bytes in [(1, 8), (3, 30), (100, 1 << 20)]:
+        whole, long = outcomes(folder, 3, mode, steps, chunk_bytes)
+        assert long is not None
+        same(whole, long)
+    assert whole.passed == (how == "repeated")
+
+
+def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
+    folder = failing_copy(tmp_path, "ulp")
+    path = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    runner, fmu = worker_fmu(path.read_bytes(), str(path))
+    labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
+    out = tmp_path / "out.csv"
+    long = run_long_case(folder, "ulp", runner, fmu, labels, Exact(), "failed", result_file=out, steps_per_chunk=2,
+                         chunk_bytes=16)
+    assert not long.passed and long.png.startswith(b"\x89PNG")
+    whole = run_case(folder, "ulp", None, runner, fmu, labels, Exact(), "failed")
+    write_trace(tmp_path / "whole.csv", whole.result)
+    assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+
+
+def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
+    import fmutrace.longcase as longcase
+
+    monkeypatch.setattr(longcase, "LONG_CASE_BYTES", 0)
+    scenario = SCENARIO_ROOT / "RateLimiter" / "asymmetric"
+    path = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    start = {"rateUpPar": "2.0", "rateDownPar": "0.5"}
+    with open(tmp_path / "long.csv", "w") as out:
+        written = simulate_long(path, scenario / "RateLimiter_in.csv", out, start, 0.0, 8.0, 0.5, None,
+                                steps_per_chunk=3, chunk_bytes=8)
+    whole = simulate(path, scenario / "RateLimiter_in.csv", start, 0.0, 8.0, 0.5)
+    write_trace(tmp_path / "whole.csv", whole)
+    assert written == len(whole)
+    assert (tmp_path / "long.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
