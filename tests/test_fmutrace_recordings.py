@@ -159,13 +159,16 @@ def test_a_value_that_is_none_names_its_line_and_column(tmp_path):
     assert "cell.csv, line 3, column 5: '16#00G0' in column 'status' is not a number" in said
 
 
-def test_filetime_read_as_seconds_is_refused_naming_the_unit(tmp_path):
-    text = "time;value;setChangeRate;delayedValue\n" + "".join(
-        f"{134081208000000000 + k * 2500000};0;4;0\n" for k in range(5))
-    said = bad(tmp_path, "filetime.csv", text, "--step-size", "0.25")
+def test_a_counter_read_as_seconds_is_refused_naming_the_unit_and_filetime_is_known(tmp_path):
+    text = "time;value;setChangeRate;delayedValue\n" + "".join(f"{5000000000 + k * 250000};0;4;0\n" for k in range(5))
+    said = bad(tmp_path, "counter.csv", text, "--step-size", "0.25")
     assert "with its time read as seconds (assumed: column 'time' names no unit)" in said and "--time-unit" in said
+    assert compare(SIEMENS[3], tmp_path / "counter.csv", "--time-unit", "us").returncode == 0
     path = tmp_path / "filetime.csv"
-    assert compare(SIEMENS[3], path, "--time-unit", "filetime").returncode == 0
+    path.write_text("time;value;setChangeRate;delayedValue\n" + "".join(
+        f"{134081208000000000 + k * 2500000};0;4;0\n" for k in range(5)))
+    done = compare(SIEMENS[3], path)
+    assert done.returncode == 0 and "time as FILETIME" in done.stdout
 
 
 def test_milliseconds_read_as_seconds_against_the_cycle_are_refused(tmp_path):

@@ -187,12 +187,24 @@ def test_filetime_stamps_lose_no_resolution(tmp_path):
 
 
 def test_a_unit_that_would_mean_an_absurd_number_of_steps_is_refused_naming_it(tmp_path):
-    path = tmp_path / "filetime.csv"
-    path.write_text("time;u;y\n" + "".join(f"{134081208000000000 + k * 100000};1;1\n" for k in range(4)))
+    """A controller's microsecond counter in a column that names no unit, read as seconds."""
+    path = tmp_path / "counter.csv"
+    path.write_text("time;u;y\n" + "".join(f"{5000000000 + k * 10000};1;1\n" for k in range(4)))
     with pytest.raises(InputError, match=r"read as seconds \(assumed: column 'time' names no unit\).*--time-unit"):
         normalise(read_recording(path)[0], step_size=0.01)
-    recording = normalise(read_recording(path)[0], time_unit="FILETIME")
+    recording = normalise(read_recording(path)[0], time_unit="us")
     assert recording.step_size == 0.01
+
+
+def test_stamps_of_a_column_without_a_unit_are_known_by_their_size(tmp_path):
+    path = tmp_path / "filetime.csv"
+    path.write_text("time;u;y\n" + "".join(f"{134081208000000000 + k * 100000};1;1\n" for k in range(4)))
+    recording = normalise(read_recording(path)[0])
+    assert (recording.time_unit, recording.step_size) == ("FILETIME", 0.01)
+    path.write_text("time;u;y\n" + "".join(f"{1795186800000 + k * 10};1;1\n" for k in range(4)))
+    recording = normalise(read_recording(path)[0])
+    assert (recording.time_unit, recording.step_size) == ("ms", 0.01)
+    assert "Unix time in ms" in recording.time_source
 
 
 def test_a_stamp_off_its_cycle_is_reported_and_two_on_one_cycle_refused(tmp_path):

@@ -133,7 +133,7 @@ def read(text):
         elif bare_name(time_name) in CYCLE_WORDS:
             unit, source = "cycles", f"column {time_name!r}"
         else:
-            unit, source = "s", f"assumed: column {time_name!r} names no unit"
+            unit, source = timebase.unnamed_unit(stamps, time_name)
     grids.check_increasing(text, stamps, lines, time_column + 1, time_name)
     skip = {time_column} | set(index_columns)
     channels = [grids.channel_from(text, table[:, j], lines, stamps, stamp_present, j + 1, names[j], decimal_comma)

@@ -43,6 +43,22 @@ def unit_in_name(name):
     return UNIT_WORDS.get(word) or UNIT_WORDS.get(word.lower())
 
 
+# stamps of a time column that names no unit, by their size: FILETIME of the years 1981 to 2108 (100 ns ticks
+# since 1601, as TwinCAT and Windows stamp), Unix time in ms of 2001 to 2096; anything else is seconds
+FILETIME_SIZED = (1.2e17, 1.6e17)
+UNIX_MS_SIZED = (1e12, 4e12)
+
+
+def unnamed_unit(stamps, name):
+    """(unit, why) of a time column that names no unit."""
+    first = stamps[0]
+    if stamps.dtype.kind == "i" and FILETIME_SIZED[0] <= first <= FILETIME_SIZED[1]:
+        return "FILETIME", f"column {name!r} names no unit; its stamps are FILETIME-sized"
+    if UNIX_MS_SIZED[0] <= first <= UNIX_MS_SIZED[1]:
+        return "ms", f"column {name!r} names no unit; its stamps are Unix time in ms"
+    return "s", f"assumed: column {name!r} names no unit"
+
+
 # -- date strings ---------------------------------------------------------------
 _MONTHS = {m: i + 1 for i, m in enumerate(("jan", "feb", "mar", "apr", "may", "jun", "jul", "aug", "sep", "oct",
                                           "nov", "dec"))}
