@@ -226,3 +226,16 @@ def test_the_readmes_recording_command_passes():
     assert command == "compare"
     done = compare(BUILD_DIR / Path(fmu).relative_to("build"), REPO / recording)
     assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_a_10_ms_recording_with_printed_decimals_passes_within_them(tmp_path):
+    """RateLimiter at a 10 ms cycle, its defaults (1 per second: 0.01 a cycle) from u = 0 to 2: y = 0.01 k
+    until 2, as a recorder prints it (6 decimals): the FMU's sums of 0.01 are not those decimals' doubles,
+    so only --abs-tol for the printing makes it pass."""
+    rows = [(k * 10, 0 if k == 0 else 2, min(2.0, 0.01 * k)) for k in range(300)]
+    path = tmp_path / "ramp_10ms.csv"
+    path.write_text("Time [ms];u;y\n" + "".join(f"{t};{u};{y:.6f}\n".replace(".", ",") for t, u, y in rows))
+    assert compare(RATE_LIMITER[3], path).returncode == 1
+    done = compare(RATE_LIMITER[3], path, "--abs-tol", "5e-7")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "step 0.01 s" in done.stdout
