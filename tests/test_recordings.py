@@ -303,6 +303,14 @@ def test_map_names_a_channel_for_a_variable_and_roles_follow_the_variable():
         plan(recording, SIEMENS_VARIABLES, "M", [("nope", "DB_Ramp_value")])
 
 
+def test_a_channel_without_samples_is_ignored(tmp_path):
+    path = tmp_path / "empty_column.csv"
+    path.write_text("time;value;delayedValue;status\n0;1;0;\n0,25;1;1;\n")
+    result = plan(read_one(path), SIEMENS_VARIABLES, "M")
+    assert [(c.name, why) for c, why in result.ignored] == [("status", "no samples")]
+    assert [v for v, _ in result.compares] == ["delayedValue"]
+
+
 def test_two_channels_meaning_one_variable_are_refused(tmp_path):
     path = tmp_path / "twice.csv"
     path.write_text("time,MAIN.a.value,MAIN.b.value,delayedValue\n0,1,2,0\n")

@@ -96,6 +96,9 @@ def plan(recording, variables, label, maps=()):
     for channel in recording.channels:
         if id(channel) in mapped:
             continue
+        if not len(channel.values):
+            result.ignored.append((channel, "no samples"))
+            continue
         variable = None
         for candidate in dict.fromkeys((last_component(channel.symbol) if channel.symbol else None,
                                         last_component(channel.name))):
