@@ -126,7 +126,7 @@ def parser():
     rec.add_argument("--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[],
                      help="a start value of the FMU (repeatable)")
     rec.add_argument("--time-unit", choices=TIME_UNITS, help="the unit of the recording's time stamps (default: "
-                     "what the export says, else seconds)")
+                     "what the export says, else what their size says: FILETIME, Unix ms, else seconds)")
     rec.add_argument("--timing", choices=TIMINGS, default="cycle", help="cycle (default): a row is the input a "
                      "cycle read and the output it produced, as recorders write it; fmi: a row's output is the "
                      "output at its time, as fmpy and FMI cross-check files write it")
