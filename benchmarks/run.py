@@ -29,7 +29,7 @@ MODEL = "RateLimiter"
 FIXTURE = "PassThrough"
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 
-# the targets, and the anchors measured on the Reference FMUs
+# the targets (docs/performance.md), and the anchors measured on the Reference FMUs
 # (Feedthrough, -O3) and fmpy
 TARGETS = {
     "step_instructions": 150, "doStep_instructions": 60, "subcycle_instructions": 25,
