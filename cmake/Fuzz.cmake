@@ -1,6 +1,5 @@
 # Coverage-guided fuzzers (libFuzzer, with ASan and UBSan): tests/fuzz/*.c
-# on the FMI 2 and FMI 3 glue of RateLimiter and of
-# LGF_LimRateOfChangeAdvancedCI. libFuzzer comes with clang;
+# on the FMI 2 and FMI 3 glue of every model. libFuzzer comes with clang;
 # when no clang here can build a fuzzer, Debian's clang-14 and
 # libclang-rt-14-dev are installed with apt-get (as the CI machine needs).
 # Without them the ctest test 'fuzz' fails and says why: no silent skip.
@@ -29,21 +28,18 @@ if(NOT FUZZ_CLANG)
 endif()
 
 set(FUZZ_TARGETS deserialize calls)
-# fixed budget per target: 30 s with a fixed seed; inputs up to a few
-# serialized states long
+# fixed budget per target and model: 30 s with a fixed seed; inputs up to a
+# few serialized states long
 set(FUZZ_SECONDS 30)
 set(FUZZ_MAX_LEN_deserialize 600)
 set(FUZZ_MAX_LEN_calls 1024)
 if(FUZZ_CLANG)
   message(STATUS "Fuzzers built with ${FUZZ_CLANG}")
   set(fuzz_binaries)
-  # each target on the unified block and on the Siemens advanced block
-  foreach(model RateLimiter LGF_LimRateOfChangeAdvancedCI)
-    if(model STREQUAL "RateLimiter")
-      set(suffix "")
-    else()
-      set(suffix "_${model}")
-    endif()
+  set(fuzz_descriptions)
+  foreach(model IN LISTS MODELS)
+    set(suffix "_${model}")
+    list(APPEND fuzz_descriptions ${model}_description)
     # both versions' sources: a fuzzer drives both glues
     fmu_sources(fmi2_sources ${model} 2)
     fmu_sources(fmi3_sources ${model} 3)
@@ -71,7 +67,7 @@ if(FUZZ_CLANG)
     endforeach()
   endforeach()
   add_custom_target(fuzzers ALL DEPENDS ${fuzz_binaries})
-  add_dependencies(fuzzers RateLimiter_description LGF_LimRateOfChangeAdvancedCI_description)
+  add_dependencies(fuzzers ${fuzz_descriptions})
 else()
   add_test(NAME fuzz COMMAND sh -c "echo 'no clang with libFuzzer (Debian: apt-get install clang-14 libclang-rt-14-dev)'; exit 1")
 endif()

@@ -8,7 +8,8 @@ models' TOML files (the single source of truth), between the markers
 
 Without --write it exits 1 and names the stale tables if the document
 differs from what the TOML files give (the test runs it so); with --write
-it rewrites them (cmake --build build --target docs). Standard library only.
+it rewrites them (cmake --build build --target docs), and a model that has
+no table yet gets a section with one at the end. Standard library only.
 """
 import argparse
 import re
@@ -77,7 +78,12 @@ def render(document, models):
         if name not in models:
             sys.exit(f"{name}: no TOML file given for this table")
         return match.group(1) + table(models[name]) + match.group(4)
-    return MARKER.sub(replace, document)
+    text = MARKER.sub(replace, document)
+    tabled = {m.group(2) for m in MARKER.finditer(document)}
+    for name in sorted(set(models) - tabled):
+        text += (f"\n### {name}\n\n{models[name]['model']['description']}\n\n"
+                 f"<!-- generated: variables {name} -->\n{table(models[name])}<!-- end generated -->\n")
+    return text
 
 
 def main():
@@ -98,6 +104,7 @@ def main():
         return 0
     if fresh != text:
         stale = [m.group(2) for m, n in zip(MARKER.finditer(text), MARKER.finditer(fresh)) if m.group(0) != n.group(0)]
+        stale += sorted(set(models) - {m.group(2) for m in MARKER.finditer(text)})
         print(f"{args.document}: stale tables {stale}; run cmake --build build --target docs")
         return 1
     return 0

@@ -380,8 +380,28 @@ static const char *attribute(const char *text, const char *from, const char *aft
     return out;
 }
 
+/* The value reference of the first Real (FMI 3: Float64) variable of this
+ * causality: every model's cycle input u and its output y come first. */
+static unsigned first_real(const char *text, const char *causality) {
+    const char *open = version == 2 ? "<ScalarVariable" : "<Float64 ";
+    const char *close = version == 2 ? "</ScalarVariable>" : ">";
+    char element[4096], number[32];
+    for (const char *p = strstr(text, open); p; p = strstr(p + 1, open)) {
+        const char *end = strstr(p, close);
+        const size_t n = end ? (size_t)(end - p) : 0;
+        if (n == 0 || n >= sizeof element) break;
+        memcpy(element, p, n);
+        element[n] = 0;
+        if (strstr(element, causality) && (version == 3 || strstr(element, "<Real"))) {
+            return (unsigned)atoi(attribute(element, NULL, "valueReference=\"", number, sizeof number));
+        }
+    }
+    fprintf(stderr, "modelDescription.xml: no Real variable with %s\n", causality);
+    exit(2);
+}
+
 static void read_description(const char *stage, char *identifier, size_t size) {
-    char path[4096], number[32];
+    char path[4096];
     snprintf(path, sizeof path, "%s/modelDescription.xml", stage);
     FILE *f = fopen(path, "rb");
     if (!f) {
@@ -394,8 +414,8 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     fclose(f);
     attribute(text, NULL, version == 2 ? "guid=\"" : "instantiationToken=\"", token, sizeof token);
     attribute(text, "<CoSimulation", "modelIdentifier=\"", identifier, size);
-    uVr = (unsigned)atoi(attribute(text, "name=\"u\"", "valueReference=\"", number, sizeof number));
-    yVr = (unsigned)atoi(attribute(text, "name=\"y\"", "valueReference=\"", number, sizeof number));
+    uVr = first_real(text, "causality=\"input\"");
+    yVr = first_real(text, "causality=\"output\"");
 }
 
 int main(int argc, char **argv) {

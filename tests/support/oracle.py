@@ -20,6 +20,7 @@ import json
 import math
 import os
 import struct
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -435,34 +436,36 @@ def siemens_advanced_outputs(out, unified):
 VENDORS = {
     "LGF_LimRateOfChangeCI": {
         "translate": siemens, "compare_only": True,
-        "defaults": {"value": 0.0, "setChangeRate": 0.0, "defaultOutValue": 0.0, "enDefaultOutValue": False,
-                     "callOB": 30, "cycleTime": 0.0},
         "outputs": {"delayedValue": "y", "error": "error", "status": "status", "subFunctionStatus": "subFunctionStatus"},
     },
     "RateLimit": {
         "translate": irmn4, "compare_only": False,
-        "defaults": {"EnableBypass": False, "In": 0.0, "Duration": nan, "BypassValue": nan, "UpRate": nan,
-                     "DownRate": nan, "DurationPar": 0.0, "BypassValuePar": nan, "UpRatePar": 0.0,
-                     "DownRatePar": 0.0, "OutSave": False, "SavedOut": nan, "cycleTime": 0.0},
         "outputs": {"Out": "y", "RunningTime": "runningTime"},
     },
     "LGF_LimRateOfChangeAdvancedCI": {
         "translate": siemens_advanced, "compare_only": True, "neg_fallback": False, "limit_initial": False,
-        "defaults": {"autoValue": 0.0, "manualValue": 0.0, "setPosUpRateLim": 0.0, "setPosDownRateLim": 0.0,
-                     "setNegUpRateLim": 0.0, "setNegDownRateLim": 0.0, "setHighLim": 0.0, "setLowLim": 0.0,
-                     "defaultOutValue": 0.0, "enDefaultOutValue": False, "track": False, "manOp": False,
-                     "reset": False, "callOB": 30, "cycleTime": 0.0},
         "outputs": siemens_advanced_outputs,
         "output_names": ["outputValue", "posUpRateLim", "posDownRateLim", "negUpRateLim", "negDownRateLim",
                          "highLim", "lowLim", "error", "status", "subfunctionStatus"],
     },
     "Ramp": {
         "translate": codesys, "compare_only": False,
-        "defaults": {"rIn": 0.0, "rVariation": 100.0, "tTime": 10.0, "rInitValue": 0.0, "eInitial": 2,
-                     "tInitDelay": 5.0, "cycleTime": 0.0},
         "outputs": {"rOut": "y", "xRampActive": "rampActive"},
     },
 }
+
+
+MODEL_DESCRIPTIONS = Path(__file__).resolve().parents[2] / "modelDescription"
+
+
+@functools.cache
+def start_values(model):
+    """The start values of a model's inputs and parameters, from its TOML
+    file (the single source of every variable)."""
+    with open(MODEL_DESCRIPTIONS / f"{model}.toml", "rb") as f:
+        variables = tomllib.load(f)["variable"]
+    return {v["name"]: bool(v.get("start", False)) if v["type"] == "Boolean" else v.get("start", 0.0)
+            for v in variables if v["causality"] in ("input", "parameter")}
 
 
 class VendorOracle:
@@ -472,7 +475,7 @@ class VendorOracle:
     def __init__(self, model, vr, start=None, start_time=0.0):
         self.spec = VENDORS[model]
         self.vendor_vr = vr
-        self.values = dict(self.spec["defaults"])
+        self.values = dict(start_values(model))
         self.values.update(start or {})
         unified, culprits = self.spec["translate"](self.values)
         self.unified = RateLimiterOracle(self.culprit_vrs(culprits), unified, start_time,
