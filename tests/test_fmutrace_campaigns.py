@@ -264,3 +264,33 @@ def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     assert f"ERROR  case_13 on Faulty (FMI 3)\n      the simulation's process was {CRASH}" in out
     assert "3 of 5 cases pass, 0 differ, 2 failed to simulate" in out
     assert time.monotonic() - started < 60
+
+
+class _FailingStarts:
+    """dask.distributed.LocalCluster whose first `failures` starts fail as
+    one does when a worker is lost while the cluster starts."""
+
+    def __init__(self, real, failures):
+        self.real, self.failures, self.starts = real, failures, 0
+
+    def __call__(self, *args, **kwargs):
+        self.starts += 1
+        if self.starts <= self.failures:
+            raise RuntimeError("Nanny failed to start.")
+        return self.real(*args, **kwargs)
+
+
+@pytest.mark.parametrize("failures", [1, 2])
+def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path, monkeypatch):
+    """Once: a new cluster runs the campaign; every time: the cases run in
+    child processes. Never a traceback, every case run."""
+    import dask.distributed
+
+    starts = _FailingStarts(dask.distributed.LocalCluster, failures)
+    monkeypatch.setattr(dask.distributed, "LocalCluster", starts)
+    cases = pass_through_cases(tmp_path / "cases", 24)
+    result = fmutrace.compare(PASS_THROUGH, cases, jobs=2, report=tmp_path / "report")
+    assert result.passed and len(result.cases) == 24, result.summary()
+    assert starts.starts == min(failures + 1, 2)
+    assert ("Dask, 2 workers" in result.where) == (failures == 1), result.where
+    assert (tmp_path / "report" / "index.html").exists()

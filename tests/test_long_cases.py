@@ -4,7 +4,10 @@ failing signal's deviation, on every reference scenario (in chunks of a
 few steps and a few rows, so every boundary case occurs) and on
 references made to fail (one ulp off, a sample the result lacks, a
 repeated time), exact and with a tolerance. `fmutrace run` on a long
-input writes what it writes on a short one."""
+input writes what it writes on a short one. Its progress shows on a
+terminal only."""
+import io
+import re
 import shutil
 
 import numpy as np
@@ -12,6 +15,7 @@ import pytest
 
 from fmutrace import Exact, Tolerance, read_trace, write_trace
 from fmutrace.longcase import run_long_case, simulate_long
+from fmutrace.progress import SampleProgress
 from fmutrace.simulation import simulate
 from fmutrace.worker import run_case, worker_fmu
 from support.scenarios import SCENARIO_ROOT, fmu_path
@@ -106,3 +110,29 @@ def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
     write_trace(tmp_path / "whole.csv", whole)
     assert written == len(whole)
     assert (tmp_path / "long.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+
+
+class Stream(io.StringIO):
+    def __init__(self, terminal):
+        super().__init__()
+        self.terminal = terminal
+
+    def isatty(self):
+        return self.terminal
+
+
+@pytest.mark.parametrize("terminal", [True, False])
+def test_a_long_case_shows_its_progress_on_a_terminal_only(terminal, monkeypatch):
+    monkeypatch.setattr(SampleProgress, "AFTER_SECONDS", 0.0)
+    monkeypatch.setattr(SampleProgress, "EVERY_SECONDS", 0.0)
+    stream = Stream(terminal)
+    bar = SampleProgress(1_000_000, stream)
+    bar.update(250_000)
+    bar.update(1_000_000)
+    bar.close()
+    if terminal:
+        lines = stream.getvalue().split("\r")
+        assert re.fullmatch(r"250,000/1,000,000 samples, [0-9.]+ M/s, [0-9]+ s left ", lines[1])
+        assert lines[-1].startswith("1,000,000/1,000,000 samples") and lines[-1].endswith(" 0 s left \n")
+    else:
+        assert stream.getvalue() == ""

@@ -12,6 +12,7 @@ every worker) and returns the outcomes with their results and plots, so
 workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written by the caller.
 """
+import contextlib
 import logging
 import os
 import tempfile
@@ -31,6 +32,7 @@ from .worker import run_case, run_cases
 
 BATCH_CASES = 256              # cases per Dask task at most
 BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
+CLUSTER_ATTEMPTS = 2           # a local cluster whose start fails (a worker lost) is started again, once
 BATCH_ATTEMPTS = 3             # a batch lost with its worker is sent again, so many times in all
 # Dask keeps its last messages for its developers (distributed.admin.low-level-log-length, 1000): a
 # message that sends a batch keeps the batch's cases, so a campaign's client (and a local cluster's
@@ -112,26 +114,55 @@ class Dask(Executor):
 
     def run(self, todo, work, finished):
         import dask
+
+        with dask.config.set(SHORT_LOGS):
+            for attempt in range(1, CLUSTER_ATTEMPTS + 1):
+                self.submitted = False
+                try:
+                    cluster, client = self._connect()
+                except Exception:  # a local worker lost while the cluster starts ("Nanny failed to start")
+                    if self.scheduler:
+                        raise
+                    continue
+                try:
+                    workers = self._run(client, todo, work, finished)
+                    break
+                except Exception:
+                    # lost before any batch was sent (the upload to a worker that died): once more, on a new
+                    # cluster; once batches run, a lost worker costs its batch a retry (in _run)
+                    if self.submitted or self.scheduler or attempt == CLUSTER_ATTEMPTS:
+                        raise
+                finally:
+                    client.close()
+                    if cluster is not None:
+                        cluster.close()
+            else:  # no local cluster would start: the cases in child processes of this one
+                fallback = ChildProcesses()
+                fallback.run(todo, work, finished)
+                self.where = f"{fallback.where}, the local Dask cluster failed to start {CLUSTER_ATTEMPTS} times"
+                return
+        self.where = f"Dask, {workers} workers" + (f" at {self.scheduler}" if self.scheduler else " (local processes)")
+
+    def _connect(self):
+        """(cluster or None, client): the scheduler's, or a local cluster of jobs processes."""
+        import dask
         from dask.distributed import Client, LocalCluster
 
+        if self.scheduler:
+            return None, Client(self.scheduler, timeout=self.cluster_timeout or 60)
         cluster = None
-        with dask.config.set(SHORT_LOGS):
-            if self.scheduler:
-                client = Client(self.scheduler, timeout=self.cluster_timeout or 60)
-            else:
-                # a task whose worker dies is not tried on others: the batch is run isolated instead (below)
-                # (silent: a worker's death is reported by the campaign)
-                with dask.config.set(LOCAL_CLUSTER):
-                    cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
-                                           dashboard_address=None, silence_logs=logging.CRITICAL)
-                client = Client(cluster)
         try:
-            workers = self._run(client, todo, work, finished)
-        finally:
-            client.close()
+            # a task whose worker dies is not tried on others: the batch is run isolated instead (_run)
+            # (silent: a worker's death is reported by the campaign)
+            with dask.config.set(LOCAL_CLUSTER):
+                cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.CRITICAL)
+            return cluster, Client(cluster)
+        except Exception:
             if cluster is not None:
-                cluster.close()
-        self.where = f"Dask, {workers} workers" + (f" at {self.scheduler}" if self.scheduler else " (local processes)")
+                with contextlib.suppress(Exception):
+                    cluster.close()
+            raise
 
     def _run(self, client, todo, work, finished):
         from dask.distributed import as_completed
@@ -146,6 +177,7 @@ class Dask(Executor):
         submitted = {}  # future -> (fmu, batch, isolated, attempt)
 
         def submit(fmu, batch, isolated, attempt):
+            self.submitted = True
             items = [(folder, name, texts) for _, folder, name, texts in batch]
             future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), work.labels[fmu.path],
                                    work.mode, work.plots, isolated, work.case_timeout, work.recording, pure=False)

@@ -7,7 +7,10 @@ finishes (length-prefixed pickles on the child's own copy of standard
 output; what the FMU prints goes nowhere). When the child dies, the case it
 was running gets an error naming the signal; when a case runs longer than
 the per-case timeout, the child is killed and the case gets an error
-saying so. Either way a new child takes the cases after it.
+saying so. Either way a new child takes the cases after it. The child says
+when it starts each case (an empty record): the timeout counts from there,
+so a child's start-up (imports, the FMU unpacked), slow on a loaded
+machine, is never charged to a case.
 """
 import os
 import pickle
@@ -40,14 +43,21 @@ def _last_words(file):
     return f"; it said: {lines[-1][:200]}" if lines else ""
 
 
+STARTED = b""  # the child's message that it starts its next case (an empty record)
+# the most a child may take to start a case (its Python, NumPy and fmpy imports the first time): a case's timeout
+# counts from its start, so that a loaded machine's slow start-up is not charged to a case
+START_SECONDS = 300.0
+
+
 def _reader(stream, out):
-    """Outcomes from the child into out; None at its end."""
+    """Records from the child into out (STARTED, or an outcome); None at its end."""
     try:
         while True:
             header = stream.read(HEADER.size)
             if len(header) < HEADER.size:
                 break
-            out.put(pickle.loads(stream.read(HEADER.unpack(header)[0])))
+            size = HEADER.unpack(header)[0]
+            out.put(pickle.loads(stream.read(size)) if size else STARTED)
     finally:
         out.put(None)
 
@@ -70,15 +80,19 @@ def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_o
         arrived = queue.Queue()
         threading.Thread(target=_reader, args=(child.stdout, arrived), daemon=True).start()
         for index, (_, name, _) in enumerate(remaining):
-            started = time.monotonic()
+            started, running = time.monotonic(), False
             try:
-                outcome = arrived.get(timeout=case_timeout)
+                outcome = arrived.get(timeout=START_SECONDS)
+                if outcome is STARTED:
+                    started, running = time.monotonic(), True
+                    outcome = arrived.get(timeout=case_timeout)
             except queue.Empty:
                 child.kill()
                 child.wait()
-                outcome = CaseOutcome(name, **labels, status=Status.ERROR,
-                                        messages=[f"stopped after the per-case timeout of {case_timeout:g} s"],
-                                        seconds=time.monotonic() - started)
+                why = f"stopped after the per-case timeout of {case_timeout:g} s" if running else \
+                    f"the simulation's process did not start the case within {START_SECONDS:g} s"
+                outcome = CaseOutcome(name, **labels, status=Status.ERROR, messages=[why],
+                                      seconds=time.monotonic() - started)
             if outcome is None:  # the child died running this case
                 code = child.wait()
                 cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
@@ -103,7 +117,11 @@ def main():
     out = os.fdopen(os.dup(1), "wb")
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes
-    for outcome in run_cases(*pickle.loads(sys.stdin.buffer.read())):
+    def started():
+        out.write(HEADER.pack(0))
+        out.flush()
+
+    for outcome in run_cases(*pickle.loads(sys.stdin.buffer.read()), on_start=started):
         data = pickle.dumps(outcome)
         out.write(HEADER.pack(len(data)) + data)
         out.flush()

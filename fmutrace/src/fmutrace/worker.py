@@ -93,9 +93,11 @@ def worker_fmu(fmu_bytes: bytes, path: str) -> tuple:
 
 
 def run_cases(items, fmu_bytes: bytes, path: str, labels: dict, mode: Mode, plots: str,
-              recording: RecordingOptions = None):
+              recording: RecordingOptions = None, on_start=None):
     """The outcomes of the cases [(folder, name, texts or None)] of one FMU
-    in this process, as they finish."""
+    in this process, as they finish; on_start() before each case starts."""
     runner, fmu = worker_fmu(fmu_bytes, path)
     for folder, name, texts in items:
+        if on_start:
+            on_start()
         yield run_case(folder, name, texts, runner, fmu, labels, mode, plots, recording)
