@@ -1,4 +1,5 @@
-"""Simulations through fmpy.simulate_fmu.
+"""Simulations as fmpy.simulate_fmu makes them (simulate: through the
+Runner's own loop where it gives fmpy's result, else fmpy's).
 
 fmpy's co-simulation loop applies the inputs at t (a row holds from its
 time on for discrete inputs, continuous ones are interpolated; at a
@@ -142,6 +143,11 @@ def simulate(fmu: str | PathLike | Fmu, input: str | PathLike | np.ndarray | Non
         raise InputError(f"the step size must be greater than 0, not {step!r}")
     if stop is None or not stop > start:
         raise InputError(f"the stop time ({stop!r}) must be after the start time ({start!r})")
-    result = run_fmpy(str(fmu.path), fmu.model_description, start_time=start, stop_time=stop, step_size=step,
-                      inputs=inputs, start_values=values, outputs=names)
+    from .runner import Runner  # (it imports this module)
+
+    runner = Runner(fmu.path.read_bytes())  # its own loop where it gives fmpy's result, else fmpy's
+    try:
+        result = runner.run(start, stop, step, inputs, values, names)
+    finally:
+        runner.close()
     return every_nth(result, start, step, output_interval)
