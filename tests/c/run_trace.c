@@ -1,57 +1,368 @@
-/* An FMI 3 co-simulation binary driven by a script on standard input, the
- * outputs printed bit for bit: the same script gives the same text on every
- * platform whose binary computes the same numbers (the aarch64 build runs
- * under qemu-user, the Windows build under wine).
+/* An FMI 2 or FMI 3 co-simulation binary driven by a script on standard
+ * input, the outputs printed bit for bit: the same script gives the same
+ * text on every platform whose binary computes the same numbers (the
+ * aarch64 build runs under qemu-user, the Windows build under wine), and
+ * with --trap the same text with the floating-point exceptions a real-time
+ * target traps enabled (FE_INVALID, FE_DIVBYZERO, FE_OVERFLOW): one raised
+ * in any call is SIGFPE, reported with the script line, exit 3.
  *
- *   run_trace <binary.so> <instantiationToken> < script
+ *   run_trace [--fmi2] [--trap] [--keep-going] <binary> <token> < script
  *
  * Script lines:  set <F|I|L|B> <vr> <value>   (Float64 as C99 %a, Int32,
- *                                               Int64 (enumerations), Boolean 0/1)
+ *                                               Int64 (enumerations; FMI 2:
+ *                                               Integer), Boolean 0/1)
  *                init <startTime>
  *                step <t> <h>                  (C99 %a)
  *                get <F|I|B> <vr>              prints the value (Float64 as %a)
  *                save <file>                   the FMU state, serialized, into file
  *                load <file>                   the FMU state of file, deserialized and set
- * Exit 1 on any status above Warning, naming the line. */
+ *                new                           a fresh instance in place of the current one
+ * Exit 1 on any status above Warning, naming the line. --keep-going: such
+ * a status prints "refused <line number>" and the lines up to the next
+ * "new" are skipped (the instance is in its error state), exit 0. */
+#if defined(__linux__) && !defined(_GNU_SOURCE)
+#define _GNU_SOURCE /* feenableexcept */
+#endif
+#include <fenv.h>
+#include <signal.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 #include "fmu_library.h"
 
-static void log_message(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
+#if defined(__GLIBC__)
+#define HAVE_TRAPS 1
+#include <ucontext.h>
+#include <unistd.h> /* _exit */
+#endif
+
+enum { STATUS_OK = 0, STATUS_WARNING = 1, STATUS_ERROR = 3 }; /* as fmi2Status and fmi3Status */
+
+/* One FMI version's calls, values as the script carries them. */
+typedef struct {
+    void *(*instantiate)(const char *token);
+    int (*init)(void *c, double start);
+    int (*step)(void *c, double t, double h);
+    int (*set_float)(void *c, unsigned vr, double v);
+    int (*set_int)(void *c, unsigned vr, long long v, char kind);
+    int (*set_bool)(void *c, unsigned vr, int v);
+    int (*get_float)(void *c, unsigned vr, double *v);
+    int (*get_int)(void *c, unsigned vr, long long *v);
+    int (*get_bool)(void *c, unsigned vr, int *v);
+    int (*save)(void *c, unsigned char *bytes, size_t capacity, size_t *size);
+    int (*load)(void *c, const unsigned char *bytes, size_t size);
+    void (*free_instance)(void *c);
+} Fmi;
+
+/* ---- FMI 3 ---- */
+
+static struct {
+    fmi3InstantiateCoSimulationTYPE *instantiate;
+    fmi3EnterInitializationModeTYPE *enter;
+    fmi3ExitInitializationModeTYPE *leave;
+    fmi3DoStepTYPE *do_step;
+    fmi3SetFloat64TYPE *set_float;
+    fmi3SetInt32TYPE *set_int;
+    fmi3SetInt64TYPE *set_long;
+    fmi3SetBooleanTYPE *set_bool;
+    fmi3GetFloat64TYPE *get_float;
+    fmi3GetInt32TYPE *get_int;
+    fmi3GetBooleanTYPE *get_bool;
+    fmi3FreeInstanceTYPE *free_instance;
+    fmi3GetFMUStateTYPE *get_state;
+    fmi3SetFMUStateTYPE *set_state;
+    fmi3FreeFMUStateTYPE *free_state;
+    fmi3SerializedFMUStateSizeTYPE *state_size;
+    fmi3SerializeFMUStateTYPE *serialize;
+    fmi3DeserializeFMUStateTYPE *deserialize;
+} f3;
+
+static void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
     (void)env;
     (void)status;
     (void)category;
     (void)message;
 }
 
+static void *instantiate3(const char *token) {
+    return f3.instantiate("trace", token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL, logger3, NULL);
+}
+static int init3(void *c, double start) {
+    int status = f3.enter(c, fmi3False, 0.0, start, fmi3False, 0.0);
+    return status <= STATUS_WARNING ? (int)f3.leave(c) : status;
+}
+static int step3(void *c, double t, double h) {
+    fmi3Boolean event, terminate, early;
+    fmi3Float64 last;
+    return f3.do_step(c, t, h, fmi3True, &event, &terminate, &early, &last);
+}
+static int set_float3(void *c, unsigned vr, double v) {
+    const fmi3ValueReference r = vr;
+    return f3.set_float(c, &r, 1, &v, 1);
+}
+static int set_int3(void *c, unsigned vr, long long v, char kind) {
+    const fmi3ValueReference r = vr;
+    if (kind == 'L') {
+        const fmi3Int64 value = (fmi3Int64)v;
+        return f3.set_long(c, &r, 1, &value, 1);
+    }
+    const fmi3Int32 value = (fmi3Int32)v;
+    return f3.set_int(c, &r, 1, &value, 1);
+}
+static int set_bool3(void *c, unsigned vr, int v) {
+    const fmi3ValueReference r = vr;
+    const fmi3Boolean value = v != 0;
+    return f3.set_bool(c, &r, 1, &value, 1);
+}
+static int get_float3(void *c, unsigned vr, double *v) {
+    const fmi3ValueReference r = vr;
+    return f3.get_float(c, &r, 1, v, 1);
+}
+static int get_int3(void *c, unsigned vr, long long *v) {
+    const fmi3ValueReference r = vr;
+    fmi3Int32 value = 0;
+    const int status = f3.get_int(c, &r, 1, &value, 1);
+    *v = value;
+    return status;
+}
+static int get_bool3(void *c, unsigned vr, int *v) {
+    const fmi3ValueReference r = vr;
+    fmi3Boolean value = fmi3False;
+    const int status = f3.get_bool(c, &r, 1, &value, 1);
+    *v = value ? 1 : 0;
+    return status;
+}
+static int save3(void *c, unsigned char *bytes, size_t capacity, size_t *size) {
+    fmi3FMUState state = NULL;
+    int status = f3.get_state(c, &state);
+    if (status <= STATUS_WARNING) status = f3.state_size(c, state, size);
+    if (status <= STATUS_WARNING) status = *size <= capacity ? f3.serialize(c, state, bytes, *size) : STATUS_ERROR;
+    f3.free_state(c, &state);
+    return status;
+}
+static int load3(void *c, const unsigned char *bytes, size_t size) {
+    fmi3FMUState state = NULL;
+    int status = f3.deserialize(c, bytes, size, &state);
+    if (status <= STATUS_WARNING) status = f3.set_state(c, state);
+    f3.free_state(c, &state);
+    return status;
+}
+static void free3(void *c) {
+    f3.free_instance(c);
+}
+
+static Fmi load_fmi3(void) {
+    f3.instantiate = (fmi3InstantiateCoSimulationTYPE *)function("fmi3InstantiateCoSimulation");
+    f3.enter = (fmi3EnterInitializationModeTYPE *)function("fmi3EnterInitializationMode");
+    f3.leave = (fmi3ExitInitializationModeTYPE *)function("fmi3ExitInitializationMode");
+    f3.do_step = (fmi3DoStepTYPE *)function("fmi3DoStep");
+    f3.set_float = (fmi3SetFloat64TYPE *)function("fmi3SetFloat64");
+    f3.set_int = (fmi3SetInt32TYPE *)function("fmi3SetInt32");
+    f3.set_long = (fmi3SetInt64TYPE *)function("fmi3SetInt64");
+    f3.set_bool = (fmi3SetBooleanTYPE *)function("fmi3SetBoolean");
+    f3.get_float = (fmi3GetFloat64TYPE *)function("fmi3GetFloat64");
+    f3.get_int = (fmi3GetInt32TYPE *)function("fmi3GetInt32");
+    f3.get_bool = (fmi3GetBooleanTYPE *)function("fmi3GetBoolean");
+    f3.free_instance = (fmi3FreeInstanceTYPE *)function("fmi3FreeInstance");
+    f3.get_state = (fmi3GetFMUStateTYPE *)function("fmi3GetFMUState");
+    f3.set_state = (fmi3SetFMUStateTYPE *)function("fmi3SetFMUState");
+    f3.free_state = (fmi3FreeFMUStateTYPE *)function("fmi3FreeFMUState");
+    f3.state_size = (fmi3SerializedFMUStateSizeTYPE *)function("fmi3SerializedFMUStateSize");
+    f3.serialize = (fmi3SerializeFMUStateTYPE *)function("fmi3SerializeFMUState");
+    f3.deserialize = (fmi3DeserializeFMUStateTYPE *)function("fmi3DeserializeFMUState");
+    const Fmi fmi = { instantiate3, init3, step3, set_float3, set_int3, set_bool3, get_float3, get_int3, get_bool3,
+                      save3, load3, free3 };
+    return fmi;
+}
+
+/* ---- FMI 2 ---- */
+
+static struct {
+    fmi2InstantiateTYPE *instantiate;
+    fmi2SetupExperimentTYPE *setup;
+    fmi2EnterInitializationModeTYPE *enter;
+    fmi2ExitInitializationModeTYPE *leave;
+    fmi2DoStepTYPE *do_step;
+    fmi2SetRealTYPE *set_real;
+    fmi2SetIntegerTYPE *set_int;
+    fmi2SetBooleanTYPE *set_bool;
+    fmi2GetRealTYPE *get_real;
+    fmi2GetIntegerTYPE *get_int;
+    fmi2GetBooleanTYPE *get_bool;
+    fmi2FreeInstanceTYPE *free_instance;
+    fmi2GetFMUstateTYPE *get_state;
+    fmi2SetFMUstateTYPE *set_state;
+    fmi2FreeFMUstateTYPE *free_state;
+    fmi2SerializedFMUstateSizeTYPE *state_size;
+    fmi2SerializeFMUstateTYPE *serialize;
+    fmi2DeSerializeFMUstateTYPE *deserialize;
+} f2;
+
+static void logger2(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                 fmi2String message, ...) {
+    (void)env;
+    (void)name;
+    (void)status;
+    (void)category;
+    (void)message;
+}
+
+static const fmi2CallbackFunctions callbacks2 = { logger2, calloc, free, NULL, NULL };
+
+static void *instantiate2(const char *token) {
+    return f2.instantiate("trace", fmi2CoSimulation, token, NULL, &callbacks2, fmi2False, fmi2False);
+}
+static int init2(void *c, double start) {
+    int status = f2.setup(c, fmi2False, 0.0, start, fmi2False, 0.0);
+    if (status <= STATUS_WARNING) status = f2.enter(c);
+    return status <= STATUS_WARNING ? (int)f2.leave(c) : status;
+}
+static int step2(void *c, double t, double h) {
+    return f2.do_step(c, t, h, fmi2True);
+}
+static int set_float2(void *c, unsigned vr, double v) {
+    const fmi2ValueReference r = vr;
+    return f2.set_real(c, &r, 1, &v);
+}
+static int set_int2(void *c, unsigned vr, long long v, char kind) {
+    (void)kind; /* an enumeration is an Integer in FMI 2 */
+    const fmi2ValueReference r = vr;
+    const fmi2Integer value = (fmi2Integer)v;
+    return f2.set_int(c, &r, 1, &value);
+}
+static int set_bool2(void *c, unsigned vr, int v) {
+    const fmi2ValueReference r = vr;
+    const fmi2Boolean value = v != 0;
+    return f2.set_bool(c, &r, 1, &value);
+}
+static int get_float2(void *c, unsigned vr, double *v) {
+    const fmi2ValueReference r = vr;
+    return f2.get_real(c, &r, 1, v);
+}
+static int get_int2(void *c, unsigned vr, long long *v) {
+    const fmi2ValueReference r = vr;
+    fmi2Integer value = 0;
+    const int status = f2.get_int(c, &r, 1, &value);
+    *v = value;
+    return status;
+}
+static int get_bool2(void *c, unsigned vr, int *v) {
+    const fmi2ValueReference r = vr;
+    fmi2Boolean value = fmi2False;
+    const int status = f2.get_bool(c, &r, 1, &value);
+    *v = value ? 1 : 0;
+    return status;
+}
+static int save2(void *c, unsigned char *bytes, size_t capacity, size_t *size) {
+    fmi2FMUstate state = NULL;
+    int status = f2.get_state(c, &state);
+    if (status <= STATUS_WARNING) status = f2.state_size(c, state, size);
+    if (status <= STATUS_WARNING) status = *size <= capacity ? f2.serialize(c, state, (fmi2Byte *)bytes, *size) : STATUS_ERROR;
+    f2.free_state(c, &state);
+    return status;
+}
+static int load2(void *c, const unsigned char *bytes, size_t size) {
+    fmi2FMUstate state = NULL;
+    int status = f2.deserialize(c, (const fmi2Byte *)bytes, size, &state);
+    if (status <= STATUS_WARNING) status = f2.set_state(c, state);
+    f2.free_state(c, &state);
+    return status;
+}
+static void free2(void *c) {
+    f2.free_instance(c);
+}
+
+static Fmi load_fmi2(void) {
+    f2.instantiate = (fmi2InstantiateTYPE *)function("fmi2Instantiate");
+    f2.setup = (fmi2SetupExperimentTYPE *)function("fmi2SetupExperiment");
+    f2.enter = (fmi2EnterInitializationModeTYPE *)function("fmi2EnterInitializationMode");
+    f2.leave = (fmi2ExitInitializationModeTYPE *)function("fmi2ExitInitializationMode");
+    f2.do_step = (fmi2DoStepTYPE *)function("fmi2DoStep");
+    f2.set_real = (fmi2SetRealTYPE *)function("fmi2SetReal");
+    f2.set_int = (fmi2SetIntegerTYPE *)function("fmi2SetInteger");
+    f2.set_bool = (fmi2SetBooleanTYPE *)function("fmi2SetBoolean");
+    f2.get_real = (fmi2GetRealTYPE *)function("fmi2GetReal");
+    f2.get_int = (fmi2GetIntegerTYPE *)function("fmi2GetInteger");
+    f2.get_bool = (fmi2GetBooleanTYPE *)function("fmi2GetBoolean");
+    f2.free_instance = (fmi2FreeInstanceTYPE *)function("fmi2FreeInstance");
+    f2.get_state = (fmi2GetFMUstateTYPE *)function("fmi2GetFMUstate");
+    f2.set_state = (fmi2SetFMUstateTYPE *)function("fmi2SetFMUstate");
+    f2.free_state = (fmi2FreeFMUstateTYPE *)function("fmi2FreeFMUstate");
+    f2.state_size = (fmi2SerializedFMUstateSizeTYPE *)function("fmi2SerializedFMUstateSize");
+    f2.serialize = (fmi2SerializeFMUstateTYPE *)function("fmi2SerializeFMUstate");
+    f2.deserialize = (fmi2DeSerializeFMUstateTYPE *)function("fmi2DeSerializeFMUstate");
+    const Fmi fmi = { instantiate2, init2, step2, set_float2, set_int2, set_bool2, get_float2, get_int2, get_bool2,
+                      save2, load2, free2 };
+    return fmi;
+}
+
+/* ---- floating-point traps ---- */
+
+static volatile long current_line;
+
+#ifdef HAVE_TRAPS
+/* where: the binary and the offset in it of the instruction that trapped
+ * (addr2line -e <binary> <offset> names the source line) */
+static void trapped(int signal_number, siginfo_t *info, void *context) {
+    (void)signal_number;
+    const char *what = info->si_code == FPE_FLTINV   ? "FE_INVALID"
+                       : info->si_code == FPE_FLTDIV ? "FE_DIVBYZERO"
+                       : info->si_code == FPE_FLTOVF ? "FE_OVERFLOW"
+                                                     : "another floating-point exception";
+    const char *binary = "?";
+    size_t offset = 0;
+#if defined(__x86_64__)
+    Dl_info where;
+    const greg_t pc = ((ucontext_t *)context)->uc_mcontext.gregs[REG_RIP];
+    if (dladdr((void *)pc, &where) && where.dli_fname) {
+        binary = where.dli_fname;
+        offset = (size_t)pc - (size_t)where.dli_fbase;
+    }
+#else
+    (void)context;
+#endif
+    char message[600];
+    const int n = snprintf(message, sizeof message, "line %ld: SIGFPE, %s raised in %s+0x%zx\n", (long)current_line,
+                           what, binary, offset);
+    if (n > 0 && fwrite(message, 1, (size_t)n, stderr)) fflush(stderr);
+    _exit(3);
+}
+
+static int enable_traps(void) {
+    struct sigaction action;
+    memset(&action, 0, sizeof action);
+    action.sa_sigaction = trapped;
+    action.sa_flags = SA_SIGINFO;
+    sigemptyset(&action.sa_mask);
+    return sigaction(SIGFPE, &action, NULL) == 0 && feenableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW) != -1;
+}
+#else
+static int enable_traps(void) {
+    fprintf(stderr, "--trap: this platform's C library cannot enable floating-point traps\n");
+    return 0;
+}
+#endif
+
 int main(int argc, char **argv) {
-    if (argc != 3) {
-        fprintf(stderr, "usage: run_trace <binary.so> <instantiationToken> < script\n");
+    int fmi2 = 0, trap = 0, keep_going = 0, a = 1;
+    for (; a < argc && argv[a][0] == '-'; a++) {
+        if (strcmp(argv[a], "--fmi2") == 0) fmi2 = 1;
+        else if (strcmp(argv[a], "--trap") == 0) trap = 1;
+        else if (strcmp(argv[a], "--keep-going") == 0) keep_going = 1;
+        else break;
+    }
+    if (argc - a != 2) {
+        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] <binary> <token> < script\n");
         return 2;
     }
-    if (!open_library(argv[1])) return 2;
-    fmi3InstantiateCoSimulationTYPE *instantiate = (fmi3InstantiateCoSimulationTYPE *)function("fmi3InstantiateCoSimulation");
-    fmi3EnterInitializationModeTYPE *enter = (fmi3EnterInitializationModeTYPE *)function("fmi3EnterInitializationMode");
-    fmi3ExitInitializationModeTYPE *leave = (fmi3ExitInitializationModeTYPE *)function("fmi3ExitInitializationMode");
-    fmi3DoStepTYPE *do_step = (fmi3DoStepTYPE *)function("fmi3DoStep");
-    fmi3SetFloat64TYPE *set_float = (fmi3SetFloat64TYPE *)function("fmi3SetFloat64");
-    fmi3SetInt32TYPE *set_int = (fmi3SetInt32TYPE *)function("fmi3SetInt32");
-    fmi3SetInt64TYPE *set_long = (fmi3SetInt64TYPE *)function("fmi3SetInt64");
-    fmi3SetBooleanTYPE *set_bool = (fmi3SetBooleanTYPE *)function("fmi3SetBoolean");
-    fmi3GetFloat64TYPE *get_float = (fmi3GetFloat64TYPE *)function("fmi3GetFloat64");
-    fmi3GetInt32TYPE *get_int = (fmi3GetInt32TYPE *)function("fmi3GetInt32");
-    fmi3GetBooleanTYPE *get_bool = (fmi3GetBooleanTYPE *)function("fmi3GetBoolean");
-    fmi3FreeInstanceTYPE *free_instance = (fmi3FreeInstanceTYPE *)function("fmi3FreeInstance");
-    fmi3GetFMUStateTYPE *get_state = (fmi3GetFMUStateTYPE *)function("fmi3GetFMUState");
-    fmi3SetFMUStateTYPE *set_state = (fmi3SetFMUStateTYPE *)function("fmi3SetFMUState");
-    fmi3FreeFMUStateTYPE *free_state = (fmi3FreeFMUStateTYPE *)function("fmi3FreeFMUState");
-    fmi3SerializedFMUStateSizeTYPE *state_size = (fmi3SerializedFMUStateSizeTYPE *)function("fmi3SerializedFMUStateSize");
-    fmi3SerializeFMUStateTYPE *serialize = (fmi3SerializeFMUStateTYPE *)function("fmi3SerializeFMUState");
-    fmi3DeserializeFMUStateTYPE *deserialize = (fmi3DeserializeFMUStateTYPE *)function("fmi3DeserializeFMUState");
+    if (!open_library(argv[a])) return 2;
+    const Fmi fmi = fmi2 ? load_fmi2() : load_fmi3();
+    const char *token = argv[a + 1];
+    if (trap && !enable_traps()) return 2;
 
-    fmi3Instance c = instantiate("trace", argv[2], NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL,
-                                 log_message, NULL);
+    void *c = fmi.instantiate(token);
     if (!c) {
         fprintf(stderr, "instantiation failed\n");
         return 1;
@@ -59,74 +370,67 @@ int main(int argc, char **argv) {
     char line[256], kind, path[200];
     unsigned vr;
     long line_number = 0;
-    int status = fmi3OK;
-    while (status <= fmi3Warning && fgets(line, sizeof line, stdin)) {
-        line_number++;
-        double a, b;
+    int status = STATUS_OK, skipping = 0;
+    static unsigned char bytes[1 << 16];
+    while (fgets(line, sizeof line, stdin)) {
+        current_line = ++line_number;
+        double x, y;
         long long n;
-        if (sscanf(line, "set %c %u %lld", &kind, &vr, &n) == 3 && kind != 'F') {
-            const fmi3ValueReference r = vr;
-            if (kind == 'I') {
-                const fmi3Int32 v = (fmi3Int32)n;
-                status = set_int(c, &r, 1, &v, 1);
-            } else if (kind == 'L') {
-                const fmi3Int64 v = (fmi3Int64)n;
-                status = set_long(c, &r, 1, &v, 1);
-            } else {
-                const fmi3Boolean v = n != 0;
-                status = set_bool(c, &r, 1, &v, 1);
+        if (strncmp(line, "new", 3) == 0) {
+            fmi.free_instance(c);
+            c = fmi.instantiate(token);
+            if (!c) {
+                fprintf(stderr, "line %ld: instantiation failed\n", line_number);
+                return 1;
             }
-        } else if (sscanf(line, "set F %u %la", &vr, &a) == 2) {
-            const fmi3ValueReference r = vr;
-            status = set_float(c, &r, 1, &a, 1);
-        } else if (sscanf(line, "init %la", &a) == 1) {
-            status = enter(c, fmi3False, 0.0, a, fmi3False, 0.0);
-            if (status <= fmi3Warning) status = leave(c);
-        } else if (sscanf(line, "step %la %la", &a, &b) == 2) {
-            fmi3Boolean event, terminate, early;
-            fmi3Float64 last;
-            status = do_step(c, a, b, fmi3True, &event, &terminate, &early, &last);
+            skipping = 0;
+            continue;
+        }
+        if (skipping) continue;
+        if (sscanf(line, "set %c %u %lld", &kind, &vr, &n) == 3 && kind != 'F') {
+            status = kind == 'B' ? fmi.set_bool(c, vr, n != 0) : fmi.set_int(c, vr, n, kind);
+        } else if (sscanf(line, "set F %u %la", &vr, &x) == 2) {
+            status = fmi.set_float(c, vr, x);
+        } else if (sscanf(line, "init %la", &x) == 1) {
+            status = fmi.init(c, x);
+        } else if (sscanf(line, "step %la %la", &x, &y) == 2) {
+            status = fmi.step(c, x, y);
         } else if (sscanf(line, "get %c %u", &kind, &vr) == 2) {
-            const fmi3ValueReference r = vr;
             if (kind == 'F') {
-                fmi3Float64 v;
-                status = get_float(c, &r, 1, &v, 1);
+                double v = 0.0;
+                status = fmi.get_float(c, vr, &v);
                 printf("%a\n", v);
             } else if (kind == 'I') {
-                fmi3Int32 v;
-                status = get_int(c, &r, 1, &v, 1);
-                printf("%d\n", (int)v);
+                long long v = 0;
+                status = fmi.get_int(c, vr, &v);
+                printf("%lld\n", v);
             } else {
-                fmi3Boolean v;
-                status = get_bool(c, &r, 1, &v, 1);
-                printf("%d\n", v ? 1 : 0);
+                int v = 0;
+                status = fmi.get_bool(c, vr, &v);
+                printf("%d\n", v);
             }
         } else if (sscanf(line, "save %199s", path) == 1) {
-            fmi3FMUState state = NULL;
             size_t size = 0;
-            static fmi3Byte bytes[1 << 16];
-            status = get_state(c, &state);
-            if (status <= fmi3Warning) status = state_size(c, state, &size);
-            if (status <= fmi3Warning && size <= sizeof bytes) status = serialize(c, state, bytes, size);
+            status = fmi.save(c, bytes, sizeof bytes, &size);
             FILE *f = fopen(path, "wb");
-            if (!f || fwrite(bytes, 1, size, f) != size || fclose(f) != 0 || size > sizeof bytes) status = fmi3Error;
-            free_state(c, &state);
+            if (!f || fwrite(bytes, 1, size, f) != size || fclose(f) != 0) status = STATUS_ERROR;
         } else if (sscanf(line, "load %199s", path) == 1) {
-            static fmi3Byte bytes[1 << 16];
             FILE *f = fopen(path, "rb");
             const size_t size = f ? fread(bytes, 1, sizeof bytes, f) : 0;
             if (f) fclose(f);
-            fmi3FMUState state = NULL;
-            status = deserialize(c, bytes, size, &state);
-            if (status <= fmi3Warning) status = set_state(c, state);
-            free_state(c, &state);
+            status = fmi.load(c, bytes, size);
         } else {
             fprintf(stderr, "line %ld: cannot read '%s'\n", line_number, line);
             return 2;
         }
+        if (status > STATUS_WARNING) {
+            if (!keep_going) break;
+            printf("refused %ld\n", line_number);
+            skipping = 1;
+        }
     }
-    free_instance(c);
-    if (status > fmi3Warning) {
+    fmi.free_instance(c);
+    if (status > STATUS_WARNING && !keep_going) {
         fprintf(stderr, "line %ld: status %d\n", line_number, status);
         return 1;
     }

@@ -1,6 +1,6 @@
 """Reference scenarios as scripts of tests/c/run_trace.c, the C harness
-built for each platform: natively on x86_64 Linux, under qemu-user for
-aarch64 Linux, under wine for Windows."""
+built for each platform: natively on x86_64 Linux (with floating-point
+traps too), under qemu-user for aarch64 Linux, under wine for Windows."""
 import os
 
 from support.fmu_driver import BUILD_DIR
@@ -8,10 +8,10 @@ from support.importers import input_values
 from support.process import run as run_bounded
 
 QEMU = [os.environ.get("RL_QEMU_AARCH64") or "qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
-KINDS = {"Float64": "F", "Int32": "I", "Enumeration": "L", "Boolean": "B"}
-HARNESS = {"x86_64-linux": [str(BUILD_DIR / "run_trace")],
+KINDS = {"Float64": "F", "Real": "F", "Int32": "I", "Integer": "I", "Enumeration": "L", "Boolean": "B"}
+HARNESS = {"x86_64-linux": [str(BUILD_DIR / "run_trace")], "linux64": [str(BUILD_DIR / "run_trace")],
            "aarch64-linux": QEMU + [str(BUILD_DIR / "aarch64" / "run_trace")]}
-SUFFIX = {"x86_64-linux": ".so", "aarch64-linux": ".so", "x86_64-windows": ".dll"}
+SUFFIX = {"x86_64-linux": ".so", "linux64": ".so", "aarch64-linux": ".so", "x86_64-windows": ".dll"}
 
 
 def script_parts(scenario, md):
@@ -45,14 +45,16 @@ def script(scenario, md):
     return "\n".join(head + [line for block in blocks for line in block]) + "\n"
 
 
-def run_script(platform, stage, model, token, text, tmp_path, what, wine=None):
+def run_script(platform, stage, model, token, text, tmp_path, what, wine=None, options=()):
     """run_trace's output lines for the script text, on platform's binary
-    of the staged FMU (wine: the environment of a wine prefix, for Windows)."""
+    of the staged FMU (wine: the environment of a wine prefix, for Windows;
+    options: run_trace's, e.g. --fmi2 for the linux64 binary, --trap)."""
     (tmp_path / "script").write_text(text)
     command = HARNESS.get(platform) or [os.path.join(wine["WINE_DIR"], "wine64"),
                                         str(BUILD_DIR / "windows" / "run_trace.exe")]
     with open(tmp_path / "script") as script_file:
-        done = run_bounded(command + [str(stage / "binaries" / platform / f"{model}{SUFFIX[platform]}"), token],
+        done = run_bounded(command + list(options) +
+                           [str(stage / "binaries" / platform / f"{model}{SUFFIX[platform]}"), token],
                            timeout=300, stdin=script_file, what=what, cwd=tmp_path, env=wine)
     assert done.returncode == 0, done.stderr
     return [line.strip() for line in done.stdout.splitlines()]
