@@ -396,6 +396,25 @@ def test_api_compare_returns_the_outcomes(tmp_path):
         fmutrace.compare(LAG[3], tmp_path / "nothing")
 
 
+def test_api_comparison_modes_as_objects(tmp_path):
+    """A mode given as an object judges as the command's options that make
+    it: x off by 1e-4 from t = 0.1 on fails exactly and within 1e-5, passes
+    within 1e-3; the exit codes are the command's."""
+    lag_case(tmp_path / "lag", lambda t, x: x + 1e-4 if t > 0 else x)
+    exact = fmutrace.compare(LAG[3], tmp_path / "lag", mode=fmutrace.Exact())
+    assert not exact.passed and exact.exit_code == 1 == fmutrace.SimulationError.exit_code
+    assert exact.cases[0].status == fmutrace.Status.FAIL == "fail"
+    assert fmutrace.compare(LAG[3], tmp_path / "lag", mode=fmutrace.Tolerance(abs_tol=1e-3)).passed
+    narrow = fmutrace.compare(LAG[3], tmp_path / "lag", mode=fmutrace.Tolerance(abs_tol=1e-5))
+    assert narrow.cases[0].messages[0].startswith("x leaves the band first at t=0.1")
+    assert fmutrace.comparison_mode(abs_tol=1e-5) == fmutrace.Tolerance(abs_tol=1e-5)
+    assert fmutrace.comparison_mode() == fmutrace.Exact()
+    assert fmutrace.comparison_mode(tube_time=0.1, tube_value=1e-3) == fmutrace.Tube(0.1, 1e-3)
+    with pytest.raises(fmutrace.InputError, match="tube-time must be a finite number >= 0") as refused:
+        fmutrace.Tube(-1.0, 0.0)
+    assert refused.value.exit_code == 2
+
+
 @pytest.mark.parametrize("version", [2, 3])
 def test_a_simulation_that_fails_is_an_error_case_not_a_crash(version, tmp_path):
     """zeroRate 7 in the input table (the checks cover start values, not

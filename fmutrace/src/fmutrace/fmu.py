@@ -5,6 +5,7 @@ import hashlib
 import math
 import os
 import shutil
+from os import PathLike
 import tempfile
 import zipfile
 from pathlib import Path
@@ -25,7 +26,7 @@ REAL_TYPES = ("Real", "Float32", "Float64")  # FMI 2 and FMI 3 floating-point ty
 class Fmu:
     """An FMU file and its model description."""
 
-    def __init__(self, path, model_description=None):
+    def __init__(self, path: str | PathLike, model_description=None):
         """path: the .fmu file; model_description: fmpy's, if read already
         (a worker has it from the unpacked FMU)."""
         self.path = Path(path)
