@@ -472,6 +472,19 @@ def test_the_readme_pytest_example_runs(tmp_path):
     assert re.search(r"\b[1-9]\d* passed", done.stdout)
 
 
+def test_a_folder_of_links_to_case_folders_is_a_folder_of_cases(tmp_path):
+    """As the benchmarks give a part of their cases: links to case folders
+    (and a link loop) in a folder of their own; not a recording."""
+    write_case(tmp_path / "cases" / "step", "PassThrough", STEP_REF, DIALECTS["comma"], STEP_OPT)
+    linked = tmp_path / "linked"
+    linked.mkdir()
+    (linked / "step").symlink_to(tmp_path / "cases" / "step")
+    (linked / "loop").symlink_to(linked)
+    done = fmutrace_cli("compare", PASS_THROUGH[3], linked)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1 of 1 cases pass" in done.stdout
+
+
 def test_find_cases_names_each_case_folder_once(tmp_path):
     """Names are the paths below the folder searched, sorted; a case folder
     given itself takes its own name; a name found below two folders given

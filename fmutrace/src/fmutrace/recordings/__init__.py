@@ -92,7 +92,13 @@ def is_recording(path):
     if os.path.isfile(path) or (os.pathsep in path and all(os.path.isfile(p) for p in path.split(os.pathsep))):
         return True
     if os.path.isdir(path):
-        for _, _, names in os.walk(path):
+        seen = set()  # folders by identity: linked folders are searched (as find_cases does), a link loop ends
+        for folder, subfolders, names in os.walk(path, followlinks=True):
+            status = os.stat(folder)
+            if (status.st_dev, status.st_ino) in seen:
+                subfolders.clear()
+                continue
+            seen.add((status.st_dev, status.st_ino))
             if any(n.endswith("_ref.csv") for n in names):
                 return False
         return True
