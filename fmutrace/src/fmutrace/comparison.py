@@ -121,7 +121,7 @@ class Mode:
         raise NotImplementedError
 
 
-class _Pointwise(Mode):
+class Pointwise(Mode):
     """Each reference sample against the result's at its time."""
 
     fills_band = False
@@ -151,7 +151,7 @@ class _Pointwise(Mode):
 
 
 @dataclass(frozen=True)
-class Exact(_Pointwise):
+class Exact(Pointwise):
     name: ClassVar[str] = "exact"
 
     def describe(self):
@@ -163,7 +163,7 @@ class Exact(_Pointwise):
 
 
 @dataclass(frozen=True)
-class Tolerance(_Pointwise):
+class Tolerance(Pointwise):
     rel_tol: float = 0.0
     abs_tol: float = 0.0
 
