@@ -5,7 +5,7 @@
  *   fmu_bench <2|3> <binary.so> <token> <u_vr> <y_vr> <cycleTime_vr|-1> <steps> <repeats> [vr=value ...]
  *
  * vr=value: Real start values set before initialisation (the benchmark of
- * a configuration with the section 6 features in use).
+ * a configuration with output limits and rates below 0 in use).
  *
  * Under valgrind --tool=callgrind each measured loop is bracketed by client
  * requests (zero, then dump with the loop's name), so that the caller can

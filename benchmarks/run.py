@@ -50,7 +50,7 @@ def model_info(build, model, version):
     return binary, token, vr
 
 
-# The section 6 features in use (second row): output limits far from the
+# Output limits and rates below 0 in use (second row): output limits far from the
 # ramp and other rates below 0, so that only their cost shows
 FEATURES = {"yMaxPar": 1e300, "yMinPar": -1e300, "rateUpNeg": 2.0, "rateDownNeg": 2.0}
 

@@ -1,5 +1,6 @@
 /* FMI-version independent part of every FMU: variable access, the cycle
- * scheduler (SPEC section 2), FMU states and their serialization, logging.
+ * scheduler (docs/fmi.md, Time: the communication step is the PLC cycle),
+ * FMU states and their serialization, logging.
  * fmi2_glue.c and fmi3_glue.c map the FMI C APIs onto it; a model
  * (model.h, models/<Model>.c) maps its variables onto the kernel. */
 #ifndef FMU_CORE_H

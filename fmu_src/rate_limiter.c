@@ -204,8 +204,9 @@ static double leg_time(double length, double rate, const RlPrepared *p) {
     return length / perSecond;
 }
 
-/* The time from y to uc at the current rates (SPEC section 6): the part of
- * the way below 0 at the Neg rate, the rest at the other. */
+/* The time from y to uc at the current rates (rules.md, Outputs derived
+ * from the last cycle): the part of the way below 0 at the Neg rate, the
+ * rest at the other. */
 static double remaining_time(const RlState *s, const RlPrepared *p, double y, double uc) {
     const RlConfig *c = &p->config;
     double below, above, total;

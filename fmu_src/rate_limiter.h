@@ -1,4 +1,4 @@
-/* Rate limiter kernel: the cycle logic of SPEC sections 3 and 6, shared by
+/* Rate limiter kernel: the cycle rules (docs/rules.md), shared by
  * every model. Pure C99: no FMI types, no allocation, no globals. */
 #ifndef RATE_LIMITER_H
 #define RATE_LIMITER_H
@@ -101,9 +101,9 @@ static inline bool rl_status_is_error(int status) {
 /* Rule 0: an "or Par" input that is NaN falls back to its parameter. */
 RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource);
 
-/* The section 6 features off, for the blocks of section 4: the same rates
- * below 0, no output limits, no hold, the initial output as it is. Call
- * after the rates are set. */
+/* rules.md, Output limits, rates below 0 and hold: off, for the vendor
+ * blocks that have none of them: the same rates below 0, no output limits,
+ * no hold, the initial output as it is. Call after the rates are set. */
 void rl_without_section6(RlConfig *config);
 
 /* Status word of a configuration (first match of the status table). */
@@ -218,8 +218,8 @@ static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u
  * held: the same as rl_cycle for each, in fewer instructions. */
 void rl_run(RlState *state, const RlPrepared *prepared, double u, uint64_t first, uint64_t last, double cycleTime);
 
-/* The outputs derived from the last cycle (SPEC sections 3 and 6),
- * computed when read: they cost the cycles nothing. prepared must be the
+/* rules.md, Outputs derived from the last cycle, computed when read: they
+ * cost the cycles nothing. prepared must be the
  * configuration the last cycle ran with. */
 typedef struct {
     bool rampActive;           /* rule 6 decided it and left y != uc */

@@ -161,7 +161,7 @@ def test_the_largest_finite_step_is_taken(version):
 @pytest.mark.parametrize("version", [2, 3])
 def test_huge_cycle_time_holds(version):
     """cycleTime 1e9: no cycle ends within 10 s, so the output holds at its
-    initial value (SPEC section 2: a step that ends no cycle changes nothing)."""
+    initial value (fmi.md, Time: a step that ends no cycle changes nothing)."""
     fmu = Instance("RateLimiter", version)
     try:
         fmu.start(cycleTime=1e9, u=3.0)

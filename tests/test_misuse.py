@@ -1,4 +1,4 @@
-"""SPEC section 5: every misuse gets an error status and one log message
+"""fmi.md, FMI behaviour: every misuse gets an error status and one log message
 naming the function; the instance keeps its last good state, refuses
 further calls until recovered (FMU state or reset), then runs on."""
 import ctypes

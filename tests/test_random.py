@@ -29,7 +29,7 @@ parameters = st.fixed_dictionaries({
     "initValue": reals,
     "initDelay": st.sampled_from([0.0, 0.3, 1.0, 2.0]),
     "u": reals,
-    # section 6: limits (none by default, NaN none too), here and in the changes
+    # output limits (rules.md, rule 0; none by default, NaN none too), here and in the changes
     "yMaxPar": st.sampled_from([inf, nan, 5.0, 1.0, 0.0, -2.0]),
     "yMinPar": st.sampled_from([-inf, nan, -5.0, -1.0, 0.0, 2.0]),
 })
@@ -167,7 +167,7 @@ def test_directed_runs_agree_with_oracle(version, model, start, run, start_time)
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("skipped", [(), (0,)])
 def test_steps_that_end_no_cycle_change_no_output(version, skipped):
-    """SPEC section 2: a step that ends no cycle changes nothing, also when a
+    """fmi.md, Time: a step that ends no cycle changes nothing, also when a
     rate or a limit changed before it (remainingTime and the limit flags
     stay those of the last cycle's configuration), whether or not the
     outputs were read after that cycle."""

@@ -290,7 +290,7 @@ def test_a_state_is_got_or_deserialized_into_an_existing_one_in_place(version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_the_reported_status_travels_with_the_state(version):
-    """A status word is logged once, when it changes (SPEC section 5). A
+    """A status word is logged once, when it changes (rules.md, Status words). A
     state carries what was reported: an instance set to a serialized state
     whose error status was already reported steps with fmi*OK and logs
     nothing; from a state taken before, the same error is reported as the

@@ -1,4 +1,4 @@
-"""SPEC section 5: instances are independent and run concurrently on
+"""fmi.md, FMI behaviour: instances are independent and run concurrently on
 different threads (ctypes releases the GIL inside every FMI call)."""
 import math
 from concurrent.futures import ThreadPoolExecutor

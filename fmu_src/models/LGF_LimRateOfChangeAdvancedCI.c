@@ -1,5 +1,5 @@
-/* LGF_LimRateOfChangeAdvancedCI (Siemens, SPEC section 7): rates per
- * quadrant (per second, 0 holds), output limits, and the modes reset,
+/* LGF_LimRateOfChangeAdvancedCI (Siemens; docs/models.md,
+ * LGF_LimRateOfChangeAdvancedCI): rates per quadrant (per second, 0 holds), output limits, and the modes reset,
  * manOp, enDefaultOutValue and track (first match wins), each of which
  * sets the output as a bypass does; the output starts at 0, not limited. */
 #include "LGF_LimRateOfChangeAdvancedCI_variables.h"

@@ -1,4 +1,4 @@
-/* LGF_LimRateOfChangeCI (Siemens, SPEC section 4): one rate per second for
+/* LGF_LimRateOfChangeCI (Siemens; docs/models.md, LGF_LimRateOfChangeCI): one rate per second for
  * both directions (0 holds), enDefaultOutValue as the bypass, output from 0,
  * a NaN value compared rather than passed, callOB validated. */
 #include "LGF_LimRateOfChangeCI_variables.h"

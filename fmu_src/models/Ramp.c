@@ -1,4 +1,4 @@
-/* Ramp (CODESYS, SPEC section 4): rVariation per tTime in both directions,
+/* Ramp (CODESYS; docs/models.md, Ramp): rVariation per tTime in both directions,
  * per task cycle when tTime = 0, rVariation 0 holds; eInitial and
  * tInitDelay are the kernel's init modes. */
 #include "Ramp_variables.h"

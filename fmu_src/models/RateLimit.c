@@ -1,4 +1,4 @@
-/* RateLimit (Honeywell IRMN4, SPEC section 4): rates per second, 0 = no
+/* RateLimit (Honeywell IRMN4; docs/models.md, RateLimit): rates per second, 0 = no
  * limit, null (NaN) inputs fall back to their parameters, Duration capped at
  * the block's 259200 s, OutSave/SavedOut restart. */
 #include "RateLimit_variables.h"

@@ -1,4 +1,4 @@
-/* RateLimiter: the unified block (SPEC sections 3 and 6), a direct mapping
+/* RateLimiter: the unified block (docs/rules.md), a direct mapping
  * of its variables onto the kernel. */
 #include "RateLimiter_variables.h"
 

@@ -1,5 +1,5 @@
 /* Unit tests of the rate limiter kernel: every rule (0 to 6, 5b) and every
- * status code of SPEC sections 3 and 6, and the outputs derived from a
+ * status code (docs/rules.md), and the outputs derived from a
  * cycle. Expected values are worked by hand. */
 #include <math.h>
 #include <stdbool.h>
@@ -596,7 +596,7 @@ static void test_fast_paths_equal_rules(void) {
         c.initDelay = 0.02;
         c.bypass = flags & 1;
         c.passNonFinite = flags & 2;
-        /* section 6 in play, one at a time (each must clear plain): other
+        /* output limits, rates below 0 and hold in play, one at a time (each must clear plain): other
          * rates below 0, a high or a low limit, hold */
         if (extra == 1) c.rateUpNeg = (RlValue){ 0.7, SRC_RATE_UP_NEG };
         if (extra == 2) c.rateDownNeg = (RlValue){ 2.0, SRC_RATE_DOWN_NEG };
@@ -694,7 +694,7 @@ static void test_steady_ramp_equals_rules(void) {
     }
 }
 
-/* ---- SPEC section 6 ------------------------------------------------- */
+/* ---- rules.md, Output limits, rates below 0 and hold ------------------ */
 
 static void test_status_section6(void) {
     RlConfig c = defaults();
@@ -918,7 +918,7 @@ static void test_derived_outputs(void) {
     CHECK_EQ(outputs(&b).remainingTime, 0.0);
 }
 
-/* The vendor blocks have none of section 6: rl_without_section6 turns every
+/* The vendor blocks have no output limits, rates below 0 or hold: rl_without_section6 turns every
  * one of its features off, whatever the configuration held. */
 /* remainingTime over the legs of the way, each sign of y and uc, up and
  * down: below 0 at the Neg rate, above at the other. Rates per 1 s: up 1,

@@ -1,5 +1,7 @@
-"""An independent model of the rate limiter, written from SPEC sections 2,
-3, 6, 7 and 8 (not from the C code), to check the FMUs against.
+"""An independent model of the rate limiter, written from the cycle rules
+(docs/rules.md), the time model (docs/fmi.md), the vendor readings
+(docs/models.md) and the arithmetic of SPEC section 8, not from the C code,
+to check the FMUs against.
 
 The oracle speaks the unified block's variable names. It follows the
 project's documented conventions where the contract leaves room:
@@ -97,7 +99,7 @@ class RateLimiterOracle:
         self.cycles_done = 0
         u = self.real(self.values["u"])
         y = self.real(self.values["initValue"]) if self.values["initMode"] == 1 else u
-        # section 6: limited if y is finite and yMin <= yMax (a NaN limit: none)
+        # rules.md, Initialisation: limited if y is finite and yMin <= yMax (a NaN limit: none)
         low, high = self.limits()
         if limit_initial and finite(y) and low <= high:
             y = min(max(y, low), high)
@@ -138,7 +140,7 @@ class RateLimiterOracle:
 
     def resolve_neg(self, name):
         """rateUpNeg / rateDownNeg: NaN falls back to the resolved rateUp /
-        rateDown (section 6)."""
+        rateDown (rules.md, rule 0)."""
         value = self.values[name]
         if math.isnan(value) and self.neg_fallback:
             return self.resolve(name[:-3])
@@ -254,7 +256,7 @@ class RateLimiterOracle:
         self.y = y
         self.u_prev = u
 
-    # -- SPEC section 2: a communication step --------------------------------
+    # -- a communication step (fmi.md, Time: the communication step is the PLC cycle)
     def do_step(self, t, h, inputs=None):
         """Set the inputs (held for the whole step), then run every cycle
         whose end lies in (t, t+h]."""
@@ -269,7 +271,7 @@ class RateLimiterOracle:
             for n in range(self.cycles_done + 1, last + 1):
                 self.cycle(c, n * c)
             if last > self.cycles_done:
-                self.last = self.evaluate_outputs()  # the outputs are those of the last cycle run (SPEC section 2)
+                self.last = self.evaluate_outputs()  # the outputs are those of the last cycle run (fmi.md, Time)
             self.cycles_done = max(self.cycles_done, last)
         else:
             self.cycle(h, end - self.t0)
@@ -277,7 +279,7 @@ class RateLimiterOracle:
         self.time = end
         return self.outputs()
 
-    # -- section 6: what the last cycle leaves besides y -----------------------
+    # -- rules.md, Outputs derived from the last cycle ---------------------------
     def remaining_time(self, y, uc):
         """The way from y to uc in legs: below 0 at the Neg rate, the rest at
         the other; each leg's length / rate per second."""
@@ -337,7 +339,7 @@ class RateLimiterOracle:
         }
 
 
-# -- SPEC section 4: the vendor blocks, each read as the unified block -------
+# -- the vendor blocks, each read as the unified block (models.md) ---------
 nan = math.nan
 
 
@@ -387,7 +389,7 @@ def codesys(v):
 
 
 def siemens_advanced(v):
-    """SPEC section 7: modes (first match wins) reset, manOp,
+    """models.md, LGF_LimRateOfChangeAdvancedCI: modes (first match wins) reset, manOp,
     enDefaultOutValue, track set the output as a bypass does; else a ramp
     towards autoValue within [setLowLim, setHighLim]."""
     ob = v["callOB"]
@@ -470,7 +472,7 @@ def start_values(model):
 
 class VendorOracle:
     """A vendor block: its own variables, translated onto the unified oracle
-    before every step, as SPEC section 4 describes it."""
+    before every step, as models.md describes it."""
 
     def __init__(self, model, vr, start=None, start_time=0.0):
         self.spec = VENDORS[model]
