@@ -237,24 +237,28 @@ FmuStatus fmu_enter_initialization(FmuInstance *instance) {
     return FMU_OK;
 }
 
-/* Log a change of the status word once; an error status is a warning. */
-FMU_NOINLINE static FmuStatus log_status(FmuInstance *instance) {
+/* Log a change of the status word once. A status is the PLC block's
+ * business, not an FMI error: the call that sees it returns OK (importers
+ * such as OMSimulator stop on any other status) and an error status is
+ * logged as a message of status Warning in logStatusWarning. */
+FMU_NOINLINE static void log_status(FmuInstance *instance) {
     const RlPrepared *p = &instance->prepared;
     instance->core.reportedStatus = p->status;
     if (rl_status_is_error(p->status)) {
         const FmuVariable *cause = &instance->model->variables[p->statusSource];
         fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds",
                 (unsigned)p->status, rl_status_text(p->status), cause->name, instance->core.values[p->statusSource]);
-        return FMU_WARNING;
+    } else {
+        fmu_log(instance, FMU_OK, "status 16#%04X: %s", (unsigned)p->status, rl_status_text(p->status));
     }
-    fmu_log(instance, FMU_OK, "status 16#%04X: %s", (unsigned)p->status, rl_status_text(p->status));
-    return FMU_OK;
 }
 
 static inline FmuStatus report_status(FmuInstance *instance) {
-    return instance->prepared.status == instance->core.reportedStatus ? FMU_OK : log_status(instance);
+    if (instance->prepared.status != instance->core.reportedStatus) {
+        log_status(instance);
+    }
+    return FMU_OK;
 }
-
 
 FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     initialize_block(instance);
