@@ -2,7 +2,10 @@
 tunable changes mid-run) through the FMU and the oracle: every output must
 agree bit for bit after every step the importer reads it (outputs are
 published when read, so reading after some steps only must not change
-them)."""
+them). Ramp and RateLimit compute in REAL, RateLimiter in either
+arithmetic (SPEC section 8): the values include some that binary32 cannot
+hold (beyond its largest value, below its smallest) and times between
+milliseconds."""
 import math
 
 import pytest
@@ -10,12 +13,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from support.fmu_driver import MODELS, Instance
-from support.oracle import oracle_for, output_names
+from support.oracle import LREAL, REAL, oracle_for, output_names
 
 nan, inf = math.nan, math.inf
-SPECIAL = [0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 10.0, nan, inf, -inf]
+# 3.5e38 is an infinity in binary32, 1e-46 a zero, 16777217 an even neighbour's
+SPECIAL = [0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 10.0, nan, inf, -inf, 3.5e38, -3.5e38, 1e-46, 16777217.0]
 reals = st.one_of(st.sampled_from(SPECIAL), st.floats(-100, 100, allow_nan=False))
-rates = st.one_of(st.sampled_from([0.0, 0.5, 1.0, 2.0, 10.0, inf, nan, -1.0]), st.floats(0, 50))
+# 1e-50 is a rate of 0 in binary32, -1e-50 a -0 (not negative there)
+rates = st.one_of(st.sampled_from([0.0, 0.5, 1.0, 2.0, 10.0, inf, nan, -1.0, 1e-50, -1e-50, 3.5e38]),
+                  st.floats(0, 50))
 durations = st.sampled_from([0.0, 0.25, 0.5, 1.0, 3.0, inf, nan, -1.0])
 
 parameters = st.fixed_dictionaries({
@@ -57,7 +63,8 @@ start_times = st.sampled_from([0.0, 0.0, 1.0, -0.3, 12.5])
 steps = st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), changes), min_size=1, max_size=40)
 
 cycle_times = st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0])
-times = st.sampled_from([0.0, 0.3, 1.0, 2.0, 10.0])
+# TIME pins hold whole milliseconds: 2.5 ms is 2, 0.4 ms is T#0s
+times = st.sampled_from([0.0, 0.3, 1.0, 2.0, 10.0, 0.0025, 0.0004, 0.3005, 1.0015])
 VENDOR_STRATEGIES = {
     "LGF_LimRateOfChangeAdvancedCI": (
         st.fixed_dictionaries({"autoValue": reals, "manualValue": reals, "setPosUpRateLim": rates,
@@ -178,10 +185,11 @@ def test_steps_that_end_no_cycle_change_no_output(version, skipped):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("arithmetic", [LREAL, REAL])
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(start=parameters, run=steps, skipped=st.sets(st.integers(0, 39)), start_time=start_times)
-def test_rate_limiter_agrees_with_oracle(version, start, run, skipped, start_time):
-    run_against_oracle("RateLimiter", version, start, run, skipped, start_time)
+def test_rate_limiter_agrees_with_oracle(version, arithmetic, start, run, skipped, start_time):
+    run_against_oracle("RateLimiter", version, dict(start, arithmetic=arithmetic), run, skipped, start_time)
 
 
 @pytest.mark.parametrize("version", [2, 3])

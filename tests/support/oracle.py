@@ -173,7 +173,7 @@ class RateLimiterOracle:
         y_min, y_max = self.resolve("yMin"), self.resolve("yMax")
         if y_min.value > y_max.value:
             return 0x8204, y_min.name
-        if not finite(cycle) or cycle < 0:
+        if not finite(cycle) or cycle < 0 or not self.values.get("cycleValid", True):
             return 0x8601, "cycleTime"
         return 0, None
 
@@ -350,7 +350,8 @@ def siemens(v):
         "u": v["value"], "rateUp": v["setChangeRate"], "rateDown": v["setChangeRate"],
         "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
         "bypass": v["enDefaultOutValue"], "bypassValue": v["defaultOutValue"], "bypassValuePar": nan,
-        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"] if ob_valid else nan,
+        # an invalid callOB is reported by the status; the cycles are still cycleTime's
+        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"], "cycleValid": ob_valid,
         "initMode": 1, "initValue": 0.0, "initDelay": 0.0,
     }
     culprits = {"rateUp": "setChangeRate", "rateDown": "setChangeRate", "rateUpPar": "setChangeRate",
@@ -370,6 +371,7 @@ def irmn4(v):
         "duration": min(duration, 259200.0) if not math.isnan(duration) else nan,
         "durationPar": min(duration_par, 259200.0), "cycleTime": v["cycleTime"],
         "initMode": 1 if restart else 2, "initValue": v["SavedOut"], "initDelay": 0.0,
+        "arithmetic": REAL,  # the IRMN4 family's analog pins are 32-bit floats
     }
     culprits = {"rateUp": "UpRate", "rateDown": "DownRate", "rateUpPar": "UpRatePar",
                 "rateDownPar": "DownRatePar", "duration": "Duration", "durationPar": "DurationPar",
@@ -380,9 +382,10 @@ def irmn4(v):
 def codesys(v):
     unified = {
         "u": v["rIn"], "rateUp": v["rVariation"], "rateDown": v["rVariation"], "rateUpPar": nan,
-        "rateDownPar": nan, "ratePeriod": v["tTime"], "zeroRate": 1, "bypass": False, "bypassValue": nan,
+        "rateDownPar": nan, "ratePeriod": time_ms(v["tTime"]), "zeroRate": 1, "bypass": False, "bypassValue": nan,
         "bypassValuePar": nan, "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"],
-        "initMode": v["eInitial"], "initValue": v["rInitValue"], "initDelay": v["tInitDelay"],
+        "initMode": v["eInitial"], "initValue": v["rInitValue"], "initDelay": time_ms(v["tInitDelay"]),
+        "arithmetic": REAL,  # REAL pins, TIME in milliseconds
     }
     culprits = {"rateUp": "rVariation", "rateDown": "rVariation", "ratePeriod": "tTime", "cycleTime": "cycleTime"}
     return unified, culprits
@@ -411,7 +414,7 @@ def siemens_advanced(v):
         "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
         "yMax": v["setHighLim"], "yMin": v["setLowLim"], "yMaxPar": nan, "yMinPar": nan, "hold": False,
         "bypass": mode != "ramp", "bypassValue": value, "bypassValuePar": nan,
-        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"] if ob_valid else nan,
+        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"], "cycleValid": ob_valid,
         "initMode": 1, "initValue": 0.0, "initDelay": 0.0, "mode": mode,
     }
     culprits = {"rateUp": "setPosUpRateLim", "rateDown": "setPosDownRateLim", "rateUpNeg": "setNegDownRateLim",
