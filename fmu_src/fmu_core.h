@@ -245,11 +245,11 @@ static inline bool fmu_time_matches(double t, double time) {
  * t and a finite u. False: nothing done, take the general step. */
 static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     FmuCore *core = &instance->core;
-    const double u = core->values[instance->inputVr];
-    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance && fabs(u) <= DBL_MAX)) {
+    /* the cycle itself, if u is finite in the block's arithmetic (y stays finite) */
+    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance &&
+          rl_ramp_steady(&core->block, &instance->prepared, core->values[instance->inputVr]))) {
         return false;
     }
-    rl_ramp_steady(&core->block, &instance->prepared, u); /* y stays finite */
     instance->outputsStale = FMU_STALE_ALL;
     core->time = t + h;
     return true; /* no status change: that needs a new configuration */

@@ -42,7 +42,7 @@ int rl_status(const RlConfig *c, int *source) {
         status = RL_STATUS_DURATION; culprit = &c->duration;
     } else if (c->yMin.value > c->yMax.value) {
         status = RL_STATUS_LIMITS; culprit = &c->yMin;
-    } else if (!(c->cycleTime.value >= 0) || !isfinite(c->cycleTime.value)) {
+    } else if (c->cycleRefused || !(c->cycleTime.value >= 0) || !isfinite(c->cycleTime.value)) {
         status = RL_STATUS_NO_CYCLE; culprit = &c->cycleTime;
     }
     *source = culprit ? culprit->source : 0;
@@ -54,14 +54,40 @@ static double cycle_limit(double rate, const RlConfig *c, double period) {
     if (rate == 0) {
         return c->zeroRate == RL_ZERO_RATE_NO_LIMIT ? INFINITY : 0.0;
     }
-    if (c->ratePeriod.value > 0) {
-        return rate * period / c->ratePeriod.value;
-    }
-    return rate;
+    return c->real ? rl_per_cycle_real(rate, period, c->ratePeriod.value)
+                   : rl_per_cycle_lreal(rate, period, c->ratePeriod.value);
 }
 
-void rl_prepare(RlPrepared *p, const RlConfig *c, double period) {
-    p->config = *c;
+static double binary32(double x) {
+    return (double)rl_binary32(x);
+}
+
+static RlValue binary32_value(RlValue v) {
+    v.value = binary32(v.value);
+    return v;
+}
+
+/* REAL: the values that enter the signal path, rounded once here (SPEC
+ * section 8); times (duration, cycleTime, initDelay) stay binary64. */
+static RlConfig entered(const RlConfig *c) {
+    RlConfig r = *c;
+    if (c->real) {
+        r.rateUp = binary32_value(c->rateUp);
+        r.rateDown = binary32_value(c->rateDown);
+        r.rateUpNeg = binary32_value(c->rateUpNeg);
+        r.rateDownNeg = binary32_value(c->rateDownNeg);
+        r.yMax = binary32_value(c->yMax);
+        r.yMin = binary32_value(c->yMin);
+        r.ratePeriod = binary32_value(c->ratePeriod);
+        r.bypassValue = binary32(c->bypassValue);
+        r.initValue = binary32(c->initValue);
+    }
+    return r;
+}
+
+void rl_prepare(RlPrepared *p, const RlConfig *config, double period) {
+    p->config = entered(config);
+    const RlConfig *c = &p->config;
     p->period = period;
     p->status = rl_status(c, &p->statusSource);
     p->maxUp = cycle_limit(c->rateUp.value, c, period);
@@ -89,7 +115,10 @@ static void running_reset(RlState *s) {
     s->runBase = 0.0;
 }
 
-void rl_init(RlState *s, const RlConfig *c, double u) {
+void rl_init(RlState *s, const RlConfig *config, double u) {
+    const RlConfig rounded = entered(config);
+    const RlConfig *c = &rounded;
+    if (c->real) u = binary32(u);
     double y = c->initMode == RL_INIT_VALUE ? c->initValue : u;
     /* within the limits that are set, unless they are inverted */
     if (c->limitInitialOutput && isfinite(y) && !(c->yMin.value > c->yMax.value)) {
@@ -108,6 +137,7 @@ void rl_init(RlState *s, const RlConfig *c, double u) {
 void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
     const RlConfig *c = &p->config;
     double y;
+    u = rl_input(p, u);
 
     if (c->passNonFinite && !isfinite(u)) {
         y = u;
@@ -143,6 +173,7 @@ void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t 
     if (first > last) {
         return;
     }
+    u = rl_input(p, u);
     rl_cycle(s, p, u, (double)first * cycleTime);
     if (!rl_only_ramps(s, p, u)) {
         for (uint64_t n = first + 1; n <= last; n++) {
@@ -154,24 +185,11 @@ void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t 
      * (plain): after the first cycle uPrevious is u and runPeriod is T, so
      * each cycle is rl_ramp without its resets; once y reaches u nothing
      * changes any more (and yPrevious is y too). */
-    double y = s->y, yp = s->yPrevious;
-    uint64_t cycles = s->runCycles;
-    uint64_t n = first + 1;
-    for (; n <= last && y != u; n++) {
-        cycles++;
-        yp = y;
-        if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
-            y = u;
-        } else {
-            y = rl_step_towards(y, u, p->maxUp, p->maxDown);
-        }
+    if (p->config.real) {
+        rl_run_steady_real(s, p, u, first, last);
+    } else {
+        rl_run_steady_lreal(s, p, u, first, last);
     }
-    if (n <= last) {
-        yp = y; /* cycles that found y at u */
-    }
-    s->y = y;
-    s->yPrevious = yp;
-    s->runCycles = cycles;
     if (last > first) {
         s->decided = RL_DECIDED_RAMP; /* cycles first + 1 .. last */
     }
@@ -233,12 +251,16 @@ void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
     const bool ramped = s->decided == RL_DECIDED_RAMP;
     const bool jumped = p->durationLimited && rl_running_time(s) >= p->durationReached;
     const bool negative = yp < 0;
+    const bool real = p->config.real;
+    const double maxUp = negative ? p->maxUpNeg : p->maxUp, maxDown = negative ? p->maxDownNeg : p->maxDown;
     o->rampActive = ramped && y != uc;
-    o->limitingUp = ramped && !jumped && yp + (negative ? p->maxUpNeg : p->maxUp) < uc;
-    o->limitingDown = ramped && !jumped && yp - (negative ? p->maxDownNeg : p->maxDown) > uc;
+    o->limitingUp = ramped && !jumped && (real ? rl_cut_up_real(yp, maxUp, uc) : rl_cut_up_lreal(yp, maxUp, uc));
+    o->limitingDown = ramped && !jumped &&
+                      (real ? rl_cut_down_real(yp, maxDown, uc) : rl_cut_down_lreal(yp, maxDown, uc));
     o->highLimit = isfinite(y) && y >= p->yHigh;
     o->lowLimit = isfinite(y) && y <= p->yLow;
-    o->dydt = s->decided != RL_DECIDED_NOTHING && isfinite(y) && isfinite(yp) ? (y - yp) / p->period : 0.0;
+    o->dydt = s->decided != RL_DECIDED_NOTHING && isfinite(y) && isfinite(yp)
+                  ? (real ? rl_dydt_real(y, yp, p->period) : rl_dydt_lreal(y, yp, p->period)) : 0.0;
     o->remainingTime = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc)
                            ? remaining_time(s, p, y, uc) : 0.0;
 }

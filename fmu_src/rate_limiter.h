@@ -8,6 +8,12 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+/* REAL arithmetic (SPEC section 8) rounds every float operation to float:
+ * a target that evaluates floats in a wider type (x87) would not. */
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#error "the kernel needs FLT_EVAL_METHOD 0 (each float operation rounded to float): build with SSE, not x87"
+#endif
+
 /* Status words (Siemens convention: RL_STATUS_ERROR and above are errors). */
 enum {
     RL_STATUS_OK                = 0x0000,
@@ -23,6 +29,8 @@ enum {
 enum { RL_ZERO_RATE_HOLD = 1, RL_ZERO_RATE_NO_LIMIT = 2 };
 
 enum { RL_INIT_VALUE = 1, RL_INIT_INPUT = 2, RL_INIT_INPUT_DELAYED = 3 };
+
+enum { RL_ARITHMETIC_LREAL = 1, RL_ARITHMETIC_REAL = 2 };
 
 /* Which rule decided the last cycle, for the outputs derived from it */
 enum { RL_DECIDED_NOTHING = 0, /* no cycle yet */
@@ -50,6 +58,8 @@ typedef struct {
     RlValue ratePeriod;        /* s; 0 = change per cycle */
     RlValue duration;          /* s; 0 = never jump */
     RlValue cycleTime;         /* s; only validated here */
+    bool cycleRefused;         /* no valid cycle, whatever cycleTime says (an
+                                  invalid callOB): 0x8601 from cycleTime.source */
     bool bypass;
     double bypassValue;        /* non-finite: output follows u */
     int zeroRate;              /* RL_ZERO_RATE_* */
@@ -60,6 +70,9 @@ typedef struct {
      * only compared with the output, so NaN holds and +-inf ramps. */
     bool passNonFinite;
     bool limitInitialOutput;   /* the initial output within [yMin, yMax] */
+    /* REAL (SPEC section 8): the signal path in binary32. rl_prepare
+     * rounds the values that enter it; u is rounded each cycle (rl_input). */
+    bool real;
 } RlConfig;
 
 /* Per-configuration values derived once, not every cycle. */
@@ -135,70 +148,69 @@ static inline void rl_hold_period(RlState *s, double period) {
     if (s->runPeriod != period) rl_period_changed(s, period);
 }
 
-/* Rule 6's step of y towards the target at the per-cycle limits, never
- * past it: every path that ramps (rl_ramp_cycle, rl_run's sub-cycles, and
- * through them the FMUs' common step) takes it from here. */
-static inline double rl_step_towards(double y, double target, double maxUp, double maxDown) {
-    if (target > y) {
-        const double limited = y + maxUp;
-        return limited < target ? limited : target;
-    }
-    if (target < y) {
-        const double limited = y - maxDown;
-        return limited > target ? limited : target;
-    }
-    return y;
-}
-
 /* The target uc = min(max(u, yMin), yMax); a NaN u stays NaN. */
 static inline double rl_target(double u, const RlPrepared *p) {
     return u < p->yLow ? p->yLow : u > p->yHigh ? p->yHigh : u;
 }
 
-/* Rule 6: ramp towards uc at the limits picked by the output's sign, or
- * jump to uc once the duration has run out. steady: u and y are finite,
- * runPeriod is already p->period (rl_hold_period) and the configuration
- * is plain (uc is u, the limits are the same for both signs), which
- * spares the checks; a constant, so each caller gets its own copy. */
-static inline void rl_ramp_cycle(RlState *s, const RlPrepared *p, double u, bool steady) {
-    const double yp = s->y;
-    const bool negative = !steady && yp < 0;
-    const double target = steady ? u : rl_target(u, p);
-    double y = yp;
-    if (u != s->uPrevious) {
-        s->runCycles = 0;
-        s->runBase = 0.0;
+/* x rounded to binary32 (to nearest, ties to even). Beyond the largest
+ * float C leaves the conversion undefined (IEEE makes it an infinity):
+ * what rounds to an infinity, from 2^128 - 2^103 on, is made one here. */
+#define RL_FLOAT_OVERFLOW 3.4028235677973366e38
+static inline float rl_binary32(double x) {
+    if (isgreaterequal(fabs(x), RL_FLOAT_OVERFLOW)) {
+        return x > 0 ? (float)INFINITY : -(float)INFINITY;
     }
-    if (y != target) {
-        if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
-        s->runCycles++;
-    }
-    if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
-        y = target;
-    } else {
-        y = rl_step_towards(y, target, negative ? p->maxUpNeg : p->maxUp, negative ? p->maxDownNeg : p->maxDown);
-    }
-    s->decided = RL_DECIDED_RAMP;
-    s->yPrevious = yp;
-    s->y = y;
-    s->uPrevious = u;
+    return (float)x;
 }
 
+/* The kernel's arithmetic, once per type (rate_limiter_rules.h): RL_ENTER
+ * brings a double that is not yet the type's into it. */
+#define RL_NUM double
+#define RL_SUFFIX _lreal
+#define RL_ENTER(x) (x)
+#define RL_FINITE_BELOW INFINITY
+#include "rate_limiter_rules.h"
+#undef RL_NUM
+#undef RL_SUFFIX
+#undef RL_ENTER
+#undef RL_FINITE_BELOW
+#define RL_NUM float
+#define RL_SUFFIX _real
+#define RL_ENTER(x) rl_binary32(x)
+#define RL_FINITE_BELOW RL_FLOAT_OVERFLOW
+#include "rate_limiter_rules.h"
+#undef RL_NUM
+#undef RL_SUFFIX
+#undef RL_ENTER
+#undef RL_FINITE_BELOW
+
+/* A value as it enters the block's arithmetic: u, every cycle. */
+static inline double rl_input(const RlPrepared *p, double u) {
+    return p->config.real ? (double)rl_binary32(u) : u;
+}
+
+/* Rule 6 (rl_ramp_cycle_lreal / _real) for a u that has entered. */
 static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
-    rl_ramp_cycle(s, p, u, false);
+    if (p->config.real) {
+        rl_ramp_cycle_real(s, p, u, false);
+    } else {
+        rl_ramp_cycle_lreal(s, p, u, false);
+    }
 }
 
-/* rl_ramp for finite u and y after rl_hold_period(s, p->period), with a
- * plain configuration: the same state. */
-static inline void rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
-    rl_ramp_cycle(s, p, u, true);
+/* rl_ramp after rl_hold_period(s, p->period) for a finite y, with a plain
+ * configuration: the same state. false: u is not finite in the block's
+ * arithmetic, nothing done (take the general path). */
+static inline bool rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
+    return p->config.real ? rl_ramp_steady_real(s, p, u) : rl_ramp_steady_lreal(s, p, u);
 }
 
 /* Rules 1-6 in their order. */
 void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
 
 /* The common case: finite u and y and a plain configuration, so that of
- * the rules only rule 6 (rl_ramp) applies. */
+ * the rules only rule 6 (rl_ramp) applies. u has entered. */
 static inline bool rl_only_ramps(const RlState *state, const RlPrepared *prepared, double u) {
     return prepared->plain && fabs(u - state->y) <= DBL_MAX;
 }
@@ -207,6 +219,7 @@ static inline bool rl_only_ramps(const RlState *state, const RlPrepared *prepare
  * to the end of this cycle. Inline, as the common case is a few
  * instructions. */
 static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed) {
+    u = rl_input(prepared, u);
     if (rl_only_ramps(state, prepared, u)) {
         rl_ramp(state, prepared, u);
     } else {

@@ -18,7 +18,7 @@ static int configure(const double *v, RlConfig *c) {
     c->yMin = (RlValue){ v[VR_setLowLim], VR_setLowLim };
     c->hold = false;
     c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
+    siemens_cycle(c, v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     int mode;
     if (v[VR_reset] != 0) {
         mode = MODE_RESET;
@@ -43,6 +43,7 @@ static int configure(const double *v, RlConfig *c) {
     c->initDelay = 0.0;
     c->passNonFinite = false;
     c->limitInitialOutput = false;
+    c->real = false;
     return mode;
 }
 

@@ -8,7 +8,7 @@ static int configure(const double *v, RlConfig *c) {
     c->rateUp = c->rateDown = (RlValue){ v[VR_setChangeRate], VR_setChangeRate };
     c->ratePeriod = (RlValue){ 1.0, VR_setChangeRate };
     c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = siemens_cycle(v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
+    siemens_cycle(c, v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     c->bypass = v[VR_enDefaultOutValue] != 0;
     c->bypassValue = v[VR_defaultOutValue];
     c->zeroRate = RL_ZERO_RATE_HOLD;
@@ -16,6 +16,7 @@ static int configure(const double *v, RlConfig *c) {
     c->initValue = 0.0;
     c->initDelay = 0.0;
     c->passNonFinite = false;
+    c->real = false;
     rl_without_section6(c);
     return 0;
 }

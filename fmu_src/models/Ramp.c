@@ -1,11 +1,18 @@
 /* Ramp (CODESYS; docs/models.md, Ramp): rVariation per tTime in both directions,
  * per task cycle when tTime = 0, rVariation 0 holds; eInitial and
- * tInitDelay are the kernel's init modes. */
+ * tInitDelay are the kernel's init modes. REAL pins, TIME in whole
+ * milliseconds (SPEC section 8). */
 #include "Ramp_variables.h"
+
+/* A TIME pin set in seconds: whole milliseconds, ties to even (nearbyint,
+ * not round: 0.0025 s is 2 ms), used in seconds. */
+static double time_ms(double seconds) {
+    return nearbyint(seconds * 1000.0) / 1000.0;
+}
 
 static int configure(const double *v, RlConfig *c) {
     c->rateUp = c->rateDown = (RlValue){ v[VR_rVariation], VR_rVariation };
-    c->ratePeriod = (RlValue){ v[VR_tTime], VR_tTime };
+    c->ratePeriod = (RlValue){ time_ms(v[VR_tTime]), VR_tTime };
     c->duration = (RlValue){ 0.0, 0 };
     c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };
     c->bypass = false;
@@ -13,8 +20,9 @@ static int configure(const double *v, RlConfig *c) {
     c->zeroRate = RL_ZERO_RATE_HOLD;
     c->initMode = (int)v[VR_eInitial];
     c->initValue = v[VR_rInitValue];
-    c->initDelay = v[VR_tInitDelay];
+    c->initDelay = time_ms(v[VR_tInitDelay]);
     c->passNonFinite = true;
+    c->real = true;
     rl_without_section6(c);
     return 0;
 }

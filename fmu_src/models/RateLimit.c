@@ -1,6 +1,7 @@
 /* RateLimit (Honeywell IRMN4; docs/models.md, RateLimit): rates per second, 0 = no
  * limit, null (NaN) inputs fall back to their parameters, Duration capped at
- * the block's 259200 s, OutSave/SavedOut restart. */
+ * the block's 259200 s, OutSave/SavedOut restart. REAL: the IRMN4 family's
+ * analog pins are 32-bit floats (SPEC section 8). */
 #include "RateLimit_variables.h"
 
 #define DURATION_MAX 259200.0
@@ -22,6 +23,7 @@ static int configure(const double *v, RlConfig *c) {
     c->initValue = v[VR_SavedOut];
     c->initDelay = 0.0;
     c->passNonFinite = true;
+    c->real = true;
     rl_without_section6(c);
     return 0;
 }

@@ -21,6 +21,7 @@ static int configure(const double *v, RlConfig *c) {
     c->initDelay = v[VR_initDelay];
     c->passNonFinite = true;
     c->limitInitialOutput = true;
+    c->real = (int)v[VR_arithmetic] == RL_ARITHMETIC_REAL;
     return 0;
 }
 

@@ -5,15 +5,14 @@
 
 #include "model.h"
 
-/* cycleTime (the OB interval) counts only when callOB is a cyclic
- * interrupt OB, 30..38 or 123 and above; else there is no valid cycle,
- * and callOB is the cause. */
-static inline RlValue siemens_cycle(double callOB, int callOBVr, double cycleTime, int cycleTimeVr) {
+/* A callOB that is no cyclic interrupt OB (30..38 or 123 and above) is a
+ * configuration error, 16#8601 caused by callOB; the block still runs its
+ * cycles at cycleTime (the OB interval): only the status reports it. */
+static inline void siemens_cycle(RlConfig *c, double callOB, int callOBVr, double cycleTime, int cycleTimeVr) {
     const bool cyclic = (callOB >= 30 && callOB <= 38) || callOB >= 123;
-    RlValue cycle;
-    cycle.value = cyclic ? cycleTime : NAN;
-    cycle.source = cyclic ? cycleTimeVr : callOBVr;
-    return cycle;
+    c->cycleTime.value = cycleTime;
+    c->cycleTime.source = cyclic ? cycleTimeVr : callOBVr;
+    c->cycleRefused = !cyclic;
 }
 
 #endif

@@ -1,6 +1,7 @@
 /* Unit tests of the rate limiter kernel: every rule (0 to 6, 5b) and every
  * status code (docs/rules.md), and the outputs derived from a
  * cycle. Expected values are worked by hand. */
+#include <float.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -585,8 +586,10 @@ static void test_fast_paths_equal_rules(void) {
     for (size_t y0 = 0; y0 < 3; y0++)
     for (size_t in = 0; in < 6; in++)
     for (size_t n = 0; n < 4; n++)
-    for (int extra = 0; extra < 6; extra++) {
+    for (int extra = 0; extra < 6; extra++)
+    for (int real = 0; real <= 1; real++) {
         RlConfig c = defaults();
+        c.real = real;
         c.rateUp.value = rates[r];
         c.rateDown.value = rates[(r + 1) % 4];
         c.duration.value = durations[d];
@@ -656,8 +659,10 @@ static void test_steady_ramp_equals_rules(void) {
     for (size_t d = 0; d < 3; d++)
     for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
     for (size_t in = 0; in < ROWS; in++)
-    for (int repeat = 1; repeat <= 12; repeat += 11) {
+    for (int repeat = 1; repeat <= 12; repeat += 11)
+    for (int real = 0; real <= 1; real++) {
         RlConfig c = defaults();
+        c.real = real;
         c.rateUp.value = rates[r];
         c.rateDown.value = rates[(r + 2) % 3];
         c.duration.value = durations[d];
@@ -676,9 +681,8 @@ static void test_steady_ramp_equals_rules(void) {
             for (int n = 0; n < repeat; n++) {
                 const double u = inputs[in][k];
                 elapsed += periods[k];
-                if (held && isfinite(u)) {
-                    rl_ramp_steady(&steady, &p, u);
-                } else {
+                /* as the FMU: the common step unless u is not finite in the arithmetic */
+                if (!(held && rl_ramp_steady(&steady, &p, u))) {
                     rl_cycle(&steady, &p, u, elapsed);
                 }
                 held = p.plain && isfinite(steady.y);
@@ -1060,6 +1064,135 @@ static void test_init_of_a_used_state(void) {
     CHECK_EQ(s.runBase, 0.0);
 }
 
+/* ---- SPEC section 8: REAL ------------------------------------------- */
+
+/* binary32 rounding as a value enters: to nearest, ties to even, and
+ * from 2^128 - 2^103 on (halfway above FLT_MAX) an infinity */
+static void test_binary32_entry(void) {
+    CHECK_BITS((double)rl_binary32(0.01), 0.009999999776482582);
+    CHECK_BITS((double)rl_binary32(1.0 + ldexp(1.0, -24)), 1.0);              /* a tie: to even */
+    CHECK_BITS((double)rl_binary32(1.0 + 3 * ldexp(1.0, -24)), 1.0 + ldexp(1.0, -22));
+    CHECK_BITS((double)rl_binary32(RL_FLOAT_OVERFLOW), INFINITY);
+    CHECK_BITS((double)rl_binary32(-RL_FLOAT_OVERFLOW), -INFINITY);
+    CHECK_BITS((double)rl_binary32(nextafter(RL_FLOAT_OVERFLOW, 0.0)), (double)FLT_MAX);
+    CHECK_BITS((double)rl_binary32(1e300), INFINITY);
+    CHECK_BITS((double)rl_binary32(-1e-50), -0.0);
+    CHECK_TRUE(isnan(rl_binary32(NAN)));
+}
+
+/* Worked by hand (SPEC section 8): 0.01 per cycle from 262000. In REAL the
+ * step is the float 0.009999999776, which below 2^18 rounds up to the
+ * float spacing 2^-6 and at 2^18 = 262144 (spacing 2^-5) rounds away: the
+ * ramp stalls there, still limited. In LREAL each step is 0.01 rounded to
+ * the double spacing, 171798692 * 2^-34 on both sides of 2^18. */
+static void test_real_ramp_stalls_at_2_pow_18(void) {
+    RlConfig c = defaults();
+    c.ratePeriod.value = 0.0;
+    c.rateUp.value = c.rateDown.value = 0.01;
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = 262000.0;
+    for (int real = 0; real <= 1; real++) {
+        c.real = real;
+        Block b;
+        start(&b, &c, 1e6, 0.01);
+        for (int n = 1; n <= 9216; n++) {
+            cycle(&b, 1e6);
+            if (real && (n == 1 || n == 9215)) CHECK_BITS(b.state.y, 262000.0 + n / 64.0);
+        }
+        CHECK_BITS(b.state.y, real ? 262144.0 : 262000.0 + ldexp(9216.0 * 171798692.0, -34));
+        RlState run = b.state;
+        for (int n = 0; n < 20000 - 9216; n++) cycle(&b, 1e6);
+        rl_run(&run, &b.prepared, 1e6, 9217, 20000, 0.01);
+        check_same_state(&run, &b.state);
+        CHECK_BITS(b.state.y, real ? 262144.0 : 262000.0 + ldexp(20000.0 * 171798692.0, -34));
+        const RlOutputs o = outputs(&b);
+        CHECK_TRUE(o.rampActive && o.limitingUp); /* REAL: yp + maxUp = 262144 < 1e6, and no move */
+        CHECK_BITS(o.dydt, real ? 0.0 : ldexp(171798692.0, -34) / 0.01);
+    }
+}
+
+/* 1e-5 per cycle from 20 to 30: the float step is 5.24 spacings of 2^-19
+ * and rounds to 5, so 30 takes 2^20 = 1,048,576 cycles; the double step
+ * 2814749767 * 2^-48 is a little under 1e-5: 1,000,001 cycles. */
+static void test_real_slow_ramp(void) {
+    RlConfig c = defaults();
+    c.ratePeriod.value = 0.0;
+    c.rateUp.value = c.rateDown.value = 1e-5;
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = 20.0;
+    Block b;
+    c.real = true;
+    start(&b, &c, 30.0, 0.01);
+    rl_run(&b.state, &b.prepared, 30.0, 1, (1u << 20) - 1, 0.01);
+    CHECK_BITS(b.state.y, 30.0 - 5 * ldexp(1.0, -19));
+    rl_run(&b.state, &b.prepared, 30.0, 1u << 20, 1u << 20, 0.01);
+    CHECK_BITS(b.state.y, 30.0);
+    c.real = false;
+    start(&b, &c, 30.0, 0.01);
+    rl_run(&b.state, &b.prepared, 30.0, 1, 1000000, 0.01);
+    CHECK_BITS(b.state.y, 20.0 + ldexp(1000000.0 * 2814749767.0, -48));
+    rl_run(&b.state, &b.prepared, 30.0, 1000001, 1000001, 0.01);
+    CHECK_BITS(b.state.y, 30.0);
+}
+
+/* What enters is judged in binary32: values beyond the float range are
+ * infinities, tiny ones zeros, and values equal as floats are equal. */
+static void test_real_entry_values(void) {
+    for (int real = 0; real <= 1; real++) {
+        RlConfig c = defaults();
+        c.real = real;
+        RlPrepared p;
+        c.rateUp.value = -1e-50;                       /* -0 in binary32: not negative */
+        rl_prepare(&p, resolved(&c), 0.1);
+        CHECK_EQ(p.status, real ? RL_STATUS_OK : RL_STATUS_RATE_NEGATIVE);
+        CHECK_EQ(p.maxUp, real ? 0.0 : -1e-50 * 0.1);  /* a rate of 0 holds */
+        c = defaults(); c.real = real;
+        c.ratePeriod.value = 1e39;                     /* +inf in binary32 */
+        rl_prepare(&p, resolved(&c), 0.1);
+        CHECK_EQ(p.status, real ? RL_STATUS_RATE_PERIOD : RL_STATUS_OK);
+        c = defaults(); c.real = real;
+        c.yMax.value = 1.0; c.yMin.value = 1.00000001; /* the same float */
+        rl_prepare(&p, resolved(&c), 0.1);
+        CHECK_EQ(p.status, real ? RL_STATUS_OK : RL_STATUS_LIMITS);
+        /* a u beyond the float range passes as +inf (rule 1); a finite one ramps */
+        c = defaults(); c.real = real;
+        Block b;
+        start(&b, &c, 0.0, 0.1);
+        CHECK_BITS(cycle(&b, 1e39), real ? INFINITY : 0.1);
+        /* inputs that differ below float precision are the same input */
+        start(&b, &c, 0.0, 0.1);
+        cycle(&b, 5.0);
+        cycle(&b, 5.0000000001);
+        CHECK_EQ(rl_running_time(&b.state), real ? 0.2 : 0.1);
+        CHECK_BITS(b.state.uPrevious, real ? 5.0 : 5.0000000001);
+        /* the initial output enters too */
+        c.initMode = RL_INIT_VALUE;
+        c.initValue = 0.1;
+        start(&b, &c, 0.0, 0.1);
+        CHECK_BITS(b.state.y, real ? 0.10000000149011612 : 0.1);
+        /* the limit: rate * T / ratePeriod, each step in binary32 */
+        c = defaults(); c.real = real;
+        c.rateUp.value = 3.0;
+        c.ratePeriod.value = 0.7;
+        rl_prepare(&p, resolved(&c), 0.1);
+        CHECK_BITS(p.maxUp, real ? (double)((3.0f * 0.1f) / 0.7f) : 3.0 * 0.1 / 0.7);
+    }
+}
+
+/* dydt in binary32: (y - yp) / T, T rounded; a step of 2^-6 over the float
+ * 0.01 is 1.5625000349, the float 1.5625 */
+static void test_real_dydt(void) {
+    RlConfig c = defaults();
+    c.real = true;
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = 262000.0;
+    Block b;
+    start(&b, &c, 1e6, 0.01);
+    cycle(&b, 1e6);
+    CHECK_BITS(b.state.y, 262000.015625);
+    CHECK_BITS(outputs(&b).dydt, 1.5625);
+}
+
 int main(void) {
     test_rule0_resolve();
     test_rule0_limits();
@@ -1087,6 +1220,11 @@ int main(void) {
     test_derived_outputs_by_cycle();
     test_without_section6();
     test_init_of_a_used_state();
+    test_binary32_entry();
+    test_real_ramp_stalls_at_2_pow_18();
+    test_real_slow_ramp();
+    test_real_entry_values();
+    test_real_dydt();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }

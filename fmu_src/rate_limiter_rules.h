@@ -1,0 +1,123 @@
+/* The kernel's arithmetic over one value type RL_NUM, one source compiled
+ * twice: rate_limiter.h includes it with RL_NUM double (names ending
+ * _lreal) and float (_real), SPEC section 8. Outside these functions the
+ * block keeps its values as doubles (state, limits, configuration): in
+ * REAL they are binary32 values widened, so the conversions here are exact
+ * and every operation below is one RL_NUM operation, rounded as C rounds
+ * it with FLT_EVAL_METHOD 0, in the contract's order. No include guard: it
+ * is meant to be included once per type. */
+
+#define RL_NAME(name) RL_NAME_(name, RL_SUFFIX)
+#define RL_NAME_(name, suffix) RL_NAME__(name, suffix)
+#define RL_NAME__(name, suffix) name##suffix
+
+/* Rule 0's per-cycle limit of a rate other than 0: rate * T / ratePeriod
+ * left to right, or the rate itself per cycle. */
+static inline double RL_NAME(rl_per_cycle)(double rate, double period, double ratePeriod) {
+    if (ratePeriod > 0) {
+        return (double)((RL_NUM)rate * RL_ENTER(period) / (RL_NUM)ratePeriod);
+    }
+    return rate;
+}
+
+/* Rule 6's step of y towards the target at the per-cycle limits, never
+ * past it: every path that ramps (rl_ramp_cycle, rl_run's sub-cycles, and
+ * through them the FMUs' common step) takes it from here. */
+static inline RL_NUM RL_NAME(rl_step_towards)(RL_NUM y, RL_NUM target, RL_NUM maxUp, RL_NUM maxDown) {
+    if (target > y) {
+        const RL_NUM limited = y + maxUp;
+        return limited < target ? limited : target;
+    }
+    if (target < y) {
+        const RL_NUM limited = y - maxDown;
+        return limited > target ? limited : target;
+    }
+    return y;
+}
+
+/* Rule 6: ramp towards uc at the limits picked by the output's sign, or
+ * jump to uc once the duration has run out. u has entered the block's
+ * arithmetic (rl_input). steady: u and y are finite, runPeriod is already
+ * p->period (rl_hold_period) and the configuration is plain (uc is u, the
+ * limits are the same for both signs), which spares the checks; a
+ * constant, so each caller gets its own copy. */
+static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, double u, bool steady) {
+    const double ypHeld = s->y;
+    const RL_NUM yp = (RL_NUM)ypHeld;
+    const bool negative = !steady && yp < 0;
+    const RL_NUM target = (RL_NUM)(steady ? u : rl_target(u, p));
+    RL_NUM y = yp;
+    if (u != s->uPrevious) {
+        s->runCycles = 0;
+        s->runBase = 0.0;
+    }
+    if (y != target) {
+        if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
+        s->runCycles++;
+    }
+    if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
+        y = target;
+    } else {
+        y = RL_NAME(rl_step_towards)(y, target, (RL_NUM)(negative ? p->maxUpNeg : p->maxUp),
+                                     (RL_NUM)(negative ? p->maxDownNeg : p->maxDown));
+    }
+    s->decided = RL_DECIDED_RAMP;
+    s->yPrevious = ypHeld;
+    s->y = (double)y;
+    s->uPrevious = u;
+}
+
+/* The common step's cycle: false (nothing done) if u is not finite in the
+ * arithmetic, else rule 6 as rl_ramp_cycle's steady one (the caller has
+ * checked the rest: plain, y finite, runPeriod). RL_FINITE_BELOW: the
+ * magnitude from which a double is not finite in RL_NUM (binary32: what
+ * rounds to an infinity), so the conversion is exact or rounds. */
+static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, double u) {
+    if (!(fabs(u) < RL_FINITE_BELOW)) {
+        return false;
+    }
+    RL_NAME(rl_ramp_cycle)(s, p, (double)(RL_NUM)u, true);
+    return true;
+}
+
+/* rl_run's cycles after the first, u held and plain: each is rule 6
+ * without its resets; once y reaches u nothing changes any more. */
+static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, double uHeld, uint64_t first, uint64_t last) {
+    const RL_NUM u = (RL_NUM)uHeld, maxUp = (RL_NUM)p->maxUp, maxDown = (RL_NUM)p->maxDown;
+    RL_NUM y = (RL_NUM)s->y, yp = (RL_NUM)s->yPrevious;
+    uint64_t cycles = s->runCycles;
+    uint64_t n = first + 1;
+    for (; n <= last && y != u; n++) {
+        cycles++;
+        yp = y;
+        if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
+            y = u;
+        } else {
+            y = RL_NAME(rl_step_towards)(y, u, maxUp, maxDown);
+        }
+    }
+    if (n <= last) {
+        yp = y; /* cycles that found y at u */
+    }
+    s->y = (double)y;
+    s->yPrevious = (double)yp;
+    s->runCycles = cycles;
+}
+
+/* The derived outputs that compute: dydt = (y - yp) / T, and whether the
+ * step's limit cut it (yp + maxUp < uc, yp - maxDown > uc). */
+static inline double RL_NAME(rl_dydt)(double y, double yp, double period) {
+    return (double)(((RL_NUM)y - (RL_NUM)yp) / RL_ENTER(period));
+}
+
+static inline bool RL_NAME(rl_cut_up)(double yp, double maxUp, double uc) {
+    return (RL_NUM)yp + (RL_NUM)maxUp < (RL_NUM)uc;
+}
+
+static inline bool RL_NAME(rl_cut_down)(double yp, double maxDown, double uc) {
+    return (RL_NUM)yp - (RL_NUM)maxDown > (RL_NUM)uc;
+}
+
+#undef RL_NAME
+#undef RL_NAME_
+#undef RL_NAME__
