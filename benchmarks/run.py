@@ -33,6 +33,8 @@ PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 # (Feedthrough, -O3) and fmpy
 TARGETS = {
     "step_instructions": 150, "doStep_instructions": 60, "subcycle_instructions": 25,
+    # the same budgets for the REAL (binary32) path
+    "real_step_instructions": 150, "real_doStep_instructions": 60, "real_subcycle_instructions": 25,
     "step_over_kernel": 2.0, "instance_bytes": 1024, "fmpy_ratio": 1.05,
 }
 ANCHORS = {
@@ -55,10 +57,17 @@ def model_info(build, model, version):
 FEATURES = {"yMaxPar": 1e300, "yMinPar": -1e300, "rateUpNeg": 2.0, "rateDownNeg": 2.0}
 
 
+# The REAL (binary32) path: the Ramp FB, whose pins are REAL (SPEC section 8)
+REAL_MODEL = "Ramp"
+# each model's input u and output y
+PINS = {"RateLimiter": ("u", "y"), "Ramp": ("rIn", "rOut"), "PassThrough": ("u", "y")}
+
+
 def bench_args(build, model, version, steps, repeats, start=None):
     binary, token, vr = model_info(build, model, version)
     extra = [f"{vr[name]}={value!r}" for name, value in (start or {}).items()]
-    return [str(build / "fmu_bench"), str(version), str(binary), token, str(vr["u"]), str(vr["y"]),
+    u, y = PINS[model]
+    return [str(build / "fmu_bench"), str(version), str(binary), token, str(vr[u]), str(vr[y]),
             str(vr.get("cycleTime", -1)), str(steps), str(repeats)] + extra
 
 
@@ -164,6 +173,9 @@ def table(results, smoke, commands):
          "{:.0f}", ""),
         ("instructions, doStep alone, limits and Neg rates in use", "features_doStep_instructions", "{:.0f}", ""),
         ("instructions per extra sub-cycle", "subcycle_instructions", "{:.1f}", "<= 25"),
+        ("instructions, set u + doStep + get y, REAL (Ramp)", "real_step_instructions", "{:.0f}", "<= 150"),
+        ("instructions, doStep alone, REAL (Ramp)", "real_doStep_instructions", "{:.0f}", "<= 60"),
+        ("instructions per extra sub-cycle, REAL (Ramp)", "real_subcycle_instructions", "{:.1f}", "<= 25"),
         ("instructions, set u alone / get y alone", "set_get_instructions", "{}", ""),
         ("instructions, kernel rl_cycle (floor)", "kernel_instructions", "{:.0f}", ""),
         ("instructions, PassThrough set + doStep + get", "fixture_step_instructions", "{:.0f}", ""),
@@ -231,6 +243,9 @@ def main():
             features = run_callgrind(build, MODEL, version, cg_steps, FEATURES)
             r["features_step_instructions"] = features["step_instructions"]
             r["features_doStep_instructions"] = features["doStep_instructions"]
+            real = run_callgrind(build, REAL_MODEL, version, cg_steps)
+            for key in ("step_instructions", "doStep_instructions", "subcycle_instructions"):
+                r[f"real_{key}"] = real[key]
         r.update(run_fmpy(build, version, fmpy_steps, fmpy_repeats))
         results[version] = r
         print(f"FMI {version}: " + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
