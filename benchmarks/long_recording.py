@@ -88,11 +88,19 @@ def generate(root, hours):
     return folder, cycles
 
 
-def measured(command):
-    """(seconds, peak MB, exit status, output) of a command in a fresh process: its own VmHWM, from wait4."""
+def measured(command, timeout=None):
+    """(seconds, peak MB, exit status, output) of a command in a fresh process: its own VmHWM, from wait4.
+    Killed after timeout seconds (status -9)."""
     started = time.perf_counter()
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    timer = None
+    if timeout is not None:
+        import threading
+        timer = threading.Timer(timeout, process.kill)
+        timer.start()
     output = process.stdout.read()
+    if timer is not None:
+        timer.cancel()
     _, status, usage = os.wait4(process.pid, 0)
     seconds = time.perf_counter() - started
     process.returncode = os.waitstatus_to_exitcode(status)
@@ -127,6 +135,7 @@ def main():
     parser.add_argument("--build-dir", type=Path, default=Path("build"))
     parser.add_argument("--hours", type=float, nargs="+", default=[1, 12, 48])
     parser.add_argument("--smoke", action="store_true", help="a 36 s recording: keeps the script working in CI")
+    parser.add_argument("--anchor-timeout", type=float, default=900.0, help="seconds fmpy may take (default 900)")
     parser.add_argument("--child", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -177,13 +186,20 @@ def main():
 
     shortest = rows[0]
     case = root / f"{shortest['hours']:g}h" / "case"
-    seconds, _, status, output = measured([sys.executable, __file__, "--child", "fmpy", str(fmu), str(case)])
-    if status != 0:
+    seconds, _, status, output = measured([sys.executable, __file__, "--child", "fmpy", str(fmu), str(case)],
+                                          timeout=args.anchor_timeout)
+    if status == -9:
+        anchor = None
+        print(f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles) did not finish "
+              f"within {args.anchor_timeout:g} s; fmutrace run on it: {shortest['run_s']:.1f} s in all, more than "
+              f"{args.anchor_timeout / shortest['run_s']:.0f} times faster")
+    elif status != 0:
         raise SystemExit(f"fmpy.simulate_fmu failed:\n{output[-3000:]}")
-    anchor = float(output.split()[-1])
-    print(f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles): {anchor:.1f} s "
-          f"of simulation ({anchor / shortest['cycles'] * 1e6:.1f} us per cycle); fmutrace run on it: "
-          f"{shortest['run_s']:.1f} s in all, {anchor / shortest['run_s']:.1f} times faster")
+    else:
+        anchor = float(output.split()[-1])
+        print(f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles): {anchor:.1f} s "
+              f"of simulation ({anchor / shortest['cycles'] * 1e6:.1f} us per cycle); fmutrace run on it: "
+              f"{shortest['run_s']:.1f} s in all, {anchor / shortest['run_s']:.1f} times faster")
     print(json.dumps({"rows": rows, "fmpy_seconds": anchor}))
     for line in missed:
         print(f"MISSED: {line}")
