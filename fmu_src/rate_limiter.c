@@ -67,8 +67,8 @@ static RlValue binary32_value(RlValue v) {
     return v;
 }
 
-/* REAL: the values that enter the signal path, rounded once here (SPEC
- * section 8); times (duration, cycleTime, initDelay) stay binary64. */
+/* REAL: the values that enter the signal path, rounded once here (rules.md,
+ * Arithmetic); times (duration, cycleTime, initDelay) stay binary64. */
 static RlConfig entered(const RlConfig *c) {
     RlConfig r = *c;
     if (c->real) {

@@ -8,7 +8,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-/* REAL arithmetic (SPEC section 8) rounds every float operation to float:
+/* REAL arithmetic (rules.md, Arithmetic) rounds every float operation to float:
  * a target that evaluates floats in a wider type (x87) would not. */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
 #error "the kernel needs FLT_EVAL_METHOD 0 (each float operation rounded to float): build with SSE, not x87"
@@ -70,7 +70,7 @@ typedef struct {
      * only compared with the output, so NaN holds and +-inf ramps. */
     bool passNonFinite;
     bool limitInitialOutput;   /* the initial output within [yMin, yMax] */
-    /* REAL (SPEC section 8): the signal path in binary32. rl_prepare
+    /* REAL (rules.md, Arithmetic): the signal path in binary32. rl_prepare
      * rounds the values that enter it; u is rounded each cycle (rl_input). */
     bool real;
 } RlConfig;

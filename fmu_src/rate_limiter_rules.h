@@ -1,6 +1,6 @@
 /* The kernel's arithmetic over one value type RL_NUM, one source compiled
  * twice: rate_limiter.h includes it with RL_NUM double (names ending
- * _lreal) and float (_real), SPEC section 8. Outside these functions the
+ * _lreal) and float (_real), rules.md, Arithmetic. Outside these functions the
  * block keeps its values as doubles (state, limits, configuration): in
  * REAL they are binary32 values widened, so the conversions here are exact
  * and every operation below is one RL_NUM operation, rounded as C rounds

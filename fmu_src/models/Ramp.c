@@ -1,7 +1,7 @@
 /* Ramp (CODESYS; docs/models.md, Ramp): rVariation per tTime in both directions,
  * per task cycle when tTime = 0, rVariation 0 holds; eInitial and
  * tInitDelay are the kernel's init modes. REAL pins, TIME in whole
- * milliseconds (SPEC section 8). */
+ * milliseconds (rules.md, Arithmetic). */
 #include "Ramp_variables.h"
 
 /* A TIME pin set in seconds: whole milliseconds, ties to even (nearbyint,

@@ -1,7 +1,7 @@
 /* RateLimit (Honeywell IRMN4; docs/models.md, RateLimit): rates per second, 0 = no
  * limit, null (NaN) inputs fall back to their parameters, Duration capped at
  * the block's 259200 s, OutSave/SavedOut restart. REAL: the IRMN4 family's
- * analog pins are 32-bit floats (SPEC section 8). */
+ * analog pins are 32-bit floats (rules.md, Arithmetic). */
 #include "RateLimit_variables.h"
 
 #define DURATION_MAX 259200.0
