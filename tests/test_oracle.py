@@ -1,4 +1,4 @@
-"""The oracle's binary32 arithmetic (SPEC section 8) checked on its own:
+"""The oracle's binary32 arithmetic (rules.md, Arithmetic) checked on its own:
 f32 rounds as IEEE binary32 does, one operation of binary32 values in
 binary64 rounded by f32 is the operation in binary32 (numpy's float32
 scalars, which compute each operation in single precision, agree bit for

@@ -3,7 +3,7 @@ tunable changes mid-run) through the FMU and the oracle: every output must
 agree bit for bit after every step the importer reads it (outputs are
 published when read, so reading after some steps only must not change
 them). Ramp and RateLimit compute in REAL, RateLimiter in either
-arithmetic (SPEC section 8): the values include some that binary32 cannot
+arithmetic (rules.md, Arithmetic): the values include some that binary32 cannot
 hold (beyond its largest value, below its smallest) and times between
 milliseconds."""
 import math

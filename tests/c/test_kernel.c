@@ -1064,7 +1064,7 @@ static void test_init_of_a_used_state(void) {
     CHECK_EQ(s.runBase, 0.0);
 }
 
-/* ---- SPEC section 8: REAL ------------------------------------------- */
+/* ---- rules.md, Arithmetic: REAL---------------------------------------- */
 
 /* binary32 rounding as a value enters: to nearest, ties to even, and
  * from 2^128 - 2^103 on (halfway above FLT_MAX) an infinity */
@@ -1080,7 +1080,7 @@ static void test_binary32_entry(void) {
     CHECK_TRUE(isnan(rl_binary32(NAN)));
 }
 
-/* Worked by hand (SPEC section 8): 0.01 per cycle from 262000. In REAL the
+/* Worked by hand (rules.md, Arithmetic): 0.01 per cycle from 262000. In REAL the
  * step is the float 0.009999999776, which below 2^18 rounds up to the
  * float spacing 2^-6 and at 2^18 = 262144 (spacing 2^-5) rounds away: the
  * ramp stalls there, still limited. In LREAL each step is 0.01 rounded to
