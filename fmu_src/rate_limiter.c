@@ -94,6 +94,9 @@ void rl_prepare(RlPrepared *p, const RlConfig *config, double period) {
     p->maxDown = cycle_limit(c->rateDown.value, c, period);
     p->maxUpNeg = cycle_limit(c->rateUpNeg.value, c, period);
     p->maxDownNeg = cycle_limit(c->rateDownNeg.value, c, period);
+    /* binary32 values in REAL, so exact; LREAL never reads them */
+    p->maxUpReal = c->real ? (float)p->maxUp : 0.0f;
+    p->maxDownReal = c->real ? (float)p->maxDown : 0.0f;
     p->yLow = isnan(c->yMin.value) ? -INFINITY : c->yMin.value;
     p->yHigh = isnan(c->yMax.value) ? INFINITY : c->yMax.value;
     p->durationReached = c->duration.value * (1.0 - RL_TIME_TOLERANCE);

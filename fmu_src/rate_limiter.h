@@ -81,6 +81,9 @@ typedef struct {
     double period;             /* T the limits were computed for */
     double maxUp, maxDown;     /* per-cycle limits; +inf = no limit */
     double maxUpNeg, maxDownNeg; /* the same while the output is < 0 */
+    /* REAL: maxUp and maxDown as the binary32 values they are (rl_prepare
+     * rounds what they come from), so that rule 6 reads them unconverted */
+    float maxUpReal, maxDownReal;
     double yLow, yHigh;        /* output limits; -inf and +inf for none */
     double durationReached;    /* runningTime at or above this jumps */
     double initDelayEnd;       /* elapsed time up to which initMode 3 tracks */
@@ -165,25 +168,34 @@ static inline float rl_binary32(double x) {
 }
 
 /* The kernel's arithmetic, once per type (rate_limiter_rules.h): RL_ENTER
- * brings a double that is not yet the type's into it. */
+ * brings a double that is not yet the type's into it; RL_MAX_UP and
+ * RL_MAX_DOWN are the per-cycle limits in the type. */
 #define RL_NUM double
 #define RL_SUFFIX _lreal
 #define RL_ENTER(x) (x)
 #define RL_FINITE_BELOW INFINITY
+#define RL_MAX_UP(p) ((p)->maxUp)
+#define RL_MAX_DOWN(p) ((p)->maxDown)
 #include "rate_limiter_rules.h"
 #undef RL_NUM
 #undef RL_SUFFIX
 #undef RL_ENTER
 #undef RL_FINITE_BELOW
+#undef RL_MAX_UP
+#undef RL_MAX_DOWN
 #define RL_NUM float
 #define RL_SUFFIX _real
 #define RL_ENTER(x) rl_binary32(x)
 #define RL_FINITE_BELOW RL_FLOAT_OVERFLOW
+#define RL_MAX_UP(p) ((p)->maxUpReal)
+#define RL_MAX_DOWN(p) ((p)->maxDownReal)
 #include "rate_limiter_rules.h"
 #undef RL_NUM
 #undef RL_SUFFIX
 #undef RL_ENTER
 #undef RL_FINITE_BELOW
+#undef RL_MAX_UP
+#undef RL_MAX_DOWN
 
 /* A value as it enters the block's arithmetic: u, every cycle. */
 static inline double rl_input(const RlPrepared *p, double u) {

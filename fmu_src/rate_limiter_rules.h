@@ -51,15 +51,17 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
         s->runCycles = 0;
         s->runBase = 0.0;
     }
-    if (y != target) {
+    /* y != target; steady (both finite), as the comparisons the step
+     * makes, so that they are made once */
+    if (steady ? target > y || target < y : y != target) {
         if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
         s->runCycles++;
     }
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
         y = target;
     } else {
-        y = RL_NAME(rl_step_towards)(y, target, (RL_NUM)(negative ? p->maxUpNeg : p->maxUp),
-                                     (RL_NUM)(negative ? p->maxDownNeg : p->maxDown));
+        y = RL_NAME(rl_step_towards)(y, target, negative ? (RL_NUM)p->maxUpNeg : RL_MAX_UP(p),
+                                     negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p));
     }
     s->decided = RL_DECIDED_RAMP;
     s->yPrevious = ypHeld;
@@ -83,7 +85,7 @@ static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, doub
 /* rl_run's cycles after the first, u held and plain: each is rule 6
  * without its resets; once y reaches u nothing changes any more. */
 static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, double uHeld, uint64_t first, uint64_t last) {
-    const RL_NUM u = (RL_NUM)uHeld, maxUp = (RL_NUM)p->maxUp, maxDown = (RL_NUM)p->maxDown;
+    const RL_NUM u = (RL_NUM)uHeld, maxUp = RL_MAX_UP(p), maxDown = RL_MAX_DOWN(p);
     RL_NUM y = (RL_NUM)s->y, yp = (RL_NUM)s->yPrevious;
     uint64_t cycles = s->runCycles;
     uint64_t n = first + 1;
