@@ -4,7 +4,9 @@
 components, their connectors (kind and type from the FMUs' model
 descriptions) and connections, the parameter values in an SSV file per
 component (bound to it: the binding every importer tested reads), both
-FMUs under resources/. The zip's entries are sorted and time-stamped
+FMUs under resources/. Beside the standard content the system carries
+OMSimulator's annotation naming its master algorithm (a fixed-step master
+at the system's step size): OMSimulator refuses a system without one. The zip's entries are sorted and time-stamped
 2000-01-01, so the same inputs give the same bytes.
 
     ssp.py <system.toml> <build dir> <out.ssp>
@@ -20,6 +22,7 @@ from fmpy import read_model_description
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
 TYPES = {"Real": "Real", "Float64": "Real", "Integer": "Integer", "Int32": "Integer", "Boolean": "Boolean",
          "String": "String"}
 KINDS = {"input": "input", "output": "output", "parameter": "parameter"}
@@ -81,13 +84,23 @@ def package(system_toml, build_dir, out):
                            f'endElement="{end}" endConnector="{end_connector}"/>')
     files["SystemStructure.ssd"] = "\n".join(
         ['<?xml version="1.0" encoding="UTF-8"?>',
-         f'<ssd:SystemStructureDescription xmlns:ssc="{SSC}" xmlns:ssd="{SSD}" version="1.0" '
+         f'<ssd:SystemStructureDescription xmlns:ssc="{SSC}" xmlns:ssd="{SSD}" xmlns:oms="{OMS}" version="1.0" '
          f'name={quoteattr(system["name"])}>',
          f'  <ssd:System name={quoteattr(system["name"])} description={quoteattr(system["description"])}>',
          "    <ssd:Elements>"] + components + [
          "    </ssd:Elements>",
          "    <ssd:Connections>"] + connections + [
          "    </ssd:Connections>",
+         "    <ssd:Annotations>",
+         '      <ssc:Annotation type="org.openmodelica">',
+         "        <oms:Annotations>",
+         "          <oms:SimulationInformation>",
+         f'            <oms:FixedStepMaster description="oms-ma" stepSize="{system["stepSize"]!r}" '
+         'relativeTolerance="1e-06"/>',
+         "          </oms:SimulationInformation>",
+         "        </oms:Annotations>",
+         "      </ssc:Annotation>",
+         "    </ssd:Annotations>",
          "  </ssd:System>",
          f'  <ssd:DefaultExperiment startTime="{system["startTime"]!r}" stopTime="{system["stopTime"]!r}"/>',
          "</ssd:SystemStructureDescription>", ""])

@@ -13,6 +13,7 @@ against the SSP 1.0 schemas fmpy ships."""
 import math
 import os
 import sys
+import tomllib
 import zipfile
 from pathlib import Path
 
@@ -22,7 +23,7 @@ from fmpy import read_model_description
 from fmpy.util import read_csv
 
 from support.closed_loop import H, LIMITER, N, PLANT
-from support.fmu_driver import BUILD_DIR, TESTS, fmu_file
+from support.fmu_driver import BUILD_DIR, REPO, TESTS, fmu_file
 from support.process import run as run_bounded
 from support.oracle import oracle_for
 
@@ -91,6 +92,27 @@ def test_the_ssp_package_is_valid_against_the_ssp_schemas():
             assert validator.validate(document), (name, validator.error_log)
         with z.open("resources/RateLimiter.fmu") as inside:
             assert inside.read() == (BUILD_DIR / "fmi2" / "RateLimiter.fmu").read_bytes()
+
+
+def test_the_ssp_package_names_omsimulators_master_algorithm():
+    """Beside the standard content, the system carries OMSimulator's
+    vendor annotation with its master algorithm: a fixed-step master
+    ("oms-ma") at the system's step size (OMSimulator refuses a system
+    without one; docs/testing.md has the run)."""
+    from lxml import etree
+
+    with zipfile.ZipFile(BUILD_DIR / "ssp" / "RateLimiterLoop.ssp") as z:
+        ssd = etree.fromstring(z.read("SystemStructure.ssd"))
+    ns = {"ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+          "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+          "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"}
+    masters = ssd.findall("ssd:System/ssd:Annotations/ssc:Annotation[@type='org.openmodelica']/oms:Annotations/"
+                          "oms:SimulationInformation/oms:FixedStepMaster", ns)
+    system = tomllib.loads((REPO / "modelDescription" / "systems" / "RateLimiterLoop.toml").read_text())["system"]
+    assert len(masters) == 1 and masters[0].get("description") == "oms-ma"
+    assert float(masters[0].get("stepSize")) == system["stepSize"]
+    experiment = ssd.find("ssd:DefaultExperiment", ns)
+    assert float(experiment.get("stopTime")) == system["stopTime"]
 
 
 def test_a_broken_package_fails_the_schema():
