@@ -4,7 +4,8 @@
 #   fmu_sources(<var> <Model> <2|3>): the kernel, the core, the FMI glue
 #   of that version and the model's mapping
 #   FMU_HEADERS: the headers they include (the source FMU carries them)
-set(FMU_HEADERS fmu_src/rate_limiter.h fmu_src/rate_limiter_rules.h fmu_src/model.h fmu_src/fmu_core.h fmu_src/models/siemens.h)
+set(FMU_HEADERS fmu_src/rate_limiter.h fmu_src/rate_limiter_rules.h fmu_src/model.h fmu_src/fmu_core.h
+                fmu_src/models/siemens.h fmu_src/models/unified.h)
 
 function(fmu_sources out model version)
   set(${out} fmu_src/rate_limiter.c fmu_src/fmu_core.c fmu_src/fmi${version}_glue.c fmu_src/models/${model}.c

@@ -147,7 +147,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
     (void)toleranceDefined;
     (void)tolerance;
     BEGIN(SetupExperiment);
-    if (stopTimeDefined && !(stopTime >= startTime)) {
+    if (stopTimeDefined && !isgreaterequal(stopTime, startTime)) {
         return (fmi2Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
     }
     return (fmi2Status)fmu_setup_experiment(I, FN, startTime);

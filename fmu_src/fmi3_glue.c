@@ -147,7 +147,7 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
     (void)toleranceDefined;
     (void)tolerance;
     BEGIN(EnterInitializationMode);
-    if (stopTimeDefined && !(stopTime >= startTime)) {
+    if (stopTimeDefined && !isgreaterequal(stopTime, startTime)) {
         return (fmi3Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
     }
     CHECK(fmu_setup_experiment(I, FN, startTime));

@@ -176,7 +176,7 @@ FMU_NOINLINE static void configure(FmuInstance *instance) {
     }
     instance->modelMode = instance->model->configure(instance->core.values, &instance->prepared.config);
     const double c = instance->prepared.config.cycleTime.value;
-    instance->cycleTime = c > 0 && isfinite(c) ? c : 0.0;
+    instance->cycleTime = isgreater(c, 0) && isfinite(c) ? c : 0.0;
     instance->prepareDue = true;
     instance->configDirty = false;
 }
@@ -274,9 +274,9 @@ FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *func
                                          bool *ran) {
     FmuCore *core = &instance->core;
     const double cycle = instance->cycleTime;
-    const double last = floor((end - core->startTime) / cycle + RL_TIME_TOLERANCE);
+    const double last = floor(rl_quotient(rl_sum(end, -core->startTime), cycle) + RL_TIME_TOLERANCE);
     const double pending = last - (double)core->cycles;
-    if (!(pending <= FMU_MAX_CYCLES_PER_STEP)) {
+    if (!islessequal(pending, FMU_MAX_CYCLES_PER_STEP)) {
         return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
                          h, pending, cycle, FMU_MAX_CYCLES_PER_STEP);
     }
@@ -296,16 +296,19 @@ FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *func
 FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h) {
     FmuCore *core = &instance->core;
 
-    if (!(h > 0 && h <= DBL_MAX)) {
+    if (!(isgreater(h, 0) && islessequal(h, DBL_MAX))) {
         return fmu_error(instance, function, "communicationStepSize must be finite and > 0, not %g", h);
     }
     if (!fmu_time_matches(t, core->time)) {
         return fmu_error(instance, function, "currentCommunicationPoint %.17g is not the FMU's time %.17g", t, core->time);
     }
+    const double end = rl_sum(t, h);
+    if (isinf(end)) {
+        return fmu_error(instance, function, "a step of %g s from %g would end past the largest time", h, t);
+    }
     if (instance->configDirty) {
         configure(instance);
     }
-    const double end = t + h;
     const double u = core->values[instance->model->inputVr];
     bool ran = true;
     if (instance->cycleTime > 0) {
@@ -315,7 +318,7 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
         if (instance->prepareDue || instance->prepared.period != h) {
             prepare(instance, h);
         }
-        rl_cycle(&core->block, &instance->prepared, u, end - core->startTime);
+        rl_cycle(&core->block, &instance->prepared, u, rl_sum(end, -core->startTime));
     }
     core->time = end;
     if (ran) {
@@ -326,7 +329,10 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     /* The next step may be the common one (fmu_step_fast) if it has this h,
      * the configuration stays, one cycle per step, only rule 6 applies to
      * any finite u (plain) and y is finite: then it stays so. */
-    if (instance->cycleTime == 0 && instance->prepared.plain && isfinite(core->block.y)) {
+    /* (The common step adds h to the time unchecked: with h <= 2^960 and
+     * |time| <= 2^1022 the time needs 2^62 steps to overflow.) */
+    if (instance->cycleTime == 0 && instance->prepared.plain && rl_steady_value(core->block.y) &&
+        islessequal(h, 9.7453140114e288 /* ~2^960 */) && islessequal(fabs(core->time), 4.49423283715579e307 /* 2^1022 */)) {
         rl_hold_period(&core->block, h);
         instance->fastPeriod = h;
         /* the general tolerance, RL_TIME_TOLERANCE * |time|, only grows
@@ -453,8 +459,8 @@ static bool value_possible(const FmuVariable *v, double value) {
     case FMU_BOOLEAN:
         return value == 0.0 || value == 1.0;
     default: /* Integer, Enumeration: an int32 in range */
-        return value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0 &&
-               value >= v->min && value <= v->max;
+        return value == floor(value) && isgreaterequal(value, -2147483648.0) && islessequal(value, 2147483647.0) &&
+               isgreaterequal(value, v->min) && islessequal(value, v->max);
     }
 }
 
@@ -522,8 +528,8 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     }
     /* runningTime is a sum of whole cycles: no NaN, infinity or negative */
     if (!isfinite(s.startTime) || !isfinite(s.time) || s.cycles > MAX_EXACT_CYCLES ||
-        s.block.runCycles > MAX_EXACT_CYCLES || !(s.block.runPeriod >= 0 && s.block.runPeriod <= DBL_MAX) ||
-        !(s.block.runBase >= 0 && s.block.runBase <= DBL_MAX)) {
+        s.block.runCycles > MAX_EXACT_CYCLES || !(isgreaterequal(s.block.runPeriod, 0) && islessequal(s.block.runPeriod, DBL_MAX)) ||
+        !(isgreaterequal(s.block.runBase, 0) && islessequal(s.block.runBase, DBL_MAX))) {
         return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
     }
     *out = s;

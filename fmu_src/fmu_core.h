@@ -167,7 +167,7 @@ static inline double fmu_get(FmuInstance *instance, unsigned vr) {
 
 /* A declared range also refuses NaN; without one NaN means "not connected". */
 static inline bool fmu_in_range(const FmuVariable *v, double value) {
-    return (value >= v->min && value <= v->max) || (v->min == -INFINITY && v->max == INFINITY);
+    return (isgreaterequal(value, v->min) && islessequal(value, v->max)) || (v->min == -INFINITY && v->max == INFINITY);
 }
 
 static inline bool fmu_settable(const FmuInstance *instance, int typeMask, unsigned vr, double value) {
@@ -235,7 +235,7 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance);
 /* currentCommunicationPoint within a relative RL_TIME_TOLERANCE of the
  * FMU's time, whatever the step size (NaN and infinity are not) */
 static inline bool fmu_time_matches(double t, double time) {
-    return fabs(t - time) <= RL_TIME_TOLERANCE * fabs(time);
+    return islessequal(fabs(t - time), RL_TIME_TOLERANCE * fabs(time));
 }
 
 /* The common step, inline in the glue: the same step size as the step
@@ -246,7 +246,7 @@ static inline bool fmu_time_matches(double t, double time) {
 static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     FmuCore *core = &instance->core;
     /* the cycle itself, if u is finite in the block's arithmetic (y stays finite) */
-    if (!(h == instance->fastPeriod && fabs(t - core->time) <= instance->fastTolerance &&
+    if (!(h == instance->fastPeriod && islessequal(fabs(t - core->time), instance->fastTolerance) &&
           rl_ramp_steady(&core->block, &instance->prepared, core->values[instance->inputVr]))) {
         return false;
     }

@@ -29,20 +29,20 @@ int rl_status(const RlConfig *c, int *source) {
 
     const RlValue *rates[4] = { &c->rateUp, &c->rateDown, &c->rateUpNeg, &c->rateDownNeg };
     for (int i = 0; i < 4 && !culprit; i++) {
-        if (rates[i]->value < 0) { status = RL_STATUS_RATE_NEGATIVE; culprit = rates[i]; }
+        if (isless(rates[i]->value, 0)) { status = RL_STATUS_RATE_NEGATIVE; culprit = rates[i]; }
     }
     for (int i = 0; i < 4 && !culprit; i++) {
         if (isnan(rates[i]->value)) { status = RL_STATUS_RATE_NAN; culprit = rates[i]; }
     }
     if (culprit) {
         /* the first match above */
-    } else if (!(c->ratePeriod.value >= 0) || !isfinite(c->ratePeriod.value)) {
+    } else if (!isgreaterequal(c->ratePeriod.value, 0) || !isfinite(c->ratePeriod.value)) {
         status = RL_STATUS_RATE_PERIOD; culprit = &c->ratePeriod;
-    } else if (!(c->duration.value >= 0)) {
+    } else if (!isgreaterequal(c->duration.value, 0)) {
         status = RL_STATUS_DURATION; culprit = &c->duration;
-    } else if (c->yMin.value > c->yMax.value) {
+    } else if (isgreater(rl_low_limit(c->yMin.value), rl_high_limit(c->yMax.value))) {
         status = RL_STATUS_LIMITS; culprit = &c->yMin;
-    } else if (c->cycleRefused || !(c->cycleTime.value >= 0) || !isfinite(c->cycleTime.value)) {
+    } else if (c->cycleRefused || !isgreaterequal(c->cycleTime.value, 0) || !isfinite(c->cycleTime.value)) {
         status = RL_STATUS_NO_CYCLE; culprit = &c->cycleTime;
     }
     *source = culprit ? culprit->source : 0;
@@ -97,8 +97,8 @@ void rl_prepare(RlPrepared *p, const RlConfig *config, double period) {
     /* binary32 values in REAL, so exact; LREAL never reads them */
     p->maxUpReal = c->real ? (float)p->maxUp : 0.0f;
     p->maxDownReal = c->real ? (float)p->maxDown : 0.0f;
-    p->yLow = isnan(c->yMin.value) ? -INFINITY : c->yMin.value;
-    p->yHigh = isnan(c->yMax.value) ? INFINITY : c->yMax.value;
+    p->yLow = rl_low_limit(c->yMin.value);
+    p->yHigh = rl_high_limit(c->yMax.value);
     p->durationReached = c->duration.value * (1.0 - RL_TIME_TOLERANCE);
     p->initDelayEnd = c->initDelay + RL_TIME_TOLERANCE * period;
     /* The fast paths (rl_cycle, rl_run, fmu_step_fast) run rule 6 alone
@@ -106,11 +106,12 @@ void rl_prepare(RlPrepared *p, const RlConfig *config, double period) {
      * 6 that can decide a cycle with a finite u and y (2 bypass, 3 delayed
      * init, 5 error hold, 5b hold, and any new one) and everything that
      * makes rule 6 ramp otherwise (output limits, other limits below 0)
-     * must clear it here. */
+     * must clear it here; so must a per-cycle limit too large for the
+     * unchecked sums of the steady paths (RL_STEADY_BELOW). */
     p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && !rl_status_is_error(p->status) && !c->hold &&
                p->yLow == -INFINITY && p->yHigh == INFINITY && p->maxUpNeg == p->maxUp &&
-               p->maxDownNeg == p->maxDown;
-    p->durationLimited = c->duration.value > 0;
+               p->maxDownNeg == p->maxDown && rl_steady_limit(p->maxUp) && rl_steady_limit(p->maxDown);
+    p->durationLimited = isgreater(c->duration.value, 0);
 }
 
 static void running_reset(RlState *s) {
@@ -124,9 +125,10 @@ void rl_init(RlState *s, const RlConfig *config, double u) {
     if (c->real) u = binary32(u);
     double y = c->initMode == RL_INIT_VALUE ? c->initValue : u;
     /* within the limits that are set, unless they are inverted */
-    if (c->limitInitialOutput && isfinite(y) && !(c->yMin.value > c->yMax.value)) {
-        if (y < c->yMin.value) y = c->yMin.value;
-        if (y > c->yMax.value) y = c->yMax.value;
+    const double low = rl_low_limit(c->yMin.value), high = rl_high_limit(c->yMax.value);
+    if (c->limitInitialOutput && isfinite(y) && !isgreater(low, high)) {
+        if (isless(y, low)) y = low;
+        if (isgreater(y, high)) y = high;
     }
     s->y = y;
     s->yPrevious = y;
@@ -148,7 +150,7 @@ void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
     } else if (c->bypass) {
         y = isfinite(c->bypassValue) ? c->bypassValue : u;
         running_reset(s);
-    } else if (c->initMode == RL_INIT_INPUT_DELAYED && elapsed <= p->initDelayEnd) {
+    } else if (c->initMode == RL_INIT_INPUT_DELAYED && islessequal(elapsed, p->initDelayEnd)) {
         y = u;
         running_reset(s);
     } else if (!isfinite(s->y) && isfinite(u)) {
@@ -221,8 +223,10 @@ static double leg_time(double length, double rate, const RlPrepared *p) {
     if (rate == 0) {
         return c->zeroRate == RL_ZERO_RATE_NO_LIMIT ? 0.0 : INFINITY;
     }
-    const double perSecond = c->ratePeriod.value > 0 ? rate / c->ratePeriod.value : rate / p->period;
-    return length / perSecond;
+    const double perSecond = isgreater(c->ratePeriod.value, 0) ? rl_quotient(rate, c->ratePeriod.value)
+                                                                : rl_quotient(rate, p->period);
+    /* a rate that underflows to 0 per second takes for ever, as IEEE has it */
+    return perSecond == 0 ? INFINITY : rl_quotient(length, perSecond);
 }
 
 /* The time from y to uc at the current rates (rules.md, Outputs derived
@@ -234,11 +238,11 @@ static double remaining_time(const RlState *s, const RlPrepared *p, double y, do
     if (uc > y) {
         below = y < 0 ? (uc < 0 ? uc : 0.0) - y : 0.0;
         above = uc > 0 ? uc - (y > 0 ? y : 0.0) : 0.0;
-        total = leg_time(below, c->rateUpNeg.value, p) + leg_time(above, c->rateUp.value, p);
+        total = rl_sum(leg_time(below, c->rateUpNeg.value, p), leg_time(above, c->rateUp.value, p));
     } else {
         below = uc < 0 ? (y < 0 ? y : 0.0) - uc : 0.0;
         above = y > 0 ? y - (uc > 0 ? uc : 0.0) : 0.0;
-        total = leg_time(below, c->rateDownNeg.value, p) + leg_time(above, c->rateDown.value, p);
+        total = rl_sum(leg_time(below, c->rateDownNeg.value, p), leg_time(above, c->rateDown.value, p));
     }
     if (p->durationLimited) {
         const double left = c->duration.value - rl_running_time(s);
@@ -252,16 +256,16 @@ void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
     const double y = s->y, yp = s->yPrevious;
     const double uc = rl_target(s->uPrevious, p);
     const bool ramped = s->decided == RL_DECIDED_RAMP;
-    const bool jumped = p->durationLimited && rl_running_time(s) >= p->durationReached;
-    const bool negative = yp < 0;
+    const bool jumped = p->durationLimited && isgreaterequal(rl_running_time(s), p->durationReached);
+    const bool negative = isless(yp, 0);
     const bool real = p->config.real;
     const double maxUp = negative ? p->maxUpNeg : p->maxUp, maxDown = negative ? p->maxDownNeg : p->maxDown;
     o->rampActive = ramped && y != uc;
     o->limitingUp = ramped && !jumped && (real ? rl_cut_up_real(yp, maxUp, uc) : rl_cut_up_lreal(yp, maxUp, uc));
     o->limitingDown = ramped && !jumped &&
                       (real ? rl_cut_down_real(yp, maxDown, uc) : rl_cut_down_lreal(yp, maxDown, uc));
-    o->highLimit = isfinite(y) && y >= p->yHigh;
-    o->lowLimit = isfinite(y) && y <= p->yLow;
+    o->highLimit = isfinite(y) && isgreaterequal(y, p->yHigh);
+    o->lowLimit = isfinite(y) && islessequal(y, p->yLow);
     o->dydt = s->decided != RL_DECIDED_NOTHING && isfinite(y) && isfinite(yp)
                   ? (real ? rl_dydt_real(y, yp, p->period) : rl_dydt_lreal(y, yp, p->period)) : 0.0;
     o->remainingTime = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc)

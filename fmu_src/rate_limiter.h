@@ -151,9 +151,21 @@ static inline void rl_hold_period(RlState *s, double period) {
     if (s->runPeriod != period) rl_period_changed(s, period);
 }
 
+/* An output limit as the block reads it (rules.md, rule 0): NaN, the
+ * infinity of its side or the largest finite double of its side (the
+ * parameters' default, for importers that refuse infinite start values)
+ * is no limit, the infinity of its side. */
+static inline double rl_high_limit(double yMax) {
+    return isnan(yMax) || isgreaterequal(yMax, DBL_MAX) ? INFINITY : yMax;
+}
+
+static inline double rl_low_limit(double yMin) {
+    return isnan(yMin) || islessequal(yMin, -DBL_MAX) ? -INFINITY : yMin;
+}
+
 /* The target uc = min(max(u, yMin), yMax); a NaN u stays NaN. */
 static inline double rl_target(double u, const RlPrepared *p) {
-    return u < p->yLow ? p->yLow : u > p->yHigh ? p->yHigh : u;
+    return isless(u, p->yLow) ? p->yLow : isgreater(u, p->yHigh) ? p->yHigh : u;
 }
 
 /* x rounded to binary32 (to nearest, ties to even). Beyond the largest
@@ -167,33 +179,104 @@ static inline float rl_binary32(double x) {
     return (float)x;
 }
 
+/* Quiet arithmetic: the results IEEE gives, an overflow included (the
+ * infinity of its sign), without raising FE_OVERFLOW, which real-time
+ * targets trap (docs/fmi.md). An overflow is found before the operation:
+ * from the operands' exponents, or from the operands halved (a power of 2,
+ * so the halved result rounds as the whole one). */
+
+/* m * 2^e, m 0 or in [0.25, 2], reaches 2^DBL_MAX_EXP: it overflows. */
+static inline bool rl_overflows(double m, int e) {
+    return m != 0 &&
+           (e > DBL_MAX_EXP + 2 || (e >= DBL_MAX_EXP - 1 && isgreaterequal(m, ldexp(1.0, DBL_MAX_EXP - e))));
+}
+
+/* a * b for a, b not NaN */
+static inline double rl_product(double a, double b) {
+    if (!isfinite(a) || !isfinite(b)) return a * b;
+    int ea, eb;
+    const double m = frexp(a, &ea) * frexp(b, &eb);
+    return rl_overflows(fabs(m), ea + eb) ? copysign(INFINITY, m) : a * b;
+}
+
+/* a / 0 as IEEE has it (NaN for 0 / 0, else the infinity of the signs),
+ * without raising FE_DIVBYZERO or FE_INVALID */
+static inline double rl_by_zero(double a, double b) {
+    return a == 0 || isnan(a) ? NAN : copysign(INFINITY, signbit(a) == signbit(b) ? 1.0 : -1.0);
+}
+
+/* a / b for a, b not NaN and not both infinite */
+static inline double rl_quotient(double a, double b) {
+    if (b == 0) return rl_by_zero(a, b);
+    if (!isfinite(a) || !isfinite(b)) return a / b;
+    int ea, eb;
+    const double m = frexp(a, &ea) / frexp(b, &eb);
+    return rl_overflows(fabs(m), ea - eb) ? copysign(INFINITY, m) : a / b;
+}
+
+/* a + b for a finite and b not NaN: the halved sum reaches 2^(DBL_MAX_EXP - 1) */
+static inline double rl_sum(double a, double b) {
+    if (islessequal(fabs(b), DBL_MAX - fabs(a)) || !isfinite(b)) return a + b;
+    const double half = a * 0.5 + b * 0.5;
+    return isgreaterequal(fabs(half), 8.98846567431158e307 /* 2^1023 */) ? copysign(INFINITY, half) : a + b;
+}
+
+/* The same in binary32: a float operation done in binary64 and rounded to
+ * binary32 once gives the binary32 result (53 >= 2 * 24 + 2 bits). */
+static inline float rl_sum_real(float a, float b) {
+    return rl_binary32((double)a + (double)b);
+}
+
+static inline float rl_product_real(float a, float b) {
+    return rl_binary32((double)a * (double)b);
+}
+
+static inline float rl_quotient_real(float a, float b) {
+    return rl_binary32(b == 0 ? rl_by_zero(a, b) : (double)a / (double)b);
+}
+
+#define rl_sum_lreal rl_sum
+#define rl_product_lreal rl_product
+#define rl_quotient_lreal rl_quotient
+
+/* The steady paths (the FMUs' common step, rl_run's held cycles, both
+ * plain: rl_prepare) add and subtract unchecked: u, y and the per-cycle
+ * limits below 2^126 in magnitude (or an infinite limit) keep every sum
+ * below 2^127, finite in either arithmetic, so nothing overflows. A larger
+ * value takes the general path, whose sums are quiet (rl_sum). */
+#define RL_STEADY_BELOW 8.507059173023462e37 /* 2^126 */
+
+static inline bool rl_steady_value(double x) {
+    return isless(fabs(x), RL_STEADY_BELOW);
+}
+
+static inline bool rl_steady_limit(double limit) {
+    return rl_steady_value(limit) || limit == INFINITY;
+}
+
 /* The kernel's arithmetic, once per type (rate_limiter_rules.h): RL_ENTER
  * brings a double that is not yet the type's into it; RL_MAX_UP and
  * RL_MAX_DOWN are the per-cycle limits in the type. */
 #define RL_NUM double
 #define RL_SUFFIX _lreal
 #define RL_ENTER(x) (x)
-#define RL_FINITE_BELOW INFINITY
 #define RL_MAX_UP(p) ((p)->maxUp)
 #define RL_MAX_DOWN(p) ((p)->maxDown)
 #include "rate_limiter_rules.h"
 #undef RL_NUM
 #undef RL_SUFFIX
 #undef RL_ENTER
-#undef RL_FINITE_BELOW
 #undef RL_MAX_UP
 #undef RL_MAX_DOWN
 #define RL_NUM float
 #define RL_SUFFIX _real
 #define RL_ENTER(x) rl_binary32(x)
-#define RL_FINITE_BELOW RL_FLOAT_OVERFLOW
 #define RL_MAX_UP(p) ((p)->maxUpReal)
 #define RL_MAX_DOWN(p) ((p)->maxDownReal)
 #include "rate_limiter_rules.h"
 #undef RL_NUM
 #undef RL_SUFFIX
 #undef RL_ENTER
-#undef RL_FINITE_BELOW
 #undef RL_MAX_UP
 #undef RL_MAX_DOWN
 
@@ -224,7 +307,7 @@ void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double
 /* The common case: finite u and y and a plain configuration, so that of
  * the rules only rule 6 (rl_ramp) applies. u has entered. */
 static inline bool rl_only_ramps(const RlState *state, const RlPrepared *prepared, double u) {
-    return prepared->plain && fabs(u - state->y) <= DBL_MAX;
+    return prepared->plain && rl_steady_value(u) && rl_steady_value(state->y);
 }
 
 /* One cycle of length prepared->period; elapsed is the time from the start

@@ -14,8 +14,9 @@
 /* Rule 0's per-cycle limit of a rate other than 0: rate * T / ratePeriod
  * left to right, or the rate itself per cycle. */
 static inline double RL_NAME(rl_per_cycle)(double rate, double period, double ratePeriod) {
-    if (ratePeriod > 0) {
-        return (double)((RL_NUM)rate * RL_ENTER(period) / (RL_NUM)ratePeriod);
+    if (isgreater(ratePeriod, 0)) {
+        if (!isfinite(ratePeriod)) return rate; /* status 16#8202: the block holds, the limit is not used */
+        return (double)RL_NAME(rl_quotient)(RL_NAME(rl_product)((RL_NUM)rate, RL_ENTER(period)), (RL_NUM)ratePeriod);
     }
     return rate;
 }
@@ -23,13 +24,17 @@ static inline double RL_NAME(rl_per_cycle)(double rate, double period, double ra
 /* Rule 6's step of y towards the target at the per-cycle limits, never
  * past it: every path that ramps (rl_ramp_cycle, rl_run's sub-cycles, and
  * through them the FMUs' common step) takes it from here. */
-static inline RL_NUM RL_NAME(rl_step_towards)(RL_NUM y, RL_NUM target, RL_NUM maxUp, RL_NUM maxDown) {
-    if (target > y) {
-        const RL_NUM limited = y + maxUp;
+/* steady (a constant): the operands are steady values (RL_STEADY_BELOW),
+ * so the sums are unchecked; else they are quiet, and so are the
+ * comparisons with the target, which a Siemens block's NaN input reaches
+ * (neither holds: y stays). Inside a branch nothing is NaN. */
+static inline RL_NUM RL_NAME(rl_step_towards)(RL_NUM y, RL_NUM target, RL_NUM maxUp, RL_NUM maxDown, bool steady) {
+    if (steady ? target > y : isgreater(target, y)) {
+        const RL_NUM limited = steady ? y + maxUp : RL_NAME(rl_sum)(y, maxUp);
         return limited < target ? limited : target;
     }
-    if (target < y) {
-        const RL_NUM limited = y - maxDown;
+    if (steady ? target < y : isless(target, y)) {
+        const RL_NUM limited = steady ? y - maxDown : RL_NAME(rl_sum)(y, -maxDown);
         return limited > target ? limited : target;
     }
     return y;
@@ -44,7 +49,7 @@ static inline RL_NUM RL_NAME(rl_step_towards)(RL_NUM y, RL_NUM target, RL_NUM ma
 static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, double u, bool steady) {
     const double ypHeld = s->y;
     const RL_NUM yp = (RL_NUM)ypHeld;
-    const bool negative = !steady && yp < 0;
+    const bool negative = !steady && isless(yp, 0);
     const RL_NUM target = (RL_NUM)(steady ? u : rl_target(u, p));
     RL_NUM y = yp;
     if (u != s->uPrevious) {
@@ -57,11 +62,11 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
         if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
         s->runCycles++;
     }
-    if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
+    if (p->durationLimited && rl_running_time(s) >= p->durationReached) { /* both finite */
         y = target;
     } else {
         y = RL_NAME(rl_step_towards)(y, target, negative ? (RL_NUM)p->maxUpNeg : RL_MAX_UP(p),
-                                     negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p));
+                                     negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p), steady);
     }
     s->decided = RL_DECIDED_RAMP;
     s->yPrevious = ypHeld;
@@ -69,13 +74,12 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
     s->uPrevious = u;
 }
 
-/* The common step's cycle: false (nothing done) if u is not finite in the
- * arithmetic, else rule 6 as rl_ramp_cycle's steady one (the caller has
- * checked the rest: plain, y finite, runPeriod). RL_FINITE_BELOW: the
- * magnitude from which a double is not finite in RL_NUM (binary32: what
- * rounds to an infinity), so the conversion is exact or rounds. */
+/* The common step's cycle: false (nothing done) if u is not a steady value
+ * (RL_STEADY_BELOW: finite in either arithmetic, its sums too), else rule 6
+ * as rl_ramp_cycle's steady one (the caller has checked the rest: plain,
+ * y steady, runPeriod). */
 static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, double u) {
-    if (!(fabs(u) < RL_FINITE_BELOW)) {
+    if (!rl_steady_value(u)) {
         return false;
     }
     RL_NAME(rl_ramp_cycle)(s, p, (double)(RL_NUM)u, true);
@@ -95,7 +99,7 @@ static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, doubl
         if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
             y = u;
         } else {
-            y = RL_NAME(rl_step_towards)(y, u, maxUp, maxDown);
+            y = RL_NAME(rl_step_towards)(y, u, maxUp, maxDown, true);
         }
     }
     if (n <= last) {
@@ -109,15 +113,15 @@ static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, doubl
 /* The derived outputs that compute: dydt = (y - yp) / T, and whether the
  * step's limit cut it (yp + maxUp < uc, yp - maxDown > uc). */
 static inline double RL_NAME(rl_dydt)(double y, double yp, double period) {
-    return (double)(((RL_NUM)y - (RL_NUM)yp) / RL_ENTER(period));
+    return (double)RL_NAME(rl_quotient)(RL_NAME(rl_sum)((RL_NUM)y, -(RL_NUM)yp), RL_ENTER(period));
 }
 
 static inline bool RL_NAME(rl_cut_up)(double yp, double maxUp, double uc) {
-    return (RL_NUM)yp + (RL_NUM)maxUp < (RL_NUM)uc;
+    return isless(RL_NAME(rl_sum)((RL_NUM)yp, (RL_NUM)maxUp), (RL_NUM)uc);
 }
 
 static inline bool RL_NAME(rl_cut_down)(double yp, double maxDown, double uc) {
-    return (RL_NUM)yp - (RL_NUM)maxDown > (RL_NUM)uc;
+    return isgreater(RL_NAME(rl_sum)((RL_NUM)yp, -(RL_NUM)maxDown), (RL_NUM)uc);
 }
 
 #undef RL_NAME

@@ -52,6 +52,9 @@ def load(path):
             sys.exit(f"{where}: Enumeration needs a declaredType from [enumerations]")
         if v["causality"] in ("input", "parameter") and "start" not in v:
             sys.exit(f"{where}: inputs and parameters need a start value")
+        if isinstance(v.get("start"), float) and math.isinf(v["start"]):
+            sys.exit(f"{where}: an infinite start value (FMI Library and OMSimulator refuse it); "
+                     "the largest finite double (1.7976931348623157e308) can mean 'no limit'")
         if v["causality"] in ("output", "independent") and "start" in v:
             sys.exit(f"{where}: outputs are calculated and take no start value")
         if v.get("unit") and v["unit"] not in UNITS:

@@ -8,6 +8,7 @@ import struct
 import sys
 import tomllib
 import zipfile
+from xml.etree import ElementTree
 
 import pytest
 from fmpy import read_model_description
@@ -157,6 +158,67 @@ def test_documentation_and_icon_are_inside(model, version):
     width, height = png_size(ramp)
     assert width >= 400 and height >= 200
     assert png_size(icon) == (128, 128)
+
+
+def start_attributes(xml, version):
+    """Each variable's start attribute as the model description writes it."""
+    variables = ElementTree.fromstring(xml).find("ModelVariables")
+    if version == 2:
+        return {v.get("name"): v[0].get("start") for v in variables if v[0].get("start") is not None}
+    return {v.get("name"): v.get("start") for v in variables if v.get("start") is not None}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_start_values_are_finite_or_a_nan_that_means_something(model, version):
+    """FMI Library and OMSimulator refuse INF start values: none in any
+    model description (a "none" limit starts at the largest finite double,
+    which the model reads as no limit). A NaN start is left only where NaN
+    means something no finite value does (not connected: the parameter
+    instead; no bypass value: the output follows the input), as the
+    variable's description says."""
+    with zipfile.ZipFile(fmu_file(model, version)) as z:
+        xml = z.read("modelDescription.xml").decode()
+    starts = start_attributes(xml, version)
+    assert starts and len(starts) == len([v for v in toml(model)["variable"] if "start" in v])
+    descriptions = {v["name"]: v.get("description", "") for v in toml(model)["variable"]}
+    for name, start in starts.items():
+        assert "INF" not in start.upper(), (name, start)
+        if start.lower() == "nan":
+            assert re.search(r"\((NaN|null)[:,]", descriptions[name]), (name, descriptions[name])
+
+
+def test_the_largest_finite_limits_are_no_limits():
+    """RateLimiter's yMaxPar and yMinPar start at +-1.7976931348623157e308,
+    read as no limit exactly as NaN and infinity are: the same outputs, the
+    flags included, for an output driven to the largest finite double."""
+    runs = []
+    for high, low in ((sys.float_info.max, -sys.float_info.max), (math.inf, -math.inf), (math.nan, math.nan)):
+        fmu = Instance("RateLimiter", 3)
+        try:
+            fmu.start(yMaxPar=high, yMinPar=low, rateUpPar=math.inf, rateDownPar=math.inf)
+            outputs = []
+            for u in (sys.float_info.max, -sys.float_info.max, 5.0):
+                fmu.set(u=u)
+                fmu.step(0.5)
+                outputs.append(tuple(fmu.get(n) for n in ("y", "highLimit", "lowLimit", "rampActive", "status")))
+            runs.append(outputs)
+        finally:
+            fmu.free()
+    assert runs[0] == runs[1] == runs[2]
+    assert runs[0][0] == (sys.float_info.max, False, False, False, 0)
+
+
+def test_generator_refuses_an_infinite_start(tmp_path):
+    toml_file = tmp_path / "Probe.toml"
+    toml_file.write_text('[model]\nidentifier = "Probe"\ndescription = "probe"\n'
+                         '[[variable]]\nname = "time"\nvr = 0\ntype = "Real"\ncausality = "independent"\n'
+                         'variability = "continuous"\n'
+                         '[[variable]]\nname = "limit"\nvr = 1\ntype = "Real"\ncausality = "parameter"\n'
+                         'variability = "tunable"\nstart = inf\n')
+    done = run_bounded([sys.executable, str(REPO / "modelDescription" / "generate.py"), str(toml_file),
+                        str(tmp_path / "gen")], timeout=60, what="generate.py")
+    assert done.returncode != 0 and "infinite start value" in done.stderr
 
 
 def test_docs_tables_are_generated_from_the_toml_files():

@@ -7,6 +7,7 @@ arithmetic (rules.md, Arithmetic): the values include some that binary32 cannot
 hold (beyond its largest value, below its smallest) and times between
 milliseconds."""
 import math
+import sys
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -24,7 +25,7 @@ rates = st.one_of(st.sampled_from([0.0, 0.5, 1.0, 2.0, 10.0, inf, nan, -1.0, 1e-
                   st.floats(0, 50))
 durations = st.sampled_from([0.0, 0.25, 0.5, 1.0, 3.0, inf, nan, -1.0])
 
-parameters = st.fixed_dictionaries({
+PARAMETERS = {
     "rateUpPar": rates, "rateDownPar": rates,
     "bypassValuePar": st.one_of(st.just(nan), reals),
     "durationPar": durations,
@@ -36,10 +37,12 @@ parameters = st.fixed_dictionaries({
     "initDelay": st.sampled_from([0.0, 0.3, 1.0, 2.0]),
     "u": reals,
     # output limits (rules.md, rule 0; none by default, NaN none too), here and in the changes
-    "yMaxPar": st.sampled_from([inf, nan, 5.0, 1.0, 0.0, -2.0]),
-    "yMinPar": st.sampled_from([-inf, nan, -5.0, -1.0, 0.0, 2.0]),
-})
-limits = st.one_of(st.just(nan), st.sampled_from([inf, -inf, 0.0, 3.0, -3.0]), st.floats(-20, 20))
+    "yMaxPar": st.sampled_from([inf, nan, 5.0, 1.0, 0.0, -2.0, sys.float_info.max]),
+    "yMinPar": st.sampled_from([-inf, nan, -5.0, -1.0, 0.0, 2.0, -sys.float_info.max]),
+}
+parameters = st.fixed_dictionaries(PARAMETERS)
+limits = st.one_of(st.just(nan), st.sampled_from([inf, -inf, 0.0, 3.0, -3.0, sys.float_info.max, -sys.float_info.max]),
+                   st.floats(-20, 20))
 
 changes = st.fixed_dictionaries({}, optional={
     "u": reals,
@@ -65,7 +68,18 @@ steps = st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), ch
 cycle_times = st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0])
 # TIME pins hold whole milliseconds: 2.5 ms is 2, 0.4 ms is T#0s
 times = st.sampled_from([0.0, 0.3, 1.0, 2.0, 10.0, 0.0025, 0.0004, 0.3005, 1.0015])
+# RateLimiterStatic: RateLimiter's parameters, and its inputs u, bypass, hold
+static_parameters = {"rateUpNeg": st.one_of(st.just(nan), rates), "rateDownNeg": st.one_of(st.just(nan), rates),
+                     "bypass": st.booleans(), "hold": st.booleans()}
 VENDOR_STRATEGIES = {
+    "RateLimiterStatic": (
+        st.fixed_dictionaries({**PARAMETERS, **static_parameters}),
+        st.fixed_dictionaries({}, optional={
+            "u": reals, "bypass": st.booleans(), "hold": st.booleans(), "rateUpPar": rates, "rateDownPar": rates,
+            "bypassValuePar": st.one_of(st.just(nan), reals), "durationPar": durations,
+            "ratePeriod": st.sampled_from([1.0, 0.0, 0.5, -1.0]), "zeroRate": st.sampled_from([1, 2]),
+            "rateUpNeg": st.one_of(st.just(nan), rates), "rateDownNeg": st.one_of(st.just(nan), rates),
+            "yMaxPar": limits, "yMinPar": limits})),
     "LGF_LimRateOfChangeAdvancedCI": (
         st.fixed_dictionaries({"autoValue": reals, "manualValue": reals, "setPosUpRateLim": rates,
                                "setPosDownRateLim": rates, "setNegUpRateLim": rates, "setNegDownRateLim": rates,

@@ -51,7 +51,7 @@ static void publish(const RlState *block, const RlPrepared *prepared, int modelM
     RlOutputs o;
     rl_outputs(block, prepared, &o);
     /* the quadrant of the output the rate was picked by */
-    const bool negative = block->yPrevious < 0;
+    const bool negative = isless(block->yPrevious, 0);
     const bool reset = modelMode == MODE_RESET;
     v[VR_outputValue] = block->y;
     v[VR_posUpRateLim] = o.limitingUp && !negative;

@@ -11,7 +11,7 @@ static int configure(const double *v, RlConfig *c) {
     c->rateDown = rl_resolve(v[VR_DownRate], VR_DownRate, v[VR_DownRatePar], VR_DownRatePar);
     c->ratePeriod = (RlValue){ 1.0, VR_UpRatePar };
     c->duration = rl_resolve(v[VR_Duration], VR_Duration, v[VR_DurationPar], VR_DurationPar);
-    if (c->duration.value > DURATION_MAX) {
+    if (isgreater(c->duration.value, DURATION_MAX)) {
         c->duration.value = DURATION_MAX;
     }
     c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };

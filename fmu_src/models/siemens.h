@@ -9,7 +9,7 @@
  * configuration error, 16#8601 caused by callOB; the block still runs its
  * cycles at cycleTime (the OB interval): only the status reports it. */
 static inline void siemens_cycle(RlConfig *c, double callOB, int callOBVr, double cycleTime, int cycleTimeVr) {
-    const bool cyclic = (callOB >= 30 && callOB <= 38) || callOB >= 123;
+    const bool cyclic = (isgreaterequal(callOB, 30) && islessequal(callOB, 38)) || isgreaterequal(callOB, 123);
     c->cycleTime.value = cycleTime;
     c->cycleTime.source = cyclic ? cycleTimeVr : callOBVr;
     c->cycleRefused = !cyclic;

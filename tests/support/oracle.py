@@ -22,6 +22,7 @@ import json
 import math
 import os
 import struct
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -54,7 +55,7 @@ def time_ms(seconds):
 PARAMETER_DEFAULTS = {
     "rateUpPar": 1.0, "rateDownPar": 1.0, "bypassValuePar": math.nan, "durationPar": 0.0,
     "ratePeriod": 1.0, "zeroRate": 1, "cycleTime": 0.0, "initMode": 2, "initValue": 0.0, "initDelay": 0.0,
-    "yMaxPar": math.inf, "yMinPar": -math.inf, "arithmetic": LREAL,
+    "yMaxPar": sys.float_info.max, "yMinPar": -sys.float_info.max, "arithmetic": LREAL,
 }
 INPUT_DEFAULTS = {
     "u": 0.0, "rateUp": math.nan, "rateDown": math.nan, "bypass": False, "bypassValue": math.nan,
@@ -151,9 +152,11 @@ class RateLimiterOracle:
                 self.resolve_neg("rateDownNeg"))
 
     def limits(self):
-        """yMin and yMax after fallback; NaN means no limit."""
+        """yMin and yMax after fallback; NaN, an infinity or the largest
+        finite double (its negative for yMin) means no limit (rules.md, rule 0)."""
         low, high = self.resolve("yMin").value, self.resolve("yMax").value
-        return (-math.inf if math.isnan(low) else low), (math.inf if math.isnan(high) else high)
+        return (-math.inf if math.isnan(low) or low <= -sys.float_info.max else low,
+                math.inf if math.isnan(high) or high >= sys.float_info.max else high)
 
     def evaluate_status(self):
         rates = self.rates()
@@ -170,9 +173,9 @@ class RateLimiterOracle:
             return 0x8202, "ratePeriod"
         if math.isnan(duration.value) or duration.value < 0:
             return 0x8203, duration.name
-        y_min, y_max = self.resolve("yMin"), self.resolve("yMax")
-        if y_min.value > y_max.value:
-            return 0x8204, y_min.name
+        low, high = self.limits()
+        if low > high:
+            return 0x8204, self.resolve("yMin").name
         if not finite(cycle) or cycle < 0 or not self.values.get("cycleValid", True):
             return 0x8601, "cycleTime"
         return 0, None
@@ -423,6 +426,15 @@ def siemens_advanced(v):
     return unified, culprits
 
 
+def unified_static(v):
+    """RateLimiterStatic (rules.md): RateLimiter with every "or Par" input
+    unconnected (NaN), its parameters under the same names; rateUpNeg and
+    rateDownNeg, parameters here, fall back to the resolved rates."""
+    unified = {name: v[name] for name in v if name in PARAMETER_DEFAULTS or name in INPUT_DEFAULTS}
+    unified.update({"rateUp": nan, "rateDown": nan, "bypassValue": nan, "duration": nan, "yMax": nan, "yMin": nan})
+    return unified, {name: name for name in v}
+
+
 def siemens_advanced_outputs(out, unified):
     negative = out["_yp"] < 0          # the quadrant the rate was picked by
     reset = out["_mode"] == "reset"
@@ -439,6 +451,9 @@ def siemens_advanced_outputs(out, unified):
 
 
 VENDORS = {
+    "RateLimiterStatic": {
+        "translate": unified_static, "compare_only": False, "outputs": {name: name for name in OUTPUTS},
+    },
     "LGF_LimRateOfChangeCI": {
         "translate": siemens, "compare_only": True,
         "outputs": {"delayedValue": "y", "error": "error", "status": "status", "subFunctionStatus": "subFunctionStatus"},

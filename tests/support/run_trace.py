@@ -14,11 +14,12 @@ HARNESS = {"x86_64-linux": [str(BUILD_DIR / "run_trace")], "linux64": [str(BUILD
 SUFFIX = {"x86_64-linux": ".so", "linux64": ".so", "aarch64-linux": ".so", "x86_64-windows": ".dll"}
 
 
-def script_parts(scenario, md):
+def script_parts(scenario, md, times=None):
     """The scenario as run_trace's script: the start (start values and the
     inputs at the start, initialization, the outputs) and one block per
     step (the inputs, a row holding from its time on; the step; the
-    recorded outputs)."""
+    recorded outputs). times: the communication points (default: the
+    grid of the scenario's step size)."""
     variables = {v.name: v for v in md.modelVariables}
 
     def set_line(name, value):
@@ -30,8 +31,9 @@ def script_parts(scenario, md):
     gets = [f"get {KINDS[variables[name].type]} {variables[name].valueReference}" for name in scenario.outputs]
     o = scenario.options
     start, h = o["StartTime"], o["StepSize"]
-    n = round((o["StopTime"] - start) / h)
-    times = [start + k * h for k in range(n + 1)]
+    if times is None:
+        n = round((o["StopTime"] - start) / h)
+        times = [start + k * h for k in range(n + 1)]
     head = [set_line(name, value) for name, value in scenario.start_values.items()]
     head += [set_line(name, value) for name, value in input_values(scenario, start).items()]
     head += [f"init {start.hex()}"] + gets
@@ -40,8 +42,8 @@ def script_parts(scenario, md):
     return head, blocks
 
 
-def script(scenario, md):
-    head, blocks = script_parts(scenario, md)
+def script(scenario, md, times=None):
+    head, blocks = script_parts(scenario, md, times)
     return "\n".join(head + [line for block in blocks for line in block]) + "\n"
 
 

@@ -1,0 +1,59 @@
+/* What the unified blocks share (RateLimiter and RateLimiterStatic): the
+ * settings both take from variables of the same names, and their outputs,
+ * published from the block's state and its last cycle. */
+#ifndef UNIFIED_H
+#define UNIFIED_H
+
+#include "model.h"
+
+/* The value references of those variables in the model. */
+typedef struct {
+    unsigned hold, ratePeriod, cycleTime, bypass, zeroRate, initMode, initValue, initDelay, arithmetic;
+    unsigned y, rampActive, runningTime, dydt, limitingUp, limitingDown, highLimit, lowLimit, remainingTime;
+} UnifiedVariables;
+
+static inline RlValue unified_value(const double *v, unsigned vr) {
+    RlValue value;
+    value.value = v[vr];
+    value.source = (int)vr;
+    return value;
+}
+
+/* Everything but the rates, limits, duration and bypass value, which each
+ * model resolves its own way. */
+static inline void unified_configure(const UnifiedVariables *vr, const double *v, RlConfig *c) {
+    c->hold = v[vr->hold] != 0;
+    c->ratePeriod = unified_value(v, vr->ratePeriod);
+    c->cycleTime = unified_value(v, vr->cycleTime);
+    c->bypass = v[vr->bypass] != 0;
+    c->zeroRate = (int)v[vr->zeroRate];
+    c->initMode = (int)v[vr->initMode];
+    c->initValue = v[vr->initValue];
+    c->initDelay = v[vr->initDelay];
+    c->passNonFinite = true;
+    c->limitInitialOutput = true;
+    c->real = (int)v[vr->arithmetic] == RL_ARITHMETIC_REAL;
+}
+
+static inline void unified_publish(const UnifiedVariables *vr, const RlState *block, const RlPrepared *prepared,
+                                   double *v) {
+    RlOutputs o;
+    rl_outputs(block, prepared, &o);
+    v[vr->y] = block->y;
+    v[vr->rampActive] = o.rampActive;
+    v[vr->runningTime] = rl_running_time(block);
+    v[vr->dydt] = o.dydt;
+    v[vr->limitingUp] = o.limitingUp;
+    v[vr->limitingDown] = o.limitingDown;
+    v[vr->highLimit] = o.highLimit;
+    v[vr->lowLimit] = o.lowLimit;
+    v[vr->remainingTime] = o.remainingTime;
+}
+
+/* The table of a unified block's variables, from its generated header */
+#define UNIFIED_VARIABLES                                                                                         \
+    { VR_hold, VR_ratePeriod, VR_cycleTime, VR_bypass, VR_zeroRate, VR_initMode, VR_initValue, VR_initDelay,       \
+      VR_arithmetic, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp, VR_limitingDown, VR_highLimit, \
+      VR_lowLimit, VR_remainingTime }
+
+#endif
