@@ -57,7 +57,7 @@ def model_info(build, model, version):
 FEATURES = {"yMaxPar": 1e300, "yMinPar": -1e300, "rateUpNeg": 2.0, "rateDownNeg": 2.0}
 
 
-# The REAL (binary32) path: the Ramp FB, whose pins are REAL (SPEC section 8)
+# The REAL (binary32) path: the Ramp FB, whose pins are REAL (rules.md, Arithmetic)
 REAL_MODEL = "Ramp"
 # each model's input u and output y
 PINS = {"RateLimiter": ("u", "y"), "Ramp": ("rIn", "rOut"), "PassThrough": ("u", "y")}

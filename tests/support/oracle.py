@@ -1,6 +1,6 @@
 """An independent model of the rate limiter, written from the cycle rules
 (docs/rules.md), the time model (docs/fmi.md), the vendor readings
-(docs/models.md) and the arithmetic of SPEC section 8, not from the C code,
+(docs/models.md) and the arithmetic of rules.md, Arithmetic, not from the C code,
 to check the FMUs against.
 
 The oracle speaks the unified block's variable names. It follows the
@@ -8,7 +8,7 @@ project's documented conventions where the contract leaves room:
 runningTime is counted in whole cycles (cycles * T, with the sum started
 afresh when T changes), and time comparisons use a relative 1e-9.
 
-Arithmetic (SPEC section 8): LREAL computes in Python floats (binary64).
+Arithmetic (rules.md, Arithmetic): LREAL computes in Python floats (binary64).
 REAL rounds every value that enters a cycle and the result of every
 operation of the signal path to binary32 with f32, in the order the
 contract writes it. f32 of one +, -, * or / of two binary32 values computed
