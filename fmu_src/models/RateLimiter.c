@@ -3,27 +3,17 @@
 #include "RateLimiter_variables.h"
 #include "unified.h"
 
-static const UnifiedVariables variables = UNIFIED_VARIABLES;
-
-static int configure(const double *v, RlConfig *c) {
+/* Each "or Par" input, NaN when not connected, falls back to its parameter. */
+static void resolve(const double *v, RlConfig *c) {
     c->rateUp = rl_resolve(v[VR_rateUp], VR_rateUp, v[VR_rateUpPar], VR_rateUpPar);
     c->rateDown = rl_resolve(v[VR_rateDown], VR_rateDown, v[VR_rateDownPar], VR_rateDownPar);
-    c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);
-    c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source);
     c->yMax = rl_resolve(v[VR_yMax], VR_yMax, v[VR_yMaxPar], VR_yMaxPar);
     c->yMin = rl_resolve(v[VR_yMin], VR_yMin, v[VR_yMinPar], VR_yMinPar);
     c->duration = rl_resolve(v[VR_duration], VR_duration, v[VR_durationPar], VR_durationPar);
     c->bypassValue = rl_resolve(v[VR_bypassValue], VR_bypassValue, v[VR_bypassValuePar], VR_bypassValuePar).value;
-    unified_configure(&variables, v, c);
-    return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
-    (void)modelMode;
-    unified_publish(&variables, block, prepared, v);
-}
-
-static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };
+UNIFIED_MAPPING(resolve);
 
 const ModelDefinition fmuModel = {
     MODEL_TABLE,

@@ -6,27 +6,17 @@
 #include "RateLimiterStatic_variables.h"
 #include "unified.h"
 
-static const UnifiedVariables variables = UNIFIED_VARIABLES;
-
-static int configure(const double *v, RlConfig *c) {
+/* The parameters stand where RateLimiter's "or Par" inputs fall back. */
+static void resolve(const double *v, RlConfig *c) {
     c->rateUp = unified_value(v, VR_rateUpPar);
     c->rateDown = unified_value(v, VR_rateDownPar);
-    c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);
-    c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source);
     c->yMax = unified_value(v, VR_yMaxPar);
     c->yMin = unified_value(v, VR_yMinPar);
     c->duration = unified_value(v, VR_durationPar);
     c->bypassValue = v[VR_bypassValuePar];
-    unified_configure(&variables, v, c);
-    return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
-    (void)modelMode;
-    unified_publish(&variables, block, prepared, v);
-}
-
-static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };
+UNIFIED_MAPPING(resolve);
 
 const ModelDefinition fmuModel = {
     MODEL_TABLE,

@@ -56,4 +56,22 @@ static inline void unified_publish(const UnifiedVariables *vr, const RlState *bl
       VR_arithmetic, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp, VR_limitingDown, VR_highLimit, \
       VR_lowLimit, VR_remainingTime }
 
+/* The mapping of a unified block: resolve(v, c) sets rateUp,
+ * rateDown, yMax, yMin, duration and bypassValue the model's own way; the
+ * rates below 0 fall back to the resolved rates, and the rest is shared. */
+#define UNIFIED_MAPPING(resolve)                                                                                     \
+    static const UnifiedVariables variables = UNIFIED_VARIABLES;                                                 \
+    static int configure(const double *v, RlConfig *c) {                                                         \
+        resolve(v, c);                                                                                           \
+        c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);             \
+        c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source);   \
+        unified_configure(&variables, v, c);                                                                     \
+        return 0;                                                                                                \
+    }                                                                                                            \
+    static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {            \
+        (void)modelMode;                                                                                         \
+        unified_publish(&variables, block, prepared, v);                                                         \
+    }                                                                                                            \
+    static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus }
+
 #endif
