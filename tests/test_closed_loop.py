@@ -3,8 +3,8 @@ and proportional controller, built by CMake) and RateLimiter, coupled in
 ecospy (FMI 2 and 3), libcosimpy (FMI 2) and a scripted fmpy loop (FMI 2
 and 3), and the SSP package build/ssp/RateLimiterLoop.ssp run unchanged by
 ecospy and libcosimpy, each in its own process. All must agree with an
-oracle: the contract's rate limiter (tests/oracle.py) and the plant's exact
-step response, coupled the same way (at each communication point the
+oracle: the rate limiter of docs/rules.md (tests/support/oracle.py) and the
+plant's exact step response, coupled the same way (at each communication point the
 outputs go to the inputs, then both step). fmpy's SSP support reads the
 package and runs it, with a master of its own (it does not apply the
 components' parameter bindings, and it steps and records in another

@@ -1,6 +1,6 @@
 """Hostile values in every input and parameter: NaN, +-inf, -0.0,
 subnormals, 1e308, huge and tiny rates, cycleTime of 1e-9 and 1e9. Never a
-crash or an endless step; where the contract's status table applies the FMU
+crash or an endless step; where the status table (rules.md, Status words) applies the FMU
 agrees with the oracle bit for bit; a value outside a declared range is
 refused with an error and the last good value kept."""
 import math

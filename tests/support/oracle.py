@@ -4,14 +4,14 @@
 to check the FMUs against.
 
 The oracle speaks the unified block's variable names. It follows the
-project's documented conventions where the contract leaves room:
+project's documented conventions where the rules leave room:
 runningTime is counted in whole cycles (cycles * T, with the sum started
 afresh when T changes), and time comparisons use a relative 1e-9.
 
 Arithmetic (rules.md, Arithmetic): LREAL computes in Python floats (binary64).
 REAL rounds every value that enters a cycle and the result of every
 operation of the signal path to binary32 with f32, in the order the
-contract writes it. f32 of one +, -, * or / of two binary32 values computed
+rules write it. f32 of one +, -, * or / of two binary32 values computed
 in binary64 is that operation correctly rounded in binary32: binary64 has
 more than twice binary32's precision plus two bits, so the double rounding
 is innocuous (test_oracle.py checks it against numpy's float32 scalars).
