@@ -12,10 +12,12 @@ set(REQUIREMENTS ${CMAKE_SOURCE_DIR}/fmutrace/requirements.txt)
 if(RL_TESTS)
   list(APPEND REQUIREMENTS ${CMAKE_SOURCE_DIR}/tests/requirements.txt)
 endif()
-set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${REQUIREMENTS} ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml)
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${REQUIREMENTS} ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml
+             ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_steps.c)
 
 file(READ ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml requirements_text)
-foreach(file IN LISTS REQUIREMENTS)
+# fmutrace's step loop in C is compiled by its install: a changed source installs it again
+foreach(file IN LISTS REQUIREMENTS ITEMS ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_steps.c)
   file(READ ${file} text)
   string(APPEND requirements_text "${text}")
 endforeach()
@@ -46,7 +48,13 @@ if(NOT EXISTS ${venv_stamp})
   if(pip_failed)
     message(FATAL_ERROR "pip install ${pip_args} failed")
   endif()
-  # the trace tool, editable: the venv runs the source tree's fmutrace
+  # the trace tool, editable: the venv runs the source tree's fmutrace; its
+  # step loop in C (fmutrace/_steps.c) compiles against the Python headers
+  execute_process(COMMAND ${VENV_PYTHON} -c "import sysconfig; print(sysconfig.get_path('include'))"
+                  OUTPUT_VARIABLE python_include OUTPUT_STRIP_TRAILING_WHITESPACE)
+  if(NOT EXISTS ${python_include}/Python.h)
+    apt_install("No Python headers for fmutrace's step loop in C" python3-dev)
+  endif()
   execute_process(COMMAND ${VENV_PYTHON} -m pip install --disable-pip-version-check -q --no-deps
                           --no-build-isolation -e ${CMAKE_SOURCE_DIR}/fmutrace
                   RESULT_VARIABLE pip_failed)

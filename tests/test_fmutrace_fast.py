@@ -1,6 +1,7 @@
 """fmutrace's fast paths equal its general paths, bit for bit:
 
-- the Runner (one instance reused through reset, its own step loop)
+- the Runner (one instance reused through reset, its own step loop in C,
+  _steps.c, and in Python where that is not built)
   against fmpy.simulate_fmu on a fresh instance, on every reference
   scenario of every model and FMI version and on random traces (random
   inputs and parameters, Boolean and enumeration columns, events, steps
@@ -19,6 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fmutrace import read_trace, write_trace
+from fmutrace import runner as runner_module
 from fmutrace.runner import FastLoopFailed, Runner, discrete_rows
 from fmutrace.simulation import run_fmpy
 from fmutrace import traces as trace_module
@@ -138,6 +140,49 @@ def test_an_instance_that_failed_is_replaced_and_the_next_trace_is_right():
         r.run(0.0, 1.0, 0.1, bad, {}, ["y"])
     fast, plain = both("RateLimiter", 3, 0.0, 1.0, 0.1, good, {"rateUpPar": 3.0}, ["y", "status"])
     assert same_bits(fast, plain)
+
+
+def python_loop_result(model, version, *args):
+    """Runner.run with the steps in Python (the loop used where _steps.c is not built)."""
+    r = runner(model, version)
+    r.c_loop = False
+    try:
+        return r.run(*args)
+    finally:
+        r.c_loop = runner_module.C_STEPS is not None
+
+
+def test_the_step_loop_in_c_is_built():
+    """The project's set-up compiles it (pip install of fmutrace): the fast loop's speed depends on it."""
+    assert runner_module.C_STEPS is not None and runner("RateLimiter", 3).c_loop
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_the_c_and_python_step_loops_agree_on_every_reference_scenario(version):
+    for s in SCENARIOS:
+        o = s.options
+        args = (o["StartTime"], o["StopTime"], o["StepSize"], s.inputs, s.start_values, s.outputs, o["RelTol"])
+        assert same_bits(python_loop_result(s.model, version, *args), runner(s.model, version).run(*args)), s.name
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
+@given(trace=random_traces(), version=st.sampled_from([2, 3]))
+def test_the_c_and_python_step_loops_agree_on_random_traces(trace, version):
+    model, start, stop, step, inputs, start_values, outputs = trace
+    c_result = runner(model, version).run(start, stop, step, inputs, start_values, outputs)
+    assert same_bits(python_loop_result(model, version, start, stop, step, inputs, start_values, outputs), c_result)
+
+
+def test_both_step_loops_stop_at_a_failing_call_as_fmpy_does():
+    bad = np.array([(0.0, 0.0, 1.0), (0.2, 1.0, 7.0)], dtype=[("time", float), ("u", float), ("zeroRate", float)])
+    for c_loop in (True, False):
+        r = runner("RateLimiter", 2)
+        r.c_loop = c_loop
+        through_fmpy = r.fmpy_runs
+        with pytest.raises(Exception, match="zeroRate = 7 is outside its range"):
+            r.run(0.0, 1.0, 0.1, bad, {}, ["y"])
+        assert r.fmpy_runs == through_fmpy + 1  # the fast loop stopped and left the story to fmpy
+    r.c_loop = runner_module.C_STEPS is not None
 
 
 def chunked(model, version, start, stop, step, inputs, start_values, outputs, steps, rows, tolerance=None):

@@ -8,7 +8,9 @@ start-value function and calls, in its order); its steps then run from
 arrays: the input values of every step are computed at once with fmpy's
 rule (`discrete_rows`), the outputs are read with the FMI functions
 straight from the library into arrays kept from trace to trace, one call
-per variable type as fmpy's recorder makes them.
+per variable type as fmpy's recorder makes them. The step loop runs in C
+(_steps.c, a chunk of steps per call, the FMU's own FMI functions), or in
+Python where that module was not built: the same calls in the same order.
 
 The fast loop gives fmpy's result when (checked by `fast_path_problem`
 before a trace starts):
@@ -99,7 +101,24 @@ FFI.cdef("\n".join(
     + [f"int fmi3{verb}{kind}(void *, const unsigned int *, size_t, char *, size_t);"
        for kind in FMI3_TYPES for verb in ("Set", "Get")]
     + ["int fmi2DoStep(void *, double, double, int);",
-       "int fmi3DoStep(void *, double, double, bool, bool *, bool *, bool *, double *);"]))
+       "int fmi3DoStep(void *, double, double, bool, bool *, bool *, bool *, double *);",
+       # _steps.c: a chunk of steps in C, the same calls as _steps_python
+       "typedef struct { void (*function)(void); const unsigned int *vrs; size_t count; char *rows;"
+       " ptrdiff_t row_bytes; } fmutrace_calls;",
+       "size_t fmutrace_steps(int, void (*)(void), void *, const double *, const double *, size_t, const long long *,"
+       " const fmutrace_calls *, size_t, const fmutrace_calls *, size_t);"]))
+
+
+def _load_c_steps():
+    """fmutrace_steps from the compiled _steps module; None if it was not built (the Python loop then)."""
+    try:
+        from . import _steps
+        return FFI.dlopen(_steps.__file__).fmutrace_steps
+    except (ImportError, OSError, AttributeError):
+        return None
+
+
+C_STEPS = _load_c_steps()
 
 STEPS_PER_CHUNK = 1 << 17  # steps run between two result chunks (a long run's memory: its pointers, its rows)
 KEPT_SHAPES = 8  # grids and output arrays kept for traces of so many shapes (memory stays flat)
@@ -180,31 +199,24 @@ class _InputRows:
             raise FastLoopFailed("no input rows")
 
     def _setter(self, rows):
-        """set_inputs(j): sets the values of the table's rows[j] (global indices)."""
-        fmi3, component = self.runner.fmi3, self.runner._component
+        """The calls that set the table's rows (global indices): per FMI type
+        (function, value references, count, the rows' values)."""
         calls = []
         for function, vrs, count, dtype, names in self.setters:
             table = np.asarray(np.stack([self.table[name] for name in names]), dtype=dtype)  # fmpy's conversion
             values = np.ascontiguousarray(table[:, rows - self.offset].T)
-            calls.append((function, vrs, count, values, _row_pointers(values)))
-
-        def set_inputs(row):
-            status = 0
-            for function, vrs, count, _, pointers in calls:
-                status |= function(component, vrs, count, pointers[row], count) if fmi3 else \
-                    function(component, vrs, count, pointers[row])
-            return status
-        return set_inputs
+            calls.append((function, vrs, count, values))
+        return calls
 
     def first(self, start):
-        """set_inputs for the initialization (its argument 0): the row before the first event at start."""
+        """The setter calls for the initialization (their row 0): the row before the first event at start."""
         self._reach(start)
         row = discrete_rows(self.table["time"], np.array([start]), after_event=False) + self.offset
         return self._setter(row)
 
     def steps(self, times):
-        """(set_at, set_inputs) of steps at times: set_at[k] the argument of
-        set_inputs before step k, None where the row stays the one set."""
+        """(set_at, setters) of steps at times: set_at[k] the row of the
+        setter calls set before step k, -1 where the row stays the one set."""
         self._reach(times[-1])
         t = self.table["time"]
         rows = discrete_rows(t, times, after_event=True) + self.offset
@@ -212,42 +224,72 @@ class _InputRows:
         changed[0] = self.last_row is None or rows[0] != self.last_row
         changed[1:] = rows[1:] != rows[:-1]
         at = np.flatnonzero(changed)
-        set_at = [None] * len(times)
-        for j, k in enumerate(at.tolist()):
-            set_at[k] = j
-        set_inputs = self._setter(rows[at])
+        set_at = np.full(len(times), -1, dtype=np.int64)
+        set_at[at] = np.arange(len(at))
+        setters = self._setter(rows[at])
         self.last_row = rows[-1]
         keep = max(int(np.searchsorted(t, times[-1])) - 1, 0)
         self.table, self.offset = self.table[keep:], self.offset + keep
-        return set_at, set_inputs
+        return set_at, setters
 
 
-def _steps_fmi2(do_step, component, times, sizes, set_at, set_inputs, getters):
+def _set_row(fmi3, component, setters, row, pointers=None):
+    """Sets row of every setter call (pointers: each call's row pointers, if made); the statuses OR-ed."""
+    status = 0
+    for i, (function, vrs, count, values) in enumerate(setters):
+        at = pointers[i][row] if pointers else FFI.cast("char *", values.ctypes.data) + row * values.strides[0]
+        status |= function(component, vrs, count, at, count) if fmi3 else function(component, vrs, count, at)
+    return status
+
+
+def _steps_python(fmi3, do_step, component, times, sizes, set_at, setters, getters, flags):
     """Per step: the inputs where they change, doStep, one get per output
-    type into the step's row; False as soon as a call fails."""
-    for t, h, row, k in zip(times, sizes, set_at, itertools.count()):
-        if row is not None and set_inputs(row) > 1:
+    type into the step's row; False as soon as a call fails (or an FMI 3
+    step asks to terminate or returns early). getters: (function, value
+    references, count, a pointer to each step's row)."""
+    if fmi3:
+        event, terminate, early, last = flags
+    pointers = [_row_pointers(values) for _, _, _, values in setters]
+    for t, h, row, k in zip(times.tolist(), sizes.tolist(), set_at.tolist(), itertools.count()):
+        if row >= 0 and _set_row(fmi3, component, setters, row, pointers) > 1:
             return False
-        status = do_step(component, t, h, 1)
-        for get, vrs, n, rows in getters:
-            status |= get(component, vrs, n, rows[k])
-        if status > 1:
-            return False
+        if fmi3:
+            status = do_step(component, t, h, True, event, terminate, early, last)
+            for get, vrs, n, rows in getters:
+                status |= get(component, vrs, n, rows[k], n)
+            if status > 1 or terminate[0] or early[0]:
+                return False
+        else:
+            status = do_step(component, t, h, 1)
+            for get, vrs, n, rows in getters:
+                status |= get(component, vrs, n, rows[k])
+            if status > 1:
+                return False
     return True
 
 
-def _steps_fmi3(do_step, component, times, sizes, set_at, set_inputs, getters, flags):
-    """_steps_fmi2 for FMI 3; False also when a step asks to terminate or returns early."""
-    event, terminate, early, last = flags
-    for t, h, row, k in zip(times, sizes, set_at, itertools.count()):
-        if row is not None and set_inputs(row) > 1:
-            return False
-        status = do_step(component, t, h, True, event, terminate, early, last)
-        for get, vrs, n, rows in getters:
-            status |= get(component, vrs, n, rows[k], n)
-        if status > 1 or terminate[0] or early[0]:
-            return False
-    return True
+def _call_table(calls):
+    """fmutrace_calls of (function, value references, count, rows array, first row's pointer)."""
+    table = FFI.new("fmutrace_calls[]", max(len(calls), 1))
+    for entry, (function, vrs, count, values, first) in zip(table, calls):
+        entry.function, entry.vrs, entry.count = FFI.cast("void (*)(void)", function), vrs, count
+        entry.rows, entry.row_bytes = first, values.strides[0]
+    return table
+
+
+def _steps_c(fmi3, do_step, component, times, sizes, set_at, setters, getters):
+    """_steps_python's loop in C (_steps.c): the same calls in the same order."""
+    setter_table = _call_table([(f, vrs, n, values, FFI.cast("char *", values.ctypes.data))
+                                for f, vrs, n, values in setters])
+    getter_table = _call_table(getters)
+    times = np.ascontiguousarray(times, dtype=np.float64)
+    sizes = np.ascontiguousarray(sizes, dtype=np.float64)
+    set_at = np.ascontiguousarray(set_at, dtype=np.int64)
+    done = C_STEPS(int(fmi3), FFI.cast("void (*)(void)", do_step), component,
+                   FFI.cast("double *", times.ctypes.data), FFI.cast("double *", sizes.ctypes.data), len(times),
+                   FFI.cast("long long *", set_at.ctypes.data), setter_table, len(setters), getter_table,
+                   len(getters))
+    return done == len(times)
 
 
 class Runner:
@@ -262,6 +304,7 @@ class Runner:
         self.variable_step = bool(self.md.coSimulation.canHandleVariableCommunicationStepSize)
         self.fmu = self._lib = None
         self.fast_runs = self.fmpy_runs = 0
+        self.c_loop = C_STEPS is not None  # the steps in C (_steps.c), else in Python: the same calls
         self._grids = {}    # (start, step, n) -> the communication points and step sizes as C doubles
         self._buffers = {}  # (kind, count, n) -> output array kept from trace to trace, and its rows as C pointers
 
@@ -386,7 +429,7 @@ class Runner:
             times = start + np.arange(k, k + m + 1, dtype=np.float64) * step
             if k == 0:
                 times[0] = start
-            grid = times, times[:-1].tolist(), (times[1:] - times[:-1]).tolist()
+            grid = times, times[:-1], times[1:] - times[:-1]
             if k:
                 return grid  # a long run's later chunks: not kept
             _forget_oldest(self._grids)
@@ -452,7 +495,7 @@ class Runner:
                     remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
                     fmu.enterInitializationMode()
                 remaining = apply_start_values(fmu, self.md, remaining, settable=settable_in_initialization_mode)
-                if remaining or (first is not None and first(0) > 1):
+                if remaining or (first is not None and _set_row(fmi3, component, first, 0) > 1):
                     raise FastLoopFailed("a start value or an input was refused")
                 fmu.exitInitializationMode()
             except FastLoopFailed:
@@ -472,15 +515,19 @@ class Runner:
             times, step_times, step_sizes = self._grid(start, step, k, m)
             with _quiet():
                 if inputs is not None:
-                    set_at, set_inputs = inputs.steps(times[:-1])
+                    set_at, setters = inputs.steps(times[:-1])
                 else:
-                    set_at, set_inputs = [None] * m, None
-                step_getters = [(function, vrs, count, pointers[1:m + 1])
-                                for function, vrs, count, pointers, _, _, _ in getters]
-                if not (_steps_fmi3(self._do_step, component, step_times, step_sizes, set_at, set_inputs,
-                                    step_getters, self._step_flags) if fmi3 else
-                        _steps_fmi2(self._do_step, component, step_times, step_sizes, set_at, set_inputs,
-                                    step_getters)):
+                    set_at, setters = np.full(m, -1, dtype=np.int64), []
+                if self.c_loop:
+                    done = _steps_c(fmi3, self._do_step, component, step_times, step_sizes, set_at, setters,
+                                    [(function, vrs, count, values, pointers[1])
+                                     for function, vrs, count, pointers, values, _, _ in getters])
+                else:
+                    done = _steps_python(fmi3, self._do_step, component, step_times, step_sizes, set_at, setters,
+                                         [(function, vrs, count, pointers[1:m + 1])
+                                          for function, vrs, count, pointers, _, _, _ in getters],
+                                         self._step_flags if fmi3 else None)
+                if not done:
                     raise FastLoopFailed("a step failed")
             chunk = result(slice(1, m + 1), times[1:])
             if pending is not None:
