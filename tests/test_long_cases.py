@@ -139,3 +139,35 @@ def test_a_long_case_shows_its_progress_on_a_terminal_only(terminal, monkeypatch
         assert lines[-1].startswith("1,000,000/1,000,000 samples") and lines[-1].endswith(" 0 s left \n")
     else:
         assert stream.getvalue() == ""
+
+
+@pytest.mark.parametrize("width", [10, 5000, 100_000])
+def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
+    from fmutrace.longcase import _last_time
+
+    names = ["time"] + [f"s{i}" for i in range(width // 10)]
+    lines = [",".join(names), ",".join(["0.5"] + ["1.25"] * (len(names) - 1)),
+             ",".join(["7.75"] + ["0.123456789"] * (len(names) - 1))]
+    path = tmp_path / "wide.csv"
+    path.write_text("\n".join(lines) + "\n\n")
+    assert _last_time(path) == 7.75
+
+
+@pytest.mark.parametrize("parts", [1, 2, 7])
+def test_a_verdict_given_in_chunks_is_the_verdict_on_the_whole(parts):
+    from fmutrace.comparison import Band, Verdict, _verdict
+
+    rng = np.random.default_rng(parts)
+    times = np.arange(50) * 0.1
+    expected = rng.integers(-3, 4, 50).astype(float)
+    values = expected.copy()
+    values[[4, 17, 30]] += [0.5, -2.0, 2.0]
+    values[40] = np.nan  # an infinite excess: the largest
+    for mode in MODES:
+        lower, upper, ok = mode.bounds(values, expected)
+        band = Band(times, values, lower, upper, ok, values - expected)
+        verdict = Verdict("y")
+        for piece in np.array_split(np.arange(50), parts):
+            verdict.add(Band(*(a[piece] for a in (times, values, lower, upper, ok, values - expected))))
+        assert verdict.deviation.to_json() == _verdict("y", band).to_json()
+        assert verdict.deviation.largest_at == times[40] and verdict.deviation.time == times[4]

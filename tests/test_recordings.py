@@ -16,7 +16,8 @@ from fmutrace import InputError, TraceError
 from fmutrace.recordings import (FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file,
                                  read_recording)
 from fmutrace.recordings.align import align
-from fmutrace.recordings.text import decode, numbers, split
+from fmutrace.recordings.text import decode, numbers
+from fmutrace.traces import split_cells as split
 from fmutrace.recordings.timebase import parse_date, unit_in_name
 from support.oracle import oracle_for
 

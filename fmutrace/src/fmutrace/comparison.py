@@ -133,7 +133,7 @@ class Pointwise(Mode):
         raise NotImplementedError
 
     def bands(self, result, reference, names):
-        index = _aligned(result["time"], reference["time"])
+        index = aligned(result["time"], reference["time"])
         use = index >= 0
         times = reference["time"][use]
         bands = {}
@@ -242,7 +242,7 @@ def comparison_mode(rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float
     return Tolerance(rel_tol, abs_tol) if (rel_tol or abs_tol) else EXACT
 
 
-def _aligned(result_time, reference_time):
+def aligned(result_time, reference_time):
     """For each reference time, the index of the result sample at that
     time (-1 if none); at a repeated reference time only the last row is
     compared (the others get -2)."""
@@ -258,22 +258,39 @@ def _aligned(result_time, reference_time):
     return np.where(last, best, -2)
 
 
-def _verdict(name, band):
-    ok = band.ok
-    deviation = Deviation(name, bool(ok.all()), compared=len(ok), failed=int((~ok).sum()))
-    if not deviation.passed:
+class Verdict:
+    """A signal's Deviation from its bands given one after the other (a
+    long case's chunks, in time order): the same as from the whole band at
+    once (the first failing sample, the first of the largest excesses)."""
+
+    def __init__(self, name):
+        self.deviation = Deviation(name, True)
+
+    def add(self, band):
+        ok, d = band.ok, self.deviation
+        failed = int((~ok).sum())
+        d.compared += len(ok)
+        if not failed:
+            return
+        d.passed, d.failed = False, d.failed + failed
         times, values, lower, upper = band.times, band.values, band.lower, band.upper
         with np.errstate(invalid="ignore"):
             excess = np.where(values > upper, values - upper, lower - values)
         excess = np.where(np.isnan(excess), np.inf, excess)
         excess = np.where(ok, -np.inf, excess)
-        first = int(np.argmin(ok))
+        if d.time is None:
+            first = int(np.argmin(ok))
+            d.time, d.value = float(times[first]), float(values[first])
+            d.lower, d.upper, d.excess = float(lower[first]), float(upper[first]), float(excess[first])
         worst = int(np.argmax(excess))
-        deviation.time, deviation.value = float(times[first]), float(values[first])
-        deviation.lower, deviation.upper = float(lower[first]), float(upper[first])
-        deviation.excess = float(excess[first])
-        deviation.largest_excess, deviation.largest_at = float(excess[worst]), float(times[worst])
-    return deviation
+        if d.largest_excess is None or excess[worst] > d.largest_excess:
+            d.largest_excess, d.largest_at = float(excess[worst]), float(times[worst])
+
+
+def _verdict(name, band):
+    verdict = Verdict(name)
+    verdict.add(band)
+    return verdict.deviation
 
 
 def _polyline_at(times, values, at):

@@ -7,7 +7,9 @@ The reference and the inputs are read by pyarrow in chunks
 (Runner.run_chunks), each reference chunk is compared as soon as the
 result reaches it, and the figure's lines are envelopes filled as they
 go (plot.Envelope). The verdict is the in-memory path's (worker.run_case
-with comparison.compare_traces), bit for bit: every signal's counts, its
+with comparison.compare_traces), bit for bit, from the comparison
+module's own rules (its samples matched by comparison.aligned, the
+verdict accumulated by comparison.Verdict): every signal's counts, its
 first deviation and its largest, and a reference time the result lacks
 (a test runs both on the same cases). A case this path cannot take (a
 tube, a file that is not the plain CSV dialect, an input the fast loop
@@ -15,6 +17,7 @@ cannot replay, a failing FMU) goes to the in-memory path, which reads it
 or explains it: `run_long_case` returns None then, before anything is
 reported.
 """
+import contextlib
 import os
 import time
 from pathlib import Path
@@ -22,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .cases import read_options, read_start_values
-from .comparison import TIME_MATCH, Deviation, Mode, Pointwise
+from .comparison import Band, Mode, Pointwise, Verdict, aligned
 from .errors import InputError, SimulationError
 from .fmu import Fmu
 from .outcome import CaseOutcome, Status
@@ -44,67 +47,19 @@ def is_long(folder, model, texts) -> bool:
         return False
 
 
-class _Signal:
-    """One compared signal's verdict, accumulated chunk by chunk as
-    comparison._verdict gives it on the whole."""
-
-    def __init__(self, name):
-        self.name, self.compared, self.failed = name, 0, 0
-        self.first = None  # (time, value, lower, upper, excess)
-        self.largest = None  # (excess, time)
-
-    def add(self, times, values, lower, upper, ok):
-        self.compared += len(ok)
-        bad = ~ok
-        failed = int(bad.sum())
-        if not failed:
-            return
-        self.failed += failed
-        with np.errstate(invalid="ignore"):
-            excess = np.where(values > upper, values - upper, lower - values)
-        excess = np.where(np.isnan(excess), np.inf, excess)
-        excess = np.where(ok, -np.inf, excess)
-        if self.first is None:
-            i = int(np.argmax(bad))
-            self.first = (float(times[i]), float(values[i]), float(lower[i]), float(upper[i]), float(excess[i]))
-        worst = int(np.argmax(excess))
-        if self.largest is None or excess[worst] > self.largest[0]:
-            self.largest = (float(excess[worst]), float(times[worst]))
-
-    def deviation(self):
-        d = Deviation(self.name, self.failed == 0, compared=self.compared, failed=self.failed)
-        if self.failed:
-            d.time, d.value, d.lower, d.upper, d.excess = self.first
-            d.largest_excess, d.largest_at = self.largest
-        return d
-
-
 def _last_time(path):
-    """The time in the last data line of a plain CSV file (its first cell)."""
+    """The time in the last data line of a plain CSV file (its first cell),
+    however long that line is."""
     with open(path, "rb") as file:
-        file.seek(0, os.SEEK_END)
-        size = file.tell()
-        file.seek(max(0, size - 4096))
-        lines = [line for line in file.read().splitlines() if line.strip()]
-    return float(lines[-1].split(b",")[0])
-
-
-def _grid_index(times, start, step, n):
-    """For each time, the index of the result sample at it (-1 if none), as
-    comparison._aligned finds it among the communication points start + k * step."""
-    k = np.clip(np.rint((times - start) / step).astype(np.int64), 0, n)
-    best = np.full(len(times), -1)
-    candidates = [np.clip(k + d, 0, n) for d in (-2, -1, 0, 1, 2)]
-    points = [np.where(c == 0, start, start + c * step) for c in candidates]
-    # searchsorted(points, t): the first candidate at or after t (the last one if none)
-    index = candidates[-1].copy()
-    for c, p in zip(reversed(candidates), reversed(points)):
-        index = np.where(p >= times, c, index)
-    for candidate in (np.clip(index - 1, 0, n), index):
-        point = np.where(candidate == 0, start, start + candidate * step)
-        close = np.abs(point - times) <= TIME_MATCH * np.maximum(1.0, np.abs(times))
-        best = np.where((best < 0) & close, candidate, best)
-    return best
+        end = file.seek(0, os.SEEK_END)
+        size = 4096
+        while True:
+            begin = max(0, end - size)
+            file.seek(begin)
+            lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
+            if len(lines) >= 2 or begin == 0:  # a line break before the last line: it is whole
+                return float(lines[-1].split(b",")[0])
+            size *= 4
 
 
 def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mode, plots: str, result_file=None,
@@ -142,7 +97,7 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
     readme = (texts.get("README.md") or "").strip().splitlines()
     description = readme[0].lstrip("# ").strip() if readme else ""
 
-    signals = {name: _Signal(name) for name in outputs}
+    signals = {name: Verdict(name) for name in outputs}
     t_end = max(stop, bounds["time"][1])
     envelopes = {key: Envelope(start, t_end) for key in
                  [("ref", s) for s in outputs] + [("result", s) for s in outputs] + [("deviation", s) for s in outputs]
@@ -162,9 +117,11 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
     window = []  # result chunks not yet compared: [(first index, chunk)]
     reached = 0  # result samples made
     bar = progress or SampleProgress(n + 1)
-    out = open(result_file, "w", newline="\n") if result_file else None
     writer = None
-    try:
+    with contextlib.ExitStack() as stack:
+        stack.callback(bar.close)
+        out = stack.enter_context(open(result_file, "w", newline="\n")) if result_file else None
+
         def result_until(k):
             """The result window through sample k (or the end)."""
             nonlocal reached, writer
@@ -181,30 +138,24 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
                     writer.write(chunk)
                 bar.update(reached)
 
-        held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-        for chunk in trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=chunk_bytes):
+        try:
+            held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
+            for chunk in trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=chunk_bytes):
+                if held is not None:
+                    chunk = np.concatenate([held, chunk])
+                held = chunk[-1:]
+                _compare(chunk[:-1], chunk["time"][-1], start, step, n, mode, outputs, signals, envelopes, window,
+                         result_until, absent, zoom, recent)
             if held is not None:
-                chunk = np.concatenate([held, chunk])
-            held = chunk[-1:]
-            rows = chunk[:-1]
-            _compare(rows, chunk["time"][1:], start, step, n, mode, outputs, signals, envelopes, window, result_until,
-                     absent, zoom, recent)
-        if held is not None:
-            _compare(held, np.array([np.nan]), start, step, n, mode, outputs, signals, envelopes, window,
-                     result_until, absent, zoom, recent)
-        result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
-        if reached != n + 1:
-            raise FastLoopFailed("the run ended early")
-    except (FastLoopFailed, NotPlain):
-        if out is not None:
-            out.close()
-        return None
-    finally:
-        bar.close()
-    if out is not None:
-        out.close()
+                _compare(held, np.nan, start, step, n, mode, outputs, signals, envelopes, window, result_until,
+                         absent, zoom, recent)
+            result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
+            if reached != n + 1:
+                raise FastLoopFailed("the run ended early")
+        except (FastLoopFailed, NotPlain):
+            return None
 
-    deviations = [signals[s].deviation() for s in outputs]
+    deviations = [signals[s].deviation for s in outputs]
     outcome = CaseOutcome(name, **labels)
     problem = ""
     if absent[0]:
@@ -224,16 +175,28 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
     return outcome
 
 
-def _compare(rows, next_times, start, step, n, mode, outputs, signals, envelopes, window, result_until, absent, zoom,
+def _compare(rows, next_time, start, step, n, mode, outputs, signals, envelopes, window, result_until, absent, zoom,
              recent):
-    """Compares reference rows (next_times: each row's next time, NaN after the last) with the result."""
+    """Compares reference rows (next_time: the time of the row after the
+    last, NaN if none) with the result, as Pointwise.bands does on the
+    whole: comparison.aligned on the result samples around the rows' times."""
     if not len(rows):
         return
     times = rows["time"]
     for s in outputs:
         envelopes[("ref", s)].add(times, rows[s])
-    index = _grid_index(times, start, step, n)
-    index = np.where(next_times != times, index, -2)  # at a repeated time the last row is compared
+    # the communication points start + k * step from two before the first time to two after the last
+    first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2], 0, n)
+    first, last = int(first), int(last)
+    result_until(last)
+    while len(window) > 1 and window[1][0] <= first:
+        window.pop(0)  # chunks before the first sample needed
+    base = window[0][0]
+    result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
+    result = result[first - base:last - base + 1]
+    if not len(result):
+        raise FastLoopFailed("the run ended early")
+    index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
     missing = np.flatnonzero(index == -1)
     if len(missing):
         if absent[1] is None:
@@ -242,13 +205,7 @@ def _compare(rows, next_times, start, step, n, mode, outputs, signals, envelopes
     use = index >= 0
     if not use.any():
         return
-    needed = index[use]
-    result_until(int(needed[-1]))
-    while len(window) > 1 and window[1][0] <= needed[0]:
-        window.pop(0)  # chunks before the first sample needed
-    base = window[0][0]
-    result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
-    picked = result[needed - base]
+    picked = result[index[use]]
     compared_times = times[use]
     failing_now = []
     for s in outputs:
@@ -257,11 +214,12 @@ def _compare(rows, next_times, start, step, n, mode, outputs, signals, envelopes
         lower, upper, ok = mode.bounds(values, expected)
         with np.errstate(invalid="ignore", over="ignore"):
             deviation = values - expected
-        before = signals[s].failed
-        signals[s].add(compared_times, values, lower, upper, ok)
+        verdict = signals[s].deviation
+        before = verdict.failed
+        signals[s].add(Band(compared_times, values, lower, upper, ok, deviation))
         envelopes[("deviation", s)].add(compared_times, deviation)
-        if zoom["lines"] is None and signals[s].failed > before:
-            failing_now.append(signals[s].first[0])
+        if zoom["lines"] is None and verdict.failed > before:
+            failing_now.append(verdict.time)
         recent[s] = (compared_times, values, lower, upper, deviation)
     if failing_now and zoom["lines"] is None:
         at = min(failing_now)

@@ -18,7 +18,6 @@ sample. Accepted, without options:
 Anything else raises a TraceError, which names the file, the line and
 the column.
 """
-import csv
 import io
 import math
 import re
@@ -80,13 +79,41 @@ def _separator(header):
 
 
 def split_cells(line, separator):
-    """The cells of a line, unquoted and stripped."""
-    return [cell.strip() for cell in next(csv.reader([line], delimiter=separator, skipinitialspace=True))]
+    """The cells of a line, stripped. A cell quoted as a whole loses its
+    quotes ("a;b" -> a;b, doubled quotes inside become one); quotes inside a
+    name stay ("DB_Ramp".value is a TIA Portal name as written). A space
+    separator means any run of blanks (as space-aligned exports have them).
+    The one rule for traces, case files and recorders' exports."""
+    if '"' not in line:
+        if separator == " ":
+            return line.split()
+        return [cell.strip() for cell in line.split(separator)]
+    cells, current, quoted = [], [], False
+    for char in line:
+        if char == '"':
+            quoted = not quoted
+        if char == separator and not quoted:
+            cells.append("".join(current))
+            current = []
+        else:
+            current.append(char)
+    cells.append("".join(current))
+    if separator == " ":
+        cells = [c for c in cells if c.strip()]
+    return [_unquote_cell(c.strip()) for c in cells]
+
+
+def _unquote_cell(cell):
+    if len(cell) >= 2 and cell[0] == cell[-1] == '"' and '"' not in cell[1:-1].replace('""', ""):
+        return cell[1:-1].replace('""', '"')
+    return cell
 
 
 def parse_number(text, decimal_comma=False):
-    """A cell's value as a float: a number, or a Boolean word; None if it
-    is neither."""
+    """A cell's value as a float: a number (with a decimal comma if
+    decimal_comma, where the cell has no point), or a Boolean word; None
+    if it is neither. The one rule for numbers (recordings add IEC
+    literals to it: recordings.text.cell_value)."""
     word = text.strip().lower()
     if word in BOOLEAN_WORDS:
         return BOOLEAN_WORDS[word]

@@ -31,7 +31,8 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
     the recording there (read with recording's options); labels: the
     CaseOutcome fields that name the FMU."""
     started = time.perf_counter()
-    if not is_recording(folder) and is_long(folder, fmu.model, texts):
+    recorded = texts is None and is_recording(folder)  # (texts come with a case folder only)
+    if not recorded and is_long(folder, fmu.model, texts):
         result_file = _result_file() if plots != "none" else None
         long = run_long_case(folder, name, runner, fmu, labels, mode, plots, result_file=result_file)
         if result_file and (long is None or not long.png):  # a result file only with the case's plot
@@ -42,7 +43,7 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
             return long
     outcome = CaseOutcome(name, **labels)
     try:
-        if is_recording(folder):
+        if recorded:
             case = recorded_case(str(folder), fmu, name, recording or RecordingOptions())
         else:
             case = load_case(folder, fmu, name, texts)

@@ -6,6 +6,7 @@ import operator
 
 import numpy as np
 
+from ..traces import split_cells
 from . import text as texts
 from .model import Channel
 
@@ -29,7 +30,7 @@ def body(text, first, separator, stop_words=("EOF",)):
             continue
         if line.strip() in stop_words:
             break
-        rows.append(texts.split(line, separator))
+        rows.append(split_cells(line, separator))
         numbers.append(index + 1)
     return rows, np.asarray(numbers, dtype=np.int64)
 

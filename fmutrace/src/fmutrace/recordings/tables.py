@@ -12,6 +12,7 @@ the index counts cycles) and the channels. No public sample of TIA
 Portal's export is known, so it is read by these general rules."""
 import numpy as np
 
+from ..traces import split_cells
 from . import grid as grids
 from . import text as texts
 from . import timebase
@@ -60,14 +61,14 @@ def find_header(text):
         if not line.strip():
             continue
         separator = texts.sniff_separator(line)
-        names = texts.split(line, separator)
+        names = split_cells(line, separator)
         if len(names) < 2 or sum(_is_value(n) for n in names) > len(names) // 2:
             continue
         candidates += 1
         following = next((j for j in range(i + 1, len(lines)) if lines[j].strip()), None)
         if following is None:
             continue
-        cells = texts.split(lines[following], separator)
+        cells = split_cells(lines[following], separator)
         if len(cells) == len(names) and sum(_is_value(c) for c in cells) >= max(1, len(cells) - 1):
             if any(is_time_name(n) or is_index_name(n) for n in names):
                 return i, separator, names

@@ -19,10 +19,9 @@ import re
 import numpy as np
 
 from ..errors import TraceError
-from ..traces import counts_outside_quotes
+from ..traces import counts_outside_quotes, parse_number
 
 SEPARATORS = ("\t", ";", ",", " ")
-BOOLEANS = {"true": 1.0, "false": 0.0}
 _IEC_BASED = re.compile(r"^(?:[A-Za-z_]+#)?([+-]?)(2|8|16)#([0-9A-Fa-f_]+)$")
 _TYPED = re.compile(r"^[A-Za-z_]+#(.+)$")
 
@@ -81,36 +80,6 @@ def read(path):
     return Text(path, text, encoding)
 
 
-def split(line, separator):
-    """The cells of a line, stripped. A cell quoted as a whole loses its
-    quotes ("a;b" -> a;b, doubled quotes inside become one); quotes inside a
-    name stay ("DB_Ramp".value is a TIA Portal name as written). A space
-    separator means any run of blanks (as space-aligned exports have them)."""
-    if '"' not in line:
-        if separator == " ":
-            return line.split()
-        return [cell.strip() for cell in line.split(separator)]
-    cells, current, quoted = [], [], False
-    for char in line:
-        if char == '"':
-            quoted = not quoted
-        if char == separator and not quoted:
-            cells.append("".join(current))
-            current = []
-        else:
-            current.append(char)
-    cells.append("".join(current))
-    if separator == " ":
-        cells = [c for c in cells if c.strip()]
-    return [_unquote_cell(c.strip()) for c in cells]
-
-
-def _unquote_cell(cell):
-    if len(cell) >= 2 and cell[0] == cell[-1] == '"' and '"' not in cell[1:-1].replace('""', ""):
-        return cell[1:-1].replace('""', '"')
-    return cell
-
-
 def sniff_separator(line):
     """The separator of a header line: tab, ';' or ',' (the most frequent
     one outside quotes), else blanks."""
@@ -129,13 +98,13 @@ def unquote(name):
 
 
 def cell_value(text):
-    """One cell as a float, or None."""
+    """One cell as a float, or None: traces.parse_number's rule (with a
+    decimal comma: a comma-separated file has one only in a quoted cell),
+    and IEC literals (16#FF, 2#1010_0101) with or without a type prefix
+    (WORD#16#00FF, REAL#1.5), '_' between digits."""
     cell = text.strip()
     if not cell:
         return None
-    word = cell.lower()
-    if word in BOOLEANS:
-        return BOOLEANS[word]
     based = _IEC_BASED.match(cell)
     if based:
         sign, base, digits = based.groups()
@@ -147,14 +116,7 @@ def cell_value(text):
     typed = _TYPED.match(cell)
     if typed and "#" not in typed.group(1):
         return cell_value(typed.group(1))
-    if "," in cell:  # a decimal comma (a comma-separated file has it only in a quoted cell)
-        if "." in cell or cell.count(",") > 1:
-            return None
-        cell = cell.replace(",", ".")
-    try:
-        return float(cell.replace("_", "") if "_" in cell else cell)
-    except ValueError:
-        return None
+    return parse_number(cell.replace("_", "") if "_" in cell else cell, decimal_comma=True)
 
 
 def numbers(cells, decimal_comma, where):

@@ -20,6 +20,7 @@ its cells are blank (or the row is shorter). An 'EOF' line may close the
 file."""
 import numpy as np
 
+from ..traces import split_cells
 from . import grid as grids
 from . import text as texts
 from .model import Recording
@@ -36,7 +37,7 @@ def _find(text):
         line = lines[i]
         if line.startswith("Name") and len(line) > 4 and not line[4].isalnum():
             separator = line[4]
-            following = texts.split(lines[i + 1], separator)[0] if i + 1 < len(lines) else ""
+            following = split_cells(lines[i + 1], separator)[0] if i + 1 < len(lines) else ""
             if following in KEYS:  # a channel property (the title block's Name is followed by File)
                 return i, separator
     return None, "no channel header block (rows 'Name', 'SampleTime[ms]', 'SymbolName' ... as Scope View writes)"
@@ -80,7 +81,7 @@ def read(text):
     header = {}
     index = start
     while index < len(text.lines) and text.lines[index].strip():
-        cells = texts.split(text.lines[index], separator) if separator != " " else text.lines[index].split(" ")
+        cells = split_cells(text.lines[index], separator) if separator != " " else text.lines[index].split(" ")
         header[cells[0]] = (index + 1, cells)
         index += 1
     name_line, name_cells = header["Name"]

@@ -26,6 +26,7 @@ import os
 
 import numpy as np
 
+from ..traces import split_cells
 from . import grid as grids
 from . import text as texts
 from . import timebase
@@ -83,7 +84,7 @@ def _wincc_header(text):
     for i, line in enumerate(text.lines[:20]):
         if "VarName" in line and "VarValue" in line:
             separator = texts.sniff_separator(line)
-            names = [n.strip('"') for n in texts.split(line, separator)]
+            names = [n.strip('"') for n in split_cells(line, separator)]
             if all(c in names for c in WINCC_COLUMNS):
                 return i, separator, names
     return None, None, "no header VarName, TimeString, VarValue, Validity, Time_ms"
@@ -148,7 +149,7 @@ HISTORY_KEYS = ("history", "history id", "historyid", "history name", "point", "
 def _niagara_header(text):
     for i, line in enumerate(text.lines[:20]):
         separator = texts.sniff_separator(line)
-        names = [bare_name(n) for n in texts.split(line, separator)]
+        names = [bare_name(n) for n in split_cells(line, separator)]
         if len(names) >= 4 and tuple(names[:4]) == NIAGARA_COLUMNS:
             return i, separator
     return None, "no header Timestamp, Trend Flags, Status, Value (one Niagara history per file)"
@@ -162,7 +163,7 @@ def sniff_niagara(text):
 def _point_name(text, header_index):
     for line in text.lines[:header_index]:
         separator = ":" if ":" in line and texts.sniff_separator(line) == " " else texts.sniff_separator(line)
-        cells = [c for c in texts.split(line, separator) if c]
+        cells = [c for c in split_cells(line, separator) if c]
         if len(cells) >= 2 and cells[0].strip().lower() in HISTORY_KEYS:
             return cells[1].strip().rstrip("/").split("/")[-1]
     return os.path.splitext(os.path.basename(text.path))[0]
