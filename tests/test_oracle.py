@@ -2,7 +2,8 @@
 f32 rounds as IEEE binary32 does, one operation of binary32 values in
 binary64 rounded by f32 is the operation in binary32 (numpy's float32
 scalars, which compute each operation in single precision, agree bit for
-bit), and TIME values round to whole milliseconds, ties to even."""
+bit), a division by a zero is IEEE's, and TIME values round to whole
+milliseconds, ties to even."""
 import math
 import random
 import struct
@@ -10,7 +11,8 @@ import struct
 import numpy as np
 import pytest
 
-from support.oracle import f32, time_ms
+from support.fmu_driver import Instance
+from support.oracle import REAL, RateLimiterOracle, divide, f32, time_ms
 
 FLT_MAX = struct.unpack("<f", bytes.fromhex("ffff7f7f"))[0]
 FLT_TRUE_MIN = struct.unpack("<f", bytes.fromhex("01000000"))[0]
@@ -89,3 +91,34 @@ def test_time_rounds_to_whole_milliseconds_ties_to_even():
     assert time_ms(10.0) == 10.0
     assert time_ms(0.3) == 0.3           # 300 ms, as the decimal 0.3 reads
     assert time_ms(4294967.295) == 4294967.295
+
+
+def test_division_by_a_zero_is_ieee():
+    assert divide(1.0, 0.0) == math.inf and divide(-1.0, 0.0) == -math.inf
+    assert divide(1.0, -0.0) == -math.inf and divide(-1.0, -0.0) == math.inf
+    assert math.isnan(divide(0.0, 0.0)) and math.isnan(divide(-0.0, 0.0)) and math.isnan(divide(math.nan, 0.0))
+    assert divide(3.0, 2.0) == 1.5 and math.isnan(divide(1.0, math.nan))
+
+
+@pytest.mark.parametrize("rate_period, u, y, dydt", [
+    (0.0, 10.0, 1.0, math.inf),     # ratePeriod 0: rateUp 1 per cycle; (1 - 0) / +0
+    (0.0, -10.0, -1.0, -math.inf),  # (-1 - 0) / +0
+    (1.0, 10.0, 0.0, math.nan),     # 1 * T / 1 = 0 per cycle: y stays; (0 - 0) / +0
+])
+def test_real_step_of_the_smallest_subnormal_divides_by_zero(rate_period, u, y, dydt):
+    """REAL (rules.md, Arithmetic): T = 5e-324 enters as +0 (below binary32's
+    smallest subnormal), so dydt = (y - yp) / T is a binary32 division by +0,
+    IEEE's: an infinity of the step's sign, or NaN where y did not move."""
+    start = {"arithmetic": REAL, "ratePeriod": rate_period, "rateUpPar": 1.0, "rateDownPar": 1.0}
+    oracle = RateLimiterOracle({}, start).do_step(0.0, 5e-324, {"u": u})
+    results = [oracle]
+    for version in (2, 3):  # the FMUs give the same
+        fmu = Instance("RateLimiter", version)
+        fmu.start(u=0.0, **start)
+        fmu.set(u=u)
+        fmu.step(5e-324)
+        results.append(fmu.outputs(["y", "dydt"]))
+        fmu.free()
+    for out in results:
+        assert out["y"] == y
+        assert math.isnan(out["dydt"]) if math.isnan(dydt) else out["dydt"] == dydt

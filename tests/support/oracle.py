@@ -46,6 +46,18 @@ def f64(x):
     return x
 
 
+def divide(a, b):
+    """a / b as IEEE has it (Python refuses a zero divisor): by a zero, NaN
+    for 0 / 0 and NaN, else the infinity of the signs, the zero's included.
+    A REAL T that is a binary64 subnormal enters as a zero (rules.md,
+    Arithmetic), so that dydt divides by it."""
+    if b != 0 or math.isnan(b):
+        return a / b
+    if a == 0 or math.isnan(a):
+        return math.nan
+    return math.inf if math.copysign(1.0, a) == math.copysign(1.0, b) else -math.inf
+
+
 def time_ms(seconds):
     """A TIME pin set in seconds: whole milliseconds, seconds * 1000 in
     binary64 rounded to nearest, ties to even (Python's round of a float is
@@ -331,7 +343,7 @@ class RateLimiterOracle:
             "error": error,
             "status": self.status,
             "subFunctionStatus": self.vr[self.culprit] if error else 0,
-            "dydt": real(real(y - yp) / real(self.T)) if self.decided_by and finite(y) and finite(yp) else 0.0,
+            "dydt": real(divide(real(y - yp), real(self.T))) if self.decided_by and finite(y) and finite(yp) else 0.0,
             "limitingUp": ramped and real(yp + max_up) < uc,
             "limitingDown": ramped and real(yp - max_down) > uc,
             "highLimit": finite(y) and y >= high,
