@@ -228,7 +228,7 @@ static double loop_kernel(uint64_t steps, double cycleTime) {
     config.zeroRate = RL_ZERO_RATE_HOLD;
     config.passNonFinite = true;
     rl_prepare(&prepared, &config, H);
-    rl_init(&state, &config, 0.0);
+    rl_init(&state, &prepared, 0.0);
     void (*cycle)(RlState *, const RlPrepared *, double, double) = cycleFunction;
 
     CALLGRIND_ZERO_STATS;

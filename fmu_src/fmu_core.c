@@ -203,7 +203,7 @@ static void initialize_block(FmuInstance *instance) {
     configure(instance);
     /* with cycleTime 0 the cycle length is only known at the first step */
     prepare(instance, instance->cycleTime > 0 ? instance->cycleTime : NAN);
-    rl_init(&core->block, &instance->prepared.config, core->values[instance->model->inputVr]);
+    rl_init(&core->block, &instance->prepared, core->values[instance->model->inputVr]);
     publish(instance, true);
 }
 

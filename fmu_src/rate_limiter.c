@@ -119,13 +119,12 @@ static void running_reset(RlState *s) {
     s->runBase = 0.0;
 }
 
-void rl_init(RlState *s, const RlConfig *config, double u) {
-    const RlConfig rounded = entered(config);
-    const RlConfig *c = &rounded;
-    if (c->real) u = binary32(u);
+void rl_init(RlState *s, const RlPrepared *p, double u) {
+    const RlConfig *c = &p->config;
+    u = rl_input(p, u);
     double y = c->initMode == RL_INIT_VALUE ? c->initValue : u;
     /* within the limits that are set, unless they are inverted */
-    const double low = rl_low_limit(c->yMin.value), high = rl_high_limit(c->yMax.value);
+    const double low = p->yLow, high = p->yHigh;
     if (c->limitInitialOutput && isfinite(y) && !isgreater(low, high)) {
         if (isless(y, low)) y = low;
         if (isgreater(y, high)) y = high;
@@ -142,7 +141,6 @@ void rl_init(RlState *s, const RlConfig *config, double u) {
 void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
     const RlConfig *c = &p->config;
     double y;
-    u = rl_input(p, u);
 
     if (c->passNonFinite && !isfinite(u)) {
         y = u;
@@ -179,10 +177,10 @@ void rl_run(RlState *s, const RlPrepared *p, double u, uint64_t first, uint64_t 
         return;
     }
     u = rl_input(p, u);
-    rl_cycle(s, p, u, (double)first * cycleTime);
+    rl_cycle_entered(s, p, u, (double)first * cycleTime);
     if (!rl_only_ramps(s, p, u)) {
         for (uint64_t n = first + 1; n <= last; n++) {
-            rl_cycle(s, p, u, (double)n * cycleTime);
+            rl_cycle_entered(s, p, u, (double)n * cycleTime);
         }
         return;
     }

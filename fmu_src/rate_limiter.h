@@ -128,8 +128,10 @@ int rl_status(const RlConfig *config, int *source);
 /* Derive limits and status for cycles of length period (> 0). */
 void rl_prepare(RlPrepared *prepared, const RlConfig *config, double period);
 
-/* Output at initialisation for the input u. */
-void rl_init(RlState *state, const RlConfig *config, double u);
+/* Output at initialisation for the input u, from a configuration as
+ * rl_prepare keeps it (its values have entered the arithmetic: the period
+ * is not used). */
+void rl_init(RlState *state, const RlPrepared *prepared, double u);
 
 /* Time the output has been ramping towards the current u. */
 static inline double rl_running_time(const RlState *state) {
@@ -254,31 +256,22 @@ static inline bool rl_steady_limit(double limit) {
     return rl_steady_value(limit) || limit == INFINITY;
 }
 
-/* The kernel's arithmetic, once per type (rate_limiter_rules.h): RL_ENTER
- * brings a double that is not yet the type's into it; RL_MAX_UP and
- * RL_MAX_DOWN are the per-cycle limits in the type. */
+/* The kernel's arithmetic, once per type (rate_limiter_rules.h, which
+ * undefines these after use): RL_ENTER brings a double that is not yet the
+ * type's into it; RL_MAX_UP and RL_MAX_DOWN are the per-cycle limits in
+ * the type. */
 #define RL_NUM double
 #define RL_SUFFIX _lreal
 #define RL_ENTER(x) (x)
 #define RL_MAX_UP(p) ((p)->maxUp)
 #define RL_MAX_DOWN(p) ((p)->maxDown)
 #include "rate_limiter_rules.h"
-#undef RL_NUM
-#undef RL_SUFFIX
-#undef RL_ENTER
-#undef RL_MAX_UP
-#undef RL_MAX_DOWN
 #define RL_NUM float
 #define RL_SUFFIX _real
 #define RL_ENTER(x) rl_binary32(x)
 #define RL_MAX_UP(p) ((p)->maxUpReal)
 #define RL_MAX_DOWN(p) ((p)->maxDownReal)
 #include "rate_limiter_rules.h"
-#undef RL_NUM
-#undef RL_SUFFIX
-#undef RL_ENTER
-#undef RL_MAX_UP
-#undef RL_MAX_DOWN
 
 /* A value as it enters the block's arithmetic: u, every cycle. */
 static inline double rl_input(const RlPrepared *p, double u) {
@@ -301,7 +294,7 @@ static inline bool rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
     return p->config.real ? rl_ramp_steady_real(s, p, u) : rl_ramp_steady_lreal(s, p, u);
 }
 
-/* Rules 1-6 in their order. */
+/* Rules 1-6 in their order, for a u that has entered (rl_input). */
 void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
 
 /* The common case: finite u and y and a plain configuration, so that of
@@ -310,16 +303,20 @@ static inline bool rl_only_ramps(const RlState *state, const RlPrepared *prepare
     return prepared->plain && rl_steady_value(u) && rl_steady_value(state->y);
 }
 
-/* One cycle of length prepared->period; elapsed is the time from the start
- * to the end of this cycle. Inline, as the common case is a few
- * instructions. */
-static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed) {
-    u = rl_input(prepared, u);
+/* One cycle of length prepared->period for a u that has entered; elapsed
+ * is the time from the start to the end of this cycle. Inline, as the
+ * common case is a few instructions. */
+static inline void rl_cycle_entered(RlState *state, const RlPrepared *prepared, double u, double elapsed) {
     if (rl_only_ramps(state, prepared, u)) {
         rl_ramp(state, prepared, u);
     } else {
         rl_cycle_rules(state, prepared, u, elapsed);
     }
+}
+
+/* u enters the arithmetic here, once per cycle. */
+static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u, double elapsed) {
+    rl_cycle_entered(state, prepared, rl_input(prepared, u), elapsed);
 }
 
 /* Cycles first..last (of length cycleTime, ending at n * cycleTime) with u

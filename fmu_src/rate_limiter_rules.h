@@ -5,7 +5,8 @@
  * REAL they are binary32 values widened, so the conversions here are exact
  * and every operation below is one RL_NUM operation, rounded as C rounds
  * it with FLT_EVAL_METHOD 0, in the contract's order. No include guard: it
- * is meant to be included once per type. */
+ * is meant to be included once per type, and it undefines its parameters
+ * (RL_NUM ... RL_MAX_DOWN) at the end. */
 
 #define RL_NAME(name) RL_NAME_(name, RL_SUFFIX)
 #define RL_NAME_(name, suffix) RL_NAME__(name, suffix)
@@ -127,3 +128,8 @@ static inline bool RL_NAME(rl_cut_down)(double yp, double maxDown, double uc) {
 #undef RL_NAME
 #undef RL_NAME_
 #undef RL_NAME__
+#undef RL_NUM
+#undef RL_SUFFIX
+#undef RL_ENTER
+#undef RL_MAX_UP
+#undef RL_MAX_DOWN

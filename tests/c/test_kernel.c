@@ -94,7 +94,7 @@ static void start(Block *b, const RlConfig *config, double u, double period) {
     b->period = period;
     b->cycles = 0;
     rl_prepare(&b->prepared, c, period);
-    rl_init(&b->state, c, u);
+    rl_init(&b->state, &b->prepared, u);
 }
 
 static double cycle(Block *b, double u) {
@@ -610,7 +610,7 @@ static void test_fast_paths_equal_rules(void) {
         RlPrepared p;
         rl_prepare(&p, resolved(&c), T);
         RlState run, cycles, rules;
-        rl_init(&run, resolved(&c), 1.0);
+        rl_init(&run, &p, 1.0);
         cycles = rules = run;
         uint64_t first = 1;
         for (int k = 0; k < 2; k++) { /* two inputs in turn: resets too */
@@ -619,7 +619,7 @@ static void test_fast_paths_equal_rules(void) {
             rl_run(&run, &p, u, first, last, T);
             for (uint64_t m = first; m <= last; m++) {
                 rl_cycle(&cycles, &p, u, (double)m * T);
-                rl_cycle_rules(&rules, &p, u, (double)m * T);
+                rl_cycle_rules(&rules, &p, rl_input(&p, u), (double)m * T);
             }
             check_same_state(&run, &cycles);
             check_same_state(&cycles, &rules);
@@ -670,7 +670,8 @@ static void test_steady_ramp_equals_rules(void) {
         c.zeroRate = zero;
         RlPrepared p;
         RlState steady, rules;
-        rl_init(&steady, resolved(&c), 1.0);
+        rl_prepare(&p, resolved(&c), periods[0]);
+        rl_init(&steady, &p, 1.0);
         rules = steady;
         bool held = false; /* the FMU's fastPeriod: steady steps allowed */
         double elapsed = 0.0;
@@ -688,7 +689,7 @@ static void test_steady_ramp_equals_rules(void) {
                 }
                 held = p.plain && isfinite(steady.y);
                 if (held) rl_hold_period(&steady, periods[k]);
-                rl_cycle_rules(&rules, &p, u, elapsed);
+                rl_cycle_rules(&rules, &p, rl_input(&p, u), elapsed);
                 CHECK_EQ(steady.y, rules.y);
                 CHECK_EQ(steady.uPrevious, rules.uPrevious);
                 CHECK_EQ(steady.yPrevious, rules.yPrevious);
@@ -1055,7 +1056,9 @@ static void test_init_of_a_used_state(void) {
     RlConfig c = defaults();
     RlState s = { .y = 7.0, .uPrevious = 8.0, .yPrevious = 9.0, .decided = RL_DECIDED_RAMP, .runCycles = 5,
                   .runPeriod = 0.5, .runBase = 3.0 };
-    rl_init(&s, &c, 2.0);
+    RlPrepared p;
+    rl_prepare(&p, &c, 1.0);
+    rl_init(&s, &p, 2.0);
     CHECK_EQ(s.y, 2.0);
     CHECK_EQ(s.yPrevious, 2.0);
     CHECK_EQ(s.uPrevious, 2.0);
