@@ -329,10 +329,12 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     /* The next step may be the common one (fmu_step_fast) if it has this h,
      * the configuration stays, one cycle per step, only rule 6 applies to
      * any finite u (plain) and y is finite: then it stays so. */
-    /* (The common step adds h to the time unchecked: with h <= 2^960 and
-     * |time| <= 2^1022 the time needs 2^62 steps to overflow.) */
+    /* (The common step adds h to the time and takes t - time unchecked:
+     * with h <= 2^900 and |time| <= 2^968 the time needs 2^67 steps to
+     * reach 2^969, and below 2^970, t - time is at most DBL_MAX in
+     * magnitude for any t: nothing overflows.) */
     if (instance->cycleTime == 0 && instance->prepared.plain && rl_steady_value(core->block.y) &&
-        islessequal(h, 9.7453140114e288 /* ~2^960 */) && islessequal(fabs(core->time), 4.49423283715579e307 /* 2^1022 */)) {
+        islessequal(h, 8.452712498170644e+270 /* 2^900 */) && islessequal(fabs(core->time), 2.4948003869184e+291 /* 2^968 */)) {
         rl_hold_period(&core->block, h);
         instance->fastPeriod = h;
         /* the general tolerance, RL_TIME_TOLERANCE * |time|, only grows

@@ -233,9 +233,11 @@ FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, doub
 FmuStatus fmu_enter_initialization(FmuInstance *instance);
 FmuStatus fmu_exit_initialization(FmuInstance *instance);
 /* currentCommunicationPoint within a relative RL_TIME_TOLERANCE of the
- * FMU's time, whatever the step size (NaN and infinity are not) */
+ * FMU's time (finite), whatever the step size (NaN and infinity are not);
+ * the difference quiet (rl_sum): a t far from the time raises no
+ * FE_OVERFLOW */
 static inline bool fmu_time_matches(double t, double time) {
-    return islessequal(fabs(t - time), RL_TIME_TOLERANCE * fabs(time));
+    return isfinite(t) && islessequal(fabs(rl_sum(-time, t)), RL_TIME_TOLERANCE * fabs(time));
 }
 
 /* The common step, inline in the glue: the same step size as the step
@@ -245,7 +247,9 @@ static inline bool fmu_time_matches(double t, double time) {
  * t and a finite u. False: nothing done, take the general step. */
 static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     FmuCore *core = &instance->core;
-    /* the cycle itself, if u is finite in the block's arithmetic (y stays finite) */
+    /* t - time cannot overflow at the times the common step runs at
+     * (fmu_do_step_general); the cycle itself, if u is finite in the
+     * block's arithmetic (y stays finite) */
     if (!(h == instance->fastPeriod && islessequal(fabs(t - core->time), instance->fastTolerance) &&
           rl_ramp_steady(&core->block, &instance->prepared, core->values[instance->inputVr]))) {
         return false;

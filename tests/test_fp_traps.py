@@ -5,7 +5,9 @@ and FE_OVERFLOW enabled. Any of them raised in any call is SIGFPE: the
 harness names the exception and the script line and fails. Every reference
 scenario gives its reference so, and the hostile values of test_hostile.py
 (NaN, +-inf, subnormals, +-1e308 in every input and parameter, at the start
-and mid-run; the smallest and the largest step) run without a trap."""
+and mid-run; the smallest and the largest step; a communication point at
+the far end of the range from the FMU's time) run without a trap."""
+import math
 import os
 import sys
 
@@ -125,6 +127,17 @@ def hostile_script(md):
         add(value_line(input_u, 5.0))
         add(f"step {h.hex()} {h.hex()}")
         lines.extend(gets)
+    # a communication point of the opposite sign at the far end of the range,
+    # after steps that could take the common one: t - time overflows if taken as it is
+    for start in (1e307, -1e307):
+        add("new")
+        add(f"init {start.hex()}")
+        t, h = start, 1e300
+        for _ in range(3):
+            add(f"step {t.hex()} {h.hex()}")
+            lines.extend(gets)
+            t += h
+        add(f"step {math.copysign(sys.float_info.max, -start).hex()} {h.hex()}")
     return "\n".join(lines) + "\n", refused
 
 
