@@ -92,13 +92,33 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
     except (InputError, NotPlain, OSError, ValueError, StopIteration):
         return None
     outputs = list(first_ref.dtype.names[1:])
-    start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
-    n = round((stop - start) / step)
+    stop = options["StopTime"]
     readme = (texts.get("README.md") or "").strip().splitlines()
     description = readme[0].lstrip("# ").strip() if readme else ""
 
+    def inputs():
+        yield from trace_chunks(in_path, fmu.input_problem, chunk_bytes=chunk_bytes)
+
+    title = f"{name} on {labels['fmu']}" + (f": {description}" if description else "")
+    return stream_case(name, labels, mode, plots, runner, options, start_values, input_names,
+                       inputs() if input_names else None,
+                       trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=chunk_bytes), outputs,
+                       max(stop, bounds["time"][1]), title, result_file, steps_per_chunk, progress, started=started)
+
+
+def stream_case(name, labels, mode, plots, runner, options, start_values, input_names, input_chunks, ref_chunks,
+                outputs, t_end, title, result_file=None, steps_per_chunk=STEPS_PER_CHUNK, progress=None,
+                more_messages=None, started=None):
+    """The CaseOutcome of a case given as chunks: input_chunks (None: no
+    inputs) and ref_chunks are consecutive structured arrays, time first;
+    options: StartTime, StopTime, StepSize, RelTol. None if this path
+    cannot take it (a chunk raises NotPlain, the fast loop cannot replay
+    it), before anything is reported. more_messages(passed, deviations):
+    what the outcome's messages add after the comparison's."""
+    started = time.perf_counter() if started is None else started
+    start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
+    n = round((stop - start) / step)
     signals = {name: Verdict(name) for name in outputs}
-    t_end = max(stop, bounds["time"][1])
     envelopes = {key: Envelope(start, t_end) for key in
                  [("ref", s) for s in outputs] + [("result", s) for s in outputs] + [("deviation", s) for s in outputs]
                  + [("input", s) for s in input_names]}
@@ -107,13 +127,13 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
     absent = [0, None]  # reference times without a result sample: count, the first
 
     def inputs():
-        for chunk in trace_chunks(in_path, fmu.input_problem, chunk_bytes=chunk_bytes):
+        for chunk in input_chunks:
             for s in input_names:
                 envelopes[("input", s)].add(chunk["time"], chunk[s])
             yield chunk
 
-    results = runner.run_chunks(start, stop, step, inputs() if input_names else None, input_names, start_values,
-                                outputs, options["RelTol"], steps_per_chunk=steps_per_chunk)
+    results = runner.run_chunks(start, stop, step, inputs() if input_chunks is not None else None, input_names,
+                                start_values, outputs, options["RelTol"], steps_per_chunk=steps_per_chunk)
     window = []  # result chunks not yet compared: [(first index, chunk)]
     reached = 0  # result samples made
     bar = progress or SampleProgress(n + 1)
@@ -140,7 +160,7 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
 
         try:
             held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-            for chunk in trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=chunk_bytes):
+            for chunk in ref_chunks:
                 if held is not None:
                     chunk = np.concatenate([held, chunk])
                 held = chunk[-1:]
@@ -164,8 +184,9 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
     outcome.status = Status.PASS if passed else Status.FAIL
     outcome.deviations = [d for d in deviations if not d.passed]
     outcome.messages = [problem] if problem else [d.describe() for d in deviations if not d.passed]
+    if more_messages is not None:
+        outcome.messages += more_messages(passed, outcome.deviations)
     if plots == "all" or (plots == "failed" and not passed):
-        title = f"{name} on {labels['fmu']}" + (f": {description}" if description else "")
         figure = Figure(title, [(s, *envelopes[("input", s)].line()) for s in input_names],
                         [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
                         [(s, *envelopes[("deviation", s)].line()) for s in outputs],

@@ -15,6 +15,7 @@ from .outcome import CaseOutcome, Status
 from .plot import plot_case
 from .recordings import is_recording
 from .recordings.case import RecordedCase, RecordingOptions, recorded_case
+from .recordings.stream import is_long_recording, run_long_recording
 from .runner import Runner
 
 PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV
@@ -32,9 +33,12 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
     CaseOutcome fields that name the FMU."""
     started = time.perf_counter()
     recorded = texts is None and is_recording(folder)  # (texts come with a case folder only)
-    if not recorded and is_long(folder, fmu.model, texts):
+    streamed = is_long_recording(folder) if recorded else is_long(folder, fmu.model, texts)
+    if streamed:
         result_file = _result_file() if plots != "none" else None
-        long = run_long_case(folder, name, runner, fmu, labels, mode, plots, result_file=result_file)
+        long = run_long_recording(folder, name, runner, fmu, labels, mode, plots, recording or RecordingOptions(),
+                                  result_file=result_file) if recorded else \
+            run_long_case(folder, name, runner, fmu, labels, mode, plots, result_file=result_file)
         if result_file and (long is None or not long.png):  # a result file only with the case's plot
             os.unlink(result_file)
         elif long is not None:

@@ -45,11 +45,7 @@ def _cycles_of(channel, step, notes):
     index, off = cycles(channel, step)
     if len(off):
         i = int(off[0])
-        notes.append(f"{channel.name}: {len(off)} of its {len(index)} time stamps are more than {OFF_CYCLE:g} "
-                     "of a cycle "
-                     f"({OFF_CYCLE * step:g} s) off a cycle end, matched to the nearest one; the first at "
-                     f"{channel.where(i)}: t={float(channel.times[i]):.9g} s, {float(channel.times[i] / step):.3f} "
-                     "cycles: is the step size the recorder's cycle?")
+        notes.append(off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step))
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])
@@ -57,6 +53,14 @@ def _cycles_of(channel, step, notes):
                          f"t={float(channel.times[i + 1]):.9g} s fall on the same cycle of {step:g} s: the step is "
                          "coarser than the recording (give the recorder's cycle with --step-size)")
     return index
+
+
+def off_cycle_note(name, off, samples, where, time, step):
+    """What a channel with off time stamps gets: how many of its samples,
+    the first (where: its file and line, time: seconds)."""
+    return (f"{name}: {off} of its {samples} time stamps are more than {OFF_CYCLE:g} of a cycle "
+            f"({OFF_CYCLE * step:g} s) off a cycle end, matched to the nearest one; the first at {where}: "
+            f"t={time:.9g} s, {time / step:.3f} cycles: is the step size the recorder's cycle?")
 
 
 def _interval(index):

@@ -74,12 +74,17 @@ class RecordedCase(Case):
             at = np.flatnonzero(np.rint(channel.times / step).astype(np.int64) == cycle)
             if len(at):
                 i = int(at[0])
-                messages.append(f"{deviation.name} first differs at the recording's sample of cycle {cycle} "
-                                f"({channel.where(i)}, t={float(channel.times[i]):.9g} s from its first sample): "
-                                f"recorded {float(channel.values[i])!r}, the FMU gives {deviation.value!r}")
+                messages.append(first_differs(deviation, cycle, channel.where(i), float(channel.times[i]),
+                                              float(channel.values[i])))
         if self.coarse:
             messages.append(self.coarse)
         return messages + self.notes
+
+
+def first_differs(deviation, cycle, where, time, recorded):
+    """Where a failing signal's first deviation is in the recording."""
+    return (f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={time:.9g} s "
+            f"from its first sample): recorded {recorded!r}, the FMU gives {deviation.value!r}")
 
 
 def recording_paths(paths):

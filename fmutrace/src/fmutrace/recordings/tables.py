@@ -83,15 +83,21 @@ def sniff(text):
     return find_header(text)[2] if find_header(text)[0] is None else None
 
 
-def read(text):
+def layout(text):
+    """(header's line index, separator, names, time columns, index columns) of a table's text."""
     index, separator, names = find_header(text)
     if index is None:
         raise text.error(0, 0, names)
-    header_line = index + 1
     names = [texts.unquote(n) for n in names]
-    preamble = [l for l in text.lines[:index] if l.strip()]
     time_columns = [i for i, n in enumerate(names) if is_time_name(n)]
     index_columns = [i for i, n in enumerate(names) if is_index_name(n)]
+    return index, separator, names, time_columns, index_columns
+
+
+def read(text):
+    index, separator, names, time_columns, index_columns = layout(text)
+    header_line = index + 1
+    preamble = [l for l in text.lines[:index] if l.strip()]
     seen = {}
     for i, name in enumerate(names):
         if not name:

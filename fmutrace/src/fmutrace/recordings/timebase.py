@@ -209,8 +209,11 @@ def finest_interval(channels):
         if len(steps):
             typical = float(np.median(steps))
             best = typical if best is None else min(best, typical)
-    if best is None:
-        return None
+    return None if best is None else snapped_interval(best)
+
+
+def snapped_interval(best):
+    """A typical interval between stamps as the recorder's cycle."""
     # clocks and printed stamps are not exact: a median of 0.2499985 s is a 250 ms cycle (the shortest
     # decimal within SNAP of it)
     for digits in range(1, 16):

@@ -1,0 +1,383 @@
+"""A long one-file recording (a table export: CSV/TSV, TIA Portal, CODESYS
+V3) read in blocks of lines into the long-case path (longcase.stream_case),
+in memory that does not grow with its length.
+
+The file's head (its first HEAD_BYTES) is read as the in-memory path reads
+the whole (format, header, columns, time unit, the channels matched to the
+FMU); every block of lines after it is cut into cells and converted by the
+same functions (grid.uniform_table, grid.numeric_stamps, text.values), so
+each sample has the in-memory path's bits. Each row is a cycle: its inputs
+drive the step from its cycle, its outputs are compared as align.py lays
+them. The step is the head's finest interval, checked at the end against
+the whole file's (the median of every interval, counted as the blocks go
+by); notes and the failing signals' recorded samples are the in-memory
+path's, word for word (a test runs both on the same recordings).
+
+What it takes: one file of a table export in UTF-8 or Windows-1252, a
+separator other than blanks, a time column of numbers (not dates or
+FILETIME integers), every cell filled, lines ending in LF or CR LF, no
+blank line before the end, one row per cycle (no repeated or skipped
+cycle). Anything else raises NotPlain before the outcome is made, and the
+in-memory path reads the file (or explains it).
+"""
+import io
+import os
+
+import numpy as np
+
+from ..errors import InputError, TraceError
+from ..longcase import LONG_CASE_BYTES, stream_case
+from ..traces import UNUSUAL_LINE_BREAKS, NotPlain, split_cells
+from . import TEXT_FORMATS, mdf, tables
+from . import grid as grids
+from . import text as texts
+from . import timebase
+from .align import off_cycle_note
+from .case import first_differs
+from .matching import plan
+
+HEAD_BYTES = 1 << 20      # read as the in-memory path reads a whole file
+BLOCK_BYTES = 1 << 22     # of text per block of lines after the head
+MAX_INTERVALS = 1 << 16   # distinct intervals between stamps counted for the step (more: the in-memory path)
+_CODECS = {"UTF-8": "utf-8", "UTF-8 (with BOM)": "utf-8", "Windows-1252": "cp1252"}
+_UNITS = {"filetime": "FILETIME"}
+
+
+def is_long_recording(path) -> bool:
+    """Whether the recording at path is one file large enough to be streamed."""
+    try:
+        return os.path.isfile(path) and os.path.getsize(path) >= LONG_CASE_BYTES
+    except OSError:
+        return False
+
+
+class _Table:
+    """A table export's layout from its head, and its body in blocks of rows."""
+
+    def __init__(self, path, fmu, options):
+        self.path = str(path)
+        with open(path, "rb") as file:
+            head = file.read(HEAD_BYTES)
+            at_end = not file.read(1)
+        if mdf.sniff(head[:64]) is None:
+            raise NotPlain("MDF4")
+        if not at_end:
+            head = head[:head.rfind(b"\n") + 1]
+        decoded, self.encoding = texts.decode(self.path, head)
+        if self.encoding not in _CODECS or _unusual_breaks(decoded):
+            raise NotPlain("an encoding or line breaks the blocks cannot follow")
+        text = texts.Text(self.path, decoded, self.encoding)
+        fits = next((name for name, sniff, _ in TEXT_FORMATS if sniff(text) is None), None)
+        if fits != TEXT_FORMATS[-1][0]:
+            raise NotPlain("not a table export")
+        recording = tables.read(text)
+        index, self.separator, names, time_columns, index_columns = tables.layout(text)
+        if self.separator == " " or recording.time_unit == "date":
+            raise NotPlain("blanks as the separator, or dates")
+        self.width, self.decimal_comma = len(names), self.separator != ","
+        self.time_column = time_columns[0] if time_columns else index_columns[0]
+        self.time_name = names[self.time_column]
+        rows = len(text.lines) - index - 1
+        if any(c.stamps.dtype != np.float64 or len(c.values) != rows for c in recording.channels) or rows < 2:
+            raise NotPlain("integer stamps, an empty cell or too few rows in the head")
+        time_unit = options.time_unit
+        timebase.normalise(recording, _UNITS.get(time_unit, time_unit), options.step_size, fmu.default_step)
+        self.recording = recording
+        self.origin = float(recording.channels[0].stamps[0])
+        self.factor = recording.step_size if recording.time_unit == "cycles" else \
+            timebase.TIME_FACTORS[recording.time_unit]
+        self.step_given = recording.time_unit == "cycles" or recording.step_source != \
+            "the finest interval between its time stamps"
+        # the body starts after the header's line (index: 0-based), counted in bytes of the head
+        start = 0
+        for _ in range(index + 1):
+            start = head.index(b"\n", start) + 1
+        self.body_start, self.first_line = start, index + 2
+        self.columns = {c.name: c.column - 1 for c in recording.channels}
+
+    def blocks(self, block_bytes=None):
+        """(first line number, cells, line numbers, times) of each block of
+        rows; cells: a channel's values by table.values(cells, line numbers, name)."""
+        codec = _CODECS[self.encoding]
+        number, previous = self.first_line, None
+        with open(self.path, "rb") as file:
+            file.seek(self.body_start)
+            rest, data = b"", b"x"
+            while data:
+                data = file.read(block_bytes or BLOCK_BYTES)
+                block = rest + data
+                cut = block.rfind(b"\n") + 1 if data else len(block)
+                block, rest = block[:cut], block[cut:]
+                if not data:  # the file's end: blank lines there end the table as in memory
+                    lines = block.split(b"\n")
+                    while lines and not lines[-1].strip():
+                        lines.pop()
+                    block = b"\n".join(lines)
+                if not block.strip():
+                    continue
+                fast = self._numbers(block)
+                if fast is not None:
+                    cells, stamps = fast
+                    line_numbers = np.arange(number, number + len(stamps), dtype=np.int64)
+                else:
+                    cells, line_numbers, stamps = self._cells(block, codec, number)
+                if (previous is not None and stamps[0] < previous) or (np.diff(stamps) < 0).any():
+                    raise NotPlain("time going backwards")
+                previous = stamps[-1]
+                yield number, cells, line_numbers, timebase._minus(stamps, self.origin) * self.factor
+                number += len(stamps)
+
+    def _numbers(self, block):
+        """(values by column, stamps) of a block whose every cell is a plain
+        number, read by pyarrow; None for any other (the cells are then
+        read as the in-memory path reads them). pyarrow converts a decimal
+        number correctly rounded, as NumPy's conversion of the cells does:
+        the same bits. Left to the cells: NaN (its sign and payload), time
+        stamps beyond 1e15 (grid.numeric_stamps may read those as
+        integers), a line of other cells, blanks, quotes, an empty line."""
+        import pyarrow as pa
+        import pyarrow.csv as pcsv
+
+        if b"\r" in block and block.count(b"\r") != block.count(b"\r\n"):
+            return None
+        names = [f"c{j}" for j in range(self.width)]
+        try:
+            table = pcsv.read_csv(
+                io.BytesIO(block),
+                read_options=pcsv.ReadOptions(column_names=names, use_threads=True),
+                parse_options=pcsv.ParseOptions(delimiter=self.separator, quote_char=False, ignore_empty_lines=False),
+                convert_options=pcsv.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
+                                                    strings_can_be_null=False,
+                                                    decimal_point="," if self.decimal_comma else "."))
+        except pa.ArrowInvalid:
+            return None
+        columns = [table.column(n).to_numpy() for n in names]
+        stamps = columns[self.time_column]
+        if any(np.isnan(c).any() for c in columns) or (np.abs(stamps) >= 1e15).any():
+            return None
+        return {j: c for j, c in enumerate(columns)}, stamps
+
+    def _cells(self, block, codec, number):
+        """(cells, line numbers, stamps) of a block as the in-memory path cuts and reads them."""
+        try:
+            decoded = block.decode(codec)
+        except UnicodeDecodeError:
+            raise NotPlain("bytes of another encoding") from None
+        if _unusual_breaks(decoded):
+            raise NotPlain("line breaks the blocks cannot follow")
+        text = texts.Text(self.path, decoded, self.encoding)
+        lines = text.lines
+        if any(not line.strip() or line.strip() == "EOF" for line in lines):
+            raise NotPlain("a blank line or an end marker inside the table")
+        table = grids.uniform_table(text, 0, self.separator, self.width, stop_words=())
+        if table is None or len(table[0]) != len(lines):
+            raise NotPlain("a line of other cells than the header's")
+        cells, line_numbers = table
+        line_numbers = line_numbers + (number - 1)
+        try:
+            if not grids.present(cells).all():
+                raise NotPlain("an empty cell")
+            stamps = grids.numeric_stamps(text, cells[:, self.time_column], line_numbers, self.time_column + 1,
+                                          self.time_name, self.decimal_comma)
+        except TraceError:
+            raise NotPlain("a time cell the in-memory path explains") from None
+        if stamps.dtype != np.float64:
+            raise NotPlain("integer stamps")
+        return cells, line_numbers, stamps
+
+    def values(self, cells, line_numbers, name):
+        """A channel's values in a block (text.values, as the in-memory path converts them)."""
+        j = self.columns[name]
+        if isinstance(cells, dict):
+            return cells[j]
+        try:
+            return texts.values(cells[:, j], self.decimal_comma, texts.Text(self.path, "", self.encoding),
+                                lambda i: int(line_numbers[i]), j + 1, name)
+        except TraceError:
+            raise NotPlain("a cell the in-memory path explains") from None
+
+    def last_time(self):
+        """The time of the last row (its line read from the file's end)."""
+        with open(self.path, "rb") as file:
+            end = file.seek(0, os.SEEK_END)
+            size = 4096
+            while True:
+                begin = max(self.body_start, end - size)
+                file.seek(begin)
+                lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
+                if len(lines) >= 2 or begin == self.body_start:
+                    break
+                size *= 4
+        if not lines:
+            raise NotPlain("no rows")
+        cell = split_cells(lines[-1].decode(_CODECS[self.encoding], "replace"), self.separator)
+        stamp = texts.values(np.array([cell[self.time_column] if len(cell) == self.width else ""]),
+                             self.decimal_comma, texts.Text(self.path, "", self.encoding), lambda i: 0, 0, "")
+        return float(timebase._minus(stamp, self.origin)[0] * self.factor)
+
+
+def _unusual_breaks(text):
+    return any(c in text for c in UNUSUAL_LINE_BREAKS) or "\r" in text.replace("\r\n", "")
+
+
+class _Intervals:
+    """The positive intervals between consecutive times, counted by value
+    (a recording's are a handful of values), for their exact median."""
+
+    def __init__(self):
+        self.counts, self.last = {}, None
+
+    def add(self, times):
+        joined = times if self.last is None else np.concatenate([[self.last], times])
+        self.last = times[-1]
+        steps = np.diff(joined)
+        values, counts = np.unique(steps[steps > 0], return_counts=True)
+        for value, count in zip(values.tolist(), counts.tolist()):
+            self.counts[value] = self.counts.get(value, 0) + count
+        if len(self.counts) > MAX_INTERVALS:
+            raise NotPlain("too many distinct intervals between stamps")
+
+    def median(self):
+        """np.median of all the intervals (None if there are none)."""
+        total = sum(self.counts.values())
+        if not total:
+            return None
+        middle, seen = {}, 0
+        for value in sorted(self.counts):
+            for k in ((total - 1) // 2, total // 2):
+                if seen <= k < seen + self.counts[value]:
+                    middle[k] = value
+            seen += self.counts[value]
+        return float(np.median(np.array(list(middle.values()))))  # one value, or the mean of the two middle ones
+
+
+def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, result_file=None, progress=None,
+                       block_bytes=None, steps_per_chunk=None):
+    """The CaseOutcome of the one-file recording at path, streamed; None
+    if this path cannot take it (the in-memory path then reads it)."""
+    from ..comparison import Pointwise
+    from ..runner import STEPS_PER_CHUNK
+
+    if not isinstance(mode, Pointwise):
+        return None
+    try:
+        table = _Table(path, fmu, options)
+        recording = table.recording
+        matched = plan(recording, fmu.variables, fmu.label, options.maps)
+        if not matched.compares:
+            return None
+        step = recording.step_size
+        shift = 1 if options.timing == "cycle" else 0
+        last = int(np.rint(table.last_time() / step))
+        start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
+    except (NotPlain, InputError, OSError, ValueError):
+        return None
+    drives, compares = matched.drives, matched.compares
+    stop = max(last + shift, 1) * step
+    state = {"rows": 0, "next": 0, "off": 0, "first_off": None, "span": 0.0}
+    intervals = _Intervals()
+    pending = {"inputs": [], "refs": []}
+
+    def parse():
+        """Reads the next block into both queues; False at the end."""
+        block = next(blocks, None)
+        if block is None:
+            _finish()
+            return False
+        _, cells, line_numbers, times = block
+        exact = times / step
+        index = np.rint(exact).astype(np.int64)
+        if index[0] != state["next"] or (np.diff(index) != 1).any():
+            raise NotPlain("a repeated or skipped cycle")
+        state["next"] = int(index[-1]) + 1
+        off = np.flatnonzero(np.abs(exact - index) > timebase.OFF_CYCLE)
+        if len(off) and state["first_off"] is None:
+            state["first_off"] = (int(line_numbers[off[0]]), float(times[off[0]]))
+        state["off"] += len(off)
+        state["rows"] += len(times)
+        state["span"] = float(times[-1])
+        if not table.step_given:
+            intervals.add(times)
+        if drives:
+            chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
+            chunk["time"] = index * step
+            for variable, channel in drives:
+                chunk[variable] = table.values(cells, line_numbers, channel.name)
+            pending["inputs"].append(chunk)
+        chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in compares])
+        chunk["time"] = (index + shift) * step
+        for variable, channel in compares:
+            chunk[variable] = table.values(cells, line_numbers, channel.name)
+        pending["refs"].append(chunk)
+        return True
+
+    def _finish():
+        """The whole file's checks, as normalise() and align() make them."""
+        if state["next"] - 1 != last:
+            raise NotPlain("the last row is not the last cycle")
+        if not table.step_given and timebase.snapped_interval(intervals.median() or step) != step:
+            raise NotPlain("the whole file's interval is another step than its head's")
+        span, samples = state["span"], state["rows"]
+        steps = span / step
+        if span > timebase.MAX_SPAN or steps > timebase.MAX_STEPS or \
+                (steps > timebase.MAX_SPARSE * samples and recording.time_source != "--time-unit"):
+            raise NotPlain("the in-memory path refuses the length")
+
+    def queue(kind):
+        while True:
+            if pending[kind]:
+                yield pending[kind].pop(0)
+            elif not parse():
+                while pending[kind]:
+                    yield pending[kind].pop(0)
+                return
+
+    blocks = table.blocks(block_bytes)
+
+    def more_messages(passed, deviations):
+        notes = []
+        if state["off"]:
+            line, time = state["first_off"]
+            notes = [off_cycle_note(channel.name, state["off"], state["rows"], f"{table.path}, line {line}", time,
+                                    step) for _, channel in drives + compares]
+        notes += matched.describe()
+        unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
+        description = (f"{recording.format}: {state['rows']} samples, time as {unit} ({recording.time_source}), "
+                       f"step {step:g} s ({recording.step_source})")
+        if passed:
+            return [description] + notes
+        return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
+
+    title = f"{name} on {labels['fmu']}: {recording.format}"
+    return stream_case(name, labels, mode, plots, runner,
+                       {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6}, start_values,
+                       tuple(v for v, _ in drives), queue("inputs") if drives else None, queue("refs"),
+                       [v for v, _ in compares], stop, title, result_file, steps_per_chunk or STEPS_PER_CHUNK,
+                       progress, more_messages)
+
+
+def _explain(table, deviations, channels, step, shift):
+    """RecordedCase.explain's messages: each failing signal's recorded sample at its first deviation."""
+    wanted = {}
+    for deviation in deviations:
+        if deviation.name in channels and deviation.time is not None:
+            wanted[deviation.name] = int(round(deviation.time / step)) - shift
+    found = {}
+    row = 0
+    if wanted:
+        for _, cells, line_numbers, times in table.blocks():
+            for name, cycle in wanted.items():
+                if name not in found and row <= cycle < row + len(times):
+                    i = cycle - row
+                    value = table.values(cells, line_numbers, channels[name].name)[i]
+                    found[name] = (int(line_numbers[i]), float(times[i]), float(value))
+            row += len(times)
+            if len(found) == len(wanted):
+                break
+    messages = []
+    for deviation in deviations:
+        if deviation.name in found:
+            line, time, value = found[deviation.name]
+            messages.append(first_differs(deviation, wanted[deviation.name], f"{table.path}, line {line}", time,
+                                          value))
+    return messages
