@@ -1,4 +1,5 @@
-/* FMI 2.0 Co-Simulation interface, shared by every model. */
+/* FMI 2.0 Co-Simulation and Model Exchange interfaces, shared by every
+ * model. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -6,39 +7,45 @@
 #include "fmu_core.h"
 
 /* Modes each function may be called in: FMI 2.0.4, section 4.2.4 (state
- * machine of a Co-Simulation slave). Step Mode stands for stepComplete,
- * stepFailed and stepCanceled: this slave never returns fmi2Pending, so
- * there is no stepInProgress. */
+ * machine of a Co-Simulation slave) and section 3.2.3 (Model Exchange).
+ * Step Mode stands for stepComplete, stepFailed and stepCanceled: this
+ * slave never returns fmi2Pending, so there is no stepInProgress. Step
+ * Mode is only ever a Co-Simulation instance's, Event Mode and
+ * Continuous-Time Mode a Model Exchange instance's; the functions of one
+ * interface alone also refuse an instance of the other (BEGIN_ONLY).
+ * Continuous-Time Mode allows sets of continuous-time inputs only, and
+ * this FMU has none: every input and parameter is set in Event Mode. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
 #define ERR  MODE_ERROR
+#define EVENT MODE_EVENT
+#define CONT MODE_CONTINUOUS
 #define NO_MODE 0
 
-#define MODES_SetDebugLogging           (INST | INIT | STEP | TERM | ERR)
+#define ANY (INST | INIT | STEP | EVENT | CONT | TERM | ERR)
+#define MODES_SetDebugLogging           ANY
 #define MODES_SetupExperiment           (INST)
 #define MODES_EnterInitializationMode   (INST)
 #define MODES_ExitInitializationMode    (INIT)
-#define MODES_Terminate                 (STEP)
-#define MODES_Reset                     (INST | INIT | STEP | TERM | ERR)
-#define MODES_GetReal                   (INIT | STEP | TERM | ERR)
+#define MODES_Terminate                 (STEP | EVENT | CONT)
+#define MODES_Reset                     ANY
+#define MODES_GetReal                   (INIT | STEP | EVENT | CONT | TERM | ERR)
 #define MODES_GetInteger                MODES_GetReal
 #define MODES_GetBoolean                MODES_GetReal
 #define MODES_GetString                 MODES_GetReal
-#define MODES_SetReal                   (INST | INIT | STEP)
+#define MODES_SetReal                   (INST | INIT | STEP | EVENT)
 #define MODES_SetInteger                MODES_SetReal
 #define MODES_SetBoolean                MODES_SetReal
 #define MODES_SetString                 MODES_SetReal
-#define MODES_GetFMUstate               (INST | INIT | STEP | TERM | ERR)
+#define MODES_GetFMUstate               ANY
 #define MODES_SetFMUstate               MODES_GetFMUstate
 #define MODES_FreeFMUstate              MODES_GetFMUstate
 #define MODES_SerializedFMUstateSize    MODES_GetFMUstate
 #define MODES_SerializeFMUstate         MODES_GetFMUstate
 #define MODES_DeSerializeFMUstate       MODES_GetFMUstate
-#define MODES_GetDirectionalDerivative  (INIT | STEP | TERM | ERR)
-#define MODES_SetRealInputDerivatives   (INST | INIT | STEP)
-#define MODES_GetRealOutputDerivatives  (STEP | TERM | ERR)
+/* Co-Simulation */
 #define MODES_DoStep                    (STEP)
 #define MODES_CancelStep                NO_MODE
 #define MODES_GetStatus                 (STEP | TERM)
@@ -46,6 +53,17 @@
 #define MODES_GetIntegerStatus          MODES_GetStatus
 #define MODES_GetBooleanStatus          MODES_GetStatus
 #define MODES_GetStringStatus           MODES_GetStatus
+/* Model Exchange */
+#define MODES_EnterEventMode            (EVENT | CONT)
+#define MODES_NewDiscreteStates         (EVENT)
+#define MODES_EnterContinuousTimeMode   (EVENT)
+#define MODES_CompletedIntegratorStep   (CONT)
+#define MODES_SetTime                   (EVENT | CONT) /* Event Mode: a pure discrete-time FMU's next instant */
+#define MODES_SetContinuousStates       (CONT)
+#define MODES_GetEventIndicators        (INIT | EVENT | CONT | TERM | ERR)
+#define MODES_GetContinuousStates       MODES_GetEventIndicators
+#define MODES_GetDerivatives            MODES_GetEventIndicators
+#define MODES_GetNominalsOfContinuousStates (INST | EVENT | CONT | TERM | ERR)
 
 typedef struct {
     FmuInstance base; /* first: an fmi2Component is an FmuInstance */
@@ -63,11 +81,22 @@ typedef struct {
     if (!I) return fmi2Error;                                                 \
     if (!(I->core.mode & (MODES_##name))) return (fmi2Status)fmu_mode_error(I, FN)
 
+/* a function of one interface: an instance of the other is refused */
+#define BEGIN_ONLY(name, fmuType)                                             \
+    BEGIN(name);                                                              \
+    if (I->modelExchange != ((fmuType) == fmi2ModelExchange)) return (fmi2Status)other_interface(I, FN)
+
 #define CHECK(expression)                                                     \
     do {                                                                      \
         const FmuStatus status_ = (expression);                               \
         if (status_ > FMU_WARNING) return (fmi2Status)status_;                \
     } while (0)
+
+FMU_COLD static FmuStatus other_interface(FmuInstance *I, const char *function) {
+    return fmu_error(I, function, "a %s function, and this instance was instantiated for %s",
+                     I->modelExchange ? "Co-Simulation" : "Model Exchange",
+                     I->modelExchange ? "Model Exchange" : "Co-Simulation");
+}
 
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
     const Fmi2Instance *g = (const Fmi2Instance *)instance;
@@ -97,8 +126,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     const char *reason = NULL;
     if (!instanceName || !*instanceName) {
         reason = "instanceName is missing";
-    } else if (fmuType != fmi2CoSimulation) {
-        reason = "this FMU supports Co-Simulation only";
+    } else if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
+        reason = "fmuType is neither fmi2ModelExchange nor fmi2CoSimulation";
     } else if (!fmuGUID || strcmp(fmuGUID, fmuModel.token) != 0) {
         reason = "the GUID does not match this FMU's model description";
     }
@@ -123,6 +152,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     g->base.logFunction = functions->logger ? log_to_importer : NULL;
     g->base.logCategories = (loggingOn ? LOG_ALL : 0) | ALWAYS_LOGGED;
     g->base.errorMode = MODE_ERROR; /* FMI 2.0.4 section 2.1.3: only reads, reset or an FMU state lead on */
+    g->base.modelExchange = fmuType == fmi2ModelExchange;
     g->base.allocate = allocate_state;
     g->base.release = release_state;
     fmu_init_instance(&g->base);
@@ -278,44 +308,88 @@ fmi2Status fmi2CancelStep(fmi2Component c) {
     return fmi2Error; /* unreachable: no mode allows it */
 }
 
-fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    (void)s;
-    (void)value;
-    BEGIN(GetStatus);
-    return fmi2Discard; /* doStep never returns fmi2Pending */
-}
+/* The status getters (FMI 2.0.4, section 4.2.3): doStep never returns
+ * fmi2Pending, so fmi2GetStatus, fmi2GetIntegerStatus and
+ * fmi2GetStringStatus have nothing to tell; fmi2LastSuccessfulTime (Real)
+ * is the FMU's time, fmi2Terminated (Boolean) is false. One body: kind
+ * is the status kind the getter answers, NO_KIND for none. */
+#define NO_KIND (-1)
+#define STATUS_GETTER(NAME, TYPE, KIND, VALUE)                                \
+    fmi2Status fmi2Get##NAME(fmi2Component c, const fmi2StatusKind s, TYPE *value) { \
+        BEGIN_ONLY(Get##NAME, fmi2CoSimulation);                              \
+        if ((KIND) == NO_KIND || (int)s != (KIND)) return fmi2Discard;        \
+        if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL"); \
+        *value = VALUE;                                                       \
+        return fmi2OK;                                                        \
+    }
 
-fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
-    BEGIN(GetRealStatus);
-    if (s != fmi2LastSuccessfulTime) return fmi2Discard;
-    if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL");
-    *value = I->core.time;
+STATUS_GETTER(Status, fmi2Status, NO_KIND, fmi2OK)
+STATUS_GETTER(RealStatus, fmi2Real, fmi2LastSuccessfulTime, I->core.time)
+STATUS_GETTER(IntegerStatus, fmi2Integer, NO_KIND, 0)
+STATUS_GETTER(BooleanStatus, fmi2Boolean, fmi2Terminated, fmi2False)
+STATUS_GETTER(StringStatus, fmi2String, NO_KIND, NULL)
+
+/* ---- Model Exchange: no continuous states, no event indicators; the cycle
+ * ends are time events (fmu_core.h) ------------------------------------- */
+
+fmi2Status fmi2EnterEventMode(fmi2Component c) {
+    BEGIN_ONLY(EnterEventMode, fmi2ModelExchange);
+    I->core.mode = MODE_EVENT;
+    I->core.eventTime = I->core.time;
     return fmi2OK;
 }
 
-fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    (void)s;
-    (void)value;
-    BEGIN(GetIntegerStatus);
-    return fmi2Discard;
-}
-
-fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    BEGIN(GetBooleanStatus);
-    if (s != fmi2Terminated) return fmi2Discard;
-    if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL");
-    *value = fmi2False;
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
+    BEGIN_ONLY(NewDiscreteStates, fmi2ModelExchange);
+    if (!eventInfo) return (fmi2Status)fmu_error(I, FN, "the eventInfo pointer is NULL");
+    double next;
+    CHECK(fmu_update_discrete_states(I, FN, &next));
+    eventInfo->newDiscreteStatesNeeded = fmi2False;
+    eventInfo->terminateSimulation = fmi2False;
+    eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
+    eventInfo->valuesOfContinuousStatesChanged = fmi2False;
+    eventInfo->nextEventTimeDefined = isnan(next) ? fmi2False : fmi2True;
+    eventInfo->nextEventTime = isnan(next) ? 0.0 : next;
     return fmi2OK;
 }
 
-fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    (void)s;
-    (void)value;
-    BEGIN(GetStringStatus);
-    return fmi2Discard;
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
+    BEGIN_ONLY(EnterContinuousTimeMode, fmi2ModelExchange);
+    fmu_leave_instant(I);
+    I->core.mode = MODE_CONTINUOUS;
+    return fmi2OK;
 }
 
-/* ---- not provided: derivatives and Model Exchange ----------------------- */
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    BEGIN_ONLY(CompletedIntegratorStep, fmi2ModelExchange);
+    if (!enterEventMode || !terminateSimulation) {
+        return (fmi2Status)fmu_error(I, FN, "an output argument pointer is NULL");
+    }
+    *enterEventMode = fmi2False;
+    *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
+    BEGIN_ONLY(SetTime, fmi2ModelExchange);
+    return (fmi2Status)fmu_set_time(I, FN, time);
+}
+
+#define NO_STATES(NAME, TYPE, WHAT)                                           \
+    fmi2Status fmi2##NAME(fmi2Component c, TYPE array[], size_t n) {          \
+        BEGIN_ONLY(NAME, fmi2ModelExchange);                                  \
+        return (fmi2Status)fmu_check_none(I, FN, WHAT, n, array);             \
+    }
+
+NO_STATES(SetContinuousStates, const fmi2Real, "continuous states")
+NO_STATES(GetContinuousStates, fmi2Real, "continuous states")
+NO_STATES(GetDerivatives, fmi2Real, "continuous states")
+NO_STATES(GetNominalsOfContinuousStates, fmi2Real, "continuous states")
+NO_STATES(GetEventIndicators, fmi2Real, "event indicators")
+
+/* ---- not provided: derivatives ------------------------------------------ */
 
 static fmi2Status unsupported(fmi2Component c, const char *function, const char *what) {
     if (!c) return fmi2Error;
@@ -323,7 +397,6 @@ static fmi2Status unsupported(fmi2Component c, const char *function, const char 
 }
 
 #define NO_DERIVATIVES "this FMU provides no derivatives (see the model description)"
-#define NO_ME "this FMU supports Co-Simulation only, not Model Exchange"
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
@@ -342,53 +415,4 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
     return unsupported(c, "fmi2GetRealOutputDerivatives", NO_DERIVATIVES);
-}
-
-fmi2Status fmi2EnterEventMode(fmi2Component c) {
-    return unsupported(c, "fmi2EnterEventMode", NO_ME);
-}
-
-fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
-    (void)eventInfo;
-    return unsupported(c, "fmi2NewDiscreteStates", NO_ME);
-}
-
-fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
-    return unsupported(c, "fmi2EnterContinuousTimeMode", NO_ME);
-}
-
-fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
-                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
-    (void)noSetFMUStatePriorToCurrentPoint; (void)enterEventMode; (void)terminateSimulation;
-    return unsupported(c, "fmi2CompletedIntegratorStep", NO_ME);
-}
-
-fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
-    (void)time;
-    return unsupported(c, "fmi2SetTime", NO_ME);
-}
-
-fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
-    (void)x; (void)nx;
-    return unsupported(c, "fmi2SetContinuousStates", NO_ME);
-}
-
-fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
-    (void)derivatives; (void)nx;
-    return unsupported(c, "fmi2GetDerivatives", NO_ME);
-}
-
-fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
-    (void)eventIndicators; (void)ni;
-    return unsupported(c, "fmi2GetEventIndicators", NO_ME);
-}
-
-fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
-    (void)x; (void)nx;
-    return unsupported(c, "fmi2GetContinuousStates", NO_ME);
-}
-
-fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
-    (void)x_nominal; (void)nx;
-    return unsupported(c, "fmi2GetNominalsOfContinuousStates", NO_ME);
 }

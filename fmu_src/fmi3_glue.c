@@ -1,5 +1,5 @@
-/* FMI 3.0 Co-Simulation interface (no event mode, no clocks), shared by
- * every model. */
+/* FMI 3.0 Co-Simulation (no event mode) and Model Exchange interfaces (no
+ * clocks), shared by every model. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -7,25 +7,35 @@
 #include "fmu_core.h"
 
 /* Modes each function may be called in: FMI 3.0.2, section 2.3 (common
- * states) and 4.2 (Co-Simulation without Event Mode). "If any function
- * called in super state FMU State Settable returns fmi3Error, the FMU
- * enters state Terminated" (2.3): there is no Error state, a failed call
- * leaves the instance Terminated (errorMode), where the values can be
- * read and the FMU-state functions, reset and free are allowed. */
+ * states), 3.2 (Model Exchange) and 4.2 (Co-Simulation without Event
+ * Mode). "If any function called in super state FMU State Settable
+ * returns fmi3Error, the FMU enters state Terminated" (2.3): there is no
+ * Error state, a failed call leaves the instance Terminated (errorMode),
+ * where the values can be read and the FMU-state functions, reset and
+ * free are allowed. Step Mode is only ever a Co-Simulation instance's,
+ * Event Mode and Continuous-Time Mode a Model Exchange instance's; the
+ * functions of Model Exchange alone also refuse a Co-Simulation instance
+ * (BEGIN_ME). Continuous-Time Mode allows sets of continuous-time inputs
+ * only, and this FMU has none: every input and parameter is set in Event
+ * Mode. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
+#define EVENT MODE_EVENT
+#define CONT MODE_CONTINUOUS
 /* the super state FMU State Settable: every state of this FMU */
-#define SETTABLE (INST | INIT | STEP | TERM)
+#define SETTABLE (INST | INIT | STEP | EVENT | CONT | TERM)
+/* the super state Initialized */
+#define INITIALIZED (STEP | EVENT | CONT | TERM)
 
 #define MODES_SetDebugLogging           SETTABLE
 #define MODES_EnterInitializationMode   (INST)
 #define MODES_ExitInitializationMode    (INIT)
-#define MODES_Terminate                 (STEP)
+#define MODES_Terminate                 (STEP | EVENT | CONT)
 #define MODES_Reset                     SETTABLE
-#define MODES_Get                       (INIT | STEP | TERM)
-#define MODES_Set                       (INST | INIT | STEP)
+#define MODES_Get                       (INIT | STEP | EVENT | CONT | TERM)
+#define MODES_Set                       (INST | INIT | STEP | EVENT)
 #define MODES_GetFMUState               SETTABLE
 #define MODES_SetFMUState               SETTABLE
 #define MODES_FreeFMUState              SETTABLE
@@ -33,6 +43,19 @@
 #define MODES_SerializeFMUState         SETTABLE
 #define MODES_DeserializeFMUState       SETTABLE
 #define MODES_DoStep                    (STEP)
+/* Model Exchange */
+#define MODES_EnterEventMode            (CONT)
+#define MODES_UpdateDiscreteStates      (EVENT)
+#define MODES_EnterContinuousTimeMode   (EVENT)
+#define MODES_CompletedIntegratorStep   (CONT)
+#define MODES_SetTime                   (CONT)
+#define MODES_SetContinuousStates       (CONT)
+#define MODES_GetContinuousStateDerivatives (INIT | EVENT | CONT | TERM)
+#define MODES_GetEventIndicators        MODES_GetContinuousStateDerivatives
+#define MODES_GetContinuousStates       MODES_GetContinuousStateDerivatives
+#define MODES_GetNominalsOfContinuousStates (INIT | INITIALIZED)
+#define MODES_GetNumberOfEventIndicators (INST | EVENT | CONT)
+#define MODES_GetNumberOfContinuousStates MODES_GetNumberOfEventIndicators
 /* every fmi3Get<Type> and fmi3Set<Type> */
 #define MODES_GetFloat32                     MODES_Get
 #define MODES_SetFloat32                     MODES_Set
@@ -72,11 +95,19 @@ typedef struct {
     if (!I) return fmi3Error;                                                 \
     if (!(I->core.mode & (MODES_##name))) return (fmi3Status)fmu_mode_error(I, FN)
 
+/* a Model Exchange function: a Co-Simulation instance is refused */
+#define BEGIN_ME(name)                                                        \
+    BEGIN(name);                                                              \
+    if (!I->modelExchange) return (fmi3Status)fmu_error(I, FN, "%s", NO_EVENT_MODE)
+
 #define CHECK(expression)                                                     \
     do {                                                                      \
         const FmuStatus status_ = (expression);                               \
         if (status_ > FMU_WARNING) return (fmi3Status)status_;                \
     } while (0)
+
+#define NO_EVENT_MODE "a Model Exchange function, and this instance was instantiated for Co-Simulation"
+#define NO_CS_EVENT_MODE "this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"
 
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
     const Fmi3Instance *g = (const Fmi3Instance *)instance;
@@ -96,25 +127,16 @@ static void release_state(FmuInstance *instance, void *memory) {
 
 const char *fmi3GetVersion(void) { return fmi3Version; }
 
-fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
-                                         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
-                                         fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
-                                         const fmi3ValueReference requiredIntermediateVariables[],
-                                         size_t nRequiredIntermediateVariables,
-                                         fmi3InstanceEnvironment instanceEnvironment,
-                                         fmi3LogMessageCallback logMessage,
-                                         fmi3IntermediateUpdateCallback intermediateUpdate) {
-    (void)resourcePath; (void)visible; (void)earlyReturnAllowed;
-    (void)requiredIntermediateVariables; (void)intermediateUpdate;
-    const char *reason = NULL;
+/* A new instance; NULL, said why, on the first problem: those of every
+ * instance, then the interface's own (interfaceRefusal, if not NULL). */
+static fmi3Instance instantiate(const char *interfaceRefusal, bool modelExchange, fmi3String instanceName,
+                                fmi3String instantiationToken, fmi3Boolean loggingOn,
+                                fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
+    const char *reason = interfaceRefusal;
     if (!instanceName || !*instanceName) {
         reason = "instanceName is missing";
     } else if (!instantiationToken || strcmp(instantiationToken, fmuModel.token) != 0) {
         reason = "the instantiationToken does not match this FMU's model description";
-    } else if (eventModeUsed) {
-        reason = "this FMU has no Event Mode (hasEventMode = false)";
-    } else if (nRequiredIntermediateVariables > 0) {
-        reason = "this FMU provides no intermediate update";
     }
     if (reason) {
         if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", reason);
@@ -127,10 +149,34 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     g->base.logFunction = logMessage ? log_to_importer : NULL;
     g->base.logCategories = loggingOn ? LOG_ALL : 0;
     g->base.errorMode = MODE_TERMINATED;
+    g->base.modelExchange = modelExchange;
     g->base.allocate = allocate_state;
     g->base.release = release_state;
     fmu_init_instance(&g->base);
     return g;
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
+                                         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                         fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
+                                         const fmi3ValueReference requiredIntermediateVariables[],
+                                         size_t nRequiredIntermediateVariables,
+                                         fmi3InstanceEnvironment instanceEnvironment,
+                                         fmi3LogMessageCallback logMessage,
+                                         fmi3IntermediateUpdateCallback intermediateUpdate) {
+    (void)resourcePath; (void)visible; (void)earlyReturnAllowed;
+    (void)requiredIntermediateVariables; (void)intermediateUpdate;
+    const char *reason = eventModeUsed ? NO_CS_EVENT_MODE
+                       : nRequiredIntermediateVariables > 0 ? "this FMU provides no intermediate update" : NULL;
+    return instantiate(reason, false, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
+                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                          fmi3InstanceEnvironment instanceEnvironment,
+                                          fmi3LogMessageCallback logMessage) {
+    (void)resourcePath; (void)visible;
+    return instantiate(NULL, true, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
 }
 
 void fmi3FreeInstance(fmi3Instance instance) {
@@ -319,6 +365,83 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     return (fmi3Status)status;
 }
 
+/* ---- Model Exchange: no continuous states, no event indicators; the cycle
+ * ends are time events (fmu_core.h) ------------------------------------- */
+
+fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
+    BEGIN_ME(EnterEventMode);
+    I->core.mode = MODE_EVENT;
+    I->core.eventTime = I->core.time;
+    return fmi3OK;
+}
+
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
+                                    fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
+                                    fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
+                                    fmi3Float64 *nextEventTime) {
+    BEGIN_ME(UpdateDiscreteStates);
+    if (!discreteStatesNeedUpdate || !terminateSimulation || !nominalsOfContinuousStatesChanged ||
+        !valuesOfContinuousStatesChanged || !nextEventTimeDefined || !nextEventTime) {
+        return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
+    }
+    double next;
+    CHECK(fmu_update_discrete_states(I, FN, &next));
+    *discreteStatesNeedUpdate = fmi3False;
+    *terminateSimulation = fmi3False;
+    *nominalsOfContinuousStatesChanged = fmi3False;
+    *valuesOfContinuousStatesChanged = fmi3False;
+    *nextEventTimeDefined = !isnan(next);
+    *nextEventTime = isnan(next) ? 0.0 : next;
+    return fmi3OK;
+}
+
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
+    BEGIN_ME(EnterContinuousTimeMode);
+    fmu_leave_instant(I);
+    I->core.mode = MODE_CONTINUOUS;
+    return fmi3OK;
+}
+
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
+    (void)noSetFMUStatePriorToCurrentPoint;
+    BEGIN_ME(CompletedIntegratorStep);
+    if (!enterEventMode || !terminateSimulation) {
+        return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
+    }
+    *enterEventMode = fmi3False;
+    *terminateSimulation = fmi3False;
+    return fmi3OK;
+}
+
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
+    BEGIN_ME(SetTime);
+    return (fmi3Status)fmu_set_time(I, FN, time);
+}
+
+#define NO_STATES(NAME, TYPE, WHAT)                                           \
+    fmi3Status fmi3##NAME(fmi3Instance instance, TYPE array[], size_t n) {    \
+        BEGIN_ME(NAME);                                                       \
+        return (fmi3Status)fmu_check_none(I, FN, WHAT, n, array);             \
+    }
+
+NO_STATES(SetContinuousStates, const fmi3Float64, "continuous states")
+NO_STATES(GetContinuousStates, fmi3Float64, "continuous states")
+NO_STATES(GetContinuousStateDerivatives, fmi3Float64, "continuous states")
+NO_STATES(GetNominalsOfContinuousStates, fmi3Float64, "continuous states")
+NO_STATES(GetEventIndicators, fmi3Float64, "event indicators")
+
+#define NUMBER_OF_NONE(NAME)                                                  \
+    fmi3Status fmi3GetNumberOf##NAME(fmi3Instance instance, size_t *n) {      \
+        BEGIN_ME(GetNumberOf##NAME);                                          \
+        if (!n) return (fmi3Status)fmu_error(I, FN, "the pointer is NULL");   \
+        *n = 0;                                                               \
+        return fmi3OK;                                                        \
+    }
+
+NUMBER_OF_NONE(EventIndicators)
+NUMBER_OF_NONE(ContinuousStates)
+
 /* ---- not provided --------------------------------------------------------- */
 
 static fmi3Status unsupported(fmi3Instance instance, const char *function, const char *what) {
@@ -327,17 +450,8 @@ static fmi3Status unsupported(fmi3Instance instance, const char *function, const
 }
 
 #define NO_DERIVATIVES "this FMU provides no derivatives or dependencies (see the model description)"
-#define NO_EVENTS "this FMU has no Event Mode, clocks or configuration mode (hasEventMode = false)"
-#define NO_ME "this FMU supports Co-Simulation only"
-
-fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
-                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
-                                          fmi3InstanceEnvironment instanceEnvironment,
-                                          fmi3LogMessageCallback logMessage) {
-    (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible;
-    if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_ME);
-    return NULL;
-}
+#define NO_CLOCKS "this FMU has no clocks or Configuration Mode"
+#define NO_SCHEDULED "this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution"
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
                                                fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
@@ -348,22 +462,18 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
                                                fmi3UnlockPreemptionCallback unlockPreemption) {
     (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible;
     (void)clockUpdate; (void)lockPreemption; (void)unlockPreemption;
-    if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_ME);
+    if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_SCHEDULED);
     return NULL;
-}
-
-fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
-    return unsupported(instance, "fmi3EnterEventMode", NO_EVENTS);
 }
 
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
     (void)vr; (void)nvr; (void)values;
-    return unsupported(instance, "fmi3GetClock", NO_EVENTS);
+    return unsupported(instance, "fmi3GetClock", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
     (void)vr; (void)nvr; (void)values;
-    return unsupported(instance, "fmi3SetClock", NO_EVENTS);
+    return unsupported(instance, "fmi3SetClock", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t *n) {
@@ -396,123 +506,64 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueRefere
 }
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
-    return unsupported(instance, "fmi3EnterConfigurationMode", NO_EVENTS);
+    return unsupported(instance, "fmi3EnterConfigurationMode", NO_CLOCKS);
 }
 
 fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
-    return unsupported(instance, "fmi3ExitConfigurationMode", NO_EVENTS);
+    return unsupported(instance, "fmi3ExitConfigurationMode", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                   fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
     (void)vr; (void)nvr; (void)intervals; (void)qualifiers;
-    return unsupported(instance, "fmi3GetIntervalDecimal", NO_EVENTS);
+    return unsupported(instance, "fmi3GetIntervalDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                    fmi3UInt64 counters[], fmi3UInt64 resolutions[], fmi3IntervalQualifier qualifiers[]) {
     (void)vr; (void)nvr; (void)counters; (void)resolutions; (void)qualifiers;
-    return unsupported(instance, "fmi3GetIntervalFraction", NO_EVENTS);
+    return unsupported(instance, "fmi3GetIntervalFraction", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 shifts[]) {
     (void)vr; (void)nvr; (void)shifts;
-    return unsupported(instance, "fmi3GetShiftDecimal", NO_EVENTS);
+    return unsupported(instance, "fmi3GetShiftDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                 fmi3UInt64 counters[], fmi3UInt64 resolutions[]) {
     (void)vr; (void)nvr; (void)counters; (void)resolutions;
-    return unsupported(instance, "fmi3GetShiftFraction", NO_EVENTS);
+    return unsupported(instance, "fmi3GetShiftFraction", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 intervals[]) {
     (void)vr; (void)nvr; (void)intervals;
-    return unsupported(instance, "fmi3SetIntervalDecimal", NO_EVENTS);
+    return unsupported(instance, "fmi3SetIntervalDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                    const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
     (void)vr; (void)nvr; (void)counters; (void)resolutions;
-    return unsupported(instance, "fmi3SetIntervalFraction", NO_EVENTS);
+    return unsupported(instance, "fmi3SetIntervalFraction", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 shifts[]) {
     (void)vr; (void)nvr; (void)shifts;
-    return unsupported(instance, "fmi3SetShiftDecimal", NO_EVENTS);
+    return unsupported(instance, "fmi3SetShiftDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                 const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
     (void)vr; (void)nvr; (void)counters; (void)resolutions;
-    return unsupported(instance, "fmi3SetShiftFraction", NO_EVENTS);
+    return unsupported(instance, "fmi3SetShiftFraction", NO_CLOCKS);
 }
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance) {
-    return unsupported(instance, "fmi3EvaluateDiscreteStates", NO_EVENTS);
-}
-
-fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
-                                    fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
-                                    fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
-                                    fmi3Float64 *nextEventTime) {
-    (void)discreteStatesNeedUpdate; (void)terminateSimulation; (void)nominalsOfContinuousStatesChanged;
-    (void)valuesOfContinuousStatesChanged; (void)nextEventTimeDefined; (void)nextEventTime;
-    return unsupported(instance, "fmi3UpdateDiscreteStates", NO_EVENTS);
-}
-
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
-    return unsupported(instance, "fmi3EnterContinuousTimeMode", NO_ME);
-}
-
-fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
-                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
-    (void)noSetFMUStatePriorToCurrentPoint; (void)enterEventMode; (void)terminateSimulation;
-    return unsupported(instance, "fmi3CompletedIntegratorStep", NO_ME);
-}
-
-fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
-    (void)time;
-    return unsupported(instance, "fmi3SetTime", NO_ME);
-}
-
-fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[], size_t nContinuousStates) {
-    (void)continuousStates; (void)nContinuousStates;
-    return unsupported(instance, "fmi3SetContinuousStates", NO_ME);
-}
-
-fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[], size_t nContinuousStates) {
-    (void)derivatives; (void)nContinuousStates;
-    return unsupported(instance, "fmi3GetContinuousStateDerivatives", NO_ME);
-}
-
-fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t nEventIndicators) {
-    (void)eventIndicators; (void)nEventIndicators;
-    return unsupported(instance, "fmi3GetEventIndicators", NO_ME);
-}
-
-fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t nContinuousStates) {
-    (void)continuousStates; (void)nContinuousStates;
-    return unsupported(instance, "fmi3GetContinuousStates", NO_ME);
-}
-
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nContinuousStates) {
-    (void)nominals; (void)nContinuousStates;
-    return unsupported(instance, "fmi3GetNominalsOfContinuousStates", NO_ME);
-}
-
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventIndicators) {
-    (void)nEventIndicators;
-    return unsupported(instance, "fmi3GetNumberOfEventIndicators", NO_ME);
-}
-
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates) {
-    (void)nContinuousStates;
-    return unsupported(instance, "fmi3GetNumberOfContinuousStates", NO_ME);
+    return unsupported(instance, "fmi3EvaluateDiscreteStates", NO_CLOCKS);
 }
 
 fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
-    return unsupported(instance, "fmi3EnterStepMode", NO_EVENTS);
+    return unsupported(instance, "fmi3EnterStepMode", NO_CS_EVENT_MODE);
 }
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
@@ -523,5 +574,5 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
     (void)clockReference; (void)activationTime;
-    return unsupported(instance, "fmi3ActivateModelPartition", NO_ME);
+    return unsupported(instance, "fmi3ActivateModelPartition", NO_SCHEDULED);
 }

@@ -9,7 +9,7 @@
 const char *const fmu_log_category_names[3] = { "logStatusError", "logStatusWarning", "logEvents" };
 
 #define SERIAL_MAGIC "RLFS"
-#define SERIAL_VERSION 2u
+#define SERIAL_VERSION 3u
 /* magic, version, model hash, payload size; CRC-32 after the payload */
 #define SERIAL_HEADER 16u
 #define SERIAL_TRAILER 4u
@@ -21,6 +21,8 @@ const char *fmu_mode_name(int mode) {
     case MODE_STEP: return "Step Mode";
     case MODE_TERMINATED: return "Terminated";
     case MODE_ERROR: return "Error (after a failed call)";
+    case MODE_EVENT: return "Event Mode";
+    case MODE_CONTINUOUS: return "Continuous-Time Mode";
     default: return "unknown";
     }
 }
@@ -51,6 +53,7 @@ void fmu_reset(FmuInstance *instance) {
         core->values[i] = model->variables[i].start;
     }
     core->mode = MODE_INSTANTIATED;
+    fmu_leave_instant(instance); /* latched: values this FMU could have */
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
     /* the start values are the outputs until Initialization Mode */
@@ -174,9 +177,13 @@ FMU_NOINLINE static void configure(FmuInstance *instance) {
     if (instance->outputsStale == FMU_STALE_ALL) {
         publish(instance, true);
     }
-    instance->modelMode = instance->model->configure(instance->core.values, &instance->prepared.config);
-    const double c = instance->prepared.config.cycleTime.value;
+    RlConfig *config = &instance->prepared.config;
+    instance->modelMode = instance->model->configure(instance->core.values, config);
+    const double c = config->cycleTime.value;
     instance->cycleTime = isgreater(c, 0) && isfinite(c) ? c : 0.0;
+    /* Model Exchange has no communication step to stand in for the cycle:
+     * without cycleTime there is none */
+    config->cycleRefused = config->cycleRefused || (instance->modelExchange && instance->cycleTime == 0);
     instance->prepareDue = true;
     instance->configDirty = false;
 }
@@ -246,8 +253,11 @@ FMU_NOINLINE static void log_status(FmuInstance *instance) {
     instance->core.reportedStatus = p->status;
     if (rl_status_is_error(p->status)) {
         const FmuVariable *cause = &instance->model->variables[p->statusSource];
-        fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds",
-                (unsigned)p->status, rl_status_text(p->status), cause->name, instance->core.values[p->statusSource]);
+        const bool noCycleInME = instance->modelExchange && p->status == RL_STATUS_NO_CYCLE;
+        fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds%s",
+                (unsigned)p->status, rl_status_text(p->status), cause->name, instance->core.values[p->statusSource],
+                noCycleInME ? ". Model Exchange runs the block at the ends of its cycles: set cycleTime to the PLC "
+                              "cycle (the interval of the cyclic interrupt OB or task)" : "");
     } else {
         fmu_log(instance, FMU_OK, "status 16#%04X: %s", (unsigned)p->status, rl_status_text(p->status));
     }
@@ -262,9 +272,26 @@ static inline FmuStatus report_status(FmuInstance *instance) {
 
 FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     initialize_block(instance);
-    instance->core.mode = MODE_STEP;
+    /* Model Exchange: Event Mode at the start time, whose instant the
+     * first cycle takes its values from */
+    instance->core.mode = instance->modelExchange ? MODE_EVENT : MODE_STEP;
     instance->core.cycles = 0;
+    instance->core.eventTime = instance->core.time;
+    fmu_leave_instant(instance);
     return report_status(instance);
+}
+
+/* The end of cycle n, t0 + n*cycleTime, computed afresh from the whole
+ * cycle count (no drift): the next time event of Model Exchange. */
+static double cycle_end(const FmuCore *core, double cycle, uint64_t n) {
+    return rl_sum(core->startTime, (double)n * cycle);
+}
+
+/* The number of whole cycles that end by the time end (a time within
+ * RL_TIME_TOLERANCE of a cycle end counts as that end): the inverse of
+ * cycle_end. */
+static double cycles_ended_by(const FmuCore *core, double cycle, double end) {
+    return floor(rl_quotient(rl_sum(end, -core->startTime), cycle) + RL_TIME_TOLERANCE);
 }
 
 /* Sub-cycling (cycleTime > 0): the cycles that end in (t, end], each end
@@ -274,7 +301,7 @@ FMU_NOINLINE static FmuStatus run_cycles(FmuInstance *instance, const char *func
                                          bool *ran) {
     FmuCore *core = &instance->core;
     const double cycle = instance->cycleTime;
-    const double last = floor(rl_quotient(rl_sum(end, -core->startTime), cycle) + RL_TIME_TOLERANCE);
+    const double last = cycles_ended_by(core, cycle, end);
     const double pending = last - (double)core->cycles;
     if (!islessequal(pending, FMU_MAX_CYCLES_PER_STEP)) {
         return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
@@ -347,6 +374,94 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     return report_status(instance);
 }
 
+/* ---- Model Exchange ------------------------------------------------------ */
+
+static bool latched_slot(const FmuVariable *v) {
+    return v->causality == FMU_INPUT || v->causality == FMU_PARAMETER;
+}
+
+/* Exchange the inputs and parameters of the values and the latched ones;
+ * true if any differs from its counterpart (bit for bit: a NaN is the same
+ * NaN). Done twice, it changes nothing. */
+static bool swap_latched(FmuInstance *instance) {
+    FmuCore *core = &instance->core;
+    bool differ = false;
+    for (unsigned i = 0; i < instance->model->count; i++) {
+        if (latched_slot(&instance->model->variables[i])) {
+            const double value = core->values[i];
+            differ = differ || memcmp(&value, &core->latched[i], sizeof value) != 0;
+            core->values[i] = core->latched[i];
+            core->latched[i] = value;
+        }
+    }
+    return differ;
+}
+
+void fmu_leave_instant(FmuInstance *instance) {
+    memcpy(instance->core.latched, instance->core.values, sizeof instance->core.latched);
+}
+
+/* The cycles ended by now, run with the latched values: the values of now
+ * set aside meanwhile, the configuration taken from the latched ones and
+ * again from the current ones before the next cycle if they differ. */
+static FmuStatus run_latched_cycles(FmuInstance *instance, const char *function) {
+    FmuCore *core = &instance->core;
+    const bool differ = swap_latched(instance);
+    if (differ || instance->configDirty) {
+        configure(instance);
+    }
+    bool ran = false;
+    FmuStatus status = FMU_OK;
+    if (instance->cycleTime > 0) {
+        const double since = rl_sum(core->time, -cycle_end(core, instance->cycleTime, core->cycles));
+        status = run_cycles(instance, function, core->time, since, core->values[instance->inputVr], &ran);
+    }
+    if (ran) {
+        instance->outputsStale = FMU_STALE_ALL;
+    }
+    swap_latched(instance);
+    if (differ) {
+        fmu_invalidate(instance);
+    }
+    return status;
+}
+
+FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, double *nextEventTime) {
+    FmuCore *core = &instance->core;
+    if (run_latched_cycles(instance, function) != FMU_OK) {
+        return FMU_ERROR;
+    }
+    *nextEventTime = instance->cycleTime > 0 ? cycle_end(core, instance->cycleTime, core->cycles + 1) : NAN;
+    return report_status(instance);
+}
+
+FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time) {
+    FmuCore *core = &instance->core;
+    if (!isfinite(time) || isless(time, core->eventTime)) {
+        return fmu_error(instance, function, "time %.17g is not finite or before the last event at %.17g", time,
+                         core->eventTime);
+    }
+    if (core->mode == MODE_EVENT && time != core->time) {
+        /* a pure discrete-time FMU's next event instant (FMI 2.0.4,
+         * section 3.2.3, fmi2SetTime in Event Mode): this one is left */
+        fmu_leave_instant(instance);
+        core->eventTime = time;
+    }
+    core->time = time;
+    if (instance->outputsStale == FMU_FRESH) {
+        instance->outputsStale = FMU_STALE_TIME;
+    }
+    return FMU_OK;
+}
+
+FmuStatus fmu_check_none(FmuInstance *instance, const char *function, const char *what, size_t n, const void *array) {
+    if (n != 0) {
+        return fmu_error(instance, function, "this FMU has no %s; n = %zu, not 0", what, n);
+    }
+    (void)array; /* none to read or write */
+    return FMU_OK;
+}
+
 /* Make a restored core the current one. */
 static void restore(FmuInstance *instance, const FmuCore *state) {
     instance->core = *state;
@@ -417,7 +532,9 @@ static double get_f64(const unsigned char **p) {
 static size_t payload_size(const ModelDefinition *model) {
     return 4 + 8 * (size_t)model->count      /* values */
          + 8 + 8 + 8 + 1 + 8 + 8 + 8         /* block */
-         + 8 + 8 + 8 + 4 + 4;                /* startTime, time, cycles, mode, status */
+         + 8 + 8 + 8                         /* startTime, time, cycles */
+         + 8 * (size_t)model->count + 8      /* latched values, eventTime */
+         + 4 + 4;                            /* mode, status */
 }
 
 static size_t serialized_size(const FmuInstance *instance) {
@@ -444,9 +561,19 @@ static void serialize(const FmuInstance *instance, const FmuCore *s, unsigned ch
     p = put_f64(p, s->startTime);
     p = put_f64(p, s->time);
     p = put_u64(p, s->cycles);
+    for (unsigned i = 0; i < model->count; i++) p = put_f64(p, s->latched[i]);
+    p = put_f64(p, s->eventTime);
     p = put_u32(p, (uint32_t)s->mode);
     p = put_u32(p, (uint32_t)s->reportedStatus);
     put_u32(p, crc32(out, (size_t)(p - out)));
+}
+
+/* A mode of this instance's interface (an FMU state taken by an instance
+ * of the other one is refused). */
+static bool fmu_mode_possible(const FmuInstance *instance, int mode) {
+    const int modes = MODE_INSTANTIATED | MODE_INITIALIZATION | MODE_TERMINATED | instance->errorMode |
+                      (instance->modelExchange ? MODE_EVENT | MODE_CONTINUOUS : MODE_STEP);
+    return mode != 0 && (mode & (mode - 1)) == 0 && (mode & modes) != 0;
 }
 
 /* Cycle counts stay exact in a double (2^53). */
@@ -511,25 +638,27 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     s.startTime = get_f64(&p);
     s.time = get_f64(&p);
     s.cycles = get_u64(&p);
+    for (unsigned i = 0; i < model->count; i++) s.latched[i] = get_f64(&p);
+    s.eventTime = get_f64(&p);
     s.mode = (int)get_u32(&p);
     s.reportedStatus = (int)get_u32(&p);
-    if (s.mode != MODE_INSTANTIATED && s.mode != MODE_INITIALIZATION && s.mode != MODE_STEP &&
-        s.mode != MODE_TERMINATED && s.mode != instance->errorMode) {
+    if (!fmu_mode_possible(instance, s.mode)) {
         return fmu_error(instance, function, "serialized state has an invalid mode %d", s.mode);
     }
     /* a checksum only proves the bytes arrived as written: every value must
      * also be one that this FMU could have made */
-    for (unsigned i = 0; i < model->count; i++) {
-        if (!value_possible(&model->variables[i], s.values[i])) {
-            return fmu_error(instance, function, "serialized state has an impossible value %g for %s", s.values[i],
-                             model->variables[i].name);
+    for (unsigned i = 0; i < 2 * model->count; i++) {
+        const FmuVariable *v = &model->variables[i % model->count];
+        const double value = i < model->count ? s.values[i] : s.latched[i - model->count];
+        if (!value_possible(v, value)) {
+            return fmu_error(instance, function, "serialized state has an impossible value %g for %s", value, v->name);
         }
     }
     if (s.block.decided > RL_DECIDED_RAMP) {
         return fmu_error(instance, function, "serialized state has an invalid rule %u", (unsigned)s.block.decided);
     }
     /* runningTime is a sum of whole cycles: no NaN, infinity or negative */
-    if (!isfinite(s.startTime) || !isfinite(s.time) || s.cycles > MAX_EXACT_CYCLES ||
+    if (!isfinite(s.startTime) || !isfinite(s.time) || !isfinite(s.eventTime) || s.cycles > MAX_EXACT_CYCLES ||
         s.block.runCycles > MAX_EXACT_CYCLES || !(isgreaterequal(s.block.runPeriod, 0) && islessequal(s.block.runPeriod, DBL_MAX)) ||
         !(isgreaterequal(s.block.runBase, 0) && islessequal(s.block.runBase, DBL_MAX))) {
         return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
@@ -587,6 +716,11 @@ FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **stat
 FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void *state) {
     if (check_state(instance, function, state) != FMU_OK) {
         return FMU_ERROR;
+    }
+    if (!fmu_mode_possible(instance, ((const FmuState *)state)->core.mode)) {
+        return fmu_error(instance, function, "an FMU state of %s, which this %s instance cannot be in",
+                         fmu_mode_name(((const FmuState *)state)->core.mode),
+                         instance->modelExchange ? "Model Exchange" : "Co-Simulation");
     }
     restore(instance, &((const FmuState *)state)->core);
     return FMU_OK;

@@ -30,13 +30,16 @@
 typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } FmuStatus;
 
 /* FMI modes as bits, so that each glue can state per function the set of
- * modes it is allowed in. */
+ * modes it is allowed in. Step Mode is Co-Simulation's, Event Mode and
+ * Continuous-Time Mode are Model Exchange's; the others are shared. */
 typedef enum {
     MODE_INSTANTIATED   = 1 << 0,
     MODE_INITIALIZATION = 1 << 1,
     MODE_STEP           = 1 << 2,
     MODE_TERMINATED     = 1 << 3,
-    MODE_ERROR          = 1 << 4
+    MODE_ERROR          = 1 << 4,
+    MODE_EVENT          = 1 << 5,
+    MODE_CONTINUOUS     = 1 << 6
 } FmuMode;
 
 /* A step that would run more cycles than this is refused (no endless loop
@@ -58,6 +61,10 @@ typedef struct {
     double startTime;
     double time;
     uint64_t cycles;        /* cycles run since the start (cycleTime > 0) */
+    /* Model Exchange: the values as the last event instant left them, which
+     * the next cycle runs with (latch), and that instant's time */
+    double latched[FMU_MAX_VARIABLES];
+    double eventTime;
     int mode;               /* FmuMode */
     int reportedStatus;     /* status word last reported in the log */
 } FmuCore;
@@ -90,12 +97,14 @@ struct FmuInstance {
     FmuLogFunction *logFunction;
     int logCategories;      /* enabled categories */
     int errorMode;          /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
+    bool modelExchange;     /* instantiated for Model Exchange, not Co-Simulation */
     void *environment;      /* the importer's instance environment */
     /* memory for FMU states, as the importer provides it (FMI 2) or not */
     void *(*allocate)(FmuInstance *instance, size_t size);
     void (*release)(FmuInstance *instance, void *memory);
 };
 
+/* modelExchange and errorMode set first */
 void fmu_init_instance(FmuInstance *instance);
 void fmu_reset(FmuInstance *instance);
 
@@ -280,6 +289,24 @@ FmuStatus fmu_serialize_state(FmuInstance *instance, const char *function, const
                               size_t size);
 FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, const unsigned char *in, size_t size,
                                 void **state);
+
+/* ---- Model Exchange (docs/fmi.md, Model Exchange) ------------------------
+ * No continuous states, no event indicators: the cycle ends are time
+ * events, and each cycle runs in Event Mode at its end with the values
+ * latched when the instant before it was left. */
+
+/* The event update: the cycles that ended by the FMU's time, with the
+ * latched values. *nextEventTime: the next cycle end, NaN if there is none
+ * (no valid cycle). */
+FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, double *nextEventTime);
+/* The instant is left (Continuous-Time Mode entered, or the time set anew
+ * in Event Mode): its values are those of the next cycle. */
+void fmu_leave_instant(FmuInstance *instance);
+/* fmi2SetTime / fmi3SetTime: a finite time, not before the last event. */
+FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time);
+/* A call that passes arrays of continuous states or event indicators:
+ * this FMU has none, so n must be 0. */
+FmuStatus fmu_check_none(FmuInstance *instance, const char *function, const char *what, size_t n, const void *array);
 
 const char *fmu_mode_name(int mode);
 

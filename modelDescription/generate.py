@@ -142,10 +142,12 @@ def fmi2_description(model, guid, sources):
     m = model["model"]
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
            f'<fmiModelDescription fmiVersion="2.0"{attributes(modelName=m["identifier"], guid=guid, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat" numberOfEventIndicators="0">',
-           f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">',
-           "    <SourceFiles>"]
-    out += [f"      <File{attributes(name=s)}/>" for s in sources]
-    out += ["    </SourceFiles>", "  </CoSimulation>"]
+           # Model Exchange (docs/fmi.md): no states, no event indicators, the cycle ends are time events
+           f'  <ModelExchange{attributes(modelIdentifier=m["identifier"])} completedIntegratorStepNotNeeded="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">']
+    source_files = ["    <SourceFiles>"] + [f"      <File{attributes(name=s)}/>" for s in sources] + ["    </SourceFiles>"]
+    out += source_files + ["  </ModelExchange>"]
+    out += [f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">']
+    out += source_files + ["  </CoSimulation>"]
     out += common_head(model, 2)
     out.append("  <ModelVariables>")
     for index, v in enumerate(model["variable"], start=1):
@@ -172,6 +174,7 @@ def fmi3_description(model, instantiation_token):
     m = model["model"]
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
            f'<fmiModelDescription fmiVersion="3.0"{attributes(modelName=m["identifier"], instantiationToken=instantiation_token, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat">',
+           f'  <ModelExchange{attributes(modelIdentifier=m["identifier"])} needsCompletedIntegratorStep="false" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false"/>',
            f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false" hasEventMode="false" providesIntermediateUpdate="false"/>']
     out += common_head(model, 3)
     out.append("  <ModelVariables>")

@@ -240,7 +240,7 @@ def test_fmi3_instantiation_refusals_name_the_first_problem():
             # compared whole: one character more or less does not match either
             ((b"a", token + b"0", False, 0), "the instantiationToken does not match this FMU's model description"),
             ((b"a", token[:-1], False, 0), "the instantiationToken does not match this FMU's model description"),
-            ((b"a", token, True, 1), "this FMU has no Event Mode (hasEventMode = false)"),
+            ((b"a", token, True, 1), "this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"),
             ((b"a", token, False, 1), "this FMU provides no intermediate update"),
         ]
         for (name, given, event_mode, n_required), reason in cases:
@@ -276,12 +276,12 @@ def test_fmi2_instantiation_refusals_name_the_first_problem():
         guid = fmu.md.guid.encode()
         cases = [((b"", 0, b"wrong"), "instanceName is missing"),
                  ((None, 1, guid), "instanceName is missing"),
-                 ((b"a", 0, b"wrong"), "this FMU supports Co-Simulation only"),
+                 ((b"a", 0, b"wrong"), "the GUID does not match this FMU's model description"),  # Model Exchange
                  ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description"),
                  ((b"a", 1, None), "the GUID does not match this FMU's model description"),
                  ((b"a", 1, guid + b"0"), "the GUID does not match this FMU's model description"),
                  ((b"a", 1, guid[:-1]), "the GUID does not match this FMU's model description"),
-                 ((b"a", 2, guid), "this FMU supports Co-Simulation only")]  # not an fmi2Type at all
+                 ((b"a", 2, guid), "fmuType is neither fmi2ModelExchange nor fmi2CoSimulation")]  # not an fmi2Type
         for (name, kind, given), reason in cases:
             messages.clear()
             assert instantiate(name, kind, given, None, byref(callbacks), 0, 0) is None
@@ -657,10 +657,11 @@ def test_fmi3_a_step_with_a_null_output_pointer_is_refused_and_the_time_stays():
         fmu.free()
 
 
-@pytest.mark.parametrize("interface", ["ModelExchange", "ScheduledExecution"])
+@pytest.mark.parametrize("interface", ["ScheduledExecution"])
 def test_fmi3_other_interfaces_are_refused_with_a_reason(interface):
-    """Co-Simulation only: no instance; the reason goes to the logger when
-    logging is on, and nothing is called otherwise."""
+    """Co-Simulation and Model Exchange only: no instance of Scheduled
+    Execution; the reason goes to the logger when logging is on, and
+    nothing is called otherwise."""
     fmu = Instance("RateLimiter", 3)
     try:
         function = getattr(fmu.fmu.dll, f"fmi3Instantiate{interface}")
@@ -672,7 +673,8 @@ def test_fmi3_other_interfaces_are_refused_with_a_reason(interface):
         extra = [None] * (3 if interface == "ScheduledExecution" else 0)
         token = fmu.md.instantiationToken.encode()
         assert function(b"a", token, None, False, True, None, log, *extra) is None
-        assert messages == [(3, b"logStatusError", b"this FMU supports Co-Simulation only")]
+        assert messages == [(3, b"logStatusError",
+                             b"this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution")]
         messages.clear()
         assert function(b"a", token, None, False, False, None, log, *extra) is None
         assert function(b"a", token, None, False, True, None, fmi3LogMessageCallback(), *extra) is None

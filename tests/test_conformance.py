@@ -1,14 +1,16 @@
 """FMI state-machine conformance: every exported function of the FMI API,
-called in every state (Instantiated, Initialization Mode, Step Mode,
-Terminated, and after an error) with valid arguments, returns what the
-standard's state table requires. A refusal is fmiError with exactly one
-log message naming the function; functions of capabilities this FMU does
-not declare (Model Exchange, derivatives, event mode, clocks, ...) refuse
-in every state.
+called in every state of each interface (Co-Simulation: Instantiated,
+Initialization Mode, Step Mode, Terminated, and after an error; Model
+Exchange: Event Mode and Continuous-Time Mode instead of Step Mode) with
+valid arguments, returns what the standard's state table requires. A
+refusal is fmiError with exactly one log message naming the function;
+functions of capabilities this FMU does not declare (derivatives, clocks,
+Scheduled Execution, ...) refuse in every state, and the functions of one
+interface refuse an instance of the other.
 
 The allowed states below are written from the standards' tables (FMI
-2.0.4 section 4.2.4; FMI 3.0 sections 2.3 and 4.2), not read from the
-FMU's own tables."""
+2.0.4 sections 3.2.3 and 4.2.4; FMI 3.0 sections 2.3, 3.2 and 4.2), not
+read from the FMU's own tables."""
 import ctypes
 import re
 from ctypes import POINTER, c_bool, c_double, c_int, c_size_t, c_uint, c_void_p
@@ -17,11 +19,17 @@ from pathlib import Path
 import pytest
 from fmpy import __file__ as fmpy_file
 
+from fmpy.fmi2 import fmi2EventInfo
+
 from support.fmu_driver import Instance, call_status
 
 STATES = ["Instantiated", "Initialization Mode", "Step Mode", "Terminated", "Error"]
 ALL = set(STATES)
 I, N, S, T, E = STATES
+# Model Exchange's own states
+EV, C = "Event Mode", "Continuous-Time Mode"
+ME_STATES = [I, N, EV, C, T, E]
+ME_ALL = set(ME_STATES)
 
 # FMI 2.0.4, Co-Simulation: function -> states in which it may be called.
 # (stepComplete, stepFailed and stepCanceled are Step Mode here: this FMU
@@ -42,6 +50,35 @@ FMI2_ALLOWED = {
     "fmi2DoStep": {S},
     "fmi2GetStatus": {S, T}, "fmi2GetRealStatus": {S, T}, "fmi2GetIntegerStatus": {S, T},
     "fmi2GetBooleanStatus": {S, T}, "fmi2GetStringStatus": {S, T},
+}
+
+# FMI 2.0.4, Model Exchange (section 3.2.3, the table of allowed calls). fmi2SetReal in Continuous-Time
+# Mode is for continuous-time inputs only (condition 5) and this FMU has none (every input is discrete,
+# as the model description says), so the set of u there is refused. fmi2SetTime in Event Mode: condition
+# 8, a pure discrete-time FMU's next event instant, which this FMU is.
+FMI2_ME_ALLOWED = {
+    "fmi2SetDebugLogging": ME_ALL,
+    "fmi2SetupExperiment": {I},
+    "fmi2EnterInitializationMode": {I},
+    "fmi2ExitInitializationMode": {N},
+    "fmi2Terminate": {EV, C},
+    "fmi2Reset": ME_ALL,
+    "fmi2GetReal": {N, EV, C, T, E}, "fmi2GetInteger": {N, EV, C, T, E},
+    "fmi2GetBoolean": {N, EV, C, T, E}, "fmi2GetString": {N, EV, C, T, E},
+    "fmi2SetReal": {I, N, EV}, "fmi2SetInteger": {I, N, EV},
+    "fmi2SetBoolean": {I, N, EV}, "fmi2SetString": {I, N, EV},
+    "fmi2GetFMUstate": ME_ALL, "fmi2SetFMUstate": ME_ALL, "fmi2FreeFMUstate": ME_ALL,
+    "fmi2SerializedFMUstateSize": ME_ALL, "fmi2SerializeFMUstate": ME_ALL, "fmi2DeSerializeFMUstate": ME_ALL,
+    "fmi2EnterEventMode": {EV, C},
+    "fmi2NewDiscreteStates": {EV},
+    "fmi2EnterContinuousTimeMode": {EV},
+    "fmi2CompletedIntegratorStep": {C},
+    "fmi2SetTime": {EV, C},
+    "fmi2SetContinuousStates": {C},
+    "fmi2GetEventIndicators": {N, EV, C, T, E},
+    "fmi2GetContinuousStates": {N, EV, C, T, E},
+    "fmi2GetDerivatives": {N, EV, C, T, E},
+    "fmi2GetNominalsOfContinuousStates": {I, EV, C, T, E},
 }
 
 # FMI 3.0, Co-Simulation without Event Mode. FMI 3 has no Error state:
@@ -75,6 +112,29 @@ FMI3_ALLOWED = {
     "fmi3DoStep": {S},
 }
 
+# FMI 3.0, Model Exchange: the common states (section 2.3: Instantiated, Initialization Mode, the super
+# state Initialized, Event Mode, Terminated) and Continuous-Time Mode (section 3.2). fmi3Set{VariableType}
+# in Continuous-Time Mode is for continuous-time inputs only, and this FMU has none (see FMI 2 above).
+FMI3_ME_ALLOWED = {
+    **{name: ({I, N, EV, C, T} if states == {I, N, S, T} else
+              {I, N, EV} if states == {I, N, S} else
+              {N, EV, C, T} if states == {N, S, T} else
+              {EV, C} if name == "fmi3Terminate" else states)
+       for name, states in FMI3_ALLOWED.items() if name != "fmi3DoStep"},
+    "fmi3EnterEventMode": {C},
+    "fmi3UpdateDiscreteStates": {EV},
+    "fmi3EnterContinuousTimeMode": {EV},
+    "fmi3CompletedIntegratorStep": {C},
+    "fmi3SetTime": {C},
+    "fmi3SetContinuousStates": {C},
+    "fmi3GetContinuousStateDerivatives": {N, EV, C, T},
+    "fmi3GetEventIndicators": {N, EV, C, T},
+    "fmi3GetContinuousStates": {N, EV, C, T},
+    "fmi3GetNominalsOfContinuousStates": {N, EV, C, T},
+    "fmi3GetNumberOfEventIndicators": {I, EV, C},
+    "fmi3GetNumberOfContinuousStates": {I, EV, C},
+}
+
 # Functions of capabilities this FMU does not have, by the standards' chapters, and the reason each
 # refusal gives. FMI 2: Model Exchange (chapter 3); directional derivatives, input derivatives and output
 # derivatives (providesDirectionalDerivative, canInterpolateInputs and maxOutputDerivativeOrder are
@@ -82,31 +142,31 @@ FMI3_ALLOWED = {
 # derivatives and dependencies (providesDirectionalDerivatives, providesAdjointDerivatives,
 # providesPerElementDependencies false; maxOutputDerivativeOrder 0); Event Mode, clocks and
 # Configuration Mode (hasEventMode false, no clocks, no structural parameters).
-FMI2_NO_ME = "this FMU supports Co-Simulation only, not Model Exchange"
 FMI2_NO_DERIVATIVES = "this FMU provides no derivatives (see the model description)"
-FMI3_NO_ME = "this FMU supports Co-Simulation only"
+FMI3_NO_SCHEDULED = "this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution"
 FMI3_NO_DERIVATIVES = "this FMU provides no derivatives or dependencies (see the model description)"
-FMI3_NO_EVENTS = "this FMU has no Event Mode, clocks or configuration mode (hasEventMode = false)"
+FMI3_NO_CLOCKS = "this FMU has no clocks or Configuration Mode"
+FMI3_NO_CS_EVENT_MODE = "this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"
 UNSUPPORTED = {
-    **{f"fmi2{name}": FMI2_NO_ME for name in (
-        "EnterEventMode", "NewDiscreteStates", "EnterContinuousTimeMode", "CompletedIntegratorStep", "SetTime",
-        "SetContinuousStates", "GetDerivatives", "GetEventIndicators", "GetContinuousStates",
-        "GetNominalsOfContinuousStates")},
     **{f"fmi2{name}": FMI2_NO_DERIVATIVES for name in (
         "GetDirectionalDerivative", "SetRealInputDerivatives", "GetRealOutputDerivatives")},
-    **{f"fmi3{name}": FMI3_NO_ME for name in (
-        "EnterContinuousTimeMode", "CompletedIntegratorStep", "SetTime", "SetContinuousStates",
-        "GetContinuousStateDerivatives", "GetEventIndicators", "GetContinuousStates",
-        "GetNominalsOfContinuousStates", "GetNumberOfEventIndicators", "GetNumberOfContinuousStates",
-        "ActivateModelPartition")},
+    "fmi3ActivateModelPartition": FMI3_NO_SCHEDULED,
+    "fmi3EnterStepMode": FMI3_NO_CS_EVENT_MODE,
     **{f"fmi3{name}": FMI3_NO_DERIVATIVES for name in (
         "GetNumberOfVariableDependencies", "GetVariableDependencies", "GetDirectionalDerivative",
         "GetAdjointDerivative", "GetOutputDerivatives")},
-    **{f"fmi3{name}": FMI3_NO_EVENTS for name in (
-        "EnterEventMode", "GetClock", "SetClock", "EnterConfigurationMode", "ExitConfigurationMode",
+    **{f"fmi3{name}": FMI3_NO_CLOCKS for name in (
+        "GetClock", "SetClock", "EnterConfigurationMode", "ExitConfigurationMode",
         "GetIntervalDecimal", "GetIntervalFraction", "GetShiftDecimal", "GetShiftFraction", "SetIntervalDecimal",
-        "SetIntervalFraction", "SetShiftDecimal", "SetShiftFraction", "EvaluateDiscreteStates",
-        "UpdateDiscreteStates", "EnterStepMode")},
+        "SetIntervalFraction", "SetShiftDecimal", "SetShiftFraction", "EvaluateDiscreteStates")},
+}
+
+# The refusal of a function of the other interface: its own text, or (fmi2DoStep, fmi3DoStep: Step Mode is
+# Co-Simulation's alone) the state's
+OTHER_INTERFACE = {
+    (2, False): "a Model Exchange function, and this instance was instantiated for Co-Simulation",
+    (2, True): "a Co-Simulation function, and this instance was instantiated for Model Exchange",
+    (3, False): "a Model Exchange function, and this instance was instantiated for Co-Simulation",
 }
 
 # not called on an instance, or ending it
@@ -148,7 +208,7 @@ def valid_call(fmu, name):
     def with_state(call):
         # a state taken in Initialization Mode on a second instance of the
         # same FMU: valid whatever state this instance is in
-        helper = Instance("RateLimiter", v, name="helper")
+        helper = Instance("RateLimiter", v, name="helper", model_exchange=fmu.model_exchange)
         try:
             helper.start()
             assert raw(helper, take_state, [c_void_p, POINTER(c_void_p)], helper.fmu.component, ctypes.byref(state)) == 0
@@ -158,6 +218,27 @@ def valid_call(fmu, name):
 
     size = c_size_t()
     buffer = ctypes.create_string_buffer(4096)
+    # Model Exchange: no continuous states, no event indicators (n = 0)
+    me_calls = {f"fmi{v}{kind}": (lambda k=f"fmi{v}{kind}": raw(fmu, k, [c_void_p, c_void_p, c_size_t], c, buffer, 0))
+                for kind in ("SetContinuousStates", "GetContinuousStates", "GetDerivatives",
+                             "GetNominalsOfContinuousStates", "GetEventIndicators", "GetContinuousStateDerivatives")}
+    me_calls[f"fmi{v}EnterEventMode"] = lambda: raw(fmu, f"fmi{v}EnterEventMode", [c_void_p], c)
+    me_calls[f"fmi{v}EnterContinuousTimeMode"] = lambda: raw(fmu, f"fmi{v}EnterContinuousTimeMode", [c_void_p], c)
+    me_calls[f"fmi{v}SetTime"] = lambda: raw(fmu, f"fmi{v}SetTime", [c_void_p, c_double], c, fmu.t)
+    me_calls[f"fmi{v}CompletedIntegratorStep"] = lambda: raw(
+        fmu, f"fmi{v}CompletedIntegratorStep", [c_void_p, c_int if v == 2 else c_bool, c_void_p, c_void_p],
+        c, 1, flag, flag)
+    if v == 2:
+        me_calls["fmi2NewDiscreteStates"] = lambda: raw(fmu, "fmi2NewDiscreteStates", [c_void_p, c_void_p], c,
+                                                        ctypes.byref(fmi2EventInfo()))
+    else:
+        me_calls["fmi3UpdateDiscreteStates"] = lambda: raw(fmu, "fmi3UpdateDiscreteStates", [c_void_p] * 7, c,
+                                                           flag, flag, flag, flag, flag, real)
+        for kind in ("EventIndicators", "ContinuousStates"):
+            me_calls[f"fmi3GetNumberOf{kind}"] = (lambda k=f"fmi3GetNumberOf{kind}": raw(
+                fmu, k, [c_void_p, POINTER(c_size_t)], c, ctypes.byref(size)))
+    if name in me_calls:
+        return me_calls[name]()
     if v == 2:
         calls = {
             "fmi2SetDebugLogging": lambda: raw(fmu, name, [c_void_p, c_int, c_size_t, c_void_p], c, 1, 0, None),
@@ -223,7 +304,7 @@ def valid_call(fmu, name):
 
         def serialize_then_deserialize():
             assert raw(fmu, ser_name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, buffer, 4096) in (0, 3)
-            helper = Instance("RateLimiter", v, name="serializer")
+            helper = Instance("RateLimiter", v, name="serializer", model_exchange=fmu.model_exchange)
             try:  # serialized by a healthy instance of the same FMU
                 helper.start()
                 h = helper.fmu.component
@@ -244,6 +325,8 @@ def valid_call(fmu, name):
 
 
 def enter(fmu, state):
+    if fmu.model_exchange:
+        return enter_model_exchange(fmu, state)
     if state in (N, S, T):
         if fmu.version == 2:
             fmu.fmu.setupExperiment(startTime=0.0)
@@ -259,28 +342,55 @@ def enter(fmu, state):
         assert call_status(fmu.fmu.doStep, fmu.t, 0.0) == 3  # h = 0: error
 
 
-# the states as the refusals name them (FMI 2's Error state: after a failed call)
-STATE_TEXT = {**{(v, state): state for v in (2, 3) for state in STATES}, (2, E): "Error (after a failed call)"}
+def enter_model_exchange(fmu, state):
+    fmu.set(cycleTime=0.1)
+    if state == N:
+        fmu.enter_initialization()
+    elif state != I:
+        fmu.start()  # Event Mode
+    if state == C:
+        fmu.fmu.enterContinuousTimeMode()
+    if state == T:
+        fmu.fmu.terminate()
+    if state == E:
+        set_time = getattr(fmu.fmu.dll, f"fmi{fmu.version}SetTime")
+        set_time.argtypes, set_time.restype = [c_void_p, c_double], c_int
+        assert set_time(fmu.fmu.component, -1.0) == 3  # before the start: error
 
-CASES = [(v, name, state) for v in (2, 3) for name in sorted(exported_functions(v)) if name not in NOT_INSTANCE_CALLS
-         for state in STATES]
+
+# the states as the refusals name them (FMI 2's Error state: after a failed call)
+STATE_TEXT = {**{(v, state): state for v in (2, 3) for state in STATES + ME_STATES},
+              (2, E): "Error (after a failed call)"}
+
+CASES = [(v, name, state, False) for v in (2, 3) for name in sorted(exported_functions(v))
+         if name not in NOT_INSTANCE_CALLS for state in STATES] + \
+        [(v, name, state, True) for v in (2, 3) for name in sorted(exported_functions(v))
+         if name not in NOT_INSTANCE_CALLS for state in ME_STATES]
+
+
+def allowed_table(version, model_exchange):
+    return {(2, False): FMI2_ALLOWED, (3, False): FMI3_ALLOWED,
+            (2, True): FMI2_ME_ALLOWED, (3, True): FMI3_ME_ALLOWED}[version, model_exchange]
 
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_every_function_is_allowed_somewhere_or_unsupported_for_a_reason(version):
     """The tables above cover the whole API: each exported function is in the state table, refused as a
     capability this FMU lacks, or (fmi2CancelStep: nothing to cancel) allowed in no state."""
-    allowed = FMI2_ALLOWED if version == 2 else FMI3_ALLOWED
-    rest = set(exported_functions(version)) - NOT_INSTANCE_CALLS - set(allowed) - set(UNSUPPORTED)
+    cs, me = allowed_table(version, False), allowed_table(version, True)
+    rest = set(exported_functions(version)) - NOT_INSTANCE_CALLS - set(cs) - set(me) - set(UNSUPPORTED)
     assert rest == ({"fmi2CancelStep"} if version == 2 else set())
-    assert not set(allowed) & set(UNSUPPORTED)
+    assert not (set(cs) | set(me)) & set(UNSUPPORTED)
 
 
-@pytest.mark.parametrize("version,function,state", CASES)
-def test_every_function_in_every_state(version, function, state):
-    allowed = (FMI2_ALLOWED if version == 2 else FMI3_ALLOWED).get(function, set())
+@pytest.mark.parametrize("version,function,state,model_exchange", CASES,
+                         ids=lambda x: {True: "ME", False: "CS"}.get(x) if isinstance(x, bool) else None)
+def test_every_function_in_every_state(version, function, state, model_exchange):
+    table = allowed_table(version, model_exchange)
+    allowed = table.get(function, set())
+    other = allowed_table(version, not model_exchange)
     row = FMI3_AFTER_ERROR if version == 3 and state == E else state
-    fmu = Instance("RateLimiter", version)
+    fmu = Instance("RateLimiter", version, model_exchange=model_exchange)
     try:
         enter(fmu, state)
         before = len(fmu.errors())
@@ -295,6 +405,9 @@ def test_every_function_in_every_state(version, function, state):
             assert new_errors[0][2].startswith(f"{function}: "), new_errors  # it names the function first
             if function in UNSUPPORTED:  # a capability this FMU does not have: says which
                 assert new_errors[0][2] == f"{function}: {UNSUPPORTED[function]}", new_errors
+            elif function not in table and function in other:  # the other interface's: says so, or the state
+                assert new_errors[0][2] in (f"{function}: {OTHER_INTERFACE.get((version, model_exchange))}",
+                                            f"{function}: not allowed in {STATE_TEXT[version, row]}"), new_errors
             else:  # refused for the state: says which
                 assert new_errors[0][2] == f"{function}: not allowed in {STATE_TEXT[version, row]}", new_errors
     finally:

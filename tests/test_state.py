@@ -248,7 +248,7 @@ REASONS = {
     "mode 0": "invalid mode 0", "mode 3": "invalid mode 3", "mode -1": "invalid mode -1",
     "running time period -0.5": "impossible time", "running time base -0.5": "impossible time",
     "variable count one more": "wrong number of variables", "variable count one fewer": "wrong number of variables",
-    "magic's last byte wrong, resealed": "no header", "older version": "format version 1",
+    "magic's last byte wrong, resealed": "no header", "older version": "format version 2",
     "model one below": "another model", "model one above": "another model",
     "payload size short, resealed": "bytes; expected", "checksum one more": "checksum", "checksum one less": "checksum",
     "header alone": "16 bytes; expected", "header one byte short": "(15 bytes, no header)",
@@ -443,7 +443,7 @@ def fnv1a(text):
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
 def test_serialized_state_layout(version, model):
-    """docs/fmi.md: magic "RLFS", format version 2, the FNV-1a hash of the
+    """docs/fmi.md: magic "RLFS", format version 3, the FNV-1a hash of the
     instantiation token, the payload size, the values; a CRC-32 of all before it at the end."""
     fmu = Instance(model, version)
     fmu.start()
@@ -451,7 +451,7 @@ def test_serialized_state_layout(version, model):
     data = bytes(api["serialize"](api["get"]()))
     token = fmu.md.guid if version == 2 else fmu.md.instantiationToken
     magic, format_version, model_hash, payload, count = struct.unpack_from("<4sIIII", data)
-    assert (magic, format_version, model_hash) == (b"RLFS", 2, fnv1a(token))
+    assert (magic, format_version, model_hash) == (b"RLFS", 3, fnv1a(token))
     assert payload == len(data) - 16 - 4 and count == len(fmu.md.modelVariables)
     assert struct.unpack("<I", data[-4:])[0] == zlib.crc32(data[:-4])
     fmu.free()

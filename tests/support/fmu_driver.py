@@ -7,9 +7,9 @@ from pathlib import Path
 from fmpy import extract, read_model_description
 from fmpy import calloc, free
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                        fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
-from fmpy.fmi3 import FMU3Slave
+from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 REPO = Path(__file__).resolve().parents[2]
 TESTS = REPO / "tests"  # the working directory of the helper scripts (python -m support.x)
@@ -36,8 +36,10 @@ def unzipped(model, version):
 class Instance:
     """One FMU instance. Values are read and written by variable name."""
 
-    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None):
+    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None,
+                 model_exchange=False):
         self.version = version
+        self.model_exchange = model_exchange
         self.unzipdir = unzipdir or unzipped(model, version)
         self.md = read_model_description(self.unzipdir)
         self.variables = {v.name: v for v in self.md.modelVariables}
@@ -45,16 +47,16 @@ class Instance:
         self.t = 0.0
         identifier = self.md.coSimulation.modelIdentifier
         if version == 2:
-            self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                                 modelIdentifier=identifier, instanceName=name)
+            self.fmu = (FMU2Model if model_exchange else FMU2Slave)(
+                guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name)
             self.callbacks = fmi2CallbackFunctions()
             self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log2)
             self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
             self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
             self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging)
         else:
-            self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                                 modelIdentifier=identifier, instanceName=name)
+            self.fmu = (FMU3Model if model_exchange else FMU3Slave)(
+                guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name)
             self.fmu.instantiate(loggingOn=logging, logMessage=self._log3)
 
     def _log2(self, environment, name, status, category, message):

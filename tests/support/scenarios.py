@@ -33,12 +33,13 @@ def discover(models=None):
     return [load(f) for f in folders if models is None or f.parent.name in models]
 
 
-def simulate(scenario, fmu):
-    """The scenario through fmpy.simulate_fmu on the FMU file fmu."""
+def simulate(scenario, fmu, fmi_type="CoSimulation", **start_values):
+    """The scenario through fmpy.simulate_fmu on the FMU file fmu, as
+    fmi_type, its start values updated by start_values."""
     o = scenario.options
     return run_fmpy(str(fmu), None, start_time=o["StartTime"], stop_time=o["StopTime"], step_size=o["StepSize"],
-                    inputs=scenario.inputs, start_values=scenario.start_values, outputs=scenario.outputs,
-                    relative_tolerance=o["RelTol"])
+                    inputs=scenario.inputs, start_values={**dict(scenario.start_values), **start_values},
+                    outputs=scenario.outputs, relative_tolerance=o["RelTol"], fmi_type=fmi_type)
 
 
 def compare(scenario, result, reference=None):

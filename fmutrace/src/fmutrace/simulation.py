@@ -31,7 +31,7 @@ def held_to(inputs, stop_time):
 
 
 def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_size, inputs, start_values, outputs,
-             relative_tolerance=None, debug_logging=False):
+             relative_tolerance=None, debug_logging=False, fmi_type="CoSimulation"):
     """One simulation: the result as a structured array ('time' first). A
     failure is a SimulationError that quotes the FMU's warnings and errors:
     an FMI 3 FMU logs nothing unless logging is on, so a failed run that
@@ -54,8 +54,13 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
                 input=held_to(inputs, stop_time),
                 start_values=dict(start_values),
                 output=list(outputs),
-                fmi_type="CoSimulation",
+                fmi_type=fmi_type,
                 debug_logging=debug_logging,
+                # Model Exchange: no continuous states, so the solver only
+                # carries the time from event to event; a row per output
+                # point, as Co-Simulation records, not one per event too
+                **({"solver": "Euler", "step_size": step_size, "record_events": False}
+                   if fmi_type == "ModelExchange" else {}),
             )
     except Exception as error:  # fmpy raises FMICallException and plain Exceptions
         said = fmu_messages(printed.getvalue())
@@ -63,7 +68,7 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
             try:
                 run_fmpy(fmu_location, model_description, start_time=start_time, stop_time=stop_time,
                          step_size=step_size, inputs=inputs, start_values=start_values, outputs=outputs,
-                         relative_tolerance=relative_tolerance, debug_logging=True)
+                         relative_tolerance=relative_tolerance, debug_logging=True, fmi_type=fmi_type)
             except SimulationError as again:
                 raise again from error
         told = f"; the FMU said: {' | '.join(said[-3:])}" if said else ""
