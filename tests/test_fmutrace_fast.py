@@ -74,6 +74,19 @@ def test_the_runner_says_why_a_trace_takes_fmpys_loop():
     assert r.fast_path_problem(0.0, 1.0, 0.1, off_grid[:1], ["y"]) is None
 
 
+def test_a_trace_whose_inputs_need_fmpy_leaves_the_instance_to_the_next_trace():
+    r = runner("RateLimiter", 2)
+    on_grid = np.array([(0.0, 0.0), (0.2, 5.0)], dtype=[("time", float), ("u", float)])
+    off_grid = np.array([(0.0, 1.0), (0.25, 2.0)], dtype=[("time", float), ("u", float)])
+    r.run(0.0, 1.0, 0.1, on_grid, {}, ["y"])
+    instance, fast, fmpy = r.fmu, r.fast_runs, r.fmpy_runs
+    fast_off, plain_off = both("RateLimiter", 2, 0.0, 1.0, 0.1, off_grid, {"rateUpPar": 3.0}, ["y"])
+    assert same_bits(fast_off, plain_off)
+    assert (r.fast_runs, r.fmpy_runs) == (fast, fmpy + 1) and r.fmu is instance  # decided before the FMU was called
+    fast_on, plain_on = both("RateLimiter", 2, 0.0, 1.0, 0.1, on_grid, {"rateUpPar": 3.0}, ["y", "status"])
+    assert same_bits(fast_on, plain_on) and r.fast_runs == fast + 1 and r.fmu is instance
+
+
 NAMES = {
     "RateLimiter": (["u", "rateUp", "bypass", "hold", "yMax", "zeroRate"], ["y", "rampActive", "status", "dydt"],
                     {"rateUpPar": (0.1, 5.0), "rateDownPar": (0.1, 5.0), "ratePeriod": (0.5, 2.0)}),

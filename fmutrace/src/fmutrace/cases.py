@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from .comparison import Comparison, Mode, compare_traces
 from .errors import InputError, TraceError
 from .fmu import Fmu
 from .traces import data_lines, parse_number, read_text, read_trace, split_cells
@@ -41,6 +42,11 @@ class Case:
     def outputs(self):
         """The reference's signals: what is recorded and compared."""
         return [n for n in self.reference.dtype.names if n != "time"]
+
+    def compare(self, result, mode: Mode) -> Comparison:
+        """The FMU's result against the reference, in mode (a recording
+        compares each signal on its own samples)."""
+        return compare_traces(result, self.reference, mode)
 
 
 def read_options(path, text, reference, fmu):

@@ -12,8 +12,9 @@ per variable type as fmpy's recorder makes them. The step loop runs in C
 (_steps.c, a chunk of steps per call, the FMU's own FMI functions), or in
 Python where that module was not built: the same calls in the same order.
 
-The fast loop gives fmpy's result when (checked by `fast_path_problem`
-before a trace starts):
+The fast loop gives fmpy's result when (`fast_path_problem`; a trace
+checks the names and the grid before it starts, and each window of its
+input table as it is read, before the FMU sees a row of it):
 - the communication points are the regular grid start + k * h and the
   last one is the stop time: no input event falls between grid points
   (fmpy would add a communication point there) and (stop - start) / h is
@@ -148,6 +149,12 @@ class FastLoopFailed(Exception):
     """The fast loop cannot give fmpy's result (a call failed, or the inputs need fmpy)."""
 
 
+class InputsNeedFmpy(FastLoopFailed):
+    """An input event falls between communication points: fmpy's loop adds
+    a point there. Raised as the input table is read; for a whole table
+    (Runner.run) before the FMU is called, so the instance stays usable."""
+
+
 @contextlib.contextmanager
 def _quiet():
     """What fmpy's default logger prints (the FMU's messages) goes nowhere."""
@@ -169,7 +176,7 @@ class _InputRows:
         self.chunks, self.runner, self.grid = chunks, runner, (start, stop, step)
         self.table, self.offset, self.done = None, 0, False  # offset: the window's first row in the table
         self.last_row = None  # the row set at the last step
-        self.setters = None   # (function, value references, count, dtype, names) per FMI type
+        self.setters = None   # (FMI type, value references, count, dtype, names) per FMI type
 
     def _read(self):
         chunk = next(self.chunks, None)
@@ -177,21 +184,17 @@ class _InputRows:
             self.done = True
             return
         if self.setters is None:
-            r, groups = self.runner, {}
-            for name in sorted(chunk.dtype.names[1:], key=r.order.get):
-                v = r.variables[name]
-                groups.setdefault(v.type, []).append(v)
-            self.setters = []
-            for variables in groups.values():
-                kind = r._kind(variables[0])
-                self.setters.append((r._set[kind], _value_references(variables), len(variables), r.types[kind][0],
-                                     [v.name for v in variables]))
+            r = self.runner
+            self.setters = [(kind, _value_references(variables), len(variables), r.types[kind][0],
+                             [v.name for v in variables])
+                            for kind, variables in r._groups(chunk.dtype.names[1:]).items()]
         self.table = chunk if self.table is None else np.concatenate([self.table, chunk])
         problem = self.runner.event_problem(*self.grid, self.table)
         if problem:
-            raise FastLoopFailed(problem)
+            raise InputsNeedFmpy(problem)
 
-    def _reach(self, time):
+    def reach(self, time):
+        """Reads the table until its window reaches past time (each window's events checked as it is read)."""
         while not self.done and (self.table is None or not (self.table["time"][-1] > time and
                                                             not _close(time, self.table["time"][-1]))):
             self._read()
@@ -202,22 +205,22 @@ class _InputRows:
         """The calls that set the table's rows (global indices): per FMI type
         (function, value references, count, the rows' values)."""
         calls = []
-        for function, vrs, count, dtype, names in self.setters:
+        for kind, vrs, count, dtype, names in self.setters:
             table = np.asarray(np.stack([self.table[name] for name in names]), dtype=dtype)  # fmpy's conversion
             values = np.ascontiguousarray(table[:, rows - self.offset].T)
-            calls.append((function, vrs, count, values))
+            calls.append((self.runner._set[kind], vrs, count, values))
         return calls
 
     def first(self, start):
         """The setter calls for the initialization (their row 0): the row before the first event at start."""
-        self._reach(start)
+        self.reach(start)
         row = discrete_rows(self.table["time"], np.array([start]), after_event=False) + self.offset
         return self._setter(row)
 
     def steps(self, times):
         """(set_at, setters) of steps at times: set_at[k] the row of the
         setter calls set before step k, -1 where the row stays the one set."""
-        self._reach(times[-1])
+        self.reach(times[-1])
         t = self.table["time"]
         rows = discrete_rows(t, times, after_event=True) + self.offset
         changed = np.empty(len(rows), dtype=bool)
@@ -233,12 +236,39 @@ class _InputRows:
         return set_at, setters
 
 
-def _set_row(fmi3, component, setters, row, pointers=None):
-    """Sets row of every setter call (pointers: each call's row pointers, if made); the statuses OR-ed."""
+def _values_call(fmi3, component, function, vrs, count):
+    """call(pointer) -> status: function, an FMI Set or Get, on count values
+    at pointer. FMI 3's takes the number of values too (count: scalars);
+    the version is decided here, once per call made."""
+    if fmi3:
+        return lambda pointer: function(component, vrs, count, pointer, count)
+    return lambda pointer: function(component, vrs, count, pointer)
+
+
+def _step_call(fmi3, do_step, component, flags):
+    """step(t, h) -> status of doStep; an FMI 3 step that asks to terminate
+    or returns early counts as an Error (the loop stops after its getters)."""
+    if not fmi3:
+        return lambda t, h: do_step(component, t, h, 1)
+    event, terminate, early, last = flags
+
+    def step(t, h):
+        status = do_step(component, t, h, True, event, terminate, early, last)
+        return 3 if terminate[0] or early[0] else status
+    return step
+
+
+def _setter_calls(fmi3, component, setters):
+    """(call, a pointer to each row) of every setter (function, value references, count, rows)."""
+    return [(_values_call(fmi3, component, function, vrs, count), _row_pointers(values))
+            for function, vrs, count, values in setters]
+
+
+def _set_row(calls, row):
+    """Sets row of every _setter_calls call; the statuses OR-ed."""
     status = 0
-    for i, (function, vrs, count, values) in enumerate(setters):
-        at = pointers[i][row] if pointers else FFI.cast("char *", values.ctypes.data) + row * values.strides[0]
-        status |= function(component, vrs, count, at, count) if fmi3 else function(component, vrs, count, at)
+    for call, pointers in calls:
+        status |= call(pointers[row])
     return status
 
 
@@ -247,24 +277,17 @@ def _steps_python(fmi3, do_step, component, times, sizes, set_at, setters, gette
     type into the step's row; False as soon as a call fails (or an FMI 3
     step asks to terminate or returns early). getters: (function, value
     references, count, a pointer to each step's row)."""
-    if fmi3:
-        event, terminate, early, last = flags
-    pointers = [_row_pointers(values) for _, _, _, values in setters]
+    set_calls = _setter_calls(fmi3, component, setters)
+    get_calls = [(_values_call(fmi3, component, function, vrs, count), rows) for function, vrs, count, rows in getters]
+    step = _step_call(fmi3, do_step, component, flags)
     for t, h, row, k in zip(times.tolist(), sizes.tolist(), set_at.tolist(), itertools.count()):
-        if row >= 0 and _set_row(fmi3, component, setters, row, pointers) > 1:
+        if row >= 0 and _set_row(set_calls, row) > 1:
             return False
-        if fmi3:
-            status = do_step(component, t, h, True, event, terminate, early, last)
-            for get, vrs, n, rows in getters:
-                status |= get(component, vrs, n, rows[k], n)
-            if status > 1 or terminate[0] or early[0]:
-                return False
-        else:
-            status = do_step(component, t, h, 1)
-            for get, vrs, n, rows in getters:
-                status |= get(component, vrs, n, rows[k])
-            if status > 1:
-                return False
+        status = step(t, h)
+        for get, rows in get_calls:
+            status |= get(rows[k])
+        if status > 1:
+            return False
     return True
 
 
@@ -388,12 +411,15 @@ class Runner:
         """The trace's result, as fmpy.simulate_fmu(..., output_interval=step)
         returns it (a structured array). SimulationError if the FMU fails."""
         inputs = held_to(inputs, stop)  # as run_fmpy gives them to fmpy
-        if self.fast_path_problem(start, stop, step, inputs, outputs) is None:
-            try:
+        names = inputs.dtype.names[1:] if inputs is not None else ()
+        if self.static_problem(start, stop, step, names, outputs) is None:
+            try:  # the input events are checked as the table is read, before the FMU is called
                 chunks = list(self._fast(start, stop, step, None if inputs is None else iter([inputs]), start_values,
                                          outputs, relative_tolerance, STEPS_PER_CHUNK))
                 self.fast_runs += 1
                 return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+            except InputsNeedFmpy:
+                pass
             except FastLoopFailed:
                 self._drop_instance()  # a call failed: fmpy tells the story on an instance of its own
         self.fmpy_runs += 1
@@ -457,13 +483,15 @@ class Runner:
     def _fast(self, start, stop, step, input_chunks, start_values, outputs, tolerance, steps_per_chunk):
         """The fast loop's result chunk by chunk (see run_chunks);
         FastLoopFailed as soon as a call fails or the inputs need fmpy."""
+        inputs = _InputRows(input_chunks, self, start, stop, step) if input_chunks is not None else None
+        if inputs is not None:
+            inputs.reach(start)  # the first window read (and its events checked) before the FMU is called
         with _quiet():
             fmu = self._instance()
         n = round((stop - start) / step)
         size = min(n, steps_per_chunk)
         component = self._component
         fmi3 = self.fmi3
-        inputs = _InputRows(input_chunks, self, start, stop, step) if input_chunks is not None else None
 
         # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
         getters, columns = [], [("time", np.float64)]
@@ -495,7 +523,7 @@ class Runner:
                     remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
                     fmu.enterInitializationMode()
                 remaining = apply_start_values(fmu, self.md, remaining, settable=settable_in_initialization_mode)
-                if remaining or (first is not None and _set_row(fmi3, component, first, 0) > 1):
+                if remaining or (first is not None and _set_row(_setter_calls(fmi3, component, first), 0) > 1):
                     raise FastLoopFailed("a start value or an input was refused")
                 fmu.exitInitializationMode()
             except FastLoopFailed:
@@ -504,8 +532,7 @@ class Runner:
                 raise FastLoopFailed(str(error)) from None
             status = 0
             for function, vrs, count, pointers, _, _, _ in getters:
-                status |= function(component, vrs, count, pointers[0], count) if fmi3 else \
-                    function(component, vrs, count, pointers[0])
+                status |= _values_call(fmi3, component, function, vrs, count)(pointers[0])
             if status > 1:
                 raise FastLoopFailed("a getter failed")
         pending = result(slice(0, 1), [start])  # the start's row goes out with the first chunk

@@ -7,14 +7,14 @@ import tempfile
 import time
 
 from .cases import load_case
-from .comparison import Comparison, Mode, compare_traces
+from .comparison import Comparison, Mode
 from .errors import InputError, SimulationError
 from .fmu import Fmu
 from .longcase import is_long, run_long_case
 from .outcome import CaseOutcome, Status
 from .plot import plot_case
 from .recordings import is_recording
-from .recordings.case import RecordedCase, RecordingOptions, recorded_case
+from .recordings.case import RecordingOptions, recorded_case
 from .recordings.stream import is_long_recording, run_long_recording
 from .runner import Runner
 
@@ -59,15 +59,14 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
         o = case.options
         result = runner.run(o["StartTime"], o["StopTime"], o["StepSize"], case.inputs, case.start_values,
                             case.outputs, o["RelTol"])
-        comparison = case.compare(result, mode) if isinstance(case, RecordedCase) else \
-            compare_traces(result, case.reference, mode)
+        comparison = case.compare(result, mode)
         outcome.status = Status.PASS if comparison.passed else Status.FAIL
     except SimulationError as error:
         result, outcome.status = None, Status.ERROR
         comparison = Comparison(problem=str(error))
     outcome.deviations = [d for d in comparison.deviations if not d.passed]  # a passing signal says nothing more
     outcome.messages = comparison.messages()
-    if isinstance(case, RecordedCase):  # what was read, matched and assumed, pass or fail
+    if recorded:  # what was read, matched and assumed, pass or fail
         outcome.messages += [case.description] + (case.explain(comparison) if not comparison.passed else case.notes)
     if result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
         outcome.result = result
