@@ -3,10 +3,15 @@ of conftest.py: a scheduler and two workers on loopback): the scenarios
 sent to them with their FMUs (or read by them, --shared-files), and the
 report the same as a serial run in this process (table, results and
 plots; only the timings differ)."""
+import tempfile
+import zipfile
+from pathlib import Path
+
 import numpy as np
 
 import fmutrace
-from support.fmu_driver import BUILD_DIR
+from fmutrace.executors import package_zip
+from support.fmu_driver import BUILD_DIR, REPO
 from support.reports import without_timings
 from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
 
@@ -33,3 +38,17 @@ def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_pa
     for page in ("index.html", "summary.md", "results.json"):
         assert without_timings((tmp_path / "distributed" / page).read_text()) == \
             without_timings((tmp_path / "serial" / page).read_text())
+
+
+def test_the_package_sent_to_the_workers_is_this_fmutrace():
+    """Dask workers import the fmutrace that compare uploads: the zip holds
+    this process's sources, made in a folder of this process (no file left
+    in the shared temporary folder by an earlier process with the same id)."""
+    package = REPO / "fmutrace" / "src" / "fmutrace"  # not fmutrace.__file__: a local cluster's scheduler, in
+    # this process, imports the uploaded zip too
+    with zipfile.ZipFile(package_zip()) as z:
+        assert sorted(z.namelist()) == sorted(f"fmutrace/{s.relative_to(package).as_posix()}"
+                                              for s in package.rglob("*.py"))
+        for name in z.namelist():
+            assert z.read(name) == (package.parent / name).read_bytes(), name
+    assert package_zip() == package_zip() and package_zip().parent != Path(tempfile.gettempdir())

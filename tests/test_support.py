@@ -15,16 +15,24 @@ from support.wine import PORT, RemotingServer, port_lock
 
 def test_a_hanging_child_and_its_grandchild_are_stopped_at_the_bound(tmp_path):
     marker = tmp_path / "grandchild.pid"
-    started = time.monotonic()
     with pytest.raises(Timeout, match="waiting for sleepers: no end within 1 s"):
         # the grandchild inherits stdout: subprocess.run would wait for it
         run(["sh", "-c", f"sleep 300 & echo $! > {marker}; echo started; wait"], timeout=1,
-            what="waiting for sleepers")
-    assert time.monotonic() - started < 30
+            what="waiting for sleepers")  # only the bound raises Timeout: the sleeper would end with status 0
     grandchild = int(marker.read_text())
-    time.sleep(0.2)
-    assert not os.path.exists(f"/proc/{grandchild}") or \
-        open(f"/proc/{grandchild}/stat").read().split(")")[1].split()[0] == "Z"
+    deadline = time.monotonic() + 30  # SIGKILL was sent; a loaded machine may take a moment to end it
+    while not gone(grandchild):
+        assert time.monotonic() < deadline, f"the grandchild {grandchild} still runs 30 s after the bound"
+        time.sleep(0.05)
+
+
+def gone(pid):
+    """pid has ended (no such process, or a zombie)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat_file:
+            return stat_file.read().split(")")[1].split()[0] == "Z"
+    except FileNotFoundError:
+        return True
 
 
 def test_output_and_exit_status_of_a_child_that_ends():
@@ -54,19 +62,17 @@ def server(tmp_path, script, seconds=60):
 
 
 def test_a_server_that_dies_at_start_is_reported_with_what_it_printed(tmp_path):
-    started = time.monotonic()
+    # a start bound longer than the tests' backstop: only noticing the exit ends the wait
     with pytest.raises(AssertionError, match="(?s)attempt 1: .*exited with status 7 .*wine: could not load"):
-        with server(tmp_path, "echo 'wine: could not load Model.dll'; exit 7"):
+        with server(tmp_path, "echo 'wine: could not load Model.dll'; exit 7", seconds=3600):
             pass
-    assert time.monotonic() - started < 30
 
 
 def test_a_server_that_never_listens_is_reported_at_the_bound(tmp_path):
-    started = time.monotonic()
+    # only the bound raises Timeout's message: the sleeper would end with status 0
     with pytest.raises(AssertionError, match="(?s)did not listen on port 8080 within 1 s.*still starting"):
         with server(tmp_path, "echo 'still starting'; sleep 300", seconds=1):
             pass
-    assert time.monotonic() - started < 30
 
 
 def test_a_port_taken_by_another_process_is_refused(tmp_path):

@@ -12,9 +12,13 @@ every worker) and returns the outcomes with their results and plots, so
 workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written by the caller.
 """
+import atexit
 import contextlib
+import functools
+import hashlib
 import logging
 import os
+import shutil
 import tempfile
 import time
 import zipfile
@@ -225,14 +229,25 @@ def executor_for(cases: int, jobs: int = None, scheduler: str = None, shared_fil
     return Dask(jobs, scheduler, shared_files, cluster_timeout)
 
 
-def package_zip():
-    """fmutrace as a zip (for Dask's upload_file), made once per process."""
-    target = Path(tempfile.gettempdir()) / f"fmutrace-package-{os.getpid()}.zip"
-    if not target.exists():
-        package = Path(__file__).resolve().parent
-        with zipfile.ZipFile(target, "w") as z:
-            for source in sorted(package.rglob("*.py")):  # its subpackages too
-                z.write(source, f"fmutrace/{source.relative_to(package).as_posix()}")
+@functools.cache
+def package_zip() -> Path:
+    """fmutrace as a zip (for Dask's upload_file), made once per process in
+    a folder of its own, removed at exit, and named by its sources' hash:
+    workers keep an upload by its name, and they (and a local cluster's
+    scheduler, in this process) import fmutrace from it. A zip named by the
+    process id in the shared temporary folder was found again by a later
+    process that got the same id, with another fmutrace inside."""
+    package = Path(__file__).resolve().parent
+    sources = [(s, f"fmutrace/{s.relative_to(package).as_posix()}") for s in sorted(package.rglob("*.py"))]
+    digest = hashlib.sha256()
+    for source, name in sources:  # its subpackages too
+        digest.update(name.encode() + b"\0" + source.read_bytes() + b"\0")
+    folder = tempfile.mkdtemp(prefix="fmutrace-package-")
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    target = Path(folder) / f"fmutrace-{digest.hexdigest()[:16]}.zip"
+    with zipfile.ZipFile(target, "w") as z:
+        for source, name in sources:
+            z.write(source, name)
     return target
 
 
