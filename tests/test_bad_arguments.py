@@ -15,6 +15,17 @@ from support.fmu_driver import STATE_FUNCTIONS, Instance, call_status, state_api
 from test_conformance import NOT_INSTANCE_CALLS, exported_functions, raw
 
 
+@pytest.fixture(params=[2, 3])
+def fmu(request):
+    """A started RateLimiter instance of FMI 2 and of FMI 3, freed after the test."""
+    instance = Instance("RateLimiter", request.param)
+    try:
+        instance.start()
+        yield instance
+    finally:
+        instance.free()
+
+
 @pytest.mark.parametrize("version", [2, 3])
 def test_null_instance_is_refused_by_every_function(version):
     fmu = Instance("RateLimiter", version)
@@ -59,42 +70,46 @@ def test_fmi3_nvalues_must_match_the_scalars(access):
         fmu.free()
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_zero_values_with_null_arrays_is_fine(version):
+def test_zero_values_with_null_arrays_is_fine(fmu):
     """nvr = 0 with every array NULL (FMI 3's valueSizes of Binary too): every getter and setter is OK."""
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        c = fmu.fmu.component
-        for kind in ALL_ACCESSOR_TYPES[version]:
-            for access in ("Get", "Set"):
-                name = f"fmi{version}{access}{kind}"
-                if version == 2:
-                    argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p], (None,)
-                elif kind == "Binary":  # valueSizes and values
-                    argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], (None, None, 0)
-                else:
-                    argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], (None, 0)
-                assert raw(fmu, name, argtypes, c, None, 0, *args) == 0, name
-        assert fmu.messages == []
-        fmu.step(0.1)
-    finally:
-        fmu.free()
+    version = fmu.version
+    c = fmu.fmu.component
+    for kind in ALL_ACCESSOR_TYPES[version]:
+        for access in ("Get", "Set"):
+            name = f"fmi{version}{access}{kind}"
+            if version == 2:
+                argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p], (None,)
+            elif kind == "Binary":  # valueSizes and values
+                argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], (None, None, 0)
+            else:
+                argtypes, args = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], (None, 0)
+            assert raw(fmu, name, argtypes, c, None, 0, *args) == 0, name
+    assert fmu.messages == []
+    fmu.step(0.1)
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_duplicate_value_references_take_the_last_value(version):
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        vr = [fmu.vr("u"), fmu.vr("u")]
-        setter = fmu.fmu.setReal if version == 2 else fmu.fmu.setFloat64
-        getter = fmu.fmu.getReal if version == 2 else fmu.fmu.getFloat64
-        setter(vr, [5.0, 0.25])
-        fmu.step(1.0)
-        assert list(getter([fmu.vr("y"), fmu.vr("y")])) == [0.25, 0.25]
-    finally:
-        fmu.free()
+def test_duplicate_value_references_take_the_last_value(fmu):
+    version = fmu.version
+    vr = [fmu.vr("u"), fmu.vr("u")]
+    setter = fmu.fmu.setReal if version == 2 else fmu.fmu.setFloat64
+    getter = fmu.fmu.getReal if version == 2 else fmu.fmu.getFloat64
+    setter(vr, [5.0, 0.25])
+    fmu.step(1.0)
+    assert list(getter([fmu.vr("y"), fmu.vr("y")])) == [0.25, 0.25]
+
+
+def raw_begin(fmu):
+    """(name, begin(start, stop defined, stop) -> status): the function that
+    takes the experiment's times, called through ctypes (fmpy's wrapper
+    would not pass every value on)."""
+    c, dll = fmu.fmu.component, fmu.fmu.dll
+    if fmu.version == 2:
+        setup = dll.fmi2SetupExperiment
+        setup.argtypes, setup.restype = [c_void_p, c_int, c_double, c_double, c_int, c_double], c_int
+        return "fmi2SetupExperiment", lambda start, defined, stop: setup(c, 0, 0.0, start, defined, stop)
+    enter = dll.fmi3EnterInitializationMode
+    enter.argtypes, enter.restype = [c_void_p, c_bool, c_double, c_double, c_bool, c_double], c_int
+    return "fmi3EnterInitializationMode", lambda start, defined, stop: enter(c, False, 0.0, start, defined, stop)
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -103,17 +118,7 @@ def test_stop_time_before_start_time_is_refused(version):
     experiment of no length) is not, nor one that is not defined."""
     fmu = Instance("RateLimiter", version)
     try:
-        c, dll = fmu.fmu.component, fmu.fmu.dll
-        if version == 2:
-            name = "fmi2SetupExperiment"
-            setup = dll.fmi2SetupExperiment
-            setup.argtypes, setup.restype = [c_void_p, c_int, c_double, c_double, c_int, c_double], c_int
-            begin = lambda start, defined, stop: setup(c, 0, 0.0, start, defined, stop)  # noqa: E731
-        else:
-            name = "fmi3EnterInitializationMode"
-            enter = dll.fmi3EnterInitializationMode
-            enter.argtypes, enter.restype = [c_void_p, c_bool, c_double, c_double, c_bool, c_double], c_int
-            begin = lambda start, defined, stop: enter(c, False, 0.0, start, defined, stop)  # noqa: E731
+        name, begin = raw_begin(fmu)
         assert begin(10.0, True, 5.0) == 3
         assert fmu.errors()[-1][2] == f"{name}: stopTime 5 is before startTime 10"
         fmu.fmu.reset()  # the standard's way on from an error
@@ -140,56 +145,46 @@ def real_accessors(fmu):
     return (f.getReal, f.setReal) if fmu.version == 2 else (f.getFloat64, f.setFloat64)
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_every_value_reference_of_an_array_is_checked_before_any_is_used(version):
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        get, set_ = real_accessors(fmu)
-        y, u, bypass = fmu.vr("y"), fmu.vr("u"), fmu.vr("bypass")
-        function = {2: ("fmi2GetReal", "fmi2SetReal"), 3: ("fmi3GetFloat64", "fmi3SetFloat64")}[version]
-        for vrs in ([y, 999], [999, y], [999, y, y]):
-            assert call_status(get, vrs) == 3, vrs
-            assert fmu.errors()[-1][2] == f"{function[0]}: unknown value reference 999"
-            fmu.fmu.reset()
-            fmu.start()
-        first_unknown = len(fmu.variables)  # value references are 0 to count - 1
-        for access, values in ((get, ()), (set_, ([7.0],))):
-            assert call_status(access, [first_unknown], *values) == 3
-            assert fmu.errors()[-1][2] == f"{function[access is set_]}: unknown value reference {first_unknown}"
-            fmu.fmu.reset()
-            fmu.start()
-        for vrs in ([bypass, y], [y, bypass]):  # a Boolean among Reals
-            assert call_status(get, vrs) == 3, vrs
-            assert fmu.errors()[-1][2] == (f"{function[0]}: bypass (value reference {bypass}) is a Boolean "
-                                           f"variable, which {function[0]} cannot access")
-            fmu.fmu.reset()
-            fmu.start()
-        for vrs in ([u, 999], [999, u]):  # nothing is set when one is refused
-            assert call_status(set_, vrs, [7.0, 7.0]) == 3, vrs
-            assert fmu.errors()[-1][2] == f"{function[1]}: unknown value reference 999"
-            fmu.fmu.reset()
-            fmu.start()
-            assert fmu.get("u") == 0.0
-    finally:
-        fmu.free()
-
-
-@pytest.mark.parametrize("version", [2, 3])
-def test_time_and_outputs_cannot_be_set(version):
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        set_ = real_accessors(fmu)[1]
-        name = "fmi2SetReal" if version == 2 else "fmi3SetFloat64"
-        assert call_status(set_, [fmu.vr("time")], [5.0]) == 3
-        assert fmu.errors()[-1][2] == f"{name}: time is an independent variable and cannot be set"
+def test_every_value_reference_of_an_array_is_checked_before_any_is_used(fmu):
+    version = fmu.version
+    get, set_ = real_accessors(fmu)
+    y, u, bypass = fmu.vr("y"), fmu.vr("u"), fmu.vr("bypass")
+    function = {2: ("fmi2GetReal", "fmi2SetReal"), 3: ("fmi3GetFloat64", "fmi3SetFloat64")}[version]
+    for vrs in ([y, 999], [999, y], [999, y, y]):
+        assert call_status(get, vrs) == 3, vrs
+        assert fmu.errors()[-1][2] == f"{function[0]}: unknown value reference 999"
         fmu.fmu.reset()
         fmu.start()
-        assert call_status(set_, [fmu.vr("y")], [5.0]) == 3
-        assert fmu.errors()[-1][2] == f"{name}: y is an output and cannot be set"
-    finally:
-        fmu.free()
+    first_unknown = len(fmu.variables)  # value references are 0 to count - 1
+    for access, values in ((get, ()), (set_, ([7.0],))):
+        assert call_status(access, [first_unknown], *values) == 3
+        assert fmu.errors()[-1][2] == f"{function[access is set_]}: unknown value reference {first_unknown}"
+        fmu.fmu.reset()
+        fmu.start()
+    for vrs in ([bypass, y], [y, bypass]):  # a Boolean among Reals
+        assert call_status(get, vrs) == 3, vrs
+        assert fmu.errors()[-1][2] == (f"{function[0]}: bypass (value reference {bypass}) is a Boolean "
+                                       f"variable, which {function[0]} cannot access")
+        fmu.fmu.reset()
+        fmu.start()
+    for vrs in ([u, 999], [999, u]):  # nothing is set when one is refused
+        assert call_status(set_, vrs, [7.0, 7.0]) == 3, vrs
+        assert fmu.errors()[-1][2] == f"{function[1]}: unknown value reference 999"
+        fmu.fmu.reset()
+        fmu.start()
+        assert fmu.get("u") == 0.0
+
+
+def test_time_and_outputs_cannot_be_set(fmu):
+    version = fmu.version
+    set_ = real_accessors(fmu)[1]
+    name = "fmi2SetReal" if version == 2 else "fmi3SetFloat64"
+    assert call_status(set_, [fmu.vr("time")], [5.0]) == 3
+    assert fmu.errors()[-1][2] == f"{name}: time is an independent variable and cannot be set"
+    fmu.fmu.reset()
+    fmu.start()
+    assert call_status(set_, [fmu.vr("y")], [5.0]) == 3
+    assert fmu.errors()[-1][2] == f"{name}: y is an output and cannot be set"
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -197,17 +192,8 @@ def test_time_and_outputs_cannot_be_set(version):
 def test_a_start_time_that_is_not_finite_is_refused_naming_the_function(version, start_time):
     fmu = Instance("RateLimiter", version)
     try:
-        c, dll = fmu.fmu.component, fmu.fmu.dll
-        if version == 2:
-            name = "fmi2SetupExperiment"
-            setup = dll.fmi2SetupExperiment
-            setup.argtypes, setup.restype = [c_void_p, c_int, c_double, c_double, c_int, c_double], c_int
-            assert setup(c, 0, 0.0, start_time, 0, 0.0) == 3
-        else:
-            name = "fmi3EnterInitializationMode"
-            enter = dll.fmi3EnterInitializationMode
-            enter.argtypes, enter.restype = [c_void_p, c_bool, c_double, c_double, c_bool, c_double], c_int
-            assert enter(c, False, 0.0, start_time, False, 0.0) == 3
+        name, begin = raw_begin(fmu)
+        assert begin(start_time, False, 0.0) == 3
         assert [m[2] for m in fmu.errors()] == [f"{name}: startTime {start_time} is not finite"]
     finally:
         fmu.free()
@@ -431,64 +417,54 @@ def accessor(fmu, name):
 ACCESSOR_TYPES = {2: ("Real", "Integer", "Boolean", "String"), 3: ("Float64", "Int32", "Int64", "Boolean", "String")}
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_a_null_array_is_refused_naming_which_one(version):
+def test_a_null_array_is_refused_naming_which_one(fmu):
     """Every getter and setter, one value or two: a NULL value reference
     array or a NULL value array is an error that says which, not a crash."""
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        values = ctypes.create_string_buffer(64)
-        vrs = (c_uint * 2)(fmu.vr("u"), fmu.vr("u"))
-        for kind in ACCESSOR_TYPES[version]:
-            for access in ("Get", "Set"):
-                name = f"fmi{version}{access}{kind}"
-                function = accessor(fmu, name)
-                for n in (1, 2):
-                    for vr, array, which in ((None, values, "value reference array"), (vrs, None, "value array")):
-                        assert function(fmu.fmu.component, vr, n, array, *([n] if version == 3 else [])) == 3
-                        assert fmu.errors()[-1][2] == f"{name}: the {which} is NULL", (name, n)
-                        fmu.fmu.reset()
-                        fmu.start()
-    finally:
-        fmu.free()
+    version = fmu.version
+    values = ctypes.create_string_buffer(64)
+    vrs = (c_uint * 2)(fmu.vr("u"), fmu.vr("u"))
+    for kind in ACCESSOR_TYPES[version]:
+        for access in ("Get", "Set"):
+            name = f"fmi{version}{access}{kind}"
+            function = accessor(fmu, name)
+            for n in (1, 2):
+                for vr, array, which in ((None, values, "value reference array"), (vrs, None, "value array")):
+                    assert function(fmu.fmu.component, vr, n, array, *([n] if version == 3 else [])) == 3
+                    assert fmu.errors()[-1][2] == f"{name}: the {which} is NULL", (name, n)
+                    fmu.fmu.reset()
+                    fmu.start()
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_a_foreign_fmu_state_is_refused_by_every_state_function(version):
+def test_a_foreign_fmu_state_is_refused_by_every_state_function(fmu):
     """Its size, serializing it, getting or deserializing into it and freeing
     it: an error naming the function, nothing written or freed, no crash
     (setting one: test_misuse.py)."""
-    fmu = Instance("RateLimiter", version)
-    try:
+    version = fmu.version
+    c, dll = fmu.fmu.component, fmu.fmu.dll
+    junk = ctypes.create_string_buffer(b"\x5a" * 4096)
+    foreign = ctypes.cast(junk, c_void_p)
+    names = [STATE_FUNCTIONS[version][which] for which in ("size", "serialize", "get", "deserialize", "free")]
+    api = state_api(fmu)
+    good = api["get"]()
+    data = bytes(api["serialize"](good))
+    api["free"](good)
+    size, out = c_size_t(7), ctypes.create_string_buffer(4096)
+    calls = {names[0]: ([c_void_p, c_void_p, c_void_p], (c, foreign, byref(size))),
+             names[1]: ([c_void_p, c_void_p, c_void_p, c_size_t], (c, foreign, out, 4096)),
+             # given a state to fill, it must be one of this FMU's
+             names[2]: ([c_void_p, c_void_p], (c, byref(foreign))),
+             names[3]: ([c_void_p, c_char_p, c_size_t, c_void_p], (c, data, len(data), byref(foreign))),
+             names[4]: ([c_void_p, c_void_p], (c, byref(foreign)))}
+    for name, (argtypes, args) in calls.items():
+        function = getattr(dll, name)
+        function.argtypes, function.restype = argtypes, c_int
+        assert function(*args) == 3, name
+        assert fmu.errors()[-1][2].startswith(f"{name}: ") and "not an FMU state" in fmu.errors()[-1][2], \
+            fmu.errors()[-1]
+        fmu.fmu.reset()
         fmu.start()
-        c, dll = fmu.fmu.component, fmu.fmu.dll
-        junk = ctypes.create_string_buffer(b"\x5a" * 4096)
-        foreign = ctypes.cast(junk, c_void_p)
-        names = [STATE_FUNCTIONS[version][which] for which in ("size", "serialize", "get", "deserialize", "free")]
-        api = state_api(fmu)
-        good = api["get"]()
-        data = bytes(api["serialize"](good))
-        api["free"](good)
-        size, out = c_size_t(7), ctypes.create_string_buffer(4096)
-        calls = {names[0]: ([c_void_p, c_void_p, c_void_p], (c, foreign, byref(size))),
-                 names[1]: ([c_void_p, c_void_p, c_void_p, c_size_t], (c, foreign, out, 4096)),
-                 # given a state to fill, it must be one of this FMU's
-                 names[2]: ([c_void_p, c_void_p], (c, byref(foreign))),
-                 names[3]: ([c_void_p, c_char_p, c_size_t, c_void_p], (c, data, len(data), byref(foreign))),
-                 names[4]: ([c_void_p, c_void_p], (c, byref(foreign)))}
-        for name, (argtypes, args) in calls.items():
-            function = getattr(dll, name)
-            function.argtypes, function.restype = argtypes, c_int
-            assert function(*args) == 3, name
-            assert fmu.errors()[-1][2].startswith(f"{name}: ") and "not an FMU state" in fmu.errors()[-1][2], \
-                fmu.errors()[-1]
-            fmu.fmu.reset()
-            fmu.start()
-        assert size.value == 7 and out.raw == bytes(4096) and foreign.value == ctypes.addressof(junk)
-        assert junk.raw == b"\x5a" * 4096 + b"\0"
-    finally:
-        fmu.free()
+    assert size.value == 7 and out.raw == bytes(4096) and foreign.value == ctypes.addressof(junk)
+    assert junk.raw == b"\x5a" * 4096 + b"\0"
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -521,29 +497,24 @@ def test_set_debug_logging_refuses_a_null_category_array_and_escapes_a_bad_name(
         fmu.free()
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_serializing_into_a_short_byte_array_is_refused_and_writes_nothing(version):
+def test_serializing_into_a_short_byte_array_is_refused_and_writes_nothing(fmu):
     """One byte short: an error giving both sizes, not a write past the end;
     exactly the size: fine."""
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        api = state_api(fmu)
-        state = api["get"]()
-        c, name = fmu.fmu.component, STATE_FUNCTIONS[version]["serialize"]
-        size = c_size_t()
-        assert raw(fmu, STATE_FUNCTIONS[version]["size"], [c_void_p, c_void_p, c_void_p], c, state, byref(size)) == 0
-        n = size.value
-        out = ctypes.create_string_buffer(b"\xa5" * (n + 8), n + 8)
-        assert raw(fmu, name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, out, n - 1) == 3
-        assert fmu.errors()[-1][2] == f"{name}: the byte array has {n - 1} bytes; the state needs {n}"
-        assert out.raw == b"\xa5" * (n + 8)
-        fmu.fmu.reset()
-        assert raw(fmu, name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, out, n) == 0
-        assert out.raw[:n] == bytes(api["serialize"](state)) and out.raw[n:] == b"\xa5" * 8
-        api["free"](state)
-    finally:
-        fmu.free()
+    version = fmu.version
+    api = state_api(fmu)
+    state = api["get"]()
+    c, name = fmu.fmu.component, STATE_FUNCTIONS[version]["serialize"]
+    size = c_size_t()
+    assert raw(fmu, STATE_FUNCTIONS[version]["size"], [c_void_p, c_void_p, c_void_p], c, state, byref(size)) == 0
+    n = size.value
+    out = ctypes.create_string_buffer(b"\xa5" * (n + 8), n + 8)
+    assert raw(fmu, name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, out, n - 1) == 3
+    assert fmu.errors()[-1][2] == f"{name}: the byte array has {n - 1} bytes; the state needs {n}"
+    assert out.raw == b"\xa5" * (n + 8)
+    fmu.fmu.reset()
+    assert raw(fmu, name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, out, n) == 0
+    assert out.raw[:n] == bytes(api["serialize"](state)) and out.raw[n:] == b"\xa5" * 8
+    api["free"](state)
 
 
 def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
@@ -705,20 +676,15 @@ def test_fmi2_string_accessors_refuse_every_value_reference():
         fmu.free()
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_freeing_through_a_null_pointer_or_a_null_state_does_nothing(version):
+def test_freeing_through_a_null_pointer_or_a_null_state_does_nothing(fmu):
     """FMI: freeing a NULL state is a no-op; a NULL pointer to one too."""
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        name = STATE_FUNCTIONS[version]["free"]
-        empty = c_void_p()
-        assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, None) == 0
-        assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, byref(empty)) == 0
-        assert fmu.messages == []
-        fmu.step(0.5)
-    finally:
-        fmu.free()
+    version = fmu.version
+    name = STATE_FUNCTIONS[version]["free"]
+    empty = c_void_p()
+    assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, None) == 0
+    assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, byref(empty)) == 0
+    assert fmu.messages == []
+    fmu.step(0.5)
 
 
 def test_fmi2_any_boolean_other_than_false_is_true():
@@ -856,28 +822,23 @@ ALL_ACCESSOR_TYPES = {2: ("Real", "Integer", "Boolean", "String"),
                       3: ("Float64", "Int32", "Int64", "Boolean") + NO_VARIABLES}
 
 
-@pytest.mark.parametrize("version", [2, 3])
-def test_zero_values_with_arrays_given_reads_and_writes_nothing(version):
+def test_zero_values_with_arrays_given_reads_and_writes_nothing(fmu):
     """nvr = 0 with real arrays (the first entry an unknown value reference):
     every getter and setter returns OK without looking at them."""
-    fmu = Instance("RateLimiter", version)
-    try:
-        fmu.start()
-        c = fmu.fmu.component
-        vrs = (c_uint * 1)(999)
-        buffer = ctypes.create_string_buffer(b"\x5a" * 64, 64)
-        sizes = (c_size_t * 1)(7)
-        for kind in ALL_ACCESSOR_TYPES[version]:
-            for access in ("Get", "Set"):
-                name = f"fmi{version}{access}{kind}"
-                if kind == "Binary":
-                    args = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], (c, vrs, 0, sizes, buffer, 0)
-                elif version == 3:
-                    args = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], (c, vrs, 0, buffer, 0)
-                else:
-                    args = [c_void_p, c_void_p, c_size_t, c_void_p], (c, vrs, 0, buffer)
-                assert raw(fmu, name, args[0], *args[1]) == 0, name
-        assert buffer.raw == b"\x5a" * 64 and sizes[0] == 7 and fmu.messages == []
-        fmu.step(0.5)
-    finally:
-        fmu.free()
+    version = fmu.version
+    c = fmu.fmu.component
+    vrs = (c_uint * 1)(999)
+    buffer = ctypes.create_string_buffer(b"\x5a" * 64, 64)
+    sizes = (c_size_t * 1)(7)
+    for kind in ALL_ACCESSOR_TYPES[version]:
+        for access in ("Get", "Set"):
+            name = f"fmi{version}{access}{kind}"
+            if kind == "Binary":
+                args = [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p, c_size_t], (c, vrs, 0, sizes, buffer, 0)
+            elif version == 3:
+                args = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], (c, vrs, 0, buffer, 0)
+            else:
+                args = [c_void_p, c_void_p, c_size_t, c_void_p], (c, vrs, 0, buffer)
+            assert raw(fmu, name, args[0], *args[1]) == 0, name
+    assert buffer.raw == b"\x5a" * 64 and sizes[0] == 7 and fmu.messages == []
+    fmu.step(0.5)
