@@ -1,5 +1,5 @@
-"""The choices made where the vendor documents are silent (README,
-"Vendor interpretations"), each checked."""
+"""The choices made where the vendor documents are silent (models.md,
+Vendor interpretations), each checked."""
 import math
 
 import pytest
