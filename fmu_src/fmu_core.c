@@ -67,7 +67,7 @@ void fmu_reset(FmuInstance *instance) {
  * the block, which configures). */
 void fmu_invalidate(FmuInstance *instance) {
     instance->configDirty = true;
-    instance->fastPeriod = NAN;
+    fmu_disarm(instance);
     if (instance->core.mode == MODE_INITIALIZATION) {
         instance->outputsStale = FMU_STALE_ALL;
     }
@@ -190,7 +190,7 @@ FMU_NOINLINE static void configure(FmuInstance *instance) {
 
 /* not inline: keeps the step's frame small */
 FMU_NOINLINE static void prepare(FmuInstance *instance, double period) {
-    instance->fastPeriod = NAN;
+    fmu_disarm(instance);
     RlConfig config = instance->prepared.config;
     rl_prepare(&instance->prepared, &config, period);
     instance->prepareDue = false;
@@ -355,21 +355,25 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     }
     /* The next step may be the common one (fmu_step_fast) if it has this h,
      * the configuration stays, one cycle per step, only rule 6 applies to
-     * any finite u (plain) and y is finite: then it stays so. */
+     * any finite u (plain), y is finite and rule 6 decided this cycle: then
+     * it stays so. */
     /* (The common step adds h to the time and takes t - time unchecked:
      * with h <= 2^900 and |time| <= 2^968 the time needs 2^67 steps to
      * reach 2^969, and below 2^970, t - time is at most DBL_MAX in
      * magnitude for any t: nothing overflows.) */
     if (instance->cycleTime == 0 && instance->prepared.plain && rl_steady_value(core->block.y) &&
+        core->block.decided == RL_DECIDED_RAMP &&
         islessequal(h, 8.452712498170644e+270 /* 2^900 */) && islessequal(fabs(core->time), 2.4948003869184e+291 /* 2^968 */)) {
         rl_hold_period(&core->block, h);
-        instance->fastPeriod = h;
+        const bool real = instance->prepared.config.real;
+        instance->fastPeriodReal = real ? h : NAN;
+        instance->fastPeriodLreal = real ? NAN : h;
         /* the general tolerance, RL_TIME_TOLERANCE * |time|, only grows
          * from here while time >= 0 (steps go forward): taken now, it is
          * never more than the general one later; before 0, exact times */
         instance->fastTolerance = core->time >= 0 ? RL_TIME_TOLERANCE * core->time : 0.0;
     } else {
-        instance->fastPeriod = NAN;
+        fmu_disarm(instance);
     }
     return report_status(instance);
 }

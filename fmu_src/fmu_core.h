@@ -82,11 +82,14 @@ struct FmuInstance {
     bool configDirty;       /* a parameter or input other than u changed */
     unsigned char outputsStale; /* FMU_STALE_*: what changed since the outputs were published */
     bool prepareDue;        /* the configuration changed: prepare before the next cycle */
-    /* Step size of the common step (fmu_step_fast): set by a general step
-     * that found the common one possible (fmu_do_step_general), NaN
-     * whenever anything it relies on changes; and its time tolerance, set
-     * there too (see there why it never exceeds the general one). */
-    double fastPeriod, fastTolerance;
+    /* Step size of the common step (fmu_step_fast), one per arithmetic of
+     * the prepared block, so that the step's compare of h also picks the
+     * arithmetic: set (the one of the block's arithmetic, the other NaN) by
+     * a general step that found the common one possible
+     * (fmu_do_step_general), both NaN whenever anything it relies on
+     * changes (fmu_disarm); and its time tolerance, set there too (see
+     * there why it never exceeds the general one). */
+    double fastPeriodReal, fastPeriodLreal, fastTolerance;
     double cycleTime;       /* sub-cycle length, 0 = one cycle per step */
     /* model->inputVr and outputVr, one load nearer. Every model's u is an
      * unranged, non-fixed Real input and its y a Real output (checked
@@ -114,6 +117,11 @@ void fmu_reset(FmuInstance *instance);
  * the common step waits for a general one, and in Initialization Mode the
  * outputs follow the values. */
 void fmu_invalidate(FmuInstance *instance);
+
+/* No common step until a general step finds it possible again. */
+static inline void fmu_disarm(FmuInstance *instance) {
+    instance->fastPeriodReal = instance->fastPeriodLreal = NAN;
+}
 
 void fmu_log(FmuInstance *instance, FmuStatus status, const char *fmt, ...);
 
@@ -252,15 +260,21 @@ static inline bool fmu_time_matches(double t, double time) {
 /* The common step, inline in the glue: the same step size as the step
  * before, no sub-cycling, nothing changed but u, and a cycle in which only
  * rule 6 applies. What does not change from step to step is checked once,
- * by the general step that sets fastPeriod (see there); what is left is h,
+ * by the general step that sets a fast period (see there); what is left is h,
  * t and a finite u. False: nothing done, take the general step. */
 static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     FmuCore *core = &instance->core;
     /* t - time cannot overflow at the times the common step runs at
      * (fmu_do_step_general); the cycle itself, if u is finite in the
      * block's arithmetic (y stays finite) */
-    if (!(h == instance->fastPeriod && islessequal(fabs(t - core->time), instance->fastTolerance) &&
-          rl_ramp_steady(&core->block, &instance->prepared, core->values[instance->inputVr]))) {
+    const double u = core->values[instance->inputVr];
+    if (h == instance->fastPeriodReal) {
+        if (!(islessequal(fabs(t - core->time), instance->fastTolerance) &&
+              rl_ramp_steady_real(&core->block, &instance->prepared, u))) {
+            return false;
+        }
+    } else if (!(h == instance->fastPeriodLreal && islessequal(fabs(t - core->time), instance->fastTolerance) &&
+                 rl_ramp_steady_lreal(&core->block, &instance->prepared, u))) {
         return false;
     }
     instance->outputsStale = FMU_STALE_ALL;

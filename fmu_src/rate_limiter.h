@@ -259,18 +259,21 @@ static inline bool rl_steady_limit(double limit) {
 /* The kernel's arithmetic, once per type (rate_limiter_rules.h, which
  * undefines these after use): RL_ENTER brings a double that is not yet the
  * type's into it; RL_MAX_UP and RL_MAX_DOWN are the per-cycle limits in
- * the type. */
+ * the type; RL_ROUND rounds a finite double within the type's range to it,
+ * widened back. */
 #define RL_NUM double
 #define RL_SUFFIX _lreal
 #define RL_ENTER(x) (x)
 #define RL_MAX_UP(p) ((p)->maxUp)
 #define RL_MAX_DOWN(p) ((p)->maxDown)
+#define RL_ROUND(x) (x)
 #include "rate_limiter_rules.h"
 #define RL_NUM float
 #define RL_SUFFIX _real
 #define RL_ENTER(x) rl_binary32(x)
 #define RL_MAX_UP(p) ((p)->maxUpReal)
 #define RL_MAX_DOWN(p) ((p)->maxDownReal)
+#define RL_ROUND(x) ((double)(float)(x))
 #include "rate_limiter_rules.h"
 
 /* A value as it enters the block's arithmetic: u, every cycle. */
@@ -281,14 +284,14 @@ static inline double rl_input(const RlPrepared *p, double u) {
 /* Rule 6 (rl_ramp_cycle_lreal / _real) for a u that has entered. */
 static inline void rl_ramp(RlState *s, const RlPrepared *p, double u) {
     if (p->config.real) {
-        rl_ramp_cycle_real(s, p, u, false);
+        rl_ramp_cycle_real(s, p, u);
     } else {
-        rl_ramp_cycle_lreal(s, p, u, false);
+        rl_ramp_cycle_lreal(s, p, u);
     }
 }
 
 /* rl_ramp after rl_hold_period(s, p->period) for a finite y, with a plain
- * configuration: the same state. false: u is not finite in the block's
+ * configuration, after a cycle rule 6 decided: the same state. false: u is not finite in the block's
  * arithmetic, nothing done (take the general path). */
 static inline bool rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
     return p->config.real ? rl_ramp_steady_real(s, p, u) : rl_ramp_steady_lreal(s, p, u);

@@ -6,7 +6,7 @@
  * and every operation below is one RL_NUM operation, rounded as C rounds
  * it with FLT_EVAL_METHOD 0, in the contract's order. No include guard: it
  * is meant to be included once per type, and it undefines its parameters
- * (RL_NUM ... RL_MAX_DOWN) at the end. */
+ * (RL_NUM ... RL_ROUND) at the end. */
 
 #define RL_NAME(name) RL_NAME_(name, RL_SUFFIX)
 #define RL_NAME_(name, suffix) RL_NAME__(name, suffix)
@@ -41,49 +41,77 @@ static inline RL_NUM RL_NAME(rl_step_towards)(RL_NUM y, RL_NUM target, RL_NUM ma
     return y;
 }
 
+/* The same step of steady operands in binary64 whatever the arithmetic:
+ * y, the target and the limits are values of the arithmetic widened, so
+ * the comparisons are the arithmetic's, and a sum rounded to the arithmetic
+ * once (RL_ROUND) is its own sum (binary64 holds 2 * 24 + 2 bits): no
+ * operand is converted. */
+static inline double RL_NAME(rl_step_steady)(double y, double target, double maxUp, double maxDown) {
+    if (target > y) {
+        const double limited = RL_ROUND(y + maxUp);
+        return limited < target ? limited : target;
+    }
+    if (target < y) {
+        const double limited = RL_ROUND(y - maxDown);
+        return limited > target ? limited : target;
+    }
+    return y;
+}
+
 /* Rule 6: ramp towards uc at the limits picked by the output's sign, or
  * jump to uc once the duration has run out. u has entered the block's
- * arithmetic (rl_input). steady: u and y are finite, runPeriod is already
- * p->period (rl_hold_period) and the configuration is plain (uc is u, the
- * limits are the same for both signs), which spares the checks; a
- * constant, so each caller gets its own copy. */
-static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, double u, bool steady) {
+ * arithmetic (rl_input). */
+static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, double u) {
     const double ypHeld = s->y;
     const RL_NUM yp = (RL_NUM)ypHeld;
-    const bool negative = !steady && isless(yp, 0);
-    const RL_NUM target = (RL_NUM)(steady ? u : rl_target(u, p));
+    const bool negative = isless(yp, 0);
+    const RL_NUM target = (RL_NUM)rl_target(u, p);
     RL_NUM y = yp;
+    /* a u equal to uPrevious (a zero of the other sign included: nothing
+     * tells them apart) is not stored, so that a held u costs no store */
     if (u != s->uPrevious) {
         s->runCycles = 0;
         s->runBase = 0.0;
+        s->uPrevious = u;
     }
-    /* y != target; steady (both finite), as the comparisons the step
-     * makes, so that they are made once */
-    if (steady ? target > y || target < y : y != target) {
-        if (!steady && p->period != s->runPeriod) rl_period_changed(s, p->period);
+    if (y != target) {
+        if (p->period != s->runPeriod) rl_period_changed(s, p->period);
         s->runCycles++;
     }
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) { /* both finite */
         y = target;
     } else {
         y = RL_NAME(rl_step_towards)(y, target, negative ? (RL_NUM)p->maxUpNeg : RL_MAX_UP(p),
-                                     negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p), steady);
+                                     negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p), false);
     }
     s->decided = RL_DECIDED_RAMP;
     s->yPrevious = ypHeld;
     s->y = (double)y;
-    s->uPrevious = u;
 }
 
 /* The common step's cycle: false (nothing done) if u is not a steady value
- * (RL_STEADY_BELOW: finite in either arithmetic, its sums too), else rule 6
- * as rl_ramp_cycle's steady one (the caller has checked the rest: plain,
- * y steady, runPeriod). */
-static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, double u) {
-    if (!rl_steady_value(u)) {
+ * (RL_STEADY_BELOW: finite in either arithmetic, its sums too), else
+ * rl_ramp_cycle in binary64 (rl_step_steady) for what the caller has
+ * checked: the configuration plain (uc is u, the limits the same for both
+ * signs), y steady, runPeriod p->period (rl_hold_period) and rule 6 decided
+ * the last cycle, which spares the checks, the conversions and the stores
+ * of decided and runPeriod. */
+static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, double uIn) {
+    if (!rl_steady_value(uIn)) {
         return false;
     }
-    RL_NAME(rl_ramp_cycle)(s, p, (double)(RL_NUM)u, true);
+    const double u = (double)(RL_NUM)uIn, yp = s->y;
+    if (u != s->uPrevious) {
+        s->runCycles = 0;
+        s->runBase = 0.0;
+        s->uPrevious = u;
+    }
+    if (u > yp || u < yp) { /* y != u, as the step's comparisons: made once */
+        s->runCycles++;
+    }
+    const bool jump = p->durationLimited && rl_running_time(s) >= p->durationReached;
+    s->y = jump ? u : RL_NAME(rl_step_steady)(yp, u, p->maxUp, p->maxDown);
+    s->yPrevious = yp;
     return true;
 }
 
@@ -133,3 +161,4 @@ static inline bool RL_NAME(rl_cut_down)(double yp, double maxDown, double uc) {
 #undef RL_ENTER
 #undef RL_MAX_UP
 #undef RL_MAX_DOWN
+#undef RL_ROUND

@@ -687,7 +687,7 @@ static void test_steady_ramp_equals_rules(void) {
                 if (!(held && rl_ramp_steady(&steady, &p, u))) {
                     rl_cycle(&steady, &p, u, elapsed);
                 }
-                held = p.plain && isfinite(steady.y);
+                held = p.plain && isfinite(steady.y) && steady.decided == RL_DECIDED_RAMP;
                 if (held) rl_hold_period(&steady, periods[k]);
                 rl_cycle_rules(&rules, &p, rl_input(&p, u), elapsed);
                 CHECK_EQ(steady.y, rules.y);
