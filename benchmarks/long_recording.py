@@ -99,8 +99,8 @@ def generate(root, hours):
         for old in folder.parent.glob("generator-*.stamp"):
             old.unlink()
         started = time.perf_counter()
-        write_case(folder, cycles)
-        write_recording(folder.parent / RECORDING, cycles)
+        # in a child: a forked command's peak memory (wait4's ru_maxrss) counts this process's pages at the fork
+        subprocess.run([sys.executable, __file__, "--child", "generate", str(folder), str(cycles)], check=True)
         stamp.touch()
         print(f"generated {cycles:,} cycles in {folder} ({time.perf_counter() - started:.1f} s)", flush=True)
     return folder, cycles
@@ -160,6 +160,9 @@ def main():
         kind, *rest = args.child
         if kind == "read":
             read_floor(rest)
+        elif kind == "generate":
+            write_case(Path(rest[0]), int(rest[1]))
+            write_recording(Path(rest[0]).parent / RECORDING, int(rest[1]))
         else:
             fmpy_anchor(Path(rest[0]), Path(rest[1]))
         return 0
