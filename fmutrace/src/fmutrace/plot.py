@@ -137,8 +137,13 @@ def draw(figure: Figure, mode: Mode, label: str) -> bytes:
     columns = 2 if figure.zoom else 1
     fig, grid = plt.subplots(rows, columns, sharex="col", figsize=(WIDTH_INCHES * (1 + 0.45 * (columns - 1)), height),
                              squeeze=False, width_ratios=[1, 0.45][:columns])
+    from matplotlib.ticker import MaxNLocator
+
     for ax in grid.ravel():
         ax.tick_params(labelsize=7)
+        # few ticks: matplotlib makes every tick as artists of its own, most of a figure's cost
+        ax.xaxis.set_major_locator(MaxNLocator(6))
+        ax.yaxis.set_major_locator(MaxNLocator(4))
     axes = list(grid[:, 0])
     if has_inputs:
         ax = axes.pop(0)
