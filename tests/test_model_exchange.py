@@ -6,13 +6,12 @@ before it was left, so Model Exchange gives Co-Simulation's outputs at
 every cycle end (the reference: the same scenario through the same FMU as
 Co-Simulation with the same cycleTime, itself checked against the
 hand-worked references by test_reference.py)."""
-import ctypes
 import math
-from ctypes import POINTER, byref, c_bool, c_double, c_int, c_size_t, c_uint, c_void_p
+from ctypes import c_bool, c_double, c_int, c_size_t, c_void_p
 
 import pytest
 from fmpy.fmi2 import FMU2Model, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, \
-    fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2EventInfo
+    fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.fmi3 import FMU3Model
 from fmpy import calloc, free, read_model_description
 
