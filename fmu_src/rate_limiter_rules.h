@@ -4,9 +4,9 @@
  * block keeps its values as doubles (state, limits, configuration): in
  * REAL they are binary32 values widened, so the conversions here are exact
  * and every operation below is one RL_NUM operation, rounded as C rounds
- * it with FLT_EVAL_METHOD 0, in the contract's order. No include guard: it
- * is meant to be included once per type, and it undefines its parameters
- * (RL_NUM ... RL_ROUND) at the end. */
+ * it with FLT_EVAL_METHOD 0, in the order rules.md writes them. No include
+ * guard: it is meant to be included once per type, and it undefines its
+ * parameters (RL_NUM ... RL_ROUND) at the end. */
 
 #define RL_NAME(name) RL_NAME_(name, RL_SUFFIX)
 #define RL_NAME_(name, suffix) RL_NAME__(name, suffix)
