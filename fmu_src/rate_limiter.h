@@ -259,21 +259,18 @@ static inline bool rl_steady_limit(double limit) {
 /* The kernel's arithmetic, once per type (rate_limiter_rules.h, which
  * undefines these after use): RL_ENTER brings a double that is not yet the
  * type's into it; RL_MAX_UP and RL_MAX_DOWN are the per-cycle limits in
- * the type; RL_ROUND rounds a finite double within the type's range to it,
- * widened back. */
+ * the type. */
 #define RL_NUM double
 #define RL_SUFFIX _lreal
 #define RL_ENTER(x) (x)
 #define RL_MAX_UP(p) ((p)->maxUp)
 #define RL_MAX_DOWN(p) ((p)->maxDown)
-#define RL_ROUND(x) (x)
 #include "rate_limiter_rules.h"
 #define RL_NUM float
 #define RL_SUFFIX _real
 #define RL_ENTER(x) rl_binary32(x)
 #define RL_MAX_UP(p) ((p)->maxUpReal)
 #define RL_MAX_DOWN(p) ((p)->maxDownReal)
-#define RL_ROUND(x) ((double)(float)(x))
 #include "rate_limiter_rules.h"
 
 /* A value as it enters the block's arithmetic: u, every cycle. */

@@ -6,7 +6,7 @@
  * and every operation below is one RL_NUM operation, rounded as C rounds
  * it with FLT_EVAL_METHOD 0, in the order rules.md writes them. No include
  * guard: it is meant to be included once per type, and it undefines its
- * parameters (RL_NUM ... RL_ROUND) at the end. */
+ * parameters (RL_NUM ... RL_MAX_DOWN) at the end. */
 
 #define RL_NAME(name) RL_NAME_(name, RL_SUFFIX)
 #define RL_NAME_(name, suffix) RL_NAME__(name, suffix)
@@ -41,21 +41,20 @@ static inline RL_NUM RL_NAME(rl_step_towards)(RL_NUM y, RL_NUM target, RL_NUM ma
     return y;
 }
 
-/* The same step of steady operands in binary64 whatever the arithmetic:
- * y, the target and the limits are values of the arithmetic widened, so
- * the comparisons are the arithmetic's, and a sum rounded to the arithmetic
- * once (RL_ROUND) is its own sum (binary64 holds 2 * 24 + 2 bits): no
- * operand is converted. */
-static inline double RL_NAME(rl_step_steady)(double y, double target, double maxUp, double maxDown) {
-    if (target > y) {
-        const double limited = RL_ROUND(y + maxUp);
-        return limited < target ? limited : target;
-    }
-    if (target < y) {
-        const double limited = RL_ROUND(y - maxDown);
-        return limited > target ? limited : target;
-    }
-    return y;
+/* The common step's limited step of steady operands (the cycle's
+ * direction chosen by the caller): y and the limits are values of the
+ * arithmetic widened, so their binary64 sum rounded to the arithmetic once
+ * is the arithmetic's own sum (binary64 holds 2 * 24 + 2 bits), compared
+ * with the target in the arithmetic, where both are. Nothing here is NaN
+ * (RL_STEADY_BELOW): the comparisons are quiet. */
+static inline double RL_NAME(rl_step_up)(double y, RL_NUM target, double maxUp) {
+    const RL_NUM limited = (RL_NUM)(y + maxUp);
+    return (double)(limited < target ? limited : target);
+}
+
+static inline double RL_NAME(rl_step_down)(double y, RL_NUM target, double maxDown) {
+    const RL_NUM limited = (RL_NUM)(y - maxDown);
+    return (double)(limited > target ? limited : target);
 }
 
 /* Rule 6: ramp towards uc at the limits picked by the output's sign, or
@@ -91,8 +90,8 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
 
 /* The common step's cycle: false (nothing done) if u is not a steady value
  * (RL_STEADY_BELOW: finite in either arithmetic, its sums too), else
- * rl_ramp_cycle in binary64 (rl_step_steady) for what the caller has
- * checked: the configuration plain (uc is u, the limits the same for both
+ * rl_ramp_cycle, the direction compared once (rl_step_up, rl_step_down),
+ * for what the caller has checked: the configuration plain (uc is u, the limits the same for both
  * signs), y steady, runPeriod p->period (rl_hold_period) and rule 6 decided
  * the last cycle, which spares the checks, the conversions and the stores
  * of decided and runPeriod. */
@@ -100,17 +99,25 @@ static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, doub
     if (!rl_steady_value(uIn)) {
         return false;
     }
-    const double u = (double)(RL_NUM)uIn, yp = s->y;
+    const RL_NUM target = (RL_NUM)uIn;
+    const double u = (double)target, yp = s->y;
     if (u != s->uPrevious) {
         s->runCycles = 0;
         s->runBase = 0.0;
         s->uPrevious = u;
     }
-    if (u > yp || u < yp) { /* y != u, as the step's comparisons: made once */
+    double y = yp;
+    if (u > yp) {
         s->runCycles++;
+        y = RL_NAME(rl_step_up)(yp, target, p->maxUp);
+    } else if (u < yp) {
+        s->runCycles++;
+        y = RL_NAME(rl_step_down)(yp, target, p->maxDown);
     }
-    const bool jump = p->durationLimited && rl_running_time(s) >= p->durationReached;
-    s->y = jump ? u : RL_NAME(rl_step_steady)(yp, u, p->maxUp, p->maxDown);
+    if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
+        y = u;
+    }
+    s->y = y;
     s->yPrevious = yp;
     return true;
 }
@@ -161,4 +168,3 @@ static inline bool RL_NAME(rl_cut_down)(double yp, double maxDown, double uc) {
 #undef RL_ENTER
 #undef RL_MAX_UP
 #undef RL_MAX_DOWN
-#undef RL_ROUND
