@@ -10,9 +10,9 @@ import math
 from ctypes import c_bool, c_double, c_int, c_size_t, c_void_p
 
 import pytest
-from fmpy.fmi2 import FMU2Model, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, \
+from fmpy.fmi2 import FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, \
     fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from fmpy.fmi3 import FMU3Model
+from fmpy.fmi3 import FMU3Model, FMU3Slave
 from fmpy import calloc, free, read_model_description
 
 from support.fmu_driver import MODELS, fmu_file, unzipped
@@ -295,3 +295,41 @@ def test_misuse_in_model_exchange_is_refused_with_a_reason(version):
         assert fmu.messages[-1][2].startswith(f"{update}: ") and "NULL" in fmu.messages[-1][2]
     finally:
         fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_state_of_a_co_simulation_instance_is_refused_in_model_exchange(version):
+    """An FMU state taken in Step Mode by a Co-Simulation instance of the
+    same FMU is a mode no Model Exchange instance can be in: setting it is
+    an error that says so, and the Model Exchange instance is not changed
+    into a Co-Simulation one."""
+    fmu = MeInstance("RateLimiter", version)
+    unzipdir = unzipped("RateLimiter", version)
+    md = read_model_description(unzipdir)
+    if version == 2:
+        cs = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
+                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="cs")
+        cs.instantiate()
+        cs.setupExperiment(startTime=0.0)
+    else:
+        cs = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipdir,
+                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="cs")
+        cs.instantiate()
+    try:
+        cs.enterInitializationMode(**({} if version == 2 else {"startTime": 0.0}))
+        cs.exitInitializationMode()
+        cs.doStep(0.0, 0.1)
+        state = cs.getFMUstate() if version == 2 else cs.getFMUState()
+        fmu.start(cycleTime=0.1)
+        fmu.update()
+        fmu.fmu.enterContinuousTimeMode()
+        name = "fmi2SetFMUstate" if version == 2 else "fmi3SetFMUState"
+        assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, state) == 3
+        errors = [m for m in fmu.messages if m[0] >= 3]
+        assert len(errors) == 1, fmu.messages
+        assert errors[0][2] == (f"{name}: an FMU state of Step Mode, which this Model Exchange instance "
+                                "cannot be in")
+        (cs.freeFMUstate if version == 2 else cs.freeFMUState)(state)
+    finally:
+        fmu.free()
+        cs.freeInstance()
