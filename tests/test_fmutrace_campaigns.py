@@ -300,3 +300,32 @@ def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path
     assert starts.starts == min(failures + 1, 2)
     assert ("Dask, 2 workers" in result.where) == (failures == 1), result.where
     assert (tmp_path / "report" / "index.html").exists()
+
+
+# evaluated in each worker: where its fmutrace comes from, and each Runner's loop and fast runs
+WORKER_LOOPS = ("(__import__('fmutrace.runner').runner.__file__, "
+                "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])")
+
+
+def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch):
+    """A local cluster's workers share this environment: they import the
+    installed fmutrace, with its compiled _steps, not an uploaded zip of
+    its Python sources (where the C loop cannot be imported)."""
+    from fmutrace import executors
+
+    reports = {}
+    run = executors.Dask._run
+
+    def run_and_ask_the_workers(self, client, todo, work, finished):
+        workers = run(self, client, todo, work, finished)
+        reports.update(client.run(eval, WORKER_LOOPS))
+        return workers
+
+    monkeypatch.setattr(executors.Dask, "_run", run_and_ask_the_workers)
+    cases = pass_through_cases(tmp_path / "cases", 40)
+    result = fmutrace.compare(PASS_THROUGH, cases, jobs=2, plots="none")
+    assert result.passed and len(result.cases) == 40 and "Dask, 2 workers" in result.where, result.summary()
+    assert len(reports) == 2, reports
+    for source, runners in reports.values():
+        assert ".zip" not in source and all(c_loop for c_loop, _ in runners), reports
+    assert sum(fast for _, runners in reports.values() for _, fast in runners) == 40, reports

@@ -171,7 +171,8 @@ class Dask(Executor):
     def _run(self, client, todo, work, finished):
         from dask.distributed import as_completed
 
-        client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
+        if self.scheduler:  # fmutrace to every worker: nothing to install there but packages. A local cluster's
+            client.upload_file(str(package_zip()))  # workers share this venv: from a zip they would miss _steps
         workers = len(client.scheduler_info()["workers"])
         shared = {path: client.scatter(data, broadcast=True) for path, data in work.fmu_bytes.items()}
         # about 8 batches per worker; at most BATCH_CASES cases each (a task's cost is a few milliseconds)
@@ -233,8 +234,8 @@ def executor_for(cases: int, jobs: int = None, scheduler: str = None, shared_fil
 def package_zip() -> Path:
     """fmutrace as a zip (for Dask's upload_file), made once per process in
     a folder of its own, removed at exit, and named by its sources' hash:
-    workers keep an upload by its name, and they (and a local cluster's
-    scheduler, in this process) import fmutrace from it. A zip named by the
+    a scheduler's workers keep an upload by its name and import fmutrace
+    from it. A zip named by the
     process id in the shared temporary folder was found again by a later
     process that got the same id, with another fmutrace inside."""
     package = Path(__file__).resolve().parent
