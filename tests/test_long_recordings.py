@@ -134,6 +134,33 @@ def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
     assert streamed is None
 
 
+def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_run_is_closed(tmp_path,
+                                                                                               monkeypatch):
+    """Through run_case, streamed first as a long recording is: a skipped
+    cycle found after the FMU ran gives the in-memory path's outcome, and
+    the stream's run (run_chunks, suspended at its last chunk) is closed."""
+    path = copy(tmp_path, "tia_portal_siemens.csv", lambda lines: lines[:10] + lines[11:], encoding="cp1252")
+    fmu_file = fmu_path(BUILD_DIR, "LGF_LimRateOfChangeCI", 3)
+    runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
+    labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
+    monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
+    whole = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
+    runs = []
+    run_chunks = runner.run_chunks
+
+    def kept_run_chunks(*args, **kwargs):
+        runs.append(run_chunks(*args, **kwargs))
+        return runs[-1]
+
+    monkeypatch.setattr(runner, "run_chunks", kept_run_chunks)
+    monkeypatch.setattr(worker, "is_long_recording", lambda path: True)
+    monkeypatch.setattr(stream, "HEAD_BYTES", 400)
+    first = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
+    assert len(runs) == 1 and runs[0].gi_frame is None  # started, given up on, closed
+    assert (first.status, first.messages) == (whole.status, whole.messages)
+    assert [d.to_json() for d in first.deviations] == [d.to_json() for d in whole.deviations]
+
+
 def test_intervals_median_is_numpys():
     rng = np.random.default_rng(5)
     for n in (1, 2, 3, 10, 11):

@@ -140,6 +140,7 @@ def stream_case(name, labels, mode, plots, runner, options, start_values, input_
     writer = None
     with contextlib.ExitStack() as stack:
         stack.callback(bar.close)
+        stack.callback(results.close)  # given up or done: the run's chunks and pointers go now, not with the frame
         out = stack.enter_context(open(result_file, "w", newline="\n")) if result_file else None
 
         def result_until(k):

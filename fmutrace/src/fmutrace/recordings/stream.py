@@ -18,7 +18,10 @@ separator other than blanks, a time column of numbers (not dates or
 FILETIME integers), every cell filled, lines ending in LF or CR LF, no
 blank line before the end, one row per cycle (no repeated or skipped
 cycle). Anything else raises NotPlain before the outcome is made, and the
-in-memory path reads the file (or explains it).
+in-memory path reads the file (or explains it): what the head shows at
+once, what the blocks show (a skipped cycle, a bad cell, the last row, the
+whole file's interval) only when they are read, after the FMU ran the
+cycles before them.
 """
 import io
 import os
