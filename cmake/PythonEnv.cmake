@@ -61,11 +61,21 @@ if(NOT EXISTS ${venv_stamp})
   if(pip_failed)
     message(FATAL_ERROR "pip install -e fmutrace failed")
   endif()
+  # the step loop's build is optional (pip -q hides a failed compile): say so,
+  # and leave the stamp unwritten so that the next configure tries again
+  execute_process(COMMAND ${VENV_PYTHON} -c "import fmutrace._steps" RESULT_VARIABLE steps_failed
+                  OUTPUT_QUIET ERROR_QUIET)
   file(GLOB old_stamps ${VENV_DIR}/requirements-*.stamp)
   if(old_stamps)
     file(REMOVE ${old_stamps})
   endif()
-  file(TOUCH ${venv_stamp})
+  if(steps_failed)
+    message(WARNING "fmutrace's step loop in C (fmutrace/_steps.c) was not built: fmutrace steps in Python, "
+                    "several times slower. It needs a C compiler and the Python headers (on Debian: "
+                    "apt-get install python3-dev); the next configure tries again.")
+  else()
+    file(TOUCH ${venv_stamp})
+  endif()
 endif()
 
 execute_process(
