@@ -172,8 +172,13 @@ def main():
     fmu = build / "fmi3" / f"{MODEL}.fmu"
     root = build / "benchmarks" / "long"
     cli = [sys.executable, "-m", "fmutrace"]
+    from fmutrace.longcase import is_long
+    from fmutrace.recordings.stream import is_long_recording
+    from fmutrace.runner import C_STEPS
+
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"Python {platform.python_version()}")
+          f"Python {platform.python_version()}; fmutrace's step loop in "
+          f"{'C (_steps.c)' if C_STEPS is not None else 'Python (_steps.c is not built)'}")
     rows, missed = [], []
     for hours in sorted(args.hours):
         case, cycles = generate(root, hours)
@@ -188,6 +193,11 @@ def main():
                    "--report", str(case.parent / "report_recording")])
         if status != 0 or f"{cycles} samples" not in output:
             raise SystemExit(f"compare of the {hours:g} h recording exited {status}:\n{output[-3000:]}")
+        for what, report_folder, long in (("case", report, is_long(case, MODEL, None)),
+                                          ("recording", case.parent / "report_recording", is_long_recording(one_file))):
+            streamed = [c.get("streamed", False) for c in json.loads((report_folder / "results.json").read_text())["cases"]]
+            if streamed != [long]:  # a long one in chunks (flat memory), a short one (--smoke) in memory
+                raise SystemExit(f"the {hours:g} h {what} was {'not ' * long}streamed")
         run_out = root / f"{hours:g}h" / "run_out.csv"
         run_seconds, run_megabytes, status, output, run_user = measured(
             cli + ["run", str(fmu), "--input", str(case / f"{MODEL}_in.csv"), "--set", "rateUpPar=100",

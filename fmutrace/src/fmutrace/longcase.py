@@ -177,7 +177,7 @@ def stream_case(name, labels, mode, plots, runner, options, start_values, input_
             return None
 
     deviations = [signals[s].deviation for s in outputs]
-    outcome = CaseOutcome(name, **labels)
+    outcome = CaseOutcome(name, **labels, streamed=True)
     problem = ""
     if absent[0]:
         problem = f"the result has no sample at t={absent[1]!r} ({absent[0]} reference times without one)"

@@ -39,6 +39,7 @@ class CaseOutcome:
     result_path: str = ""    # a long case's result, in a file of its own (the report moves it in)
     csv: str = ""            # paths in the report folder
     plot: str = ""
+    streamed: bool = False   # read, run and compared in chunks (a long case), not in memory
 
     @property
     def passed(self) -> bool:
@@ -52,6 +53,8 @@ class CaseOutcome:
             entry["result_csv"] = self.csv
         if self.plot:
             entry["plot"] = self.plot
+        if self.streamed:
+            entry["streamed"] = True
         return entry
 
     @classmethod
@@ -60,7 +63,7 @@ class CaseOutcome:
         return cls(case=entry["case"], fmu=entry["fmu"], fmu_file=entry["fmu_file"], fmu_folder=fmu_folder,
                    status=Status(entry["status"]), messages=entry["messages"],
                    deviations=[Deviation.from_json(d) for d in entry["signals"]], seconds=entry["seconds"],
-                   csv=entry.get("result_csv", ""), plot=entry.get("plot", ""))
+                   csv=entry.get("result_csv", ""), plot=entry.get("plot", ""), streamed=entry.get("streamed", False))
 
 
 class Outcomes(Sequence):
