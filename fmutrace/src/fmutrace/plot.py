@@ -8,6 +8,7 @@ show: per pixel column the first and last sample and the smallest and
 largest value (Envelope), so the picture is the same and its cost does
 not grow with the length. A long case fills its envelopes chunk by chunk."""
 import io
+import threading
 
 import numpy as np
 
@@ -126,24 +127,34 @@ def plot_case(case, result, comparison: Comparison, mode: Mode, label: str) -> b
     return draw(case_figure(case, result, comparison, label), mode, label)
 
 
-def draw(figure: Figure, mode: Mode, label: str) -> bytes:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+_reused = threading.local()  # a figure is drawn by one thread at a time
 
+
+def _layouts() -> dict:
+    """(rows, columns, has_inputs) -> (figure, axes grid) of this thread."""
+    if not hasattr(_reused, "layouts"):
+        _reused.layouts = {}
+    return _reused.layouts
+
+
+def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
+    """The figure as PNG bytes. A layout (number of panels, zoom or not)
+    is built once per process (and thread) and then only cleared and
+    refilled: making the axes and their ticks is about 40 % of a
+    figure's cost, and the picture is a freshly built one's, pixel for
+    pixel (test_fmutrace_plot)."""
     has_inputs = bool(figure.inputs)
     rows = len(figure.signals) + 1 + has_inputs
-    height = 1.6 * rows + 0.6
     columns = 2 if figure.zoom else 1
-    fig, grid = plt.subplots(rows, columns, sharex="col", figsize=(WIDTH_INCHES * (1 + 0.45 * (columns - 1)), height),
-                             squeeze=False, width_ratios=[1, 0.45][:columns])
-    from matplotlib.ticker import MaxNLocator
-
-    for ax in grid.ravel():
-        ax.tick_params(labelsize=7)
-        # few ticks: matplotlib makes every tick as artists of its own, most of a figure's cost
-        ax.xaxis.set_major_locator(MaxNLocator(6))
-        ax.yaxis.set_major_locator(MaxNLocator(4))
+    key, layouts = (rows, columns, has_inputs), _layouts()
+    if reuse and key in layouts:
+        fig, grid = layouts[key]
+        for ax in grid.ravel():
+            _clear(ax)
+    else:
+        fig, grid = _layout(*key)
+        if reuse:
+            layouts[key] = fig, grid
     axes = list(grid[:, 0])
     if has_inputs:
         ax = axes.pop(0)
@@ -163,12 +174,9 @@ def draw(figure: Figure, mode: Mode, label: str) -> bytes:
         deviation_axis.plot(times, values, drawstyle="steps-post", label=name)
     deviation_axis.set_ylabel(mode.deviation_label, fontsize=7)
     deviation_axis.legend(loc="best", fontsize=7)
-    deviation_axis.set_xlabel("time [s]")
     if figure.zoom:
         at, lines = figure.zoom
-        zoom_axes = list(grid[:, 1])
-        if has_inputs:
-            zoom_axes.pop(0).set_axis_off()
+        zoom_axes = list(grid[has_inputs:, 1])
         zoom_deviation = zoom_axes.pop()
         for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines):
             ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
@@ -177,13 +185,47 @@ def draw(figure: Figure, mode: Mode, label: str) -> bytes:
             zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=name)
         zoom_axes and zoom_axes[0].set_title(f"zoom: first deviation at t={at!r}", fontsize=8)
         zoom_deviation.axvline(at, color="C3", linewidth=0.8)
-        zoom_deviation.set_xlabel("time [s]")
     title = figure.title
     fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize=9)
+    stream = io.BytesIO()
+    fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
+    return stream.getvalue()
+
+
+def _layout(rows: int, columns: int, has_inputs: bool):
+    """A new empty figure of the layout and its axes grid (rows, columns)."""
+    from matplotlib.figure import Figure as MplFigure
+    from matplotlib.ticker import MaxNLocator
+
+    height = 1.6 * rows + 0.6
+    # no pyplot: a figure kept for reuse must not stay in pyplot's list of open figures
+    fig = MplFigure(figsize=(WIDTH_INCHES * (1 + 0.45 * (columns - 1)), height))
+    grid = fig.subplots(rows, columns, sharex="col", squeeze=False, width_ratios=[1, 0.45][:columns])
+    for ax in grid.ravel():
+        ax.tick_params(labelsize=7)
+        # few ticks: matplotlib makes every tick as artists of its own, most of a figure's cost
+        ax.xaxis.set_major_locator(MaxNLocator(6))
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+    for ax in grid[-1]:
+        ax.set_xlabel("time [s]")
+    if columns == 2 and has_inputs:
+        grid[0, 1].set_axis_off()
     # fixed margins: tight_layout would cost more than the rest of the plot
     fig.subplots_adjust(left=0.1 / (1 + 0.45 * (columns - 1)), right=0.98, top=1 - 0.45 / height,
                         bottom=0.45 / height, hspace=0.12, wspace=0.18)
-    stream = io.BytesIO()
-    fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return stream.getvalue()
+    return fig, grid
+
+
+def _clear(ax):
+    """An axis of a reused layout back to how _layout left it, its ticks
+    kept: no line, band or legend, no data limits, the colour
+    cycle from its start."""
+    for artist in (*ax.lines, *ax.collections):
+        artist.remove()
+    if ax.get_legend():
+        ax.get_legend().remove()
+    ax.set_prop_cycle(None)
+    ax.relim()
+    # the limits of a new axis: an axis left empty shows 0..1, a drawn one autoscales when it is drawn
+    ax.set_xlim(0, 1, auto=True)
+    ax.set_ylim(0, 1, auto=True)
