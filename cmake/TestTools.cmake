@@ -7,6 +7,7 @@
 #   valgrind                        memcheck (ctest memcheck_*) and callgrind (benchmarks)
 #   libtbb12, unzip                 ecospy, another importer (test_importers, test_closed_loop)
 #   qemu-user                       the aarch64 binaries and harnesses under emulation (test_aarch64)
+#   g++                             the sources compiled as C++ (test_source_fmu)
 # Python packages: tests/requirements.txt (cmake/PythonEnv.cmake).
 # A tool that still cannot be had makes its tests fail and say why.
 
@@ -53,3 +54,32 @@ if(ecospy_failed OR NOT UNZIP)
 endif()
 
 # clang with libFuzzer: cmake/Fuzz.cmake
+
+# a C++ compiler: the sources compile as C++ too (test_source_fmu)
+find_program(CXX_COMPILER g++)
+if(NOT CXX_COMPILER)
+  apt_install("No g++ to compile the sources as C++" g++)
+  find_program(CXX_COMPILER g++)
+endif()
+
+# The standard's fmi2Functions.h, in build/fmi_headers, for the tests that
+# link source FMUs into one binary (test_source_fmu): fmpy's copy names the
+# functions without FMI2_FUNCTION_PREFIX, as its shared libraries need; the
+# standard's prepends it (fmi2FullName). fmpy's fmi3Functions.h is the
+# standard's and honours FMI3_FUNCTION_PREFIX as it is.
+file(READ ${FMI_HEADERS_DIR}/fmi2Functions.h fmi2_functions)
+set(fmpy_full_name "#define fmi2FullName(name) name\n")
+string(FIND "${fmi2_functions}" "${fmpy_full_name}" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "${FMI_HEADERS_DIR}/fmi2Functions.h: no '${fmpy_full_name}' to restore the standard's from")
+endif()
+string(REPLACE "${fmpy_full_name}" "#if defined(FMI2_FUNCTION_PREFIX)
+  #define fmi2Paste(a,b)     a ## b
+  #define fmi2PasteB(a,b)    fmi2Paste(a,b)
+  #define fmi2FullName(name) fmi2PasteB(FMI2_FUNCTION_PREFIX, name)
+#else
+  #define fmi2FullName(name) name
+#endif
+" fmi2_functions "${fmi2_functions}")
+set(STANDARD_FMI_HEADERS_DIR ${CMAKE_BINARY_DIR}/fmi_headers)
+file(CONFIGURE OUTPUT ${STANDARD_FMI_HEADERS_DIR}/fmi2Functions.h CONTENT "${fmi2_functions}" @ONLY)

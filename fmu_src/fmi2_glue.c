@@ -138,8 +138,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         }
         return NULL;
     }
-    Fmi2Instance *g = functions->allocateMemory(1, sizeof *g);
-    char *name = functions->allocateMemory(strlen(instanceName) + 1, 1);
+    Fmi2Instance *g = (Fmi2Instance *)functions->allocateMemory(1, sizeof *g);
+    char *name = (char *)functions->allocateMemory(strlen(instanceName) + 1, 1);
     if (!g || !name) {
         if (g) functions->freeMemory(g);
         if (name) functions->freeMemory(name);
@@ -160,7 +160,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 }
 
 void fmi2FreeInstance(fmi2Component c) {
-    Fmi2Instance *g = c;
+    Fmi2Instance *g = (Fmi2Instance *)c;
     if (!g) return;
     const fmi2CallbackFreeMemory release = g->functions.freeMemory;
     release((void *)g->instanceName);
@@ -393,7 +393,7 @@ NO_STATES(GetEventIndicators, fmi2Real, "event indicators")
 
 static fmi2Status unsupported(fmi2Component c, const char *function, const char *what) {
     if (!c) return fmi2Error;
-    return (fmi2Status)fmu_error(c, function, "%s", what);
+    return (fmi2Status)fmu_error((FmuInstance *)c, function, "%s", what);
 }
 
 #define NO_DERIVATIVES "this FMU provides no derivatives (see the model description)"

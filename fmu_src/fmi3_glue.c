@@ -142,7 +142,7 @@ static fmi3Instance instantiate(const char *interfaceRefusal, bool modelExchange
         if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", reason);
         return NULL;
     }
-    Fmi3Instance *g = calloc(1, sizeof *g);
+    Fmi3Instance *g = (Fmi3Instance *)calloc(1, sizeof *g);
     if (!g) return NULL;
     g->logMessage = logMessage;
     g->base.environment = instanceEnvironment;
@@ -446,7 +446,7 @@ NUMBER_OF_NONE(ContinuousStates)
 
 static fmi3Status unsupported(fmi3Instance instance, const char *function, const char *what) {
     if (!instance) return fmi3Error;
-    return (fmi3Status)fmu_error(instance, function, "%s", what);
+    return (fmi3Status)fmu_error((FmuInstance *)instance, function, "%s", what);
 }
 
 #define NO_DERIVATIVES "this FMU provides no derivatives or dependencies (see the model description)"

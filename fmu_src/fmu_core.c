@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-const char *const fmu_log_category_names[3] = { "logStatusError", "logStatusWarning", "logEvents" };
+static const char *const log_category_names[3] = { "logStatusError", "logStatusWarning", "logEvents" };
 
 #define SERIAL_MAGIC "RLFS"
 #define SERIAL_VERSION 3u
@@ -75,7 +75,7 @@ void fmu_invalidate(FmuInstance *instance) {
 
 static void log_message(FmuInstance *instance, FmuStatus status, const char *fmt, va_list args) {
     const int category = status >= FMU_ERROR ? LOG_ERROR : status == FMU_WARNING ? LOG_WARNING : LOG_EVENTS;
-    const char *name = fmu_log_category_names[category == LOG_ERROR ? 0 : category == LOG_WARNING ? 1 : 2];
+    const char *name = log_category_names[category == LOG_ERROR ? 0 : category == LOG_WARNING ? 1 : 2];
     char message[512];
 
     if (!instance->logFunction || !(instance->logCategories & category)) {
@@ -105,7 +105,7 @@ FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, boo
     for (size_t i = 0; i < nCategories; i++) {
         int bit = 0;
         for (int k = 0; k < 3; k++) {
-            if (categories[i] && strcmp(categories[i], fmu_log_category_names[k]) == 0) bit = 1 << k;
+            if (categories[i] && strcmp(categories[i], log_category_names[k]) == 0) bit = 1 << k;
         }
         if (!bit) {
             return fmu_error(instance, function, "unknown log category \"%s\"", categories[i] ? categories[i] : "(null)");
@@ -679,11 +679,11 @@ typedef struct {
     FmuCore core;
 } FmuState;
 
-static FmuStatus check_state(FmuInstance *instance, const char *function, const FmuState *state) {
+static FmuStatus check_state(FmuInstance *instance, const char *function, const void *state) {
     if (!state) {
         return fmu_error(instance, function, "the FMU state is NULL");
     }
-    if (state->tag != STATE_TAG) {
+    if (((const FmuState *)state)->tag != STATE_TAG) {
         return fmu_error(instance, function, "not an FMU state of this FMU");
     }
     return FMU_OK;
@@ -691,11 +691,11 @@ static FmuStatus check_state(FmuInstance *instance, const char *function, const 
 
 /* *state, checked, or a new one, tagged; NULL after an error */
 static FmuState *state_to_fill(FmuInstance *instance, const char *function, void **state) {
-    FmuState *target = *state;
+    FmuState *target = (FmuState *)*state;
     if (target) {
         return check_state(instance, function, target) == FMU_OK ? target : NULL;
     }
-    target = instance->allocate(instance, sizeof *target);
+    target = (FmuState *)instance->allocate(instance, sizeof *target);
     if (!target) {
         fmu_error(instance, function, "out of memory");
         return NULL;

@@ -15,17 +15,6 @@
 
 #include "model.h"
 
-/* Compiler hints, portable: GCC and clang read them, any other compiler
- * (MSVC compiling the source FMU) gets nothing; FMU_PORTABLE forces that
- * (a test compiles the sources so). They change speed, never results. */
-#if defined(__GNUC__) && !defined(FMU_PORTABLE)
-#define FMU_NOINLINE __attribute__((noinline))
-#define FMU_COLD __attribute__((cold))
-#else
-#define FMU_NOINLINE
-#define FMU_COLD
-#endif
-
 /* Same numbering as fmi2Status and fmi3Status. */
 typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } FmuStatus;
 
@@ -46,9 +35,8 @@ typedef enum {
  * on a tiny cycleTime or a huge step). */
 #define FMU_MAX_CYCLES_PER_STEP 100000000.0
 
-/* Log categories (bits); names in fmu_log_category_names. */
+/* Log categories (bits), named in the model description's LogCategories */
 enum { LOG_ERROR = 1, LOG_WARNING = 2, LOG_EVENTS = 4, LOG_ALL = 7 };
-extern const char *const fmu_log_category_names[3];
 
 /* What a step changed since the outputs were last published: the time
  * only (a step that ran no cycle), or the block too. */
@@ -108,30 +96,30 @@ struct FmuInstance {
 };
 
 /* modelExchange and errorMode set first */
-void fmu_init_instance(FmuInstance *instance);
-void fmu_reset(FmuInstance *instance);
+RL_LINKAGE void fmu_init_instance(FmuInstance *instance);
+RL_LINKAGE void fmu_reset(FmuInstance *instance);
 
 /* The values or the mode changed other than by a new u (a set, a reset, a
  * restored state, Initialization Mode entered): what the core derived from
  * them is void. The configuration is taken again before the next cycle,
  * the common step waits for a general one, and in Initialization Mode the
  * outputs follow the values. */
-void fmu_invalidate(FmuInstance *instance);
+RL_LINKAGE void fmu_invalidate(FmuInstance *instance);
 
 /* No common step until a general step finds it possible again. */
 static inline void fmu_disarm(FmuInstance *instance) {
     instance->fastPeriodReal = instance->fastPeriodLreal = NAN;
 }
 
-void fmu_log(FmuInstance *instance, FmuStatus status, const char *fmt, ...);
+RL_LINKAGE void fmu_log(FmuInstance *instance, FmuStatus status, const char *fmt, ...);
 
 /* Enable log categories: all when loggingOn and none are named, else the
  * named ones; alwaysOn categories stay enabled whatever is asked. */
-FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, bool loggingOn,
-                                size_t nCategories, const char *const categories[], int alwaysOn);
+RL_LINKAGE FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, bool loggingOn,
+                                           size_t nCategories, const char *const categories[], int alwaysOn);
 
 /* The single error path: log why, enter the error mode, return FMU_ERROR. */
-FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt, ...);
+RL_LINKAGE FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt, ...);
 
 /* The checks on the path of every set, doStep and get are inline, and
  * their error paths (which say why) are not: a call that passes costs a
@@ -139,11 +127,12 @@ FmuStatus fmu_error(FmuInstance *instance, const char *function, const char *fmt
 
 /* Out-of-line error paths of the inline checks below. */
 /* A call in a mode its function's state table does not allow. */
-FMU_COLD FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
-FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr);
-FMU_COLD FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr, double value);
+RL_LINKAGE FMU_COLD FmuStatus fmu_mode_error(FmuInstance *instance, const char *function);
+RL_LINKAGE FmuStatus fmu_array_error(FmuInstance *instance, const char *function, const void *vr);
+RL_LINKAGE FMU_COLD FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int typeMask, unsigned vr,
+                                               double value);
 /* Publish the outputs (Initialization Mode: initialize the block first). */
-void fmu_refresh_outputs(FmuInstance *instance);
+RL_LINKAGE FMU_NOINLINE void fmu_refresh_outputs(FmuInstance *instance);
 
 static inline FmuStatus fmu_check_array(FmuInstance *instance, const char *function, size_t n, const void *vr,
                                         const void *values) {
@@ -246,9 +235,9 @@ static inline bool fmu_set_one(FmuInstance *instance, const char *function, int 
     return true;
 }
 
-FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime);
-FmuStatus fmu_enter_initialization(FmuInstance *instance);
-FmuStatus fmu_exit_initialization(FmuInstance *instance);
+RL_LINKAGE FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime);
+RL_LINKAGE FmuStatus fmu_enter_initialization(FmuInstance *instance);
+RL_LINKAGE FmuStatus fmu_exit_initialization(FmuInstance *instance);
 /* currentCommunicationPoint within a relative RL_TIME_TOLERANCE of the
  * FMU's time (finite), whatever the step size (NaN and infinity are not);
  * the difference quiet (rl_sum): a t far from the time raises no
@@ -283,7 +272,7 @@ static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
 }
 
 /* Any step, with every check and the status report. */
-FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h);
+RL_LINKAGE FMU_NOINLINE FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h);
 
 /* The step of both FMI versions: the common one if it applies, else the
  * general one. */
@@ -295,14 +284,15 @@ static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function,
  * is a tagged copy of the core (a foreign pointer is refused, not read);
  * serialized, it is a header, the payload and a CRC-32. *state NULL: a new
  * state is allocated, else the given one is overwritten. */
-FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **state);
-FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void *state);
-FmuStatus fmu_free_state(FmuInstance *instance, const char *function, void **state);
-FmuStatus fmu_serialized_state_size(FmuInstance *instance, const char *function, const void *state, size_t *size);
-FmuStatus fmu_serialize_state(FmuInstance *instance, const char *function, const void *state, unsigned char *out,
-                              size_t size);
-FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, const unsigned char *in, size_t size,
-                                void **state);
+RL_LINKAGE FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **state);
+RL_LINKAGE FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void *state);
+RL_LINKAGE FmuStatus fmu_free_state(FmuInstance *instance, const char *function, void **state);
+RL_LINKAGE FmuStatus fmu_serialized_state_size(FmuInstance *instance, const char *function, const void *state,
+                                               size_t *size);
+RL_LINKAGE FmuStatus fmu_serialize_state(FmuInstance *instance, const char *function, const void *state,
+                                         unsigned char *out, size_t size);
+RL_LINKAGE FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, const unsigned char *in,
+                                           size_t size, void **state);
 
 /* ---- Model Exchange (docs/fmi.md, Model Exchange) ------------------------
  * No continuous states, no event indicators: the cycle ends are time
@@ -312,16 +302,17 @@ FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, con
 /* The event update: the cycles that ended by the FMU's time, with the
  * latched values. *nextEventTime: the next cycle end, NaN if there is none
  * (no valid cycle). */
-FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, double *nextEventTime);
+RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, double *nextEventTime);
 /* The instant is left (Continuous-Time Mode entered, or the time set anew
  * in Event Mode): its values are those of the next cycle. */
-void fmu_leave_instant(FmuInstance *instance);
+RL_LINKAGE void fmu_leave_instant(FmuInstance *instance);
 /* fmi2SetTime / fmi3SetTime: a finite time, not before the last event. */
-FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time);
+RL_LINKAGE FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time);
 /* A call that passes arrays of continuous states or event indicators:
  * this FMU has none, so n must be 0. */
-FmuStatus fmu_check_none(FmuInstance *instance, const char *function, const char *what, size_t n, const void *array);
+RL_LINKAGE FmuStatus fmu_check_none(FmuInstance *instance, const char *function, const char *what, size_t n,
+                                    const void *array);
 
-const char *fmu_mode_name(int mode);
+RL_LINKAGE const char *fmu_mode_name(int mode);
 
 #endif

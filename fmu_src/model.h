@@ -2,13 +2,14 @@
  * (generated from modelDescription/<Model>.toml into <Model>_variables.h,
  * which includes this header), the mapping of its variables onto the
  * kernel (rate_limiter.h), and the outputs it publishes. A model file,
- * models/<Model>.c, defines fmuModel and nothing else; the core and the
- * FMI glue do the rest. */
+ * models/<Model>.c, defines fmuModel (FMU_MODEL) and nothing else; the
+ * core and the FMI glue do the rest. */
 #ifndef FMU_MODEL_H
 #define FMU_MODEL_H
 
 #include <math.h>
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "rate_limiter.h"
 
@@ -56,6 +57,16 @@ typedef struct {
     const FmuStatusOutputs *statusOutputs;
 } ModelDefinition;
 
+/* A model file ends with its definition: FMU_MODEL(input u, output y,
+ * configure, publish, status outputs or NULL), with the variable table of
+ * its generated header. In an FMU's unit it comes before the core, which
+ * uses it (rate_limiter.h, RL_LINKAGE). */
+#define FMU_MODEL(inputVr, outputVr, configure, publish, statusOutputs)                                  \
+    RL_DEFINITION const ModelDefinition fmuModel = { MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables,      \
+                                                     MODEL_VARIABLE_COUNT, inputVr, outputVr, configure, \
+                                                     publish, statusOutputs }
+#ifndef RL_UNIT
 extern const ModelDefinition fmuModel;
+#endif
 
 #endif

@@ -18,7 +18,7 @@ RlValue rl_resolve(double input, int inputSource, double parameter, int paramete
 void rl_without_section6(RlConfig *c) {
     c->rateUpNeg = c->rateUp;
     c->rateDownNeg = c->rateDown;
-    c->yMax = c->yMin = (RlValue){ NAN, 0 };
+    c->yMax = c->yMin = rl_value(NAN, 0);
     c->hold = false;
     c->limitInitialOutput = false;
 }

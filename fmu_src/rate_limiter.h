@@ -8,6 +8,40 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+/* Compiler hints, portable: GCC and clang read them, any other compiler
+ * (MSVC compiling the source FMU) gets nothing; FMU_PORTABLE forces that
+ * (a test compiles the sources so). They change speed, never results. */
+#if defined(__GNUC__) && !defined(FMU_PORTABLE)
+#define FMU_NOINLINE __attribute__((noinline))
+#define FMU_COLD __attribute__((cold))
+#else
+#define FMU_NOINLINE
+#define FMU_COLD
+#endif
+
+/* Linkage of what the kernel, the model, the core and the glue share
+ * (docs/fmi.md, Source FMUs). An FMU is one translation unit that defines
+ * RL_UNIT and includes them all: there everything is static, so that only
+ * the fmi* functions have external linkage and any number of FMUs link
+ * into one binary. A file compiled on its own (the kernel's C tests, the
+ * fuzzers) gets extern. The declarations carry RL_LINKAGE: a function
+ * defined later without a storage class keeps it (C99 6.2.2p5; C++ agrees).
+ * An object has no such rule: its definition carries RL_DEFINITION, and
+ * the unit defines it before any use instead of declaring it. Not every
+ * model calls every function: GCC and clang are told so (FMU_MAYBE_UNUSED). */
+#if defined(__GNUC__)
+#define FMU_MAYBE_UNUSED __attribute__((unused))
+#else
+#define FMU_MAYBE_UNUSED
+#endif
+#ifdef RL_UNIT
+#define RL_LINKAGE static FMU_MAYBE_UNUSED
+#define RL_DEFINITION static
+#else
+#define RL_LINKAGE extern
+#define RL_DEFINITION
+#endif
+
 /* REAL arithmetic (rules.md, Arithmetic) rounds every float operation to float:
  * a target that evaluates floats in a wider type (x87) would not. */
 #if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
@@ -47,6 +81,13 @@ typedef struct {
     double value;
     int source;
 } RlValue;
+
+static inline RlValue rl_value(double value, int source) {
+    RlValue v;
+    v.value = value;
+    v.source = source;
+    return v;
+}
 
 /* Everything but the signal u: parameters and slowly changing inputs, with
  * "or Par" inputs already resolved (rl_resolve). */
@@ -115,23 +156,23 @@ static inline bool rl_status_is_error(int status) {
 }
 
 /* Rule 0: an "or Par" input that is NaN falls back to its parameter. */
-RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource);
+RL_LINKAGE RlValue rl_resolve(double input, int inputSource, double parameter, int parameterSource);
 
 /* rules.md, Output limits, rates below 0 and hold: off, for the vendor
  * blocks that have none of them: the same rates below 0, no output limits,
  * no hold, the initial output as it is. Call after the rates are set. */
-void rl_without_section6(RlConfig *config);
+RL_LINKAGE void rl_without_section6(RlConfig *config);
 
 /* Status word of a configuration (first match of the status table). */
-int rl_status(const RlConfig *config, int *source);
+RL_LINKAGE int rl_status(const RlConfig *config, int *source);
 
 /* Derive limits and status for cycles of length period (> 0). */
-void rl_prepare(RlPrepared *prepared, const RlConfig *config, double period);
+RL_LINKAGE void rl_prepare(RlPrepared *prepared, const RlConfig *config, double period);
 
 /* Output at initialisation for the input u, from a configuration as
  * rl_prepare keeps it (its values have entered the arithmetic: the period
  * is not used). */
-void rl_init(RlState *state, const RlPrepared *prepared, double u);
+RL_LINKAGE void rl_init(RlState *state, const RlPrepared *prepared, double u);
 
 /* Time the output has been ramping towards the current u. */
 static inline double rl_running_time(const RlState *state) {
@@ -295,7 +336,7 @@ static inline bool rl_ramp_steady(RlState *s, const RlPrepared *p, double u) {
 }
 
 /* Rules 1-6 in their order, for a u that has entered (rl_input). */
-void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
+RL_LINKAGE void rl_cycle_rules(RlState *state, const RlPrepared *prepared, double u, double elapsed);
 
 /* The common case: finite u and y and a plain configuration, so that of
  * the rules only rule 6 (rl_ramp) applies. u has entered. */
@@ -321,7 +362,8 @@ static inline void rl_cycle(RlState *state, const RlPrepared *prepared, double u
 
 /* Cycles first..last (of length cycleTime, ending at n * cycleTime) with u
  * held: the same as rl_cycle for each, in fewer instructions. */
-void rl_run(RlState *state, const RlPrepared *prepared, double u, uint64_t first, uint64_t last, double cycleTime);
+RL_LINKAGE void rl_run(RlState *state, const RlPrepared *prepared, double u, uint64_t first, uint64_t last,
+                       double cycleTime);
 
 /* rules.md, Outputs derived from the last cycle, computed when read: they
  * cost the cycles nothing. prepared must be the
@@ -334,9 +376,9 @@ typedef struct {
     double remainingTime;      /* s the ramp still needs to reach uc */
 } RlOutputs;
 
-void rl_outputs(const RlState *state, const RlPrepared *prepared, RlOutputs *outputs);
+RL_LINKAGE void rl_outputs(const RlState *state, const RlPrepared *prepared, RlOutputs *outputs);
 
 /* Short meaning of a status word, for log messages. */
-const char *rl_status_text(int status);
+RL_LINKAGE const char *rl_status_text(int status);
 
 #endif

@@ -192,11 +192,16 @@ def fmi3_description(model, instantiation_token):
 
 
 def fmi3_build_description(model, sources):
+    """sources/buildDescription.xml (FMI 3.0, Build Configurations): the sources to compile, the same list
+    as the FMI 2 model description's SourceFiles. A product model lists its one translation unit, which
+    includes the rest and keeps everything but the FMI functions static."""
     identifier = model["model"]["identifier"]
     files = "\n".join(f"      <SourceFile{attributes(name=s)}/>" for s in sources)
+    description = (f"Any platform. A shared library defines no FMI3_FUNCTION_PREFIX; linked into one binary "
+                   f"with other FMUs, each FMU's is its modelIdentifier and _ ({identifier}_)")
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <fmiBuildDescription fmiVersion="3.0">
-  <BuildConfiguration modelIdentifier={quoteattr(identifier)}>
+  <BuildConfiguration{attributes(modelIdentifier=identifier, description=description)}>
     <SourceFileSet language="C99">
 {files}
     </SourceFileSet>
@@ -247,11 +252,6 @@ typedef char modelTimeIsValueReference0[VR_time == 0 ? 1 : -1];
 static const FmuVariable modelVariables[MODEL_VARIABLE_COUNT] = {{
 {table}
 }};
-
-/* the table's part of the model's definition (model.h): fmuModel starts
- * with MODEL_TABLE, then the mapping */
-#define MODEL_TABLE .identifier = MODEL_IDENTIFIER, .token = MODEL_TOKEN, \
-    .variables = modelVariables, .count = MODEL_VARIABLE_COUNT
 
 #endif
 """

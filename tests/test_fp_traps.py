@@ -16,8 +16,8 @@ from fmpy import read_model_description
 
 from support.fmu_driver import BUILD_DIR, MODELS
 from support.process import run as run_bounded
-from support.run_trace import HARNESS, KINDS, run_script, script
-from support.scenarios import discover, same
+from support.run_trace import HARNESS, KINDS, reference_script, run_script
+from support.scenarios import discover
 from test_hostile import HOSTILE, coerce, in_declared_range
 
 pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
@@ -36,25 +36,10 @@ def staged(model, version):
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.name for s in SCENARIOS])
 def test_scenario_runs_trapped_and_gives_its_reference(scenario, version, tmp_path):
-    """Communication points: the scenario's grid and every reference time
-    (a reference off the grid is a step there, as fmutrace runs it)."""
     stage, md = staged(scenario.model, version)
-    o = scenario.options
-    grid = [o["StartTime"] + k * o["StepSize"] for k in range(round((o["StopTime"] - o["StartTime"]) / o["StepSize"]) + 1)]
-    def on_grid(t):  # a reference time within 1e-9 of a grid point is that point
-        return next((g for g in grid if abs(g - t) <= 1e-9 * max(1.0, abs(t))), t)
-    reference_times = [on_grid(float(t)) for t in scenario.reference["time"]]
-    times = sorted(set(grid) | set(reference_times))
-    lines = run_script(PLATFORM[version], stage, scenario.model, md.guid, script(scenario, md, times), tmp_path,
-                       f"{scenario.name} (FMI {version}) with traps", options=TRAPS[version])
-    names = list(scenario.outputs)
-    assert len(lines) == len(times) * len(names)
-    row_of = {t: k for k, t in enumerate(times)}
-    for row, t in enumerate(reference_times):
-        for k, name in enumerate(names):
-            text = lines[row_of[t] * len(names) + k]
-            value = float.fromhex(text) if text.startswith(("0x", "-0x", "inf", "-inf", "nan", "-nan")) else int(text)
-            assert same(value, scenario.reference[name][row]), (name, t, text, scenario.reference[name][row])
+    text, check = reference_script(scenario, md)
+    check(run_script(PLATFORM[version], stage, scenario.model, md.guid, text, tmp_path,
+                     f"{scenario.name} (FMI {version}) with traps", options=TRAPS[version]))
 
 
 def test_a_raised_exception_is_caught_and_named(tmp_path):

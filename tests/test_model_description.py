@@ -94,10 +94,15 @@ def test_compiled_variable_table_is_the_toml(model, version):
 @pytest.mark.parametrize("model", MODELS)
 def test_the_cycle_input_takes_any_real_and_the_output_is_a_real_output(model):
     """fmu_core sets u and gets y as Reals without a table lookup: every
-    model's input (its C file's inputVr) must be an unranged, non-fixed Real
-    input and its output a Real output, as its TOML declares them."""
+    model's input (the first argument of its FMU_MODEL, in its C file or in
+    unified.h's UNIFIED_MAPPING) must be an unranged, non-fixed Real input
+    and its output a Real output, as its TOML declares them."""
     source = (REPO / "fmu_src" / "models" / f"{model}.c").read_text()
-    names = {role: re.search(rf"\.{role}Vr = VR_(\w+),", source).group(1) for role in ("input", "output")}
+    if "UNIFIED_MAPPING(" in source:
+        source = (REPO / "fmu_src" / "models" / "unified.h").read_text()
+    found = re.findall(r"^\s*FMU_MODEL\(VR_(\w+), VR_(\w+),", source, re.MULTILINE)
+    assert len(found) == 1, found
+    names = dict(zip(("input", "output"), found[0]))
     variables = {v["name"]: v for v in toml(model)["variable"]}
     u, y = variables[names["input"]], variables[names["output"]]
     assert (u["type"], u["causality"], u["variability"]) in {("Real", "input", "discrete"),
@@ -127,8 +132,9 @@ def test_sources_are_shipped(model, version):
         names = set(z.namelist())
     md = read_model_description(str(fmu_file(model, version)))
     files = md.buildConfigurations[0].sourceFileSets[0].sourceFiles
-    assert f"{model}.c" in files and "rate_limiter.c" in files
-    assert all(f"sources/{f}" in names for f in files)
+    assert files == [f"{model}_fmi{version}.c"]  # the FMU's one unit, which includes the rest (test_source_fmu.py)
+    included = ["rate_limiter.c", f"{model}.c", "fmu_core.c", f"fmi{version}_glue.c"]
+    assert all(f"sources/{f}" in names for f in files + included)
     assert f"sources/{model}_variables.h" in names
     if version == 3:
         assert "sources/buildDescription.xml" in names

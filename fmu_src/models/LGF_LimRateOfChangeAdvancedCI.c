@@ -7,17 +7,17 @@
 
 enum { MODE_RAMP, MODE_RESET, MODE_MANUAL, MODE_DEFAULT, MODE_TRACK };
 
-static int configure(const double *v, RlConfig *c) {
-    c->rateUp = (RlValue){ v[VR_setPosUpRateLim], VR_setPosUpRateLim };
-    c->rateDown = (RlValue){ v[VR_setPosDownRateLim], VR_setPosDownRateLim };
+static int model_configure(const double *v, RlConfig *c) {
+    c->rateUp = rl_value(v[VR_setPosUpRateLim], VR_setPosUpRateLim);
+    c->rateDown = rl_value(v[VR_setPosDownRateLim], VR_setPosDownRateLim);
     /* named by the output's magnitude: negUp falls below 0, negDown rises */
-    c->rateDownNeg = (RlValue){ v[VR_setNegUpRateLim], VR_setNegUpRateLim };
-    c->rateUpNeg = (RlValue){ v[VR_setNegDownRateLim], VR_setNegDownRateLim };
-    c->ratePeriod = (RlValue){ 1.0, VR_setPosUpRateLim };
-    c->yMax = (RlValue){ v[VR_setHighLim], VR_setHighLim };
-    c->yMin = (RlValue){ v[VR_setLowLim], VR_setLowLim };
+    c->rateDownNeg = rl_value(v[VR_setNegUpRateLim], VR_setNegUpRateLim);
+    c->rateUpNeg = rl_value(v[VR_setNegDownRateLim], VR_setNegDownRateLim);
+    c->ratePeriod = rl_value(1.0, VR_setPosUpRateLim);
+    c->yMax = rl_value(v[VR_setHighLim], VR_setHighLim);
+    c->yMin = rl_value(v[VR_setLowLim], VR_setLowLim);
     c->hold = false;
-    c->duration = (RlValue){ 0.0, 0 };
+    c->duration = rl_value(0.0, 0);
     siemens_cycle(c, v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     int mode;
     if (v[VR_reset] != 0) {
@@ -47,7 +47,7 @@ static int configure(const double *v, RlConfig *c) {
     return mode;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     RlOutputs o;
     rl_outputs(block, prepared, &o);
     /* the quadrant of the output the rate was picked by */
@@ -64,9 +64,4 @@ static void publish(const RlState *block, const RlPrepared *prepared, int modelM
 
 static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subfunctionStatus };
 
-const ModelDefinition fmuModel = {
-    MODEL_TABLE,
-    .inputVr = VR_autoValue, .outputVr = VR_outputValue,
-    .configure = configure, .publish = publish,
-    .statusOutputs = &statusOutputs,
-};
+FMU_MODEL(VR_autoValue, VR_outputValue, model_configure, model_publish, &statusOutputs);

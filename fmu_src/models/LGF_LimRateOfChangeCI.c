@@ -4,10 +4,10 @@
 #include "LGF_LimRateOfChangeCI_variables.h"
 #include "siemens.h"
 
-static int configure(const double *v, RlConfig *c) {
-    c->rateUp = c->rateDown = (RlValue){ v[VR_setChangeRate], VR_setChangeRate };
-    c->ratePeriod = (RlValue){ 1.0, VR_setChangeRate };
-    c->duration = (RlValue){ 0.0, 0 };
+static int model_configure(const double *v, RlConfig *c) {
+    c->rateUp = c->rateDown = rl_value(v[VR_setChangeRate], VR_setChangeRate);
+    c->ratePeriod = rl_value(1.0, VR_setChangeRate);
+    c->duration = rl_value(0.0, 0);
     siemens_cycle(c, v[VR_callOB], VR_callOB, v[VR_cycleTime], VR_cycleTime);
     c->bypass = v[VR_enDefaultOutValue] != 0;
     c->bypassValue = v[VR_defaultOutValue];
@@ -21,7 +21,7 @@ static int configure(const double *v, RlConfig *c) {
     return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     (void)prepared;
     (void)modelMode;
     v[VR_delayedValue] = block->y;
@@ -29,9 +29,4 @@ static void publish(const RlState *block, const RlPrepared *prepared, int modelM
 
 static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };
 
-const ModelDefinition fmuModel = {
-    MODEL_TABLE,
-    .inputVr = VR_value, .outputVr = VR_delayedValue,
-    .configure = configure, .publish = publish,
-    .statusOutputs = &statusOutputs,
-};
+FMU_MODEL(VR_value, VR_delayedValue, model_configure, model_publish, &statusOutputs);

@@ -10,11 +10,11 @@ static double time_ms(double seconds) {
     return nearbyint(seconds * 1000.0) / 1000.0;
 }
 
-static int configure(const double *v, RlConfig *c) {
-    c->rateUp = c->rateDown = (RlValue){ v[VR_rVariation], VR_rVariation };
-    c->ratePeriod = (RlValue){ time_ms(v[VR_tTime]), VR_tTime };
-    c->duration = (RlValue){ 0.0, 0 };
-    c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };
+static int model_configure(const double *v, RlConfig *c) {
+    c->rateUp = c->rateDown = rl_value(v[VR_rVariation], VR_rVariation);
+    c->ratePeriod = rl_value(time_ms(v[VR_tTime]), VR_tTime);
+    c->duration = rl_value(0.0, 0);
+    c->cycleTime = rl_value(v[VR_cycleTime], VR_cycleTime);
     c->bypass = false;
     c->bypassValue = NAN;
     c->zeroRate = RL_ZERO_RATE_HOLD;
@@ -27,7 +27,7 @@ static int configure(const double *v, RlConfig *c) {
     return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     (void)modelMode;
     v[VR_rOut] = block->y;
     RlOutputs o;
@@ -35,8 +35,4 @@ static void publish(const RlState *block, const RlPrepared *prepared, int modelM
     v[VR_xRampActive] = o.rampActive;
 }
 
-const ModelDefinition fmuModel = {
-    MODEL_TABLE,
-    .inputVr = VR_rIn, .outputVr = VR_rOut,
-    .configure = configure, .publish = publish,
-};
+FMU_MODEL(VR_rIn, VR_rOut, model_configure, model_publish, NULL);

@@ -6,15 +6,15 @@
 
 #define DURATION_MAX 259200.0
 
-static int configure(const double *v, RlConfig *c) {
+static int model_configure(const double *v, RlConfig *c) {
     c->rateUp = rl_resolve(v[VR_UpRate], VR_UpRate, v[VR_UpRatePar], VR_UpRatePar);
     c->rateDown = rl_resolve(v[VR_DownRate], VR_DownRate, v[VR_DownRatePar], VR_DownRatePar);
-    c->ratePeriod = (RlValue){ 1.0, VR_UpRatePar };
+    c->ratePeriod = rl_value(1.0, VR_UpRatePar);
     c->duration = rl_resolve(v[VR_Duration], VR_Duration, v[VR_DurationPar], VR_DurationPar);
     if (isgreater(c->duration.value, DURATION_MAX)) {
         c->duration.value = DURATION_MAX;
     }
-    c->cycleTime = (RlValue){ v[VR_cycleTime], VR_cycleTime };
+    c->cycleTime = rl_value(v[VR_cycleTime], VR_cycleTime);
     c->bypass = v[VR_EnableBypass] != 0;
     c->bypassValue = rl_resolve(v[VR_BypassValue], VR_BypassValue, v[VR_BypassValuePar], VR_BypassValuePar).value;
     c->zeroRate = RL_ZERO_RATE_NO_LIMIT;
@@ -28,15 +28,11 @@ static int configure(const double *v, RlConfig *c) {
     return 0;
 }
 
-static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
     (void)prepared;
     (void)modelMode;
     v[VR_Out] = block->y;
     v[VR_RunningTime] = rl_running_time(block);
 }
 
-const ModelDefinition fmuModel = {
-    MODEL_TABLE,
-    .inputVr = VR_In, .outputVr = VR_Out,
-    .configure = configure, .publish = publish,
-};
+FMU_MODEL(VR_In, VR_Out, model_configure, model_publish, NULL);

@@ -17,10 +17,3 @@ static void resolve(const double *v, RlConfig *c) {
 }
 
 UNIFIED_MAPPING(resolve);
-
-const ModelDefinition fmuModel = {
-    MODEL_TABLE,
-    .inputVr = VR_u, .outputVr = VR_y,
-    .configure = configure, .publish = publish,
-    .statusOutputs = &statusOutputs,
-};

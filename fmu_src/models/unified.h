@@ -13,10 +13,7 @@ typedef struct {
 } UnifiedVariables;
 
 static inline RlValue unified_value(const double *v, unsigned vr) {
-    RlValue value;
-    value.value = v[vr];
-    value.source = (int)vr;
-    return value;
+    return rl_value(v[vr], (int)vr);
 }
 
 /* Everything but the rates, limits, duration and bypass value, which each
@@ -56,22 +53,24 @@ static inline void unified_publish(const UnifiedVariables *vr, const RlState *bl
       VR_arithmetic, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp, VR_limitingDown, VR_highLimit, \
       VR_lowLimit, VR_remainingTime }
 
-/* The mapping of a unified block: resolve(v, c) sets rateUp,
- * rateDown, yMax, yMin, duration and bypassValue the model's own way; the
- * rates below 0 fall back to the resolved rates, and the rest is shared. */
-#define UNIFIED_MAPPING(resolve)                                                                                     \
-    static const UnifiedVariables variables = UNIFIED_VARIABLES;                                                 \
-    static int configure(const double *v, RlConfig *c) {                                                         \
-        resolve(v, c);                                                                                           \
-        c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);             \
-        c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source);   \
-        unified_configure(&variables, v, c);                                                                     \
-        return 0;                                                                                                \
-    }                                                                                                            \
-    static void publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {            \
-        (void)modelMode;                                                                                         \
-        unified_publish(&variables, block, prepared, v);                                                         \
-    }                                                                                                            \
-    static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus }
+/* The mapping of a unified block and its fmuModel (u in, y out):
+ * resolve(v, c) sets rateUp, rateDown, yMax, yMin, duration and bypassValue
+ * the model's own way; the rates below 0 fall back to the resolved rates,
+ * and the rest is shared. */
+#define UNIFIED_MAPPING(resolve)                                                                               \
+    static const UnifiedVariables unifiedVariables = UNIFIED_VARIABLES;                                        \
+    static int model_configure(const double *v, RlConfig *c) {                                                 \
+        resolve(v, c);                                                                                         \
+        c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);           \
+        c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source); \
+        unified_configure(&unifiedVariables, v, c);                                                            \
+        return 0;                                                                                              \
+    }                                                                                                          \
+    static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {    \
+        (void)modelMode;                                                                                       \
+        unified_publish(&unifiedVariables, block, prepared, v);                                                \
+    }                                                                                                          \
+    static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };               \
+    FMU_MODEL(VR_u, VR_y, model_configure, model_publish, &statusOutputs)
 
 #endif

@@ -6,7 +6,11 @@
  * target traps enabled (FE_INVALID, FE_DIVBYZERO, FE_OVERFLOW): one raised
  * in any call is SIGFPE, reported with the script line, exit 3.
  *
- *   run_trace [--fmi2] [--trap] [--keep-going] <binary> <token> < script
+ *   run_trace [--fmi2] [--trap] [--keep-going] [--prefix <P>] <binary> <token> < script
+ *
+ * <binary> "-": the FMUs are linked into the harness (source FMUs compiled
+ * with FMI2_FUNCTION_PREFIX or FMI3_FUNCTION_PREFIX), the one run is the one
+ * whose prefix is P.
  *
  * Script lines:  set <F|I|L|B> <vr> <value>   (Float64 as C99 %a, Int32,
  *                                               Int64 (enumerations; FMI 2:
@@ -351,10 +355,11 @@ int main(int argc, char **argv) {
         if (strcmp(argv[a], "--fmi2") == 0) fmi2 = 1;
         else if (strcmp(argv[a], "--trap") == 0) trap = 1;
         else if (strcmp(argv[a], "--keep-going") == 0) keep_going = 1;
+        else if (strcmp(argv[a], "--prefix") == 0 && a + 1 < argc) function_prefix = argv[++a];
         else break;
     }
     if (argc - a != 2) {
-        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] <binary> <token> < script\n");
+        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] [--prefix <P>] <binary> <token> < script\n");
         return 2;
     }
     if (!open_library(argv[a])) return 2;

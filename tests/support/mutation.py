@@ -4,7 +4,10 @@
 
 universalmutator (pinned in tests/requirements.txt) writes every mutant of
 each file in FILES: one line changed. Each mutant is compiled with the
-release flags of the build (its compile_commands.json). Then:
+release flags of the build (its compile_commands.json), in every
+translation unit that includes the file: each FMU's one unit
+(<Model>_fmi<2|3>.c in the build tree, cmake/FmuSources.cmake), and for the
+kernel the kernel's C tests. Then:
 
 - a mutant that does not compile (the build has -Werror) is stillborn;
 - a mutant whose object code equals the original's cannot change behaviour
@@ -189,22 +192,36 @@ class Builder:
         self.build = build_dir
         self.work = work
         database = json.loads((build_dir / "compile_commands.json").read_text())
-        self.commands = {}  # translation unit (path under fmu_src or tests/c) -> compiler arguments
+        # translation unit -> compiler arguments; a unit is named as CMake names its object: by its path
+        # in the build tree (an FMU's generated unit), else in the source tree (fmu_src, tests/c)
+        self.commands = {}
+        self.files = {}  # unit -> its file
         for entry in database:
             source = Path(entry["file"])
             target = entry.get("output") or entry["command"].split(" -o ")[1].split()[0]
             if target.startswith(tuple(f"CMakeFiles/{name}.dir/" for name in self.targets())):
-                name = source.relative_to(REPO).as_posix()
+                base = build_dir if source.is_relative_to(build_dir) else REPO
+                name = source.relative_to(base).as_posix()
                 self.commands.setdefault(name, shlex.split(entry["command"]))
-        self.units = sorted(u for u in self.commands if u.startswith("fmu_src/"))
+                self.files[name] = source
+        # the units of the product: the FMUs' and the kernel's own (the C tests link it)
+        self.units = sorted(u for u in self.commands if not u.startswith("tests/"))
         self.links = {t: (build_dir / "CMakeFiles" / f"{t}.dir" / "link.txt").read_text().split() for t in self.targets()}
+
+    def includes(self, unit):
+        """The files of fmu_src a unit compiles: an FMU's unit, those it includes; a file of fmu_src, itself."""
+        if unit.startswith("fmu_src/"):
+            return {Path(unit).name}
+        return {line.split('"')[1] for line in self.files[unit].read_text().splitlines()
+                if line.startswith('#include "')}
 
     @staticmethod
     def targets():
         return [f"{m}_fmi{v}" for m in MODELS for v in (2, 3)] + ["test_kernel"]
 
     def compile(self, tree, unit, output):
-        """Compile tree/<unit> with the build's flags; tree stands in for the source tree."""
+        """Compile <unit> with the build's flags; tree stands in for the source tree (a unit of fmu_src or
+        tests/c is compiled from there; an FMU's unit in the build tree includes its files from there)."""
         args = [str(tree / unit) if a == str(REPO / unit) else a.replace(str(SOURCE), str(tree / "fmu_src"))
                 for a in self.commands[unit]]
         for flag in ("-MT", "-MF"):  # no dependency files
@@ -240,7 +257,7 @@ class Stillborn(Exception):
 def units_of(file, builder):
     """The translation units whose objects a change of fmu_src/<file> can change."""
     if file.endswith(".c"):
-        return [f"fmu_src/{file}"]
+        return [u for u in builder.units if file in builder.includes(u)]
     return builder.units + ["tests/c/test_kernel.c"]
 
 

@@ -6,6 +6,7 @@ import os
 from support.fmu_driver import BUILD_DIR
 from support.importers import input_values
 from support.process import run as run_bounded
+from support.scenarios import same
 
 QEMU = [os.environ.get("RL_QEMU_AARCH64") or "qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
 KINDS = {"Float64": "F", "Real": "F", "Int32": "I", "Integer": "I", "Enumeration": "L", "Boolean": "B"}
@@ -70,3 +71,27 @@ def halves(scenario, md, state):
     first = head + [line for block in blocks[:middle] for line in block] + [f"save {state}"]
     second = [f"load {state}"] + [line for block in blocks[middle:] for line in block]
     return "\n".join(first) + "\n", "\n".join(second) + "\n", script(scenario, md)
+
+
+def reference_script(scenario, md):
+    """The scenario's script at its grid and every reference time (a
+    reference off the grid is a step there, as fmutrace runs it), and the
+    check that run_trace's output lines give the hand-worked reference."""
+    o = scenario.options
+    grid = [o["StartTime"] + k * o["StepSize"] for k in range(round((o["StopTime"] - o["StartTime"]) / o["StepSize"]) + 1)]
+
+    def on_grid(t):  # a reference time within 1e-9 of a grid point is that point
+        return next((g for g in grid if abs(g - t) <= 1e-9 * max(1.0, abs(t))), t)
+    reference_times = [on_grid(float(t)) for t in scenario.reference["time"]]
+    times = sorted(set(grid) | set(reference_times))
+    names = list(scenario.outputs)
+
+    def check(lines):
+        assert len(lines) == len(times) * len(names)
+        row_of = {t: k for k, t in enumerate(times)}
+        for row, t in enumerate(reference_times):
+            for k, name in enumerate(names):
+                text = lines[row_of[t] * len(names) + k]
+                value = float.fromhex(text) if text.startswith(("0x", "-0x", "inf", "-inf", "nan", "-nan")) else int(text)
+                assert same(value, scenario.reference[name][row]), (name, t, text, scenario.reference[name][row])
+    return script(scenario, md, times), check
