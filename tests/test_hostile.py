@@ -159,6 +159,22 @@ def test_the_largest_finite_step_is_taken(version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_a_step_ending_past_the_largest_time_is_refused_and_named(version):
+    """From half the largest double, a step of the largest double would end
+    past it: refused, the message naming the step size and where it starts."""
+    fmu = Instance("RateLimiter", version)
+    try:
+        fmu.start()
+        half = sys.float_info.max / 2
+        assert fmu.raw_step(half) == 0, fmu.messages
+        assert fmu.raw_step(sys.float_info.max) == 3
+        expected = f"a step of {sys.float_info.max:g} s from {half:g} would end past the largest time"
+        assert any(expected in m[2] for m in fmu.errors()), fmu.messages
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_huge_cycle_time_holds(version):
     """cycleTime 1e9: no cycle ends within 10 s, so the output holds at its
     initial value (fmi.md, Time: a step that ends no cycle changes nothing)."""
