@@ -7,6 +7,7 @@ A line of millions of samples is drawn decimated to what the figure can
 show: per pixel column the first and last sample and the smallest and
 largest value (Envelope), so the picture is the same and its cost does
 not grow with the length. A long case fills its envelopes chunk by chunk."""
+import importlib
 import io
 import threading
 
@@ -190,6 +191,13 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
     stream = io.BytesIO()
     fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
     return stream.getvalue()
+
+
+def load_plotting():
+    """Imports what drawing a figure needs (matplotlib, its Agg canvas): a
+    second or more on a loaded machine, paid once by a process."""
+    for module in ("matplotlib.figure", "matplotlib.backends.backend_agg"):  # the Agg canvas: savefig's
+        importlib.import_module(module)
 
 
 def _layout(rows: int, columns: int, has_inputs: bool):

@@ -12,7 +12,7 @@ from .errors import InputError, SimulationError
 from .fmu import Fmu
 from .longcase import is_long, run_long_case
 from .outcome import CaseOutcome, Status
-from .plot import plot_case
+from .plot import load_plotting, plot_case
 from .recordings import is_recording
 from .recordings.case import RecordingOptions, recorded_case
 from .recordings.stream import is_long_recording, run_long_recording
@@ -101,6 +101,8 @@ def run_cases(items, fmu_bytes: bytes, path: str, labels: dict, mode: Mode, plot
     """The outcomes of the cases [(folder, name, texts or None)] of one FMU
     in this process, as they finish; on_start() before each case starts."""
     runner, fmu = worker_fmu(fmu_bytes, path)
+    if plots != "none":
+        load_plotting()  # start-up, not the first case's time: a case's timeout counts from on_start
     for folder, name, texts in items:
         if on_start:
             on_start()
