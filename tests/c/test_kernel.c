@@ -700,6 +700,33 @@ static void test_steady_ramp_equals_rules(void) {
     }
 }
 
+/* The common step onto a zero target of the other sign: a limited step
+ * that lands exactly on +0 while u is -0 ends at the target, -0, as rule
+ * 6 says (the limited value is not below the target, so the target is
+ * taken); the bits tell the two zeros apart where == does not. */
+static void test_steady_ramp_onto_a_zero_of_the_other_sign(void) {
+    const double starts[] = { -1.0, 1.0 }; /* up from -1, down from +1, by 1 per cycle */
+    for (int real = 0; real <= 1; real++)
+    for (size_t k = 0; k < 2; k++) {
+        RlConfig c = defaults();
+        c.real = real;
+        c.rateUp.value = 2.0;   /* 2 per s for a cycle of 0.5 s: exactly 1 per cycle */
+        c.rateDown.value = 2.0;
+        RlPrepared p;
+        RlState steady, rules;
+        rl_prepare(&p, resolved(&c), 0.5);
+        rl_init(&steady, &p, starts[k]);
+        rl_cycle(&steady, &p, starts[k], 0.5); /* a decided cycle arms the common step */
+        CHECK_TRUE(p.plain && steady.decided == RL_DECIDED_RAMP);
+        rules = steady;
+        rl_hold_period(&steady, 0.5);
+        CHECK_TRUE(rl_ramp_steady(&steady, &p, -0.0));
+        rl_cycle_rules(&rules, &p, rl_input(&p, -0.0), 1.0);
+        CHECK_BITS(rules.y, -0.0);
+        CHECK_BITS(steady.y, rules.y);
+    }
+}
+
 /* ---- rules.md, Output limits, rates below 0 and hold ------------------ */
 
 static void test_status_section6(void) {
@@ -1262,6 +1289,7 @@ int main(void) {
     test_fast_paths_equal_rules();
     test_run_of_no_cycles();
     test_steady_ramp_equals_rules();
+    test_steady_ramp_onto_a_zero_of_the_other_sign();
     test_status_section6();
     test_rates_by_sign();
     test_output_limits();
