@@ -13,8 +13,11 @@
  * Mode is only ever a Co-Simulation instance's, Event Mode and
  * Continuous-Time Mode a Model Exchange instance's; the functions of one
  * interface alone also refuse an instance of the other (BEGIN_ONLY).
- * Continuous-Time Mode allows sets of continuous-time inputs only, and
- * this FMU has none: every input and parameter is set in Event Mode. */
+ * Beyond the table: the sets of Event Mode are taken in Continuous-Time
+ * Mode too, where the standard has only continuous-time inputs (condition
+ * 5), as importers such as OMSimulator set every input at each step; the
+ * next cycle uses the values the instant before it is left with
+ * (fmu_leave_instant), wherever they were set. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
@@ -35,7 +38,7 @@
 #define MODES_GetInteger                MODES_GetReal
 #define MODES_GetBoolean                MODES_GetReal
 #define MODES_GetString                 MODES_GetReal
-#define MODES_SetReal                   (INST | INIT | STEP | EVENT)
+#define MODES_SetReal                   (INST | INIT | STEP | EVENT | CONT)
 #define MODES_SetInteger                MODES_SetReal
 #define MODES_SetBoolean                MODES_SetReal
 #define MODES_SetString                 MODES_SetReal

@@ -15,9 +15,11 @@
  * free are allowed. Step Mode is only ever a Co-Simulation instance's,
  * Event Mode and Continuous-Time Mode a Model Exchange instance's; the
  * functions of Model Exchange alone also refuse a Co-Simulation instance
- * (BEGIN_ME). Continuous-Time Mode allows sets of continuous-time inputs
- * only, and this FMU has none: every input and parameter is set in Event
- * Mode. */
+ * (BEGIN_ME). Beyond the standard: the sets of Event Mode are taken in
+ * Continuous-Time Mode too, where it has only continuous-time inputs, as
+ * importers such as OMSimulator set every input at each step; the next
+ * cycle uses the values the instant before it is left with
+ * (fmu_leave_instant), wherever they were set. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
@@ -35,7 +37,7 @@
 #define MODES_Terminate                 (STEP | EVENT | CONT)
 #define MODES_Reset                     SETTABLE
 #define MODES_Get                       (INIT | STEP | EVENT | CONT | TERM)
-#define MODES_Set                       (INST | INIT | STEP | EVENT)
+#define MODES_Set                       (INST | INIT | STEP | EVENT | CONT)
 #define MODES_GetFMUState               SETTABLE
 #define MODES_SetFMUState               SETTABLE
 #define MODES_FreeFMUState              SETTABLE

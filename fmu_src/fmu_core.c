@@ -177,13 +177,9 @@ FMU_NOINLINE static void configure(FmuInstance *instance) {
     if (instance->outputsStale == FMU_STALE_ALL) {
         publish(instance, true);
     }
-    RlConfig *config = &instance->prepared.config;
-    instance->modelMode = instance->model->configure(instance->core.values, config);
-    const double c = config->cycleTime.value;
+    instance->modelMode = instance->model->configure(instance->core.values, &instance->prepared.config);
+    const double c = instance->prepared.config.cycleTime.value;
     instance->cycleTime = isgreater(c, 0) && isfinite(c) ? c : 0.0;
-    /* Model Exchange has no communication step to stand in for the cycle:
-     * without cycleTime there is none */
-    config->cycleRefused = config->cycleRefused || (instance->modelExchange && instance->cycleTime == 0);
     instance->prepareDue = true;
     instance->configDirty = false;
 }
@@ -204,10 +200,21 @@ FMU_NOINLINE static void prepare(FmuInstance *instance, double period) {
     }
 }
 
+/* Model Exchange, after configure: there is no communication step to
+ * stand in for the cycle, so without cycleTime there is no cycle. (Not in
+ * configure: Co-Simulation's step does not pay for it.) */
+static void refuse_no_cycle(FmuInstance *instance) {
+    RlConfig *config = &instance->prepared.config;
+    config->cycleRefused = config->cycleRefused || instance->cycleTime == 0;
+}
+
 /* Outputs at the start from the current parameters and inputs. */
 static void initialize_block(FmuInstance *instance) {
     FmuCore *core = &instance->core;
     configure(instance);
+    if (instance->modelExchange) {
+        refuse_no_cycle(instance);
+    }
     /* with cycleTime 0 the cycle length is only known at the first step */
     prepare(instance, instance->cycleTime > 0 ? instance->cycleTime : NAN);
     rl_init(&core->block, &instance->prepared, core->values[instance->model->inputVr]);
@@ -413,6 +420,7 @@ static FmuStatus run_latched_cycles(FmuInstance *instance, const char *function)
     const bool differ = swap_latched(instance);
     if (differ || instance->configDirty) {
         configure(instance);
+        refuse_no_cycle(instance);
     }
     bool ran = false;
     FmuStatus status = FMU_OK;

@@ -6,7 +6,11 @@ harness names the exception and the script line and fails. Every reference
 scenario gives its reference so, and the hostile values of test_hostile.py
 (NaN, +-inf, subnormals, +-1e308 in every input and parameter, at the start
 and mid-run; the smallest and the largest step; a communication point at
-the far end of the range from the FMU's time) run without a trap."""
+the far end of the range from the FMU's time) run without a trap. As Model
+Exchange (run_trace --model-exchange: time events, event updates,
+Continuous-Time Mode) too: every scenario, with cycleTime its step, gives
+the trapped Co-Simulation run's outputs, and the hostile values trap
+nothing."""
 import math
 import os
 import sys
@@ -16,7 +20,7 @@ from fmpy import read_model_description
 
 from support.fmu_driver import BUILD_DIR, MODELS
 from support.process import run as run_bounded
-from support.run_trace import HARNESS, KINDS, reference_script, run_script
+from support.run_trace import HARNESS, KINDS, reference_script, run_script, script_parts
 from support.scenarios import discover
 from test_hostile import HOSTILE, coerce, in_declared_range
 
@@ -42,13 +46,34 @@ def test_scenario_runs_trapped_and_gives_its_reference(scenario, version, tmp_pa
                      f"{scenario.name} (FMI {version}) with traps", options=TRAPS[version]))
 
 
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=[s.name for s in SCENARIOS])
+def test_model_exchange_runs_trapped_and_gives_co_simulations_outputs(scenario, version, tmp_path):
+    """cycleTime = the scenario's step, the same script as Model Exchange
+    and as Co-Simulation, both trapped: the same text, line for line."""
+    stage, md = staged(scenario.model, version)
+    cycle_time = next(v for v in md.modelVariables if v.name == "cycleTime")
+    head, blocks = script_parts(scenario, md)
+    init = next(k for k, line in enumerate(head) if line.startswith("init"))  # after the scenario's start values
+    head.insert(init, f"set F {cycle_time.valueReference} {float(scenario.options['StepSize']).hex()}")
+    text = "\n".join(head + [line for block in blocks for line in block]) + "\n"
+    runs = [run_script(PLATFORM[version], stage, scenario.model, md.guid, text, tmp_path / interface,
+                       f"{scenario.name} (FMI {version}, {interface}) with traps", options=TRAPS[version] + extra)
+            for interface, extra in (("cs", []), ("me", ["--model-exchange"]))
+            if (tmp_path / interface).mkdir() is None]
+    assert runs[0] == runs[1]
+    assert len(runs[0]) == (len(blocks) + 1) * len(scenario.outputs)
+
+
 def test_a_raised_exception_is_caught_and_named(tmp_path):
     """The traps are on: a binary whose instantiate compares a NaN by <
     (as the kernel's limit check once did) stops the harness with SIGFPE,
     reported as FE_INVALID; without --trap it runs."""
     names = ["EnterInitializationMode", "ExitInitializationMode", "DoStep", "SetFloat64", "SetInt32", "SetInt64",
              "SetBoolean", "GetFloat64", "GetInt32", "GetBoolean", "FreeInstance", "GetFMUState", "SetFMUState",
-             "FreeFMUState", "SerializedFMUStateSize", "SerializeFMUState", "DeserializeFMUState"]
+             "FreeFMUState", "SerializedFMUStateSize", "SerializeFMUState", "DeserializeFMUState",
+             "InstantiateModelExchange", "UpdateDiscreteStates", "EnterContinuousTimeMode", "SetTime",
+             "EnterEventMode"]
     source = tmp_path / "raise.c"
     source.write_text("#include <math.h>\nvolatile double limit = NAN;\nstatic int instance;\n"
                       "void *fmi3InstantiateCoSimulation(void) { return limit < 1.0 ? 0 : &instance; }\n"
@@ -126,13 +151,15 @@ def hostile_script(md):
     return "\n".join(lines) + "\n", refused
 
 
+@pytest.mark.parametrize("interface", ["Co-Simulation", "Model Exchange"])
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
-def test_hostile_values_raise_no_floating_point_exception(model, version, tmp_path):
+def test_hostile_values_raise_no_floating_point_exception(model, version, interface, tmp_path):
     stage, md = staged(model, version)
     text, must_refuse = hostile_script(md)
-    lines = run_script(PLATFORM[version], stage, model, md.guid, text, tmp_path, f"{model} (FMI {version}) hostile",
-                       options=TRAPS[version] + ["--keep-going"])
+    extra = ["--model-exchange"] if interface == "Model Exchange" else []
+    lines = run_script(PLATFORM[version], stage, model, md.guid, text, tmp_path,
+                       f"{model} (FMI {version}, {interface}) hostile", options=TRAPS[version] + ["--keep-going"] + extra)
     refused = {int(line.split()[1]) for line in lines if line.startswith("refused")}
     script_lines = text.splitlines()
     # every value outside a declared range is refused, and nothing else but

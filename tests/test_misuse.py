@@ -391,3 +391,84 @@ def test_debug_logging_categories_choose_what_is_logged(version):
         fmu.fmu.setDebugLogging(True, ["logNoSuchCategory"])
     assert 'unknown log category "logNoSuchCategory"' in fmu.errors()[-1][2]
     fmu.free()
+
+
+def me_update(fmu):
+    """The event update of either version: (nextEventTimeDefined, nextEventTime)."""
+    result = fmu.fmu.newDiscreteStates() if fmu.version == 2 else fmu.fmu.updateDiscreteStates()
+    return result[4], result[5]
+
+
+def me_raw(fmu, name, argtypes, *args):
+    function = getattr(fmu.fmu.dll, f"fmi{fmu.version}{name}")
+    function.argtypes, function.restype = [ctypes.c_void_p] + argtypes, ctypes.c_int
+    return function(fmu.fmu.component, *args)
+
+
+def cs_state_into(fmu):
+    """An FMU state of a Co-Simulation instance of the same FMU set into this Model Exchange one."""
+    other = Instance("RateLimiter", fmu.version, name="co-simulation")
+    try:
+        other.start()
+        state = state_api(other)["get"]()
+        return call_status(state_api(fmu)["set"], state)
+    finally:
+        other.release()
+
+
+# Model Exchange, in Continuous-Time Mode after the event at 0.5 s: name: (misuse, words of the message)
+ME_MISUSES = {
+    "time before the last event": (lambda f: me_raw(f, "SetTime", [ctypes.c_double], 0.25),
+                                   "SetTime: time 0.25 is not finite or before the last event at 0.5"),
+    "time NaN": (lambda f: me_raw(f, "SetTime", [ctypes.c_double], math.nan), "SetTime: time nan is not finite"),
+    "continuous states asked for": (lambda f: me_raw(f, "GetContinuousStates", [ctypes.c_void_p, ctypes.c_size_t],
+                                                     (ctypes.c_double * 1)(), 1),
+                                    "GetContinuousStates: this FMU has no continuous states; n = 1, not 0"),
+    "event indicators asked for": (lambda f: me_raw(f, "GetEventIndicators", [ctypes.c_void_p, ctypes.c_size_t],
+                                                    (ctypes.c_double * 2)(), 2),
+                                   "GetEventIndicators: this FMU has no event indicators; n = 2, not 0"),
+    "event update in Continuous-Time Mode": (
+        lambda f: me_raw(f, "NewDiscreteStates" if f.version == 2 else "UpdateDiscreteStates",
+                         [ctypes.c_void_p] * (1 if f.version == 2 else 6), *([None] * (1 if f.version == 2 else 6))),
+        "DiscreteStates: not allowed in Continuous-Time Mode"),
+    "a Co-Simulation step": (lambda f: me_raw(f, "DoStep", [ctypes.c_double, ctypes.c_double] + (
+        [ctypes.c_int] if f.version == 2 else [ctypes.c_bool] + [ctypes.c_void_p] * 4), 0.5, 0.5, 1,
+        *([] if f.version == 2 else [None] * 4)), "DoStep: not allowed in Continuous-Time Mode"),
+    "fixed parameter after initialisation": (lambda f: set_raw(f, f.vr("cycleTime"), 0.1),
+                                             ": cycleTime is a fixed parameter and cannot be set after initialization"),
+    "a Co-Simulation instance's FMU state": (cs_state_into, "an FMU state of Step Mode, which this Model Exchange "
+                                                            "instance cannot be in"),
+}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("misuse", sorted(ME_MISUSES))
+def test_model_exchange_misuse_is_an_error_and_the_instance_recovers(version, misuse):
+    """The same in Model Exchange (fmi.md, Model Exchange): cycles of 0.5 s, 2 per s."""
+    fmu = Instance("RateLimiter", version, model_exchange=True)
+    fmu.start(cycleTime=0.5, rateUpPar=2.0)
+    assert me_update(fmu) == (True, 0.5)
+    fmu.set(u=5.0)
+    fmu.fmu.enterContinuousTimeMode()
+    fmu.fmu.setTime(0.5)
+    fmu.fmu.enterEventMode()
+    assert me_update(fmu) == (True, 1.0) and fmu.get("y") == 1.0
+    fmu.fmu.enterContinuousTimeMode()
+    api = state_api(fmu)
+    good = api["get"]()
+    action, words = ME_MISUSES[misuse]
+
+    assert action(fmu) == 3
+    errors = fmu.errors()
+    assert len(errors) == 1, errors
+    assert words in errors[0][2] and errors[0][2].startswith(f"fmi{version}"), errors[0]
+
+    assert me_raw(fmu, "SetTime", [ctypes.c_double], 1.0) == 3
+    assert f"not allowed in {'Error' if version == 2 else 'Terminated'}" in fmu.errors()[-1][2]
+    assert fmu.get("y") == 1.0 and fmu.get("cycleTime") == 0.5
+    api["set"](good)
+    fmu.fmu.setTime(1.0)
+    fmu.fmu.enterEventMode()
+    assert me_update(fmu) == (True, 1.5) and fmu.get("y") == 2.0
+    api["free"](good)
+    fmu.free()

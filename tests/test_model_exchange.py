@@ -161,6 +161,27 @@ def test_a_cycle_runs_with_the_inputs_latched_at_the_previous_cycle_end(version)
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_an_input_set_in_continuous_time_mode_is_sampled_when_the_next_instant_is_left(version):
+    """As OMSimulator sets inputs at each integrator step: u set between
+    the events at 0 and 0.5 is not the cycle ending at 0.5's (which began
+    at 0 with u = 0) but the next one's."""
+    fmu = MeInstance("RateLimiter", version)
+    try:
+        fmu.start(cycleTime=0.5, rateUpPar=1.0)
+        fmu.update()
+        fmu.fmu.enterContinuousTimeMode()
+        fmu.fmu.setTime(0.2)
+        fmu.set(u=10.0)
+        fmu.fmu.setTime(0.5)
+        fmu.fmu.enterEventMode()
+        assert fmu.update() == (True, 1.0) and fmu.get("y") == 0.0
+        fmu.to_event(1.0)
+        assert fmu.update() == (True, 1.5) and fmu.get("y") == 0.5
+    finally:
+        fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_next_event_time_is_computed_afresh_from_the_cycle_count(version):
     """48 h of 10 ms cycles: the event after cycle n is start + (n+1)*0.01
     as one product and one sum, not a sum of steps (which drifts)."""

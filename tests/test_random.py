@@ -5,7 +5,9 @@ published when read, so reading after some steps only must not change
 them). Ramp and RateLimit compute in REAL, RateLimiter in either
 arithmetic (rules.md, Arithmetic): the values include some that binary32 cannot
 hold (beyond its largest value, below its smallest) and times between
-milliseconds."""
+milliseconds. The same runs as Model Exchange (cycleTime > 0: the cycle
+ends are time events) agree with the same oracle at every communication
+point (fmi.md, Model Exchange)."""
 import math
 import sys
 
@@ -124,12 +126,44 @@ def agree(fmu_value, oracle_value):
     return (math.isnan(a) and math.isnan(b)) or a == b
 
 
-def run_against_oracle(model, version, start, run, skipped=(), start_time=0.0):
+class ModelExchangeSteps:
+    """An importer's Model Exchange loop with fmpy's calls: at each
+    communication point t the FMU is in Event Mode (the inputs of t are set
+    there); a step to t + h runs every time event before it (Continuous-Time
+    Mode, the time, Event Mode, the update) and then the event at t + h."""
+
+    def __init__(self, fmu):
+        self.fmu, self.f = fmu, fmu.fmu
+        self.update = self.f.newDiscreteStates if fmu.version == 2 else self.f.updateDiscreteStates
+        self.next = None
+
+    def event_update(self):
+        result = self.update()
+        assert result[:4] == (False, False, False, False), result
+        self.next = result[5] if result[4] else None
+
+    def step(self, h):
+        end = self.fmu.t + h
+        while True:
+            at_end = self.next is None or not self.next < end
+            self.f.enterContinuousTimeMode()
+            self.f.setTime(end if at_end else self.next)
+            self.f.enterEventMode()
+            self.event_update()
+            if at_end:
+                break
+        self.fmu.t = end
+
+
+def run_against_oracle(model, version, start, run, skipped=(), start_time=0.0, model_exchange=False):
     """skipped: the steps after which the outputs are not read (the last one always is)."""
-    fmu = Instance(model, version)
+    fmu = Instance(model, version, model_exchange=model_exchange)
+    steps = ModelExchangeSteps(fmu) if model_exchange else None
     try:
         vr = {name: fmu.vr(name) for name in fmu.variables}
         fmu.start(start_time=start_time, **start)
+        if steps:
+            steps.event_update()
         oracle = oracle_for(model, vr, start, start_time)
         names = output_names(model)
         expected = oracle.outputs()
@@ -138,7 +172,7 @@ def run_against_oracle(model, version, start, run, skipped=(), start_time=0.0):
         for k, (h, inputs) in enumerate(run):
             t = fmu.t
             fmu.set(**inputs)
-            fmu.step(h)
+            steps.step(h) if steps else fmu.step(h)
             expected = oracle.do_step(t, h, inputs)
             if k in skipped and k < len(run) - 1:
                 continue
@@ -206,14 +240,43 @@ def test_rate_limiter_agrees_with_oracle(version, arithmetic, start, run, skippe
     run_against_oracle("RateLimiter", version, dict(start, arithmetic=arithmetic), run, skipped, start_time)
 
 
+# Model Exchange: a cycle only with cycleTime > 0 (0 and the invalid ones are no valid cycle there)
+ME_CYCLE_TIMES = st.sampled_from([0.1, 0.25, 0.05, 1.0, 0.3])
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(start=parameters, run=steps, skipped=st.sets(st.integers(0, 39)), start_time=start_times,
+       cycle_time=ME_CYCLE_TIMES, arithmetic=st.sampled_from([LREAL, REAL]))
+def test_rate_limiter_agrees_with_oracle_in_model_exchange(version, start, run, skipped, start_time, cycle_time,
+                                                           arithmetic):
+    run_against_oracle("RateLimiter", version, dict(start, cycleTime=cycle_time, arithmetic=arithmetic), run,
+                       skipped, start_time, model_exchange=True)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", [m for m in MODELS if m != "RateLimiter"])
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_vendor_model_agrees_with_oracle_in_model_exchange(model, version, data):
+    run_vendor_model(model, version, data, model_exchange=True)
+
+
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", [m for m in MODELS if m != "RateLimiter"])
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_vendor_model_agrees_with_oracle(model, version, data):
+    run_vendor_model(model, version, data)
+
+
+def run_vendor_model(model, version, data, model_exchange=False):
+    """A vendor model's random run (Model Exchange: with a cycleTime > 0)."""
     start_strategy, change_strategy = VENDOR_STRATEGIES[model]
     start = data.draw(start_strategy, label="start")
+    if model_exchange:
+        start["cycleTime"] = data.draw(ME_CYCLE_TIMES, label="cycleTime")
     run = data.draw(st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), change_strategy),
                              min_size=1, max_size=40), label="run")
     run_against_oracle(model, version, start, run, data.draw(st.sets(st.integers(0, 39)), label="skipped"),
-                       data.draw(start_times, label="start_time"))
+                       data.draw(start_times, label="start_time"), model_exchange=model_exchange)

@@ -6,11 +6,18 @@
  * target traps enabled (FE_INVALID, FE_DIVBYZERO, FE_OVERFLOW): one raised
  * in any call is SIGFPE, reported with the script line, exit 3.
  *
- *   run_trace [--fmi2] [--trap] [--keep-going] [--prefix <P>] <binary> <token> < script
+ *   run_trace [--fmi2] [--trap] [--keep-going] [--model-exchange] [--prefix <P>] <binary> <token> < script
  *
  * <binary> "-": the FMUs are linked into the harness (source FMUs compiled
  * with FMI2_FUNCTION_PREFIX or FMI3_FUNCTION_PREFIX), the one run is the one
  * whose prefix is P.
+ * --model-exchange: the instances are Model Exchange ones, driven as an
+ * importer without continuous states drives them: init ends with an event
+ * update in Event Mode at the start time; "step t h" enters
+ * Continuous-Time Mode and runs every time event before t + h (set the
+ * time, Event Mode, update), then the event at t + h, leaving the instance
+ * in Event Mode there, where the next inputs are set (t itself is not
+ * checked: the time is the FMU's).
  *
  * Script lines:  set <F|I|L|B> <vr> <value>   (Float64 as C99 %a, Int32,
  *                                               Int64 (enumerations; FMI 2:
@@ -28,6 +35,7 @@
 #define _GNU_SOURCE /* feenableexcept */
 #endif
 #include <fenv.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
@@ -47,6 +55,12 @@ enum { STATUS_OK = 0, STATUS_WARNING = 1, STATUS_ERROR = 3 }; /* as fmi2Status a
 /* One FMI version's calls, values as the script carries them. */
 typedef struct {
     void *(*instantiate)(const char *token);
+    /* Model Exchange: the event update (*next: the next event time, NaN
+     * for none), Continuous-Time Mode, the time, Event Mode */
+    int (*update)(void *c, double *next);
+    int (*continuous)(void *c);
+    int (*set_time)(void *c, double t);
+    int (*event)(void *c);
     int (*init)(void *c, double start);
     int (*step)(void *c, double t, double h);
     int (*set_float)(void *c, unsigned vr, double v);
@@ -62,8 +76,15 @@ typedef struct {
 
 /* ---- FMI 3 ---- */
 
+static int model_exchange;
+
 static struct {
     fmi3InstantiateCoSimulationTYPE *instantiate;
+    fmi3InstantiateModelExchangeTYPE *instantiate_me;
+    fmi3UpdateDiscreteStatesTYPE *update;
+    fmi3EnterContinuousTimeModeTYPE *continuous;
+    fmi3SetTimeTYPE *set_time;
+    fmi3EnterEventModeTYPE *event;
     fmi3EnterInitializationModeTYPE *enter;
     fmi3ExitInitializationModeTYPE *leave;
     fmi3DoStepTYPE *do_step;
@@ -91,8 +112,18 @@ static void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String c
 }
 
 static void *instantiate3(const char *token) {
+    if (model_exchange) return f3.instantiate_me("trace", token, NULL, fmi3False, fmi3False, NULL, logger3);
     return f3.instantiate("trace", token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL, logger3, NULL);
 }
+static int update3(void *c, double *next) {
+    fmi3Boolean again, stop, nominals, values, defined = fmi3False;
+    const int status = f3.update(c, &again, &stop, &nominals, &values, &defined, next);
+    if (!defined) *next = NAN;
+    return status;
+}
+static int continuous3(void *c) { return f3.continuous(c); }
+static int set_time3(void *c, double t) { return f3.set_time(c, t); }
+static int event3(void *c) { return f3.event(c); }
 static int init3(void *c, double start) {
     int status = f3.enter(c, fmi3False, 0.0, start, fmi3False, 0.0);
     return status <= STATUS_WARNING ? (int)f3.leave(c) : status;
@@ -159,6 +190,11 @@ static void free3(void *c) {
 
 static Fmi load_fmi3(void) {
     f3.instantiate = (fmi3InstantiateCoSimulationTYPE *)function("fmi3InstantiateCoSimulation");
+    f3.instantiate_me = (fmi3InstantiateModelExchangeTYPE *)function("fmi3InstantiateModelExchange");
+    f3.update = (fmi3UpdateDiscreteStatesTYPE *)function("fmi3UpdateDiscreteStates");
+    f3.continuous = (fmi3EnterContinuousTimeModeTYPE *)function("fmi3EnterContinuousTimeMode");
+    f3.set_time = (fmi3SetTimeTYPE *)function("fmi3SetTime");
+    f3.event = (fmi3EnterEventModeTYPE *)function("fmi3EnterEventMode");
     f3.enter = (fmi3EnterInitializationModeTYPE *)function("fmi3EnterInitializationMode");
     f3.leave = (fmi3ExitInitializationModeTYPE *)function("fmi3ExitInitializationMode");
     f3.do_step = (fmi3DoStepTYPE *)function("fmi3DoStep");
@@ -176,7 +212,7 @@ static Fmi load_fmi3(void) {
     f3.state_size = (fmi3SerializedFMUStateSizeTYPE *)function("fmi3SerializedFMUStateSize");
     f3.serialize = (fmi3SerializeFMUStateTYPE *)function("fmi3SerializeFMUState");
     f3.deserialize = (fmi3DeserializeFMUStateTYPE *)function("fmi3DeserializeFMUState");
-    const Fmi fmi = { instantiate3, init3, step3, set_float3, set_int3, set_bool3, get_float3, get_int3, get_bool3,
+    const Fmi fmi = { instantiate3, update3, continuous3, set_time3, event3, init3, step3, set_float3, set_int3, set_bool3, get_float3, get_int3, get_bool3,
                       save3, load3, free3 };
     return fmi;
 }
@@ -185,6 +221,10 @@ static Fmi load_fmi3(void) {
 
 static struct {
     fmi2InstantiateTYPE *instantiate;
+    fmi2NewDiscreteStatesTYPE *update;
+    fmi2EnterContinuousTimeModeTYPE *continuous;
+    fmi2SetTimeTYPE *set_time;
+    fmi2EnterEventModeTYPE *event;
     fmi2SetupExperimentTYPE *setup;
     fmi2EnterInitializationModeTYPE *enter;
     fmi2ExitInitializationModeTYPE *leave;
@@ -216,8 +256,19 @@ static void logger2(fmi2ComponentEnvironment env, fmi2String name, fmi2Status st
 static const fmi2CallbackFunctions callbacks2 = { logger2, calloc, free, NULL, NULL };
 
 static void *instantiate2(const char *token) {
-    return f2.instantiate("trace", fmi2CoSimulation, token, NULL, &callbacks2, fmi2False, fmi2False);
+    return f2.instantiate("trace", model_exchange ? fmi2ModelExchange : fmi2CoSimulation, token, NULL, &callbacks2,
+                          fmi2False, fmi2False);
 }
+static int update2(void *c, double *next) {
+    fmi2EventInfo info;
+    info.nextEventTimeDefined = fmi2False;
+    const int status = f2.update(c, &info);
+    *next = info.nextEventTimeDefined ? info.nextEventTime : NAN;
+    return status;
+}
+static int continuous2(void *c) { return f2.continuous(c); }
+static int set_time2(void *c, double t) { return f2.set_time(c, t); }
+static int event2(void *c) { return f2.event(c); }
 static int init2(void *c, double start) {
     int status = f2.setup(c, fmi2False, 0.0, start, fmi2False, 0.0);
     if (status <= STATUS_WARNING) status = f2.enter(c);
@@ -280,6 +331,10 @@ static void free2(void *c) {
 
 static Fmi load_fmi2(void) {
     f2.instantiate = (fmi2InstantiateTYPE *)function("fmi2Instantiate");
+    f2.update = (fmi2NewDiscreteStatesTYPE *)function("fmi2NewDiscreteStates");
+    f2.continuous = (fmi2EnterContinuousTimeModeTYPE *)function("fmi2EnterContinuousTimeMode");
+    f2.set_time = (fmi2SetTimeTYPE *)function("fmi2SetTime");
+    f2.event = (fmi2EnterEventModeTYPE *)function("fmi2EnterEventMode");
     f2.setup = (fmi2SetupExperimentTYPE *)function("fmi2SetupExperiment");
     f2.enter = (fmi2EnterInitializationModeTYPE *)function("fmi2EnterInitializationMode");
     f2.leave = (fmi2ExitInitializationModeTYPE *)function("fmi2ExitInitializationMode");
@@ -297,9 +352,38 @@ static Fmi load_fmi2(void) {
     f2.state_size = (fmi2SerializedFMUstateSizeTYPE *)function("fmi2SerializedFMUstateSize");
     f2.serialize = (fmi2SerializeFMUstateTYPE *)function("fmi2SerializeFMUstate");
     f2.deserialize = (fmi2DeSerializeFMUstateTYPE *)function("fmi2DeSerializeFMUstate");
-    const Fmi fmi = { instantiate2, init2, step2, set_float2, set_int2, set_bool2, get_float2, get_int2, get_bool2,
+    const Fmi fmi = { instantiate2, update2, continuous2, set_time2, event2, init2, step2, set_float2, set_int2, set_bool2, get_float2, get_int2, get_bool2,
                       save2, load2, free2 };
     return fmi;
+}
+
+/* ---- Model Exchange: init and step as an importer drives them ---- */
+
+static double next_event; /* of the last update; NaN: none */
+
+static int init_me(const Fmi *fmi, void *c, double start) {
+    int status = fmi->init(c, start);
+    return status <= STATUS_WARNING ? fmi->update(c, &next_event) : status;
+}
+
+/* From Event Mode at the FMU's time to Event Mode at t + h, through every
+ * time event before it (after 1000 of them straight to the end: the FMU
+ * runs the cycles that ended meanwhile at its next event, as a long step
+ * does). The comparisons are quiet (NaN: no event) and the sum cannot
+ * overflow: no floating-point exception of the harness's own. */
+static int step_me(const Fmi *fmi, void *c, double t, double h) {
+    if (!(isless(fabs(t), 0x1p1022) && isless(fabs(h), 0x1p1022))) return STATUS_ERROR;
+    const double end = t + h;
+    int status = STATUS_OK;
+    for (int at_end = 0, events = 0; !at_end && status <= STATUS_WARNING; events++) {
+        at_end = !isless(next_event, end) || events >= 1000;
+        const double when = at_end ? end : next_event;
+        status = fmi->continuous(c);
+        if (status <= STATUS_WARNING) status = fmi->set_time(c, when);
+        if (status <= STATUS_WARNING) status = fmi->event(c);
+        if (status <= STATUS_WARNING) status = fmi->update(c, &next_event);
+    }
+    return status;
 }
 
 /* ---- floating-point traps ---- */
@@ -355,11 +439,12 @@ int main(int argc, char **argv) {
         if (strcmp(argv[a], "--fmi2") == 0) fmi2 = 1;
         else if (strcmp(argv[a], "--trap") == 0) trap = 1;
         else if (strcmp(argv[a], "--keep-going") == 0) keep_going = 1;
+        else if (strcmp(argv[a], "--model-exchange") == 0) model_exchange = 1;
         else if (strcmp(argv[a], "--prefix") == 0 && a + 1 < argc) function_prefix = argv[++a];
         else break;
     }
     if (argc - a != 2) {
-        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] [--prefix <P>] <binary> <token> < script\n");
+        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] [--model-exchange] [--prefix <P>] <binary> <token> < script\n");
         return 2;
     }
     if (!open_library(argv[a])) return 2;
@@ -397,9 +482,9 @@ int main(int argc, char **argv) {
         } else if (sscanf(line, "set F %u %la", &vr, &x) == 2) {
             status = fmi.set_float(c, vr, x);
         } else if (sscanf(line, "init %la", &x) == 1) {
-            status = fmi.init(c, x);
+            status = model_exchange ? init_me(&fmi, c, x) : fmi.init(c, x);
         } else if (sscanf(line, "step %la %la", &x, &y) == 2) {
-            status = fmi.step(c, x, y);
+            status = model_exchange ? step_me(&fmi, c, x, y) : fmi.step(c, x, y);
         } else if (sscanf(line, "get %c %u", &kind, &vr) == 2) {
             if (kind == 'F') {
                 double v = 0.0;

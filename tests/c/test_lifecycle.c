@@ -4,7 +4,9 @@
  *
  * 1. a full simulation using every kind of call (set, step, get, FMU states,
  *    serialize and deserialize, reset, terminate, free), so that valgrind
- *    memcheck can watch all of it;
+ *    memcheck can watch all of it; then the same as Model Exchange (time
+ *    events, event updates, Continuous-Time Mode, its FMU states), each
+ *    output equal to Co-Simulation's at the same cycle end;
  * 2. <instantiations> instantiate/free cycles: afterwards as many blocks
  *    are live as before (FMI 2 memory callbacks and an interposed malloc);
  * 3. <instances> instances alive at once, each stepped with its own input,
@@ -114,7 +116,7 @@ static int failures;
 
 static int version;
 static char token[128];
-static unsigned uVr, yVr;
+static unsigned uVr, yVr, cycleTimeVr;
 
 #define F2(name) ((name##TYPE *)function(#name))
 #define F3(name) ((name##TYPE *)function(#name))
@@ -127,6 +129,17 @@ static void *instantiate(const char *name) {
     }
     return F3(fmi3InstantiateCoSimulation)(name, token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
                                            NULL, log3_message, NULL);
+}
+
+static void *instantiate_model_exchange(const char *name) {
+    if (version == 2) {
+        return F2(fmi2Instantiate)(name, fmi2ModelExchange, token, "", &callbacks, fmi2False, fmi2False);
+    }
+    return F3(fmi3InstantiateModelExchange)(name, token, NULL, fmi3False, fmi3False, NULL, log3_message);
+}
+
+static int set_real(void *c, unsigned vr, double value) {
+    return version == 2 ? F2(fmi2SetReal)(c, &vr, 1, &value) : F3(fmi3SetFloat64)(c, &vr, 1, &value, 1);
 }
 
 static void release(void *c) {
@@ -169,6 +182,38 @@ static double input(int k, int i) { return ((k + i) % 7) * 1.5 - 4.0; }
 
 /* ---- 1. a full simulation, every kind of call ------------------------- */
 
+/* FMU state: get, serialize, deserialize (corrupted bytes: refused, then
+ * recovered), set, free */
+static void state_round_trip(void *c) {
+    void *state = NULL, *copy = NULL, *bad = NULL;
+    size_t size = 0;
+    if (version == 2) {
+        CHECK(F2(fmi2GetFMUstate)(c, &state) == fmi2OK);
+        CHECK(F2(fmi2SerializedFMUstateSize)(c, state, &size) == fmi2OK);
+        fmi2Byte *bytes = LIBC(malloc)(size);
+        CHECK(F2(fmi2SerializeFMUstate)(c, state, bytes, size) == fmi2OK);
+        CHECK(F2(fmi2DeSerializeFMUstate)(c, bytes, size, &copy) == fmi2OK);
+        bytes[size / 2] ^= 0x40;
+        CHECK(F2(fmi2DeSerializeFMUstate)(c, bytes, size, &bad) == fmi2Error && bad == NULL);
+        LIBC(free)(bytes);
+        CHECK(F2(fmi2SetFMUstate)(c, copy) == fmi2OK);
+        CHECK(F2(fmi2FreeFMUstate)(c, &copy) == fmi2OK);
+        CHECK(F2(fmi2FreeFMUstate)(c, &state) == fmi2OK);
+    } else {
+        CHECK(F3(fmi3GetFMUState)(c, &state) == fmi3OK);
+        CHECK(F3(fmi3SerializedFMUStateSize)(c, state, &size) == fmi3OK);
+        fmi3Byte *bytes = LIBC(malloc)(size);
+        CHECK(F3(fmi3SerializeFMUState)(c, state, bytes, size) == fmi3OK);
+        CHECK(F3(fmi3DeserializeFMUState)(c, bytes, size, &copy) == fmi3OK);
+        bytes[size / 2] ^= 0x40;
+        CHECK(F3(fmi3DeserializeFMUState)(c, bytes, size, &bad) == fmi3Error && bad == NULL);
+        LIBC(free)(bytes);
+        CHECK(F3(fmi3SetFMUState)(c, copy) == fmi3OK);
+        CHECK(F3(fmi3FreeFMUState)(c, &copy) == fmi3OK);
+        CHECK(F3(fmi3FreeFMUState)(c, &state) == fmi3OK);
+    }
+}
+
 static void full_simulation(void) {
     void *c = instantiate("full");
     CHECK(c != NULL);
@@ -183,36 +228,7 @@ static void full_simulation(void) {
         CHECK(step(c, t, 0.01) == 0);
         get_y(c);
     }
-    /* FMU state: get, serialize, deserialize, set, free */
-    void *state = NULL, *copy = NULL;
-    size_t size = 0;
-    if (version == 2) {
-        CHECK(F2(fmi2GetFMUstate)(c, &state) == fmi2OK);
-        CHECK(F2(fmi2SerializedFMUstateSize)(c, state, &size) == fmi2OK);
-        fmi2Byte *bytes = LIBC(malloc)(size);
-        CHECK(F2(fmi2SerializeFMUstate)(c, state, bytes, size) == fmi2OK);
-        CHECK(F2(fmi2DeSerializeFMUstate)(c, bytes, size, &copy) == fmi2OK);
-        bytes[size / 2] ^= 0x40; /* corrupted bytes: refused, then recovered */
-        void *bad = NULL;
-        CHECK(F2(fmi2DeSerializeFMUstate)(c, bytes, size, &bad) == fmi2Error && bad == NULL);
-        LIBC(free)(bytes);
-        CHECK(F2(fmi2SetFMUstate)(c, copy) == fmi2OK);
-        CHECK(F2(fmi2FreeFMUstate)(c, &copy) == fmi2OK);
-        CHECK(F2(fmi2FreeFMUstate)(c, &state) == fmi2OK);
-    } else {
-        CHECK(F3(fmi3GetFMUState)(c, &state) == fmi3OK);
-        CHECK(F3(fmi3SerializedFMUStateSize)(c, state, &size) == fmi3OK);
-        fmi3Byte *bytes = LIBC(malloc)(size);
-        CHECK(F3(fmi3SerializeFMUState)(c, state, bytes, size) == fmi3OK);
-        CHECK(F3(fmi3DeserializeFMUState)(c, bytes, size, &copy) == fmi3OK);
-        bytes[size / 2] ^= 0x40;
-        void *bad = NULL;
-        CHECK(F3(fmi3DeserializeFMUState)(c, bytes, size, &bad) == fmi3Error && bad == NULL);
-        LIBC(free)(bytes);
-        CHECK(F3(fmi3SetFMUState)(c, copy) == fmi3OK);
-        CHECK(F3(fmi3FreeFMUState)(c, &copy) == fmi3OK);
-        CHECK(F3(fmi3FreeFMUState)(c, &state) == fmi3OK);
-    }
+    state_round_trip(c);
     for (int k = 0; k < 100; k++, t += 0.01) {
         set_u(c, input(k, 1));
         CHECK(step(c, t, 0.01) == 0);
@@ -227,6 +243,93 @@ static void full_simulation(void) {
     CHECK((version == 2 ? F2(fmi2Terminate)(c) : F3(fmi3Terminate)(c)) == 0);
     get_y(c);
     release(c);
+}
+
+/* ---- 1b. the same block as Model Exchange ------------------------------- */
+
+/* The event update; returns the next event time (NaN: none). */
+static double update(void *c) {
+    double next = NAN;
+    if (version == 2) {
+        fmi2EventInfo info;
+        CHECK(F2(fmi2NewDiscreteStates)(c, &info) == fmi2OK);
+        CHECK(!info.newDiscreteStatesNeeded && !info.terminateSimulation && !info.valuesOfContinuousStatesChanged);
+        if (info.nextEventTimeDefined) next = info.nextEventTime;
+    } else {
+        fmi3Boolean again, stop, nominals, values, defined;
+        CHECK(F3(fmi3UpdateDiscreteStates)(c, &again, &stop, &nominals, &values, &defined, &next) == fmi3OK);
+        CHECK(!again && !stop && !values);
+        if (!defined) next = NAN;
+    }
+    return next;
+}
+
+static int enter_continuous_time_mode(void *c) {
+    return version == 2 ? (int)F2(fmi2EnterContinuousTimeMode)(c) : (int)F3(fmi3EnterContinuousTimeMode)(c);
+}
+
+/* From Continuous-Time Mode to the event at t, as an importer without
+ * states does: set the time, check the (empty) states and indicators,
+ * complete the step, enter Event Mode. */
+static void to_event(void *c, double t) {
+    double none[1];
+    fmi2Boolean enter2 = fmi2True, stop2 = fmi2True;
+    fmi3Boolean enter3 = fmi3True, stop3 = fmi3True;
+    if (version == 2) {
+        CHECK(F2(fmi2SetTime)(c, t) == fmi2OK);
+        CHECK(F2(fmi2GetDerivatives)(c, none, 0) == fmi2OK && F2(fmi2GetEventIndicators)(c, none, 0) == fmi2OK);
+        CHECK(F2(fmi2CompletedIntegratorStep)(c, fmi2True, &enter2, &stop2) == fmi2OK && !enter2 && !stop2);
+        CHECK(F2(fmi2EnterEventMode)(c) == fmi2OK);
+    } else {
+        size_t n = 1;
+        CHECK(F3(fmi3GetNumberOfContinuousStates)(c, &n) == fmi3OK && n == 0);
+        CHECK(F3(fmi3SetTime)(c, t) == fmi3OK);
+        CHECK(F3(fmi3GetContinuousStateDerivatives)(c, none, 0) == fmi3OK &&
+              F3(fmi3GetEventIndicators)(c, none, 0) == fmi3OK);
+        CHECK(F3(fmi3CompletedIntegratorStep)(c, fmi3True, &enter3, &stop3) == fmi3OK && !enter3 && !stop3);
+        CHECK(F3(fmi3EnterEventMode)(c) == fmi3OK);
+    }
+}
+
+static void model_exchange_simulation(void) {
+    enum { CYCLES = 200 };
+    const double cycle = 0.01;
+    double expected[CYCLES];
+    void *cs = instantiate("reference");
+    CHECK(cs != NULL && set_real(cs, cycleTimeVr, cycle) == 0 && start(cs));
+    for (int k = 0; k < CYCLES; k++) {
+        set_u(cs, input(k, 2));
+        CHECK(step(cs, k * cycle, cycle) == 0);
+        expected[k] = get_y(cs);
+    }
+    release(cs);
+
+    void *c = instantiate_model_exchange("model exchange");
+    CHECK(c != NULL);
+    if (!c) return;
+    CHECK(set_real(c, cycleTimeVr, cycle) == 0);
+    CHECK(start(c));
+    double next = update(c);
+    CHECK(next == cycle);
+    int mismatches = 0;
+    for (int k = 0; k < CYCLES; k++) {
+        CHECK(set_u(c, input(k, 2)) == 0); /* the input of this instant: the next cycle's */
+        if (k > 0) {
+            next = update(c);
+            mismatches += get_y(c) != expected[k - 1];
+        }
+        CHECK(enter_continuous_time_mode(c) == 0);
+        if (k == CYCLES / 2) state_round_trip(c); /* in Continuous-Time Mode */
+        CHECK(next == (k + 1) * cycle);
+        to_event(c, next);
+    }
+    next = update(c);
+    mismatches += get_y(c) != expected[CYCLES - 1];
+    CHECK(mismatches == 0);
+    CHECK((version == 2 ? F2(fmi2Terminate)(c) : F3(fmi3Terminate)(c)) == 0);
+    get_y(c);
+    release(c);
+    printf("Model Exchange: %d cycles as time events, mismatches with Co-Simulation %d\n", CYCLES, mismatches);
 }
 
 /* ---- 2. instantiate/free cycles leave nothing behind ------------------- */
@@ -416,6 +519,9 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     attribute(text, "<CoSimulation", "modelIdentifier=\"", identifier, size);
     uVr = first_real(text, "causality=\"input\"");
     yVr = first_real(text, "causality=\"output\"");
+    /* every model has the parameter cycleTime */
+    char number[32];
+    cycleTimeVr = (unsigned)atoi(attribute(text, "name=\"cycleTime\"", "valueReference=\"", number, sizeof number));
 }
 
 int main(int argc, char **argv) {
@@ -435,6 +541,7 @@ int main(int argc, char **argv) {
     if (!open_library(binary)) return 2;
     counting = 1;
     full_simulation();
+    model_exchange_simulation();
     instantiate_free(atol(argv[3]));
     many_instances(atoi(argv[4]));
     out_of_memory();

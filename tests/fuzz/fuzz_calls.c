@@ -1,5 +1,6 @@
 /* libFuzzer target: arbitrary bytes as a sequence of FMI calls on one
- * instance (FMI 2 or 3 by the first byte): each call an opcode byte and
+ * instance (FMI 2 or 3, Co-Simulation or Model Exchange, by the first
+ * byte): each call an opcode byte and
  * its arguments (value reference byte, 8-byte double, ...). Whatever the
  * order, state or values, no call may fault; ASan and UBSan watch. */
 #include <stdint.h>
@@ -43,8 +44,9 @@ static void *allocate(size_t n, size_t size) { return calloc(n, size); }
 
 static const fmi2CallbackFunctions callbacks = { logger2, allocate, free, NULL, NULL };
 
-static void run2(Input *in) {
-    fmi2Component c = fmi2Instantiate("fuzz", fmi2CoSimulation, MODEL_TOKEN, "", &callbacks, fmi2False, byte(in) & 1);
+static void run2(Input *in, int modelExchange) {
+    fmi2Component c = fmi2Instantiate("fuzz", modelExchange ? fmi2ModelExchange : fmi2CoSimulation, MODEL_TOKEN, "",
+                                      &callbacks, fmi2False, byte(in) & 1);
     fmi2FMUstate state = NULL;
     fmi2Real t = 0;
     while (in->size) {
@@ -52,7 +54,9 @@ static void run2(Input *in) {
         fmi2Real r = 0;
         fmi2Integer i = 0;
         fmi2Boolean b = 0;
-        switch (byte(in) % 20) {
+        fmi2Real none[1];
+        fmi2EventInfo info;
+        switch (byte(in) % 26) {
         case 0: r = real(in); fmi2SetReal(c, &vr, 1, &r); break;
         case 1: i = (fmi2Integer)(int8_t)byte(in); fmi2SetInteger(c, &vr, 1, &i); break;
         case 2: b = byte(in); fmi2SetBoolean(c, &vr, 1, &b); break;
@@ -84,6 +88,17 @@ static void run2(Input *in) {
             break;
         }
         case 18: { fmi2Real when; fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &when); break; }
+        /* Model Exchange */
+        case 19: fmi2EnterEventMode(c); break;
+        case 20: fmi2NewDiscreteStates(c, (byte(in) & 7) ? &info : NULL); break;
+        case 21: fmi2EnterContinuousTimeMode(c); break;
+        case 22: {
+            const double next = (byte(in) & 1) ? real(in) : t + 0.05 * (1 + byte(in) % 8);
+            if (fmi2SetTime(c, next) <= fmi2Warning) t = next;
+            break;
+        }
+        case 23: fmi2CompletedIntegratorStep(c, fmi2True, &b, &b); break;
+        case 24: fmi2GetEventIndicators(c, none, byte(in) % 2); fmi2GetContinuousStates(c, none, byte(in) % 2); break;
         default: fmi2SetReal(c, &vr, 0, NULL); fmi2GetReal(c, NULL, 1, NULL); break;
         }
     }
@@ -95,9 +110,11 @@ static void logger3(fmi3InstanceEnvironment e, fmi3Status s, fmi3String c, fmi3S
     (void)e; (void)s; (void)c; (void)m;
 }
 
-static void run3(Input *in) {
-    fmi3Instance c = fmi3InstantiateCoSimulation("fuzz", MODEL_TOKEN, NULL, fmi3False, byte(in) & 1, fmi3False,
-                                                 fmi3False, NULL, 0, NULL, logger3, NULL);
+static void run3(Input *in, int modelExchange) {
+    fmi3Instance c = modelExchange
+        ? fmi3InstantiateModelExchange("fuzz", MODEL_TOKEN, NULL, fmi3False, byte(in) & 1, NULL, logger3)
+        : fmi3InstantiateCoSimulation("fuzz", MODEL_TOKEN, NULL, fmi3False, byte(in) & 1, fmi3False, fmi3False, NULL,
+                                      0, NULL, logger3, NULL);
     fmi3FMUState state = NULL;
     double t = 0;
     while (in->size) {
@@ -106,7 +123,10 @@ static void run3(Input *in) {
         fmi3Int32 i = 0;
         fmi3Int64 e = 0;
         fmi3Boolean b = 0, x1, x2, x3;
-        switch (byte(in) % 18) {
+        fmi3Float64 none[1], next;
+        fmi3Boolean x4, x5;
+        size_t count;
+        switch (byte(in) % 24) {
         case 0: r = real(in); fmi3SetFloat64(c, &vr, 1, &r, 1); break;
         case 1: e = (int8_t)byte(in); fmi3SetInt64(c, &vr, 1, &e, 1); break;
         case 2: b = byte(in) & 1; fmi3SetBoolean(c, &vr, 1, &b, 1); break;
@@ -137,6 +157,17 @@ static void run3(Input *in) {
             }
             break;
         }
+        /* Model Exchange */
+        case 17: fmi3EnterEventMode(c); break;
+        case 18: fmi3UpdateDiscreteStates(c, &x1, &x2, &x3, &x4, (byte(in) & 7) ? &x5 : NULL, &next); break;
+        case 19: fmi3EnterContinuousTimeMode(c); break;
+        case 20: {
+            const double when = (byte(in) & 1) ? real(in) : t + 0.05 * (1 + byte(in) % 8);
+            if (fmi3SetTime(c, when) <= fmi3Warning) t = when;
+            break;
+        }
+        case 21: fmi3CompletedIntegratorStep(c, fmi3True, &x1, &x2); break;
+        case 22: fmi3GetEventIndicators(c, none, byte(in) % 2); fmi3GetNumberOfContinuousStates(c, &count); break;
         default: fmi3SetFloat64(c, &vr, 1, NULL, 1); fmi3DoStep(c, t, 0.1, fmi3True, NULL, NULL, NULL, NULL); break;
         }
     }
@@ -148,6 +179,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     Input in = { data, size };
-    if (byte(&in) & 1) run3(&in); else run2(&in);
+    const uint8_t first = byte(&in);
+    if (first & 1) run3(&in, first & 2); else run2(&in, first & 2);
     return 0;
 }

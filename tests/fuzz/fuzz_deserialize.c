@@ -3,7 +3,8 @@
  * get) without a fault. Built with ASan and UBSan, so any memory or
  * undefined-behaviour fault stops the run. When the first byte is odd the
  * rest gets a valid CRC-32 trailer, so that the fuzzer also reaches the
- * checks behind the checksum (sizes, mode, values). */
+ * checks behind the checksum (sizes, mode, values); its bit 1 makes the
+ * instances Model Exchange ones (an accepted state runs an event update). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,13 +27,15 @@ static void *allocate(size_t n, size_t size) { return calloc(n, size); }
 
 static const fmi2CallbackFunctions callbacks = { logger2, allocate, free, NULL, NULL };
 
-static void run2(const uint8_t *data, size_t size) {
-    fmi2Component c = fmi2Instantiate("fuzz", fmi2CoSimulation, MODEL_TOKEN, "", &callbacks, fmi2False, fmi2False);
+static void run2(const uint8_t *data, size_t size, int modelExchange) {
+    fmi2Component c = fmi2Instantiate("fuzz", modelExchange ? fmi2ModelExchange : fmi2CoSimulation, MODEL_TOKEN, "",
+                                      &callbacks, fmi2False, fmi2False);
     fmi2SetupExperiment(c, fmi2False, 0, 0, fmi2False, 0);
     fmi2EnterInitializationMode(c);
     fmi2ExitInitializationMode(c);
     fmi2DoStep(c, 0.0, 0.1, fmi2True);
     fmi2FMUstate state = NULL;
+    fmi2EventInfo info;
     if (fmi2DeSerializeFMUstate(c, (const fmi2Byte *)data, size, &state) == fmi2OK) {
         if (fmi2SetFMUstate(c, state) == fmi2OK) {
             fmi2Real y;
@@ -40,6 +43,8 @@ static void run2(const uint8_t *data, size_t size) {
             fmi2Real time = 0;
             fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &time);
             fmi2DoStep(c, time, 0.1, fmi2True);
+            fmi2EnterEventMode(c);
+            fmi2NewDiscreteStates(c, &info);
             fmi2GetReal(c, &vr, 1, &y);
         }
         fmi2FreeFMUstate(c, &state);
@@ -51,9 +56,11 @@ static void logger3(fmi3InstanceEnvironment e, fmi3Status s, fmi3String c, fmi3S
     (void)e; (void)s; (void)c; (void)m;
 }
 
-static void run3(const uint8_t *data, size_t size) {
-    fmi3Instance c = fmi3InstantiateCoSimulation("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, fmi3False,
-                                                 fmi3False, NULL, 0, NULL, logger3, NULL);
+static void run3(const uint8_t *data, size_t size, int modelExchange) {
+    fmi3Instance c = modelExchange
+        ? fmi3InstantiateModelExchange("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, NULL, logger3)
+        : fmi3InstantiateCoSimulation("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
+                                      NULL, logger3, NULL);
     fmi3EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0);
     fmi3ExitInitializationMode(c);
     fmi3FMUState state = NULL;
@@ -63,6 +70,9 @@ static void run3(const uint8_t *data, size_t size) {
             fmi3Float64 last, y;
             const fmi3ValueReference vr = fmuModel.outputVr;
             fmi3DoStep(c, 0.0, 0.1, fmi3True, &a, &b, &e, &last);
+            fmi3Boolean n, v, defined;
+            fmi3EnterEventMode(c);
+            fmi3UpdateDiscreteStates(c, &a, &b, &n, &v, &defined, &last);
             fmi3GetFloat64(c, &vr, 1, &y, 1);
         }
         fmi3FreeFMUState(c, &state);
@@ -84,7 +94,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (size == 0) return 0;
-    const int fixChecksum = data[0] & 1;
+    const int fixChecksum = data[0] & 1, modelExchange = data[0] & 2;
     data++;
     size--;
     if (fixChecksum && size >= 4) {
@@ -92,12 +102,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         memcpy(copy, data, size);
         const uint32_t crc = crc32(copy, size - 4);
         for (int i = 0; i < 4; i++) copy[size - 4 + i] = (uint8_t)(crc >> (8 * i));
-        run2(copy, size);
-        run3(copy, size);
+        run2(copy, size, modelExchange);
+        run3(copy, size, modelExchange);
         free(copy);
     } else {
-        run2(data, size);
-        run3(data, size);
+        run2(data, size, modelExchange);
+        run3(data, size, modelExchange);
     }
     return 0;
 }
