@@ -585,7 +585,7 @@ static void serialize(const FmuInstance *instance, const FmuCore *s, unsigned ch
 static bool fmu_mode_possible(const FmuInstance *instance, int mode) {
     const int modes = MODE_INSTANTIATED | MODE_INITIALIZATION | MODE_TERMINATED | instance->errorMode |
                       (instance->modelExchange ? MODE_EVENT | MODE_CONTINUOUS : MODE_STEP);
-    return mode != 0 && (mode & (mode - 1)) == 0 && (mode & modes) != 0;
+    return mode > 0 && (mode & (mode - 1)) == 0 && (mode & modes) != 0; /* > 0: no mode - 1 overflow */
 }
 
 /* Cycle counts stay exact in a double (2^53). */
