@@ -421,12 +421,16 @@ ME_MISUSES = {
     "time before the last event": (lambda f: me_raw(f, "SetTime", [ctypes.c_double], 0.25),
                                    "SetTime: time 0.25 is not finite or before the last event at 0.5"),
     "time NaN": (lambda f: me_raw(f, "SetTime", [ctypes.c_double], math.nan), "SetTime: time nan is not finite"),
-    "continuous states asked for": (lambda f: me_raw(f, "GetContinuousStates", [ctypes.c_void_p, ctypes.c_size_t],
-                                                     (ctypes.c_double * 1)(), 1),
-                                    "GetContinuousStates: this FMU has no continuous states; n = 1, not 0"),
-    "event indicators asked for": (lambda f: me_raw(f, "GetEventIndicators", [ctypes.c_void_p, ctypes.c_size_t],
-                                                    (ctypes.c_double * 2)(), 2),
-                                   "GetEventIndicators: this FMU has no event indicators; n = 2, not 0"),
+    **{f"{function} with n = {n}": (
+        lambda f, function=function, n=n: me_raw(
+            f, function if f.version == 3 or function != "GetContinuousStateDerivatives" else "GetDerivatives",
+            [ctypes.c_void_p, ctypes.c_size_t], (ctypes.c_double * n)(), n),
+        f"this FMU has no {what}; n = {n}, not 0")
+       for function, what, n in (("SetContinuousStates", "continuous states", 1),
+                                 ("GetContinuousStates", "continuous states", 1),
+                                 ("GetContinuousStateDerivatives", "continuous states", 2),
+                                 ("GetNominalsOfContinuousStates", "continuous states", 3),
+                                 ("GetEventIndicators", "event indicators", 2))},
     "event update in Continuous-Time Mode": (
         lambda f: me_raw(f, "NewDiscreteStates" if f.version == 2 else "UpdateDiscreteStates",
                          [ctypes.c_void_p] * (1 if f.version == 2 else 6), *([None] * (1 if f.version == 2 else 6))),
