@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "fmu_core.h"
+#include "fmi_entries.h"
 
 /* Modes each function may be called in: FMI 2.0.4, section 4.2.4 (state
  * machine of a Co-Simulation slave) and section 3.2.3 (Model Exchange).
@@ -79,7 +79,7 @@ typedef struct {
 #define ALWAYS_LOGGED (LOG_ERROR | LOG_WARNING)
 
 #define BEGIN(name)                                                           \
-    FmuInstance *I = (FmuInstance *)c;                                        \
+    FmuInstance *I = (FmuInstance *)instance;                                        \
     static const char FN[] = "fmi2" #name;                                    \
     if (!I) return fmi2Error;                                                 \
     if (!(I->core.mode & (MODES_##name))) return (fmi2Status)fmu_mode_error(I, FN)
@@ -88,6 +88,9 @@ typedef struct {
 #define BEGIN_ONLY(name, fmuType)                                             \
     BEGIN(name);                                                              \
     if (I->modelExchange != ((fmuType) == fmi2ModelExchange)) return (fmi2Status)other_interface(I, FN)
+
+/* a Model Exchange function (fmi_entries.h) */
+#define BEGIN_ME(name) BEGIN_ONLY(name, fmi2ModelExchange)
 
 #define CHECK(expression)                                                     \
     do {                                                                      \
@@ -162,51 +165,33 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     return g;
 }
 
-void fmi2FreeInstance(fmi2Component c) {
-    Fmi2Instance *g = (Fmi2Instance *)c;
+void fmi2FreeInstance(fmi2Component instance) {
+    Fmi2Instance *g = (Fmi2Instance *)instance;
     if (!g) return;
     const fmi2CallbackFreeMemory release = g->functions.freeMemory;
     release((void *)g->instanceName);
     release(g);
 }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
+fmi2Status fmi2SetDebugLogging(fmi2Component instance, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
     BEGIN(SetDebugLogging);
     return (fmi2Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, ALWAYS_LOGGED);
 }
 
-fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+fmi2Status fmi2SetupExperiment(fmi2Component instance, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     (void)toleranceDefined;
     (void)tolerance;
     BEGIN(SetupExperiment);
-    if (stopTimeDefined && !isgreaterequal(stopTime, startTime)) {
-        return (fmi2Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
-    }
-    return (fmi2Status)fmu_setup_experiment(I, FN, startTime);
+    return (fmi2Status)fmu_setup_experiment(I, FN, startTime, stopTimeDefined, stopTime);
 }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+fmi2Status fmi2EnterInitializationMode(fmi2Component instance) {
     BEGIN(EnterInitializationMode);
     return (fmi2Status)fmu_enter_initialization(I);
 }
 
-fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    BEGIN(ExitInitializationMode);
-    return (fmi2Status)fmu_exit_initialization(I);
-}
-
-fmi2Status fmi2Terminate(fmi2Component c) {
-    BEGIN(Terminate);
-    I->core.mode = MODE_TERMINATED;
-    return fmi2OK;
-}
-
-fmi2Status fmi2Reset(fmi2Component c) {
-    BEGIN(Reset);
-    fmu_reset(I);
-    return fmi2OK;
-}
+LIFECYCLE_ENTRIES(fmi2, fmi2Component)
 
 /* ---- variable access ---------------------------------------------------- */
 
@@ -233,7 +218,7 @@ fmi2Status fmi2Reset(fmi2Component c) {
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], FROM_FMI(value[i])); \
         return fmi2OK;                                                        \
     }                                                                         \
-    fmi2Status fmi2Get##NAME(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
+    fmi2Status fmi2Get##NAME(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
         BEGIN(Get##NAME);                                                     \
         double v_;                                                            \
         if (nvr != 1 || !vr || !value) return get_##NAME(I, FN, vr, nvr, value); \
@@ -241,7 +226,7 @@ fmi2Status fmi2Reset(fmi2Component c) {
         value[0] = TO_FMI(v_);                                                \
         return fmi2OK;                                                        \
     }                                                                         \
-    fmi2Status fmi2Set##NAME(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
+    fmi2Status fmi2Set##NAME(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
         BEGIN(Set##NAME);                                                     \
         if (nvr != 1 || !vr || !value) return set_##NAME(I, FN, vr, nvr, value); \
         return fmu_set_one(I, FN, TYPE_MASK, vr[0], FROM_FMI(value[0])) ? fmi2OK : fmi2Error; \
@@ -251,14 +236,14 @@ ACCESSORS(Real, fmi2Real, TYPE_BIT(FMU_REAL), AS_REAL, AS_REAL)
 ACCESSORS(Integer, fmi2Integer, INTEGER_TYPES, AS_INTEGER, AS_REAL)
 ACCESSORS(Boolean, fmi2Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN, BOOLEAN_AS_REAL)
 
-fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+fmi2Status fmi2GetString(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
     BEGIN(GetString);
     CHECK(fmu_check_array(I, FN, nvr, vr, value));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i]));
     return fmi2OK;
 }
 
-fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+fmi2Status fmi2SetString(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
     BEGIN(SetString);
     CHECK(fmu_check_array(I, FN, nvr, vr, value));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i], 0.0));
@@ -267,46 +252,19 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 /* ---- FMU states (fmu_core.c) ---------------------------------------------- */
 
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
-    BEGIN(GetFMUstate);
-    return (fmi2Status)fmu_get_state(I, FN, FMUstate);
-}
-
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
-    BEGIN(SetFMUstate);
-    return (fmi2Status)fmu_set_state(I, FN, FMUstate);
-}
-
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
-    BEGIN(FreeFMUstate);
-    return (fmi2Status)fmu_free_state(I, FN, FMUstate);
-}
-
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
-    BEGIN(SerializedFMUstateSize);
-    return (fmi2Status)fmu_serialized_state_size(I, FN, FMUstate, size);
-}
-
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
-    BEGIN(SerializeFMUstate);
-    return (fmi2Status)fmu_serialize_state(I, FN, FMUstate, (unsigned char *)serializedState, size);
-}
-
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate *FMUstate) {
-    BEGIN(DeSerializeFMUstate);
-    return (fmi2Status)fmu_deserialize_state(I, FN, (const unsigned char *)serializedState, size, FMUstate);
-}
+FMU_STATE_ENTRIES(fmi2, fmi2Component, fmi2FMUstate, fmi2Byte, GetFMUstate, SetFMUstate, FreeFMUstate,
+                  SerializedFMUstateSize, SerializeFMUstate, DeSerializeFMUstate)
 
 /* ---- Co-Simulation -------------------------------------------------------- */
 
-fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+fmi2Status fmi2DoStep(fmi2Component instance, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
     BEGIN(DoStep);
     return (fmi2Status)fmu_do_step(I, FN, currentCommunicationPoint, communicationStepSize);
 }
 
-fmi2Status fmi2CancelStep(fmi2Component c) {
+fmi2Status fmi2CancelStep(fmi2Component instance) {
     BEGIN(CancelStep);
     return fmi2Error; /* unreachable: no mode allows it */
 }
@@ -318,7 +276,7 @@ fmi2Status fmi2CancelStep(fmi2Component c) {
  * is the status kind the getter answers, NO_KIND for none. */
 #define NO_KIND (-1)
 #define STATUS_GETTER(NAME, TYPE, KIND, VALUE)                                \
-    fmi2Status fmi2Get##NAME(fmi2Component c, const fmi2StatusKind s, TYPE *value) { \
+    fmi2Status fmi2Get##NAME(fmi2Component instance, const fmi2StatusKind s, TYPE *value) { \
         BEGIN_ONLY(Get##NAME, fmi2CoSimulation);                              \
         if ((KIND) == NO_KIND || (int)s != (KIND)) return fmi2Discard;        \
         if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL"); \
@@ -335,87 +293,45 @@ STATUS_GETTER(StringStatus, fmi2String, NO_KIND, NULL)
 /* ---- Model Exchange: no continuous states, no event indicators; the cycle
  * ends are time events (fmu_core.h) ------------------------------------- */
 
-fmi2Status fmi2EnterEventMode(fmi2Component c) {
-    BEGIN_ONLY(EnterEventMode, fmi2ModelExchange);
-    I->core.mode = MODE_EVENT;
-    I->core.eventTime = I->core.time;
-    return fmi2OK;
-}
+MODEL_EXCHANGE_ENTRIES(fmi2, fmi2Component, fmi2Real, fmi2Boolean, GetDerivatives)
 
-fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo) {
-    BEGIN_ONLY(NewDiscreteStates, fmi2ModelExchange);
+fmi2Status fmi2NewDiscreteStates(fmi2Component instance, fmi2EventInfo *eventInfo) {
+    BEGIN_ME(NewDiscreteStates);
     if (!eventInfo) return (fmi2Status)fmu_error(I, FN, "the eventInfo pointer is NULL");
-    double next;
-    CHECK(fmu_update_discrete_states(I, FN, &next));
+    bool nextEventTimeDefined;
+    CHECK(fmu_update_discrete_states(I, FN, &nextEventTimeDefined, &eventInfo->nextEventTime));
     eventInfo->newDiscreteStatesNeeded = fmi2False;
     eventInfo->terminateSimulation = fmi2False;
     eventInfo->nominalsOfContinuousStatesChanged = fmi2False;
     eventInfo->valuesOfContinuousStatesChanged = fmi2False;
-    eventInfo->nextEventTimeDefined = isnan(next) ? fmi2False : fmi2True;
-    eventInfo->nextEventTime = isnan(next) ? 0.0 : next;
+    eventInfo->nextEventTimeDefined = nextEventTimeDefined;
     return fmi2OK;
 }
-
-fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
-    BEGIN_ONLY(EnterContinuousTimeMode, fmi2ModelExchange);
-    fmu_leave_instant(I);
-    I->core.mode = MODE_CONTINUOUS;
-    return fmi2OK;
-}
-
-fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
-                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
-    (void)noSetFMUStatePriorToCurrentPoint;
-    BEGIN_ONLY(CompletedIntegratorStep, fmi2ModelExchange);
-    if (!enterEventMode || !terminateSimulation) {
-        return (fmi2Status)fmu_error(I, FN, "an output argument pointer is NULL");
-    }
-    *enterEventMode = fmi2False;
-    *terminateSimulation = fmi2False;
-    return fmi2OK;
-}
-
-fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
-    BEGIN_ONLY(SetTime, fmi2ModelExchange);
-    return (fmi2Status)fmu_set_time(I, FN, time);
-}
-
-#define NO_STATES(NAME, TYPE, WHAT)                                           \
-    fmi2Status fmi2##NAME(fmi2Component c, TYPE array[], size_t n) {          \
-        BEGIN_ONLY(NAME, fmi2ModelExchange);                                  \
-        return (fmi2Status)fmu_check_none(I, FN, WHAT, n, array);             \
-    }
-
-NO_STATES(SetContinuousStates, const fmi2Real, "continuous states")
-NO_STATES(GetContinuousStates, fmi2Real, "continuous states")
-NO_STATES(GetDerivatives, fmi2Real, "continuous states")
-NO_STATES(GetNominalsOfContinuousStates, fmi2Real, "continuous states")
-NO_STATES(GetEventIndicators, fmi2Real, "event indicators")
 
 /* ---- not provided: derivatives ------------------------------------------ */
 
-static fmi2Status unsupported(fmi2Component c, const char *function, const char *what) {
-    if (!c) return fmi2Error;
-    return (fmi2Status)fmu_error((FmuInstance *)c, function, "%s", what);
+static fmi2Status unsupported(fmi2Component instance, const char *function, const char *what) {
+    if (!instance) return fmi2Error;
+    return (fmi2Status)fmu_error((FmuInstance *)instance, function, "%s", what);
 }
 
 #define NO_DERIVATIVES "this FMU provides no derivatives (see the model description)"
 
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component instance, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
     (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown; (void)dvUnknown;
-    return unsupported(c, "fmi2GetDirectionalDerivative", NO_DERIVATIVES);
+    return unsupported(instance, "fmi2GetDirectionalDerivative", NO_DERIVATIVES);
 }
 
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
-    return unsupported(c, "fmi2SetRealInputDerivatives", NO_DERIVATIVES);
+    return unsupported(instance, "fmi2SetRealInputDerivatives", NO_DERIVATIVES);
 }
 
-fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
-    return unsupported(c, "fmi2GetRealOutputDerivatives", NO_DERIVATIVES);
+    return unsupported(instance, "fmi2GetRealOutputDerivatives", NO_DERIVATIVES);
 }

@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
-#include "fmu_core.h"
+#include "fmi_entries.h"
 
 /* Modes each function may be called in: FMI 3.0.2, section 2.3 (common
  * states), 3.2 (Model Exchange) and 4.2 (Co-Simulation without Event
@@ -195,29 +195,11 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
     (void)toleranceDefined;
     (void)tolerance;
     BEGIN(EnterInitializationMode);
-    if (stopTimeDefined && !isgreaterequal(stopTime, startTime)) {
-        return (fmi3Status)fmu_error(I, FN, "stopTime %g is before startTime %g", stopTime, startTime);
-    }
-    CHECK(fmu_setup_experiment(I, FN, startTime));
+    CHECK(fmu_setup_experiment(I, FN, startTime, stopTimeDefined, stopTime));
     return (fmi3Status)fmu_enter_initialization(I);
 }
 
-fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
-    BEGIN(ExitInitializationMode);
-    return (fmi3Status)fmu_exit_initialization(I);
-}
-
-fmi3Status fmi3Terminate(fmi3Instance instance) {
-    BEGIN(Terminate);
-    I->core.mode = MODE_TERMINATED;
-    return fmi3OK;
-}
-
-fmi3Status fmi3Reset(fmi3Instance instance) {
-    BEGIN(Reset);
-    fmu_reset(I);
-    return fmi3OK;
-}
+LIFECYCLE_ENTRIES(fmi3, fmi3Instance)
 
 /* ---- variable access ---------------------------------------------------- */
 
@@ -317,35 +299,8 @@ fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
 
 /* ---- FMU states (fmu_core.c) ---------------------------------------------- */
 
-fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
-    BEGIN(GetFMUState);
-    return (fmi3Status)fmu_get_state(I, FN, FMUState);
-}
-
-fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) {
-    BEGIN(SetFMUState);
-    return (fmi3Status)fmu_set_state(I, FN, FMUState);
-}
-
-fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
-    BEGIN(FreeFMUState);
-    return (fmi3Status)fmu_free_state(I, FN, FMUState);
-}
-
-fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size) {
-    BEGIN(SerializedFMUStateSize);
-    return (fmi3Status)fmu_serialized_state_size(I, FN, FMUState, size);
-}
-
-fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size) {
-    BEGIN(SerializeFMUState);
-    return (fmi3Status)fmu_serialize_state(I, FN, FMUState, serializedState, size);
-}
-
-fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size, fmi3FMUState *FMUState) {
-    BEGIN(DeserializeFMUState);
-    return (fmi3Status)fmu_deserialize_state(I, FN, serializedState, size, FMUState);
-}
+FMU_STATE_ENTRIES(fmi3, fmi3Instance, fmi3FMUState, fmi3Byte, GetFMUState, SetFMUState, FreeFMUState,
+                  SerializedFMUStateSize, SerializeFMUState, DeserializeFMUState)
 
 /* ---- Co-Simulation -------------------------------------------------------- */
 
@@ -370,12 +325,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
 /* ---- Model Exchange: no continuous states, no event indicators; the cycle
  * ends are time events (fmu_core.h) ------------------------------------- */
 
-fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
-    BEGIN_ME(EnterEventMode);
-    I->core.mode = MODE_EVENT;
-    I->core.eventTime = I->core.time;
-    return fmi3OK;
-}
+MODEL_EXCHANGE_ENTRIES(fmi3, fmi3Instance, fmi3Float64, fmi3Boolean, GetContinuousStateDerivatives)
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
                                     fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
@@ -386,52 +336,13 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
         !valuesOfContinuousStatesChanged || !nextEventTimeDefined || !nextEventTime) {
         return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
     }
-    double next;
-    CHECK(fmu_update_discrete_states(I, FN, &next));
+    CHECK(fmu_update_discrete_states(I, FN, nextEventTimeDefined, nextEventTime));
     *discreteStatesNeedUpdate = fmi3False;
     *terminateSimulation = fmi3False;
     *nominalsOfContinuousStatesChanged = fmi3False;
     *valuesOfContinuousStatesChanged = fmi3False;
-    *nextEventTimeDefined = !isnan(next);
-    *nextEventTime = isnan(next) ? 0.0 : next;
     return fmi3OK;
 }
-
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
-    BEGIN_ME(EnterContinuousTimeMode);
-    fmu_leave_instant(I);
-    I->core.mode = MODE_CONTINUOUS;
-    return fmi3OK;
-}
-
-fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
-                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
-    (void)noSetFMUStatePriorToCurrentPoint;
-    BEGIN_ME(CompletedIntegratorStep);
-    if (!enterEventMode || !terminateSimulation) {
-        return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
-    }
-    *enterEventMode = fmi3False;
-    *terminateSimulation = fmi3False;
-    return fmi3OK;
-}
-
-fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
-    BEGIN_ME(SetTime);
-    return (fmi3Status)fmu_set_time(I, FN, time);
-}
-
-#define NO_STATES(NAME, TYPE, WHAT)                                           \
-    fmi3Status fmi3##NAME(fmi3Instance instance, TYPE array[], size_t n) {    \
-        BEGIN_ME(NAME);                                                       \
-        return (fmi3Status)fmu_check_none(I, FN, WHAT, n, array);             \
-    }
-
-NO_STATES(SetContinuousStates, const fmi3Float64, "continuous states")
-NO_STATES(GetContinuousStates, fmi3Float64, "continuous states")
-NO_STATES(GetContinuousStateDerivatives, fmi3Float64, "continuous states")
-NO_STATES(GetNominalsOfContinuousStates, fmi3Float64, "continuous states")
-NO_STATES(GetEventIndicators, fmi3Float64, "event indicators")
 
 #define NUMBER_OF_NONE(NAME)                                                  \
     fmi3Status fmi3GetNumberOf##NAME(fmi3Instance instance, size_t *n) {      \

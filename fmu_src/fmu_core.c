@@ -235,7 +235,11 @@ static void snapshot(FmuInstance *instance, FmuCore *state) {
     *state = instance->core;
 }
 
-FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime) {
+FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime, bool stopTimeDefined,
+                               double stopTime) {
+    if (stopTimeDefined && !isgreaterequal(stopTime, startTime)) {
+        return fmu_error(instance, function, "stopTime %g is before startTime %g", stopTime, startTime);
+    }
     if (!isfinite(startTime)) {
         return fmu_error(instance, function, "startTime %g is not finite", startTime);
     }
@@ -243,6 +247,10 @@ FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, doub
     instance->core.time = startTime;
     instance->core.values[0] = startTime;
     return FMU_OK;
+}
+
+void fmu_terminate(FmuInstance *instance) {
+    instance->core.mode = MODE_TERMINATED;
 }
 
 FmuStatus fmu_enter_initialization(FmuInstance *instance) {
@@ -438,13 +446,25 @@ static FmuStatus run_latched_cycles(FmuInstance *instance, const char *function)
     return status;
 }
 
-FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, double *nextEventTime) {
+void fmu_enter_event_mode(FmuInstance *instance) {
+    instance->core.mode = MODE_EVENT;
+    instance->core.eventTime = instance->core.time;
+}
+
+FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, bool *nextEventTimeDefined,
+                                     double *nextEventTime) {
     FmuCore *core = &instance->core;
     if (run_latched_cycles(instance, function) != FMU_OK) {
         return FMU_ERROR;
     }
-    *nextEventTime = instance->cycleTime > 0 ? cycle_end(core, instance->cycleTime, core->cycles + 1) : NAN;
+    *nextEventTimeDefined = instance->cycleTime > 0;
+    *nextEventTime = *nextEventTimeDefined ? cycle_end(core, instance->cycleTime, core->cycles + 1) : 0.0;
     return report_status(instance);
+}
+
+void fmu_enter_continuous_time_mode(FmuInstance *instance) {
+    fmu_leave_instant(instance);
+    instance->core.mode = MODE_CONTINUOUS;
 }
 
 FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time) {

@@ -235,9 +235,12 @@ static inline bool fmu_set_one(FmuInstance *instance, const char *function, int 
     return true;
 }
 
-RL_LINKAGE FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime);
+/* The experiment's times: a finite start, a stop (if defined) not before it. */
+RL_LINKAGE FmuStatus fmu_setup_experiment(FmuInstance *instance, const char *function, double startTime,
+                                          bool stopTimeDefined, double stopTime);
 RL_LINKAGE FmuStatus fmu_enter_initialization(FmuInstance *instance);
 RL_LINKAGE FmuStatus fmu_exit_initialization(FmuInstance *instance);
+RL_LINKAGE void fmu_terminate(FmuInstance *instance);
 /* currentCommunicationPoint within a relative RL_TIME_TOLERANCE of the
  * FMU's time (finite), whatever the step size (NaN and infinity are not);
  * the difference quiet (rl_sum): a t far from the time raises no
@@ -299,10 +302,15 @@ RL_LINKAGE FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *fu
  * events, and each cycle runs in Event Mode at its end with the values
  * latched when the instant before it was left. */
 
+/* Event Mode entered: an instant at the FMU's time. */
+RL_LINKAGE void fmu_enter_event_mode(FmuInstance *instance);
 /* The event update: the cycles that ended by the FMU's time, with the
- * latched values. *nextEventTime: the next cycle end, NaN if there is none
- * (no valid cycle). */
-RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, double *nextEventTime);
+ * latched values. *nextEventTime: the next cycle end; none (0, and
+ * *nextEventTimeDefined false) without a valid cycle. */
+RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function,
+                                                bool *nextEventTimeDefined, double *nextEventTime);
+/* Continuous-Time Mode entered: the instant is left. */
+RL_LINKAGE void fmu_enter_continuous_time_mode(FmuInstance *instance);
 /* The instant is left (Continuous-Time Mode entered, or the time set anew
  * in Event Mode): its values are those of the next cycle. */
 RL_LINKAGE void fmu_leave_instant(FmuInstance *instance);
