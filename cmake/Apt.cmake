@@ -8,7 +8,10 @@ function(apt_install reason)
   endif()
   list(JOIN ARGN " " packages)
   message(STATUS "${reason}: installing Debian's ${packages}")
-  execute_process(COMMAND sh -c "${APT_GET} update -qq && DEBIAN_FRONTEND=noninteractive ${APT_GET} install -y -qq --no-install-recommends ${packages}"
+  # another configure (the sanitizer tree's, a second build tree) may hold
+  # apt's lock: wait for it rather than fail
+  set(wait "-o DPkg::Lock::Timeout=600")
+  execute_process(COMMAND sh -c "${APT_GET} ${wait} update -qq && DEBIAN_FRONTEND=noninteractive ${APT_GET} ${wait} install -y -qq --no-install-recommends ${packages}"
                   RESULT_VARIABLE failed OUTPUT_QUIET)
   if(failed)
     message(WARNING "apt-get install ${packages} failed")
