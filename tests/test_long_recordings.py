@@ -13,9 +13,11 @@ import pytest
 
 from fmutrace import Exact, Tolerance
 from fmutrace import worker
+from fmutrace.fmu import Fmu
 from fmutrace.longcase import LONG_CASE_BYTES
-from fmutrace.recordings import stream
+from fmutrace.recordings import stream, timebase
 from fmutrace.recordings.case import RecordingOptions
+from fmutrace.runner import Runner
 from fmutrace.worker import run_case, worker_fmu
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
@@ -136,10 +138,14 @@ def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
 
 def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_run_is_closed(tmp_path,
                                                                                                monkeypatch):
-    """Through run_case, streamed first as a long recording is: a skipped
-    cycle found after the FMU ran gives the in-memory path's outcome, and
+    """Through run_case, streamed first as a long recording is: an empty
+    cell found after the FMU ran gives the in-memory path's outcome, and
     the stream's run (run_chunks, suspended at its last chunk) is closed."""
-    path = copy(tmp_path, "tia_portal_siemens.csv", lambda lines: lines[:10] + lines[11:], encoding="cp1252")
+    def empty(lines):
+        lines[12] = lines[12].replace(";4;", ";;")
+        return lines
+
+    path = copy(tmp_path, "tia_portal_siemens.csv", empty, encoding="cp1252")
     fmu_file = fmu_path(BUILD_DIR, "LGF_LimRateOfChangeCI", 3)
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
@@ -161,11 +167,63 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
     assert [d.to_json() for d in first.deviations] == [d.to_json() for d in whole.deviations]
 
 
+def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch):
+    """A skipped cycle, time going backwards, a time cell that is no number
+    (each past the head), a step the head does not show: the pass over the
+    time column refuses the file before the FMU is instantiated (no run,
+    no result file), and run_case gives the in-memory outcome, which names
+    the file, line and column."""
+    def skipped(lines):
+        return lines[:16] + lines[17:]
+
+    def backwards(lines):
+        lines[16], lines[17] = lines[17], lines[16]
+        return lines
+
+    def not_a_number(lines):
+        cells = lines[16].split(";")
+        cells[1] = "12x"
+        lines[16] = ";".join(cells)
+        return lines
+
+    def refused(path, model):
+        """Whether the stream refuses the recording at path with its FMU never instantiated."""
+        fmu_file = fmu_path(BUILD_DIR, model, 3)
+        runner = Runner(fmu_file.read_bytes())  # its own: worker_fmu's are shared
+        fmu = Fmu(str(fmu_file), runner.md)
+        labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
+        written = tmp_path / "result.csv"
+        streamed = stream.run_long_recording(str(path), path.name, runner, fmu, labels, Exact(), "all",
+                                             RecordingOptions(), result_file=str(written), block_bytes=120)
+        return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not written.exists()
+
+    monkeypatch.setattr(stream, "HEAD_BYTES", 400)
+    for edit in (skipped, backwards, not_a_number):
+        path = copy(tmp_path, "tia_portal_siemens.csv", edit, encoding="cp1252")
+        assert len(b"".join(path.read_bytes().splitlines(keepends=True)[:16])) > 400  # the row is past the head
+        assert refused(path, "LGF_LimRateOfChangeCI"), edit.__name__
+    monkeypatch.setattr(worker, "is_long_recording", lambda path: True)
+    fmu_file = fmu_path(BUILD_DIR, "LGF_LimRateOfChangeCI", 3)
+    runner = Runner(fmu_file.read_bytes())
+    fmu = Fmu(str(fmu_file), runner.md)
+    labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
+    outcome = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
+    assert (outcome.status, outcome.streamed, runner.fmu, runner.fast_runs) == ("invalid", False, None, 0)
+    assert outcome.messages == [f"{path}, line 17, column 2: '12x' in column 'Time [ms]' is not a number, TRUE/FALSE "
+                                "or an IEC literal (16#...)"]
+    # the head's rows every 10 ms, the rest every 20 ms: the whole file's median interval is 20 ms
+    rows = [(k * 10, 1.0) for k in range(12)] + [(120 + k * 20, 1.0) for k in range(40)]
+    path = tmp_path / "two_steps.csv"
+    path.write_text("Time [ms];u;y\n" + "".join(f"{t};{u};{u}\n" for t, u in rows))
+    monkeypatch.setattr(stream, "HEAD_BYTES", 120)
+    assert refused(path, "RateLimiter")
+
+
 def test_intervals_median_is_numpys():
     rng = np.random.default_rng(5)
     for n in (1, 2, 3, 10, 11):
         times = np.cumsum(rng.choice([0.01, 0.010000000000000009, 0.009999999999999787, 0.0], n + 1))
-        counted = stream._Intervals()
+        counted = timebase.Intervals()
         for piece in np.array_split(times, 3):
             if len(piece):
                 counted.add(piece)

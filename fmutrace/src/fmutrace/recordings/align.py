@@ -42,7 +42,7 @@ class Aligned:
 
 
 def _cycles_of(channel, step, notes):
-    index, off = cycles(channel, step)
+    index, off = cycles(channel.times, step)
     if len(off):
         i = int(off[0])
         notes.append(off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step))

@@ -8,29 +8,32 @@ FMU); every block of lines after it is cut into cells and converted by the
 same functions (grid.uniform_table, grid.numeric_stamps, text.values), so
 each sample has the in-memory path's bits. Each row is a cycle: its inputs
 drive the step from its cycle, its outputs are compared as align.py lays
-them. The step is the head's finest interval, checked at the end against
-the whole file's (the median of every interval, counted as the blocks go
-by); notes and the failing signals' recorded samples are the in-memory
-path's, word for word (a test runs both on the same recordings).
+them. Before anything runs, one pass over the time column alone applies
+the whole file's rules (_time_column_pass): the step is the head's finest
+interval and must be the whole file's (timebase.Intervals, the rule
+normalise applies in memory), the length one normalise takes, every row
+the cycle after the one before; notes and the failing signals' recorded
+samples are the in-memory path's, word for word (a test runs both on the
+same recordings).
 
 What it takes: one file of a table export in UTF-8 or Windows-1252, a
 separator other than blanks, a time column of numbers (not dates or
 FILETIME integers), every cell filled, lines ending in LF or CR LF, no
 blank line before the end, one row per cycle (no repeated or skipped
 cycle). Anything else raises NotPlain before the outcome is made, and the
-in-memory path reads the file (or explains it): what the head shows at
-once, what the blocks show (a skipped cycle, a bad cell, the last row, the
-whole file's interval) only when they are read, after the FMU ran the
-cycles before them.
+in-memory path reads the file (or explains it): what the head or the time
+column shows before the FMU runs, a bad cell of another column when its
+block is read, after the FMU ran the cycles before it.
 """
 import io
 import os
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError, TraceError
 from ..longcase import LONG_CASE_BYTES, stream_case
-from ..traces import UNUSUAL_LINE_BREAKS, NotPlain, split_cells
+from ..traces import UNUSUAL_LINE_BREAKS, NotPlain
 from . import TEXT_FORMATS, mdf, tables
 from . import grid as grids
 from . import text as texts
@@ -98,11 +101,13 @@ class _Table:
         self.body_start, self.first_line = start, index + 2
         self.columns = {c.name: c.column - 1 for c in recording.channels}
 
-    def blocks(self, block_bytes=None):
+    def blocks(self, block_bytes=None, time_only=False):
         """(first line number, cells, line numbers, times) of each block of
-        rows; cells: a channel's values by table.values(cells, line numbers, name)."""
+        rows; cells: a channel's values by table.values(cells, line numbers,
+        name). time_only: pyarrow converts the time cells alone (the other
+        columns are only split), for the pass over the time column."""
         codec = _CODECS[self.encoding]
-        number, previous = self.first_line, None
+        number = self.first_line
         with open(self.path, "rb") as file:
             file.seek(self.body_start)
             rest, data = b"", b"x"
@@ -118,20 +123,18 @@ class _Table:
                     block = b"\n".join(lines)
                 if not block.strip():
                     continue
-                fast = self._numbers(block)
+                fast = self._numbers(block, time_only)
                 if fast is not None:
                     cells, stamps = fast
                     line_numbers = np.arange(number, number + len(stamps), dtype=np.int64)
                 else:
                     cells, line_numbers, stamps = self._cells(block, codec, number)
-                if (previous is not None and stamps[0] < previous) or (np.diff(stamps) < 0).any():
-                    raise NotPlain("time going backwards")
-                previous = stamps[-1]
                 yield number, cells, line_numbers, timebase._minus(stamps, self.origin) * self.factor
                 number += len(stamps)
 
-    def _numbers(self, block):
-        """(values by column, stamps) of a block whose every cell is a plain
+    def _numbers(self, block, time_only=False):
+        """(values by column, stamps) of a block whose every cell (with
+        time_only: every time cell, the only column converted) is a plain
         number, read by pyarrow; None for any other (the cells are then
         read as the in-memory path reads them). pyarrow converts a decimal
         number correctly rounded, as NumPy's conversion of the cells does:
@@ -144,21 +147,23 @@ class _Table:
         if b"\r" in block and block.count(b"\r") != block.count(b"\r\n"):
             return None
         names = [f"c{j}" for j in range(self.width)]
+        read = [self.time_column] if time_only else range(self.width)
         try:
             table = pcsv.read_csv(
                 io.BytesIO(block),
                 read_options=pcsv.ReadOptions(column_names=names, use_threads=True),
                 parse_options=pcsv.ParseOptions(delimiter=self.separator, quote_char=False, ignore_empty_lines=False),
-                convert_options=pcsv.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
-                                                    strings_can_be_null=False,
+                convert_options=pcsv.ConvertOptions(include_columns=[names[j] for j in read],
+                                                    column_types={names[j]: pa.float64() for j in read},
+                                                    null_values=[], strings_can_be_null=False,
                                                     decimal_point="," if self.decimal_comma else "."))
         except pa.ArrowInvalid:
             return None
-        columns = [table.column(n).to_numpy() for n in names]
+        columns = {j: table.column(names[j]).to_numpy() for j in read}
         stamps = columns[self.time_column]
-        if any(np.isnan(c).any() for c in columns) or (np.abs(stamps) >= 1e15).any():
+        if any(np.isnan(c).any() for c in columns.values()) or (np.abs(stamps) >= 1e15).any():
             return None
-        return {j: c for j, c in enumerate(columns)}, stamps
+        return columns, stamps
 
     def _cells(self, block, codec, number):
         """(cells, line numbers, stamps) of a block as the in-memory path cuts and reads them."""
@@ -199,59 +204,47 @@ class _Table:
         except TraceError:
             raise NotPlain("a cell the in-memory path explains") from None
 
-    def last_time(self):
-        """The time of the last row (its line read from the file's end)."""
-        with open(self.path, "rb") as file:
-            end = file.seek(0, os.SEEK_END)
-            size = 4096
-            while True:
-                begin = max(self.body_start, end - size)
-                file.seek(begin)
-                lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
-                if len(lines) >= 2 or begin == self.body_start:
-                    break
-                size *= 4
-        if not lines:
-            raise NotPlain("no rows")
-        cell = split_cells(lines[-1].decode(_CODECS[self.encoding], "replace"), self.separator)
-        stamp = texts.values(np.array([cell[self.time_column] if len(cell) == self.width else ""]),
-                             self.decimal_comma, texts.Text(self.path, "", self.encoding), lambda i: 0, 0, "")
-        return float(timebase._minus(stamp, self.origin)[0] * self.factor)
-
 
 def _unusual_breaks(text):
     return any(c in text for c in UNUSUAL_LINE_BREAKS) or "\r" in text.replace("\r\n", "")
 
 
-class _Intervals:
-    """The positive intervals between consecutive times, counted by value
-    (a recording's are a handful of values), for their exact median."""
+@dataclass
+class _Cycles:
+    """What the pre-pass over a streamed recording's time column found."""
+    rows: int
+    last: int               # the last row's cycle
+    off: int                # rows stamped more than OFF_CYCLE of a cycle off its end
+    first_off: tuple        # (line, seconds) of the first of them, or None
 
-    def __init__(self):
-        self.counts, self.last = {}, None
 
-    def add(self, times):
-        joined = times if self.last is None else np.concatenate([[self.last], times])
-        self.last = times[-1]
-        steps = np.diff(joined)
-        values, counts = np.unique(steps[steps > 0], return_counts=True)
-        for value, count in zip(values.tolist(), counts.tolist()):
-            self.counts[value] = self.counts.get(value, 0) + count
-        if len(self.counts) > MAX_INTERVALS:
-            raise NotPlain("too many distinct intervals between stamps")
-
-    def median(self):
-        """np.median of all the intervals (None if there are none)."""
-        total = sum(self.counts.values())
-        if not total:
-            return None
-        middle, seen = {}, 0
-        for value in sorted(self.counts):
-            for k in ((total - 1) // 2, total // 2):
-                if seen <= k < seen + self.counts[value]:
-                    middle[k] = value
-            seen += self.counts[value]
-        return float(np.median(np.array(list(middle.values()))))  # one value, or the mean of the two middle ones
+def _time_column_pass(table, step, block_bytes=None):
+    """The whole file's time column read once, before anything runs (only
+    its cells converted), by the rules normalise applies to a whole
+    recording: the step its intervals give (unless one was given) is the
+    head's, its length is no misread unit; and by the stream's own: every
+    row the cycle after the one before. NotPlain otherwise."""
+    recording = table.recording
+    intervals = timebase.Intervals()
+    rows, expected, off, first_off, span = 0, 0, 0, None, 0.0
+    for _, _, line_numbers, times in table.blocks(block_bytes, time_only=True):
+        index, late = timebase.cycles(times, step)
+        if index[0] != expected or (np.diff(index) != 1).any():
+            raise NotPlain("a repeated or skipped cycle")
+        expected = int(index[-1]) + 1
+        if len(late) and first_off is None:
+            first_off = (int(line_numbers[late[0]]), float(times[late[0]]))
+        off += len(late)
+        rows, span = rows + len(times), float(times[-1])
+        if not table.step_given:
+            intervals.add(times)
+            if len(intervals.values) > MAX_INTERVALS:
+                raise NotPlain("too many distinct intervals between stamps")
+    if not table.step_given and timebase.snapped_interval(intervals.median() or step) != step:
+        raise NotPlain("the whole file's interval is another step than its head's")
+    if timebase.too_long(span) or timebase.too_many_steps(span / step, rows, recording.time_source):
+        raise NotPlain("the in-memory path refuses the length")
+    return _Cycles(rows, expected - 1, off, first_off)
 
 
 def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, result_file=None, progress=None,
@@ -271,36 +264,24 @@ def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, re
             return None
         step = recording.step_size
         shift = 1 if options.timing == "cycle" else 0
-        last = int(np.rint(table.last_time() / step))
+        cycles = _time_column_pass(table, step, block_bytes)
         start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     except (NotPlain, InputError, OSError, ValueError):
         return None
     drives, compares = matched.drives, matched.compares
-    stop = max(last + shift, 1) * step
-    state = {"rows": 0, "next": 0, "off": 0, "first_off": None, "span": 0.0}
-    intervals = _Intervals()
+    stop = max(cycles.last + shift, 1) * step
     pending = {"inputs": [], "refs": []}
+    row = 0  # the next block's first row, which is its cycle (_time_column_pass)
 
     def parse():
         """Reads the next block into both queues; False at the end."""
+        nonlocal row
         block = next(blocks, None)
         if block is None:
-            _finish()
             return False
         _, cells, line_numbers, times = block
-        exact = times / step
-        index = np.rint(exact).astype(np.int64)
-        if index[0] != state["next"] or (np.diff(index) != 1).any():
-            raise NotPlain("a repeated or skipped cycle")
-        state["next"] = int(index[-1]) + 1
-        off = np.flatnonzero(np.abs(exact - index) > timebase.OFF_CYCLE)
-        if len(off) and state["first_off"] is None:
-            state["first_off"] = (int(line_numbers[off[0]]), float(times[off[0]]))
-        state["off"] += len(off)
-        state["rows"] += len(times)
-        state["span"] = float(times[-1])
-        if not table.step_given:
-            intervals.add(times)
+        index = np.arange(row, row + len(times))
+        row += len(times)
         if drives:
             chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
             chunk["time"] = index * step
@@ -313,18 +294,6 @@ def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, re
             chunk[variable] = table.values(cells, line_numbers, channel.name)
         pending["refs"].append(chunk)
         return True
-
-    def _finish():
-        """The whole file's checks, as normalise() and align() make them."""
-        if state["next"] - 1 != last:
-            raise NotPlain("the last row is not the last cycle")
-        if not table.step_given and timebase.snapped_interval(intervals.median() or step) != step:
-            raise NotPlain("the whole file's interval is another step than its head's")
-        span, samples = state["span"], state["rows"]
-        steps = span / step
-        if span > timebase.MAX_SPAN or steps > timebase.MAX_STEPS or \
-                (steps > timebase.MAX_SPARSE * samples and recording.time_source != "--time-unit"):
-            raise NotPlain("the in-memory path refuses the length")
 
     def queue(kind):
         while True:
@@ -339,13 +308,13 @@ def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, re
 
     def more_messages(passed, deviations):
         notes = []
-        if state["off"]:
-            line, time = state["first_off"]
-            notes = [off_cycle_note(channel.name, state["off"], state["rows"], f"{table.path}, line {line}", time,
-                                    step) for _, channel in drives + compares]
+        if cycles.off:
+            line, time = cycles.first_off
+            notes = [off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
+                     for _, channel in drives + compares]
         notes += matched.describe()
         unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
-        description = (f"{recording.format}: {state['rows']} samples, time as {unit} ({recording.time_source}), "
+        description = (f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
                        f"step {step:g} s ({recording.step_source})")
         if passed:
             return [description] + notes

@@ -161,7 +161,7 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
         channel.times = _minus(channel.stamps, origin) * factor
     span = max(float(c.times[-1]) for c in channels)
     assumed = (f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit])
-    if span > MAX_SPAN:
+    if too_long(span):
         raise InputError(f"{recording.label}: with its time read as {assumed}, the recording would span "
                          f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give --time-unit "
                          "(s, ms, us, ns, cycles, filetime)")
@@ -182,7 +182,7 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
             recording.step_size, recording.step_source = step, source
     steps = span / recording.step_size
     samples = max(len(c.times) for c in channels)
-    if steps > MAX_STEPS or (steps > MAX_SPARSE * samples and recording.time_source != "--time-unit"):
+    if too_many_steps(steps, samples, recording.time_source):
         raise InputError(f"{recording.label}: with its time read as {assumed} and a step of "
                          f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
                          f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit "
@@ -199,17 +199,53 @@ def _minus(stamps, origin):
     return stamps.astype(np.float64) - float(origin)
 
 
+def too_long(span):
+    """Whether a recording span seconds long is a misread unit."""
+    return span > MAX_SPAN
+
+
+def too_many_steps(steps, samples, time_source):
+    """Whether so many steps for so many samples is a misread unit (or
+    step), unless --time-unit (time_source) said the unit."""
+    return steps > MAX_STEPS or (steps > MAX_SPARSE * samples and time_source != "--time-unit")
+
+
+class Intervals:
+    """The positive intervals between consecutive times of a time column,
+    given whole or block by block, counted by value (a recorder's are a
+    handful of values): their exact median without keeping them all."""
+
+    def __init__(self, times=None):
+        self.values, self.counts, self.last = np.empty(0), np.empty(0, dtype=np.int64), None
+        if times is not None:
+            self.add(times)
+
+    def add(self, times):
+        if not len(times):
+            return
+        joined = times if self.last is None else np.concatenate([[self.last], times])
+        self.last = times[-1]
+        steps = np.diff(joined)
+        values, counts = np.unique(steps[steps > 0], return_counts=True)
+        self.values, at = np.unique(np.concatenate([self.values, values]), return_inverse=True)
+        merged = np.zeros(len(self.values), dtype=np.int64)
+        np.add.at(merged, at, np.concatenate([self.counts, counts]))
+        self.counts = merged
+
+    def median(self):
+        """np.median of all the intervals (None if there are none)."""
+        total = int(self.counts.sum())
+        if not total:
+            return None
+        middle = np.searchsorted(np.cumsum(self.counts), [(total - 1) // 2, total // 2], side="right")
+        return float(np.median(self.values[middle]))  # one value twice, or the two middle ones: their mean
+
+
 def finest_interval(channels):
     """The smallest of the channels' typical (median) positive intervals
     between samples, in seconds; None if no channel has two samples."""
-    best = None
-    for channel in channels:
-        steps = np.diff(channel.times)
-        steps = steps[steps > 0]
-        if len(steps):
-            typical = float(np.median(steps))
-            best = typical if best is None else min(best, typical)
-    return None if best is None else snapped_interval(best)
+    medians = [m for m in (Intervals(channel.times).median() for channel in channels) if m is not None]
+    return snapped_interval(min(medians)) if medians else None
 
 
 def snapped_interval(best):
@@ -223,10 +259,10 @@ def snapped_interval(best):
     return best
 
 
-def cycles(channel, step):
-    """(cycle index of each sample, indices of samples whose stamp is off
-    its cycle end by more than OFF_CYCLE of a cycle)."""
-    exact = channel.times / step
+def cycles(times, step):
+    """(cycle index of each time, indices of those off their cycle end by
+    more than OFF_CYCLE of a cycle)."""
+    exact = times / step
     index = np.rint(exact).astype(np.int64)
     off = np.flatnonzero(np.abs(exact - index) > OFF_CYCLE)
     return index, off
