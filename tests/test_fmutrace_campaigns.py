@@ -1,9 +1,11 @@
 """Campaigns that lose nothing: results journaled as each case finishes, a
 killed client resumed without recomputing, a second campaign into the same
 report folder refused, a Dask worker killed in the middle."""
+import contextlib
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -307,10 +309,12 @@ WORKER_LOOPS = ("(__import__('fmutrace.runner').runner.__file__, "
                 "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])")
 
 
-def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch):
+def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch, recwarn):
     """A local cluster's workers share this environment: they import the
     installed fmutrace, with its compiled _steps, not an uploaded zip of
-    its Python sources (where the C loop cannot be imported)."""
+    its Python sources (where the C loop cannot be imported). Its
+    scheduler starts no dashboard and leaves port 8787 alone (held here
+    while it runs): no warning that the port is in use."""
     from fmutrace import executors
 
     reports = {}
@@ -323,7 +327,12 @@ def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeyp
 
     monkeypatch.setattr(executors.Dask, "_run", run_and_ask_the_workers)
     cases = pass_through_cases(tmp_path / "cases", 40)
-    result = fmutrace.compare(PASS_THROUGH, cases, jobs=2, plots="none")
+    with socket.socket() as dashboard_port:
+        with contextlib.suppress(OSError):  # (taken already: just as well)
+            dashboard_port.bind(("127.0.0.1", 8787))
+            dashboard_port.listen()
+        result = fmutrace.compare(PASS_THROUGH, cases, jobs=2, plots="none")
+    assert not [str(w.message) for w in recwarn if "8787" in str(w.message)]
     assert result.passed and len(result.cases) == 40 and "Dask, 2 workers" in result.where, result.summary()
     assert len(reports) == 2, reports
     for source, runners in reports.values():

@@ -159,8 +159,11 @@ class Dask(Executor):
             # a task whose worker dies is not tried on others: the batch is run isolated instead (_run)
             # (silent: a worker's death is reported by the campaign)
             with dask.config.set(LOCAL_CLUSTER):
+                # no dashboard, and the scheduler's HTTP server (health, metrics) on a free loopback port:
+                # dashboard_address=None alone still takes port 8787 (and warns where that is in use)
                 cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.CRITICAL)
+                                       dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                                       silence_logs=logging.CRITICAL)
             return cluster, Client(cluster)
         except Exception:
             if cluster is not None:
