@@ -236,31 +236,44 @@ class _InputRows:
         return set_at, setters
 
 
-def _values_call(fmi3, component, function, vrs, count):
-    """call(pointer) -> status: function, an FMI Set or Get, on count values
-    at pointer. FMI 3's takes the number of values too (count: scalars);
-    the version is decided here, once per call made."""
-    if fmi3:
-        return lambda pointer: function(component, vrs, count, pointer, count)
-    return lambda pointer: function(component, vrs, count, pointer)
+class _Fmi2Calls:
+    """How the step loop calls an FMI 2 FMU (a Runner picks its version's once)."""
+    fmi_version = 2  # fmutrace_steps' first argument: its loop for this version
 
+    @staticmethod
+    def values(component, function, vrs, count):
+        """call(pointer) -> status: function, an FMI Set or Get, on count values at pointer."""
+        return lambda pointer: function(component, vrs, count, pointer)
 
-def _step_call(fmi3, do_step, component, flags):
-    """step(t, h) -> status of doStep; an FMI 3 step that asks to terminate
-    or returns early counts as an Error (the loop stops after its getters)."""
-    if not fmi3:
+    @staticmethod
+    def step(do_step, component, flags):
+        """step(t, h) -> status of doStep."""
         return lambda t, h: do_step(component, t, h, 1)
-    event, terminate, early, last = flags
-
-    def step(t, h):
-        status = do_step(component, t, h, True, event, terminate, early, last)
-        return 3 if terminate[0] or early[0] else status
-    return step
 
 
-def _setter_calls(fmi3, component, setters):
+class _Fmi3Calls:
+    """How the step loop calls an FMI 3 FMU: Set and Get take the number
+    of values too (count: scalars); a step that asks to terminate or
+    returns early counts as an Error (the loop stops after its getters)."""
+    fmi_version = 3
+
+    @staticmethod
+    def values(component, function, vrs, count):
+        return lambda pointer: function(component, vrs, count, pointer, count)
+
+    @staticmethod
+    def step(do_step, component, flags):
+        event, terminate, early, last = flags
+
+        def step(t, h):
+            status = do_step(component, t, h, True, event, terminate, early, last)
+            return 3 if terminate[0] or early[0] else status
+        return step
+
+
+def _setter_calls(calls, component, setters):
     """(call, a pointer to each row) of every setter (function, value references, count, rows)."""
-    return [(_values_call(fmi3, component, function, vrs, count), _row_pointers(values))
+    return [(calls.values(component, function, vrs, count), _row_pointers(values))
             for function, vrs, count, values in setters]
 
 
@@ -272,14 +285,15 @@ def _set_row(calls, row):
     return status
 
 
-def _steps_python(fmi3, do_step, component, times, sizes, set_at, setters, getters, flags):
+def _steps_python(calls, do_step, component, times, sizes, set_at, setters, getters, flags):
     """Per step: the inputs where they change, doStep, one get per output
     type into the step's row; False as soon as a call fails (or an FMI 3
     step asks to terminate or returns early). getters: (function, value
-    references, count, a pointer to each step's row)."""
-    set_calls = _setter_calls(fmi3, component, setters)
-    get_calls = [(_values_call(fmi3, component, function, vrs, count), rows) for function, vrs, count, rows in getters]
-    step = _step_call(fmi3, do_step, component, flags)
+    references, count, a pointer to each step's row); calls: the FMU's
+    version's _Fmi2Calls or _Fmi3Calls."""
+    set_calls = _setter_calls(calls, component, setters)
+    get_calls = [(calls.values(component, function, vrs, count), rows) for function, vrs, count, rows in getters]
+    step = calls.step(do_step, component, flags)
     for t, h, row, k in zip(times.tolist(), sizes.tolist(), set_at.tolist(), itertools.count()):
         if row >= 0 and _set_row(set_calls, row) > 1:
             return False
@@ -300,7 +314,7 @@ def _call_table(calls):
     return table
 
 
-def _steps_c(fmi3, do_step, component, times, sizes, set_at, setters, getters):
+def _steps_c(calls, do_step, component, times, sizes, set_at, setters, getters):
     """_steps_python's loop in C (_steps.c): the same calls in the same order."""
     setter_table = _call_table([(f, vrs, n, values, FFI.cast("char *", values.ctypes.data))
                                 for f, vrs, n, values in setters])
@@ -308,7 +322,7 @@ def _steps_c(fmi3, do_step, component, times, sizes, set_at, setters, getters):
     times = np.ascontiguousarray(times, dtype=np.float64)
     sizes = np.ascontiguousarray(sizes, dtype=np.float64)
     set_at = np.ascontiguousarray(set_at, dtype=np.int64)
-    done = C_STEPS(int(fmi3), FFI.cast("void (*)(void)", do_step), component,
+    done = C_STEPS(calls.fmi_version, FFI.cast("void (*)(void)", do_step), component,
                    FFI.cast("double *", times.ctypes.data), FFI.cast("double *", sizes.ctypes.data), len(times),
                    FFI.cast("long long *", set_at.ctypes.data), setter_table, len(setters), getter_table,
                    len(getters))
@@ -322,6 +336,7 @@ class Runner:
         self.folder, self.md = unpacked(fmu_bytes)
         self.fmi3 = self.md.fmiVersion.startswith("3")
         self.types = FMI3_TYPES if self.fmi3 else FMI2_TYPES
+        self.calls = _Fmi3Calls if self.fmi3 else _Fmi2Calls
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.order = {v.name: i for i, v in enumerate(self.md.modelVariables)}
         self.variable_step = bool(self.md.coSimulation.canHandleVariableCommunicationStepSize)
@@ -345,6 +360,7 @@ class Runner:
             self._do_step = getattr(self._lib, f"{prefix}DoStep")
             component = self.fmu.component
             self._component = FFI.cast("void *", component.value if isinstance(component, c_void_p) else component)
+            self._step_flags = None  # FMI 3's doStep returns these beside its status
             if self.fmi3:
                 flags = FFI.new("bool[3]")  # eventHandlingNeeded, terminateSimulation, earlyReturn
                 self._step_flags = flags, flags + 1, flags + 2, FFI.new("double *")  # and lastSuccessfulTime
@@ -490,8 +506,7 @@ class Runner:
             fmu = self._instance()
         n = round((stop - start) / step)
         size = min(n, steps_per_chunk)
-        component = self._component
-        fmi3 = self.fmi3
+        component, calls = self._component, self.calls
 
         # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
         getters, columns = [], [("time", np.float64)]
@@ -509,13 +524,13 @@ class Runner:
             chunk["time"] = times
             for _, _, _, _, values, variables, kind in getters:
                 for i, v in enumerate(variables):
-                    chunk[v.name] = values[rows, i] != 0 if kind == "Boolean" and not fmi3 else values[rows, i]
+                    chunk[v.name] = values[rows, i] != 0 if kind == "Boolean" and not self.fmi3 else values[rows, i]
             return chunk
 
         with _quiet():
             first = inputs.first(start) if inputs is not None else None
             try:
-                if fmi3:
+                if self.fmi3:
                     remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
                     fmu.enterInitializationMode(tolerance=tolerance, startTime=start, stopTime=stop)
                 else:
@@ -523,7 +538,7 @@ class Runner:
                     remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
                     fmu.enterInitializationMode()
                 remaining = apply_start_values(fmu, self.md, remaining, settable=settable_in_initialization_mode)
-                if remaining or (first is not None and _set_row(_setter_calls(fmi3, component, first), 0) > 1):
+                if remaining or (first is not None and _set_row(_setter_calls(calls, component, first), 0) > 1):
                     raise FastLoopFailed("a start value or an input was refused")
                 fmu.exitInitializationMode()
             except FastLoopFailed:
@@ -532,7 +547,7 @@ class Runner:
                 raise FastLoopFailed(str(error)) from None
             status = 0
             for function, vrs, count, pointers, _, _, _ in getters:
-                status |= _values_call(fmi3, component, function, vrs, count)(pointers[0])
+                status |= calls.values(component, function, vrs, count)(pointers[0])
             if status > 1:
                 raise FastLoopFailed("a getter failed")
         pending = result(slice(0, 1), [start])  # the start's row goes out with the first chunk
@@ -546,14 +561,14 @@ class Runner:
                 else:
                     set_at, setters = np.full(m, -1, dtype=np.int64), []
                 if self.c_loop:
-                    done = _steps_c(fmi3, self._do_step, component, step_times, step_sizes, set_at, setters,
+                    done = _steps_c(calls, self._do_step, component, step_times, step_sizes, set_at, setters,
                                     [(function, vrs, count, values, pointers[1])
                                      for function, vrs, count, pointers, values, _, _ in getters])
                 else:
-                    done = _steps_python(fmi3, self._do_step, component, step_times, step_sizes, set_at, setters,
+                    done = _steps_python(calls, self._do_step, component, step_times, step_sizes, set_at, setters,
                                          [(function, vrs, count, pointers[1:m + 1])
                                           for function, vrs, count, pointers, _, _, _ in getters],
-                                         self._step_flags if fmi3 else None)
+                                         self._step_flags)
                 if not done:
                     raise FastLoopFailed("a step failed")
             chunk = result(slice(1, m + 1), times[1:])
