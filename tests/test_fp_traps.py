@@ -168,3 +168,27 @@ def test_hostile_values_raise_no_floating_point_exception(model, version, interf
     others = [script_lines[n - 1] for n in sorted(refused - must_refuse)]
     assert all(line.startswith("step") for line in others), others[:5]
     assert len(lines) > len(refused)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_per_cycle_limit_at_the_top_of_binary32_keeps_a_real_ramp_off_the_common_step(sign, version, tmp_path):
+    """RateLimit (REAL) at 1 s cycles, 3e38 per s the way the ramp goes and
+    1 per s the other: y + maxUp (or y - maxDown) of a steady ramp from
+    |y| = 6e37 is beyond binary32's largest value, so the unchecked common
+    step would overflow as it rounds to binary32 (RL_STEADY_BELOW,
+    rate_limiter.h). Trapped, the block takes the general step, and each y
+    is u, less than one cycle's limit away, rounded to binary32."""
+    import numpy as np
+    stage, md = staged("RateLimit", version)
+    by_name = {v.name: v for v in md.modelVariables}
+    up, down = (3e38, 1.0) if sign > 0 else (1.0, 3e38)
+    inputs = [0.0, sign * 6e37, sign * 7e37]
+    lines = ["new", value_line(by_name["UpRatePar"], up), value_line(by_name["DownRatePar"], down),
+             value_line(by_name["In"], inputs[0]), "init 0x0p+0"]
+    for k, u in enumerate(inputs):
+        lines += [value_line(by_name["In"], u), f"step {float(k).hex()} {1.0.hex()}",
+                  f"get F {by_name['Out'].valueReference}"]
+    outputs = run_script(PLATFORM[version], stage, "RateLimit", md.guid, "\n".join(lines) + "\n", tmp_path,
+                         f"RateLimit (FMI {version}) at binary32's top", options=TRAPS[version])
+    assert [float.fromhex(y) for y in outputs] == [float(np.float32(u)) for u in inputs]
