@@ -695,6 +695,12 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
         !(isgreaterequal(s.block.runBase, 0) && islessequal(s.block.runBase, DBL_MAX))) {
         return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
     }
+    /* Event Mode is an instant: entering it, SetTime in it and the end of
+     * initialisation make the time that of the event (fmu_set_time relies on it) */
+    if (s.mode == MODE_EVENT && s.time != s.eventTime) {
+        return fmu_error(instance, function, "serialized state is in Event Mode at time %.17g, not at its event's %.17g",
+                         s.time, s.eventTime);
+    }
     *out = s;
     return FMU_OK;
 }

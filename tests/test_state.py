@@ -433,6 +433,49 @@ def test_a_state_taken_in_terminated_is_accepted_and_restores_terminated(version
     fmu.free()
 
 
+EVENT_TIME_OFFSET = -20  # the last event's time, then mode, reported status, CRC
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_state_in_event_mode_at_a_time_other_than_its_events_is_refused(version):
+    """Event Mode is an instant: entering it, SetTime in it and the end of
+    initialisation make the time the event's, and SetTime's test for a new
+    instant relies on it. Bytes that claim Event Mode at a later or an
+    earlier time are refused; Continuous-Time Mode after the event is what
+    a run makes, and is accepted."""
+    fmu = Instance("RateLimiter", version, model_exchange=True)
+    api = state_api(fmu)
+    update = fmu.fmu.newDiscreteStates if version == 2 else fmu.fmu.updateDiscreteStates
+    fmu.start(cycleTime=0.25)
+    update()
+    fmu.fmu.enterContinuousTimeMode()
+    fmu.fmu.setTime(0.25)
+    fmu.fmu.enterEventMode()
+    update()
+    good = api["get"]()
+    in_event = bytes(api["serialize"](good))
+    time_at = values_end(in_event) + BLOCK + 8
+    assert struct.unpack_from("<d", in_event, time_at)[0] == 0.25
+    assert struct.unpack_from("<d", in_event, len(in_event) + EVENT_TIME_OFFSET)[0] == 0.25
+    fmu.fmu.enterContinuousTimeMode()
+    fmu.fmu.setTime(0.4)
+    in_continuous = bytes(api["serialize"](api["get"]()))
+    name = STATE_FUNCTIONS[version]["deserialize"]
+    for time in (0.4, 0.1):
+        assert call_status(api["deserialize"], value_at(in_event, time_at, struct.pack("<d", time))) == 3
+        assert fmu.errors()[-1][2] == (f"{name}: serialized state is in Event Mode at time {time:.17g}, "
+                                       "not at its event's 0.25")
+        fmu.restore(good, 0.25)
+    assert len(fmu.errors()) == 2
+    for data in (in_event, in_continuous):
+        state = api["deserialize"](data)
+        api["set"](state)
+        api["free"](state)
+    assert fmu.get("time") == 0.4 and len(fmu.errors()) == 2
+    api["free"](good)
+    fmu.free()
+
+
 def fnv1a(text):
     h = 2166136261
     for byte in text.encode():
