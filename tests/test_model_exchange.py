@@ -15,7 +15,7 @@ from fmpy.fmi2 import FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 from fmpy import calloc, free, read_model_description
 
-from support.fmu_driver import MODELS, fmu_file, unzipped
+from support.fmu_driver import MODELS, Instance, fmu_file, unzipped
 from support.scenarios import discover, same, simulate
 
 SCENARIOS = discover()
@@ -158,6 +158,33 @@ def test_a_cycle_runs_with_the_inputs_latched_at_the_previous_cycle_end(version)
         assert fmu.update() == (True, 2.0) and fmu.get("y") == 1.0
     finally:
         fmu.free()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_tunable_rate_changed_at_an_instant_acts_from_the_next_cycle_either_way(version):
+    """rateUpPar set at the instant 0.5 from 3 down to 2 (its bytes compare
+    below the latched ones) and at 1.5 up to 3 again: each acts from the
+    cycle that ends at the next instant on, as Co-Simulation's set before
+    the step does (cycles of 0.5 s towards u = 100: 1.5 a cycle at 3 per s,
+    1 at 2 per s)."""
+    sets = {0: {"u": 100.0}, 1: {"rateUpPar": 2.0}, 3: {"rateUpPar": 3.0}}  # at instant n, time 0.5 n
+    me, cs = MeInstance("RateLimiter", version), Instance("RateLimiter", version)
+    try:
+        me.start(cycleTime=0.5, rateUpPar=3.0)
+        cs.start(cycleTime=0.5, rateUpPar=3.0)
+        me_y, cs_y = [], [cs.get("y")]
+        for n in range(7):
+            me.set(**sets.get(n, {}))
+            cs.set(**sets.get(n, {}))
+            assert me.update() == (True, 0.5 * (n + 1))
+            me_y.append(me.get("y"))
+            me.to_event(0.5 * (n + 1))
+            cs.step(0.5)
+            cs_y.append(cs.get("y"))
+        assert me_y == cs_y[:7] == [0.0, 1.5, 2.5, 3.5, 5.0, 6.5, 8.0]
+    finally:
+        me.free()
+        cs.free()
 
 
 @pytest.mark.parametrize("version", [2, 3])
