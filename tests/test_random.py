@@ -70,9 +70,9 @@ steps = st.lists(st.tuples(st.sampled_from([0.05, 0.1, 0.25, 0.3, 0.5, 1.0]), ch
 cycle_times = st.sampled_from([0.0, 0.0, 0.1, 0.25, 0.05, -1.0])
 # TIME pins hold whole milliseconds: 2.5 ms is 2, 0.4 ms is T#0s
 times = st.sampled_from([0.0, 0.3, 1.0, 2.0, 10.0, 0.0025, 0.0004, 0.3005, 1.0015])
-# RateLimiterStatic: RateLimiter's parameters, and its inputs u, bypass, hold
+# RateLimiterStatic: RateLimiter's parameters in either arithmetic, and its inputs u, bypass, hold
 static_parameters = {"rateUpNeg": st.one_of(st.just(nan), rates), "rateDownNeg": st.one_of(st.just(nan), rates),
-                     "bypass": st.booleans(), "hold": st.booleans()}
+                     "bypass": st.booleans(), "hold": st.booleans(), "arithmetic": st.sampled_from([LREAL, REAL])}
 VENDOR_STRATEGIES = {
     "RateLimiterStatic": (
         st.fixed_dictionaries({**PARAMETERS, **static_parameters}),
