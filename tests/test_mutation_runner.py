@@ -40,6 +40,16 @@ def test_an_entry_names_a_mutant_by_its_line_or_also_by_the_lines_above(tmp_path
     assert mutant("} else {", "}  {", ["b = 2;"]).proof(equivalents) is None
 
 
+def test_an_entry_with_several_spellings_gives_each_its_proof(tmp_path):
+    path = tmp_path / "list.txt"
+    path.write_text("fmu_src/fmu_core.c\n  - x = y - 1;\n  + x = y * 1;\n  + x = y / 1;\n  why: both read y.\n")
+    equivalents = read_equivalents(path)
+    assert len(equivalents) == 2
+    assert mutant("x = y - 1;", "x = y * 1;").proof(equivalents) == "both read y."
+    assert mutant("x = y - 1;", "x = y / 1;").proof(equivalents) == "both read y."
+    assert mutant("x = y - 1;", "x = y - 0;").proof(equivalents) is None
+
+
 def test_a_list_entry_without_its_lines_is_refused(tmp_path):
     path = tmp_path / "list.txt"
     path.write_text("fmu_src/fmu_core.c\n  + x = 1;\n  why: no '-' line.\n")

@@ -158,7 +158,8 @@ def generate(file, work, venv_bin):
 
 
 def read_equivalents(path=None):
-    """{key: proof}: blocks of 'file', '- before', '+ after', 'why: proof'."""
+    """{key: proof}: blocks of 'file', '- before', '+ after' (one or more: the
+    spellings of one mutant share its proof), 'why: proof'."""
     path = path or EQUIVALENTS
     entries, block = {}, {}
     for number, line in enumerate(path.read_text().splitlines(), 1):
@@ -167,17 +168,18 @@ def read_equivalents(path=None):
         if line.startswith("  - "):
             block["before"] = line[4:]
         elif line.startswith("  + "):
-            block["after"] = line[4:]
+            block.setdefault("after", []).append(line[4:])
         elif line.startswith("  above: "):  # each one line further up
             block.setdefault("above", []).append(line[9:].strip())
         elif line.startswith("  why: "):
             if not {"file", "before", "after"} <= set(block) <= {"file", "before", "after", "above"}:
                 raise SystemExit(f"{path}:{number}: 'why:' without its file, '-' and '+' lines")
-            key = " | ".join([f"{block['file']} | {block['before'].strip()} | {block['after'].strip()}"] +
-                             block.get("above", []))
-            if key in entries:
-                raise SystemExit(f"{path}:{number}: this mutant is listed already")
-            entries[key] = line[7:]
+            for after in block["after"]:
+                key = " | ".join([f"{block['file']} | {block['before'].strip()} | {after.strip()}"] +
+                                 block.get("above", []))
+                if key in entries:
+                    raise SystemExit(f"{path}:{number}: this mutant is listed already")
+                entries[key] = line[7:]
             block = {}
         elif not line.startswith(" "):
             block = {"file": line.strip()}
