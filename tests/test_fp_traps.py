@@ -15,6 +15,7 @@ import math
 import os
 import sys
 
+import numpy as np
 import pytest
 from fmpy import read_model_description
 
@@ -179,7 +180,6 @@ def test_a_per_cycle_limit_at_the_top_of_binary32_keeps_a_real_ramp_off_the_comm
     step would overflow as it rounds to binary32 (RL_STEADY_BELOW,
     rate_limiter.h). Trapped, the block takes the general step, and each y
     is u, less than one cycle's limit away, rounded to binary32."""
-    import numpy as np
     stage, md = staged("RateLimit", version)
     by_name = {v.name: v for v in md.modelVariables}
     up, down = (3e38, 1.0) if sign > 0 else (1.0, 3e38)

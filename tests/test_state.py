@@ -167,6 +167,7 @@ def values_end(d):
 
 BLOCK = 8 + 8 + 8 + 1 + 8 + 8 + 8  # y, uPrevious, yPrevious, decided, runCycles, runPeriod, runBase
 MODE_OFFSET = -12  # mode, reported status, CRC at the end
+EVENT_TIME_OFFSET = MODE_OFFSET - 8  # the last event's time, just before the mode
 ERROR_MODE = 16  # FMI 2's Error state, as the core numbers its modes
 
 BAD_BYTES = {
@@ -431,9 +432,6 @@ def test_a_state_taken_in_terminated_is_accepted_and_restores_terminated(version
     finally:
         fresh.release()
     fmu.free()
-
-
-EVENT_TIME_OFFSET = -20  # the last event's time, then mode, reported status, CRC
 
 
 @pytest.mark.parametrize("version", [2, 3])
