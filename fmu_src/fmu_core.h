@@ -286,7 +286,7 @@ static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function,
 
 RL_LINKAGE const char *fmu_mode_name(int mode);
 
-/* ---- for Model Exchange and FMU states (fmu_model_exchange.c, fmu_state.c) */
+/* ---- shared with Model Exchange (fmu_model_exchange.c) ------------------ */
 
 /* The kernel's configuration from the current values (the outputs of the
  * last cycle published first: they need its configuration). */
