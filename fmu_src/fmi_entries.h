@@ -1,8 +1,8 @@
 /* The entry points whose bodies are the same in FMI 2 and FMI 3, written
  * once: the end of the life cycle, the FMU-state functions and Model
  * Exchange's, each the mode check and a call into the core. Included by
- * each glue, which defines BEGIN_AS(function, modes), BEGIN_ME_AS and
- * CHECK; the macros take the version's prefix (fmi2, fmi3), its types and
+ * each glue, which defines BEGIN_AS(function, modes) and BEGIN_ME_AS; the
+ * macros take the version's prefix (fmi2, fmi3), its types and
  * the full names of the functions they define (fmi2Reset, ...), so that
  * each name appears where its function is defined. A name is stringized
  * and pasted here (#NAME, MODES_##NAME), before FMI*_FUNCTION_PREFIX
