@@ -289,6 +289,46 @@ static double loop_fmu(uint64_t steps, double cycleTime, int setAndGet, const ch
     return t1 - t0;
 }
 
+/* A plant of INSTANCES limiters stepped in turn (set u, doStep, get y of
+ * each per communication point), steps calls of each in all: what a
+ * simulator of many blocks pays, with the instances' memory out of the
+ * cache lines of one. Each instance's square wave has its own phase. */
+#define INSTANCES 1000
+static double loop_instances(uint64_t steps, double cycleTime) {
+    static void *c[INSTANCES];
+    for (int k = 0; k < INSTANCES; k++) {
+        c[k] = instantiate();
+        start(c[k], cycleTime);
+    }
+    const unsigned uVr = F.uVr, yVr = F.yVr;
+    const uint64_t points = steps / INSTANCES + 1;
+    double y = 0;
+    fmi3Boolean eventHandlingNeeded, terminateSimulation, earlyReturn;
+    fmi3Float64 lastSuccessfulTime;
+    CALLGRIND_ZERO_STATS;
+    const double t0 = now();
+    for (uint64_t i = 0; i < points; i++) {
+        for (int k = 0; k < INSTANCES; k++) {
+            double u = input(i + 37 * (uint64_t)k);
+            if (F.version == 2) {
+                F.fmi2SetReal(c[k], &uVr, 1, &u);
+                if (F.fmi2DoStep(c[k], (double)i * H, H, fmi2True) != fmi2OK) exit(1);
+                F.fmi2GetReal(c[k], &yVr, 1, &y);
+            } else {
+                F.fmi3SetFloat64(c[k], &uVr, 1, &u, 1);
+                if (F.fmi3DoStep(c[k], (double)i * H, H, fmi3True, &eventHandlingNeeded, &terminateSimulation,
+                                 &earlyReturn, &lastSuccessfulTime) != fmi3OK) exit(1);
+                F.fmi3GetFloat64(c[k], &yVr, 1, &y, 1);
+            }
+            *(volatile double *)&sink = y;
+        }
+    }
+    const double t1 = now();
+    CALLGRIND_DUMP_STATS_AT("instances");
+    for (int k = 0; k < INSTANCES; k++) release(c[k]);
+    return (t1 - t0) * (double)steps / (double)(points * INSTANCES);
+}
+
 static double loop_step(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "step"); }
 static double loop_do_step(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 0, "doStep"); }
 static double loop_cycle_1(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "cycles1"); }
@@ -374,10 +414,12 @@ int main(int argc, char **argv) {
     const double kernel = median_ns(loop_kernel, steps, 0.0, repeats);
     const double step = median_ns(loop_step, steps, 0.0, repeats);
     const double doStep = median_ns(loop_do_step, steps, 0.0, repeats);
+    const double instances = median_ns(loop_instances, steps, 0.0, repeats);
     printf("empty_loop_ns %.2f ns/step\n", empty);
     printf("kernel_ns %.2f ns/step\n", kernel);
     printf("step_ns %.2f ns/step\n", step);
     printf("doStep_ns %.2f ns/step\n", doStep);
+    printf("instances%d_ns %.2f ns/step\n", INSTANCES, instances);
     printf("step_over_kernel %.3f ratio\n", step / kernel);
     if (F.cycleVr >= 0) {
         const double one = median_ns(loop_cycle_1, steps / 100 + 1, H, repeats);

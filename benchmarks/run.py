@@ -180,6 +180,7 @@ def table(results, smoke, commands):
         ("instructions, kernel rl_cycle (floor)", "kernel_instructions", "{:.0f}", ""),
         ("instructions, PassThrough set + doStep + get", "fixture_step_instructions", "{:.0f}", ""),
         ("ns, set u + doStep + get y (median)", "step_ns", "{:.2f}", ""),
+        ("ns, 1,000 instances in turn, set u + doStep + get y of each (median)", "instances1000_ns", "{:.2f}", ""),
         ("ns, kernel rl_cycle call (median)", "kernel_ns", "{:.2f}", ""),
         ("ratio step / kernel", "step_over_kernel", "{:.2f}", "<= 2"),
         ("ns, PassThrough set + doStep + get", "fixture_step_ns", "{:.2f}", ""),

@@ -50,8 +50,8 @@ from support.process import Timeout, kill_all, run
 
 REPO = Path(__file__).resolve().parents[2]
 SOURCE = REPO / "fmu_src"
-FILES = ("rate_limiter.c", "rate_limiter.h", "rate_limiter_rules.h", "fmu_core.c", "fmi_entries.h", "fmi2_glue.c",
-         "fmi3_glue.c")
+FILES = ("rate_limiter.c", "rate_limiter.h", "rate_limiter_rules.h", "fmu_core.c", "fmu_model_exchange.c",
+         "fmu_state.c", "fmi_entries.h", "fmi2_glue.c", "fmi3_glue.c")
 KERNEL = ("rate_limiter.c", "rate_limiter.h", "rate_limiter_rules.h")
 EQUIVALENTS = REPO / "tests" / "equivalent_mutants.txt"
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
