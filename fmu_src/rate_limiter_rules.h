@@ -102,7 +102,8 @@ static inline RL_NUM RL_NAME(rl_stoppable_step)(RL_NUM e, RL_NUM b) {
     const RL_NUM q = RL_NAME(rl_quotient)(e, b);
     if (!isless(q, RL_BRAKING_COUNTED * RL_BRAKING_COUNTED)) {
         /* s * s / (2 * b) = e, less b for the cycles' head start */
-        const RL_NUM root = RL_NAME(rl_product)((RL_NUM)sqrt(2.0 * (double)b), (RL_NUM)sqrt((double)e));
+        const RL_NUM root = RL_NAME(rl_product)((RL_NUM)rl_binary32_or_not(sqrt(rl_product(2.0, (double)b)), sizeof(RL_NUM)),
+                                                (RL_NUM)sqrt((double)e));
         const RL_NUM s = RL_NAME(rl_sum)(root, -b);
         return isgreater(s, 0) ? s : 0;
     }
@@ -129,7 +130,7 @@ static inline RL_NUM RL_NAME(rl_zone_step)(RL_NUM z, RL_NUM v, RL_NUM b) {
     const RL_NUM q = RL_NAME(rl_quotient)(z, b), w = RL_NAME(rl_quotient)(v, b);
     if (!isless(q, RL_BRAKING_COUNTED * RL_BRAKING_COUNTED) || !isless(w, RL_BRAKING_COUNTED)) {
         /* s * s = v * v + 2 * b * z, less b; in binary64, quiet */
-        const double s2 = rl_sum(rl_product((double)v, (double)v), rl_product(2.0 * (double)b, (double)z));
+        const double s2 = rl_sum(rl_product((double)v, (double)v), rl_product(rl_product(2.0, (double)b), (double)z));
         const RL_NUM s = RL_NAME(rl_sum)((RL_NUM)rl_binary32_or_not(sqrt(s2), sizeof(RL_NUM)), -b);
         return isgreater(s, v) ? s : v;
     }
@@ -184,7 +185,9 @@ static inline RL_NUM RL_NAME(rl_advance)(RL_NUM y, RL_NUM delta) {
  * velocity limit of the zone beyond 0 before reaching it; it lands on uc
  * itself when within the rounding of it, and is otherwise rounded towards
  * y, so that rounding never takes the output further than planned. */
-static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous, const RlPrepared *p) {
+/* Out of line: rule 6's other paths stay small enough to inline. */
+static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous,
+                                                                   const RlPrepared *p) {
     const RL_NUM a = (RL_NUM)p->accelStep, b = (RL_NUM)p->decelStep;
     const RL_NUM e = RL_NAME(rl_sum)(uc, -y);
     /* towards the target; at the target, the way the output moves */
@@ -239,7 +242,7 @@ static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous
 
 /* The step of the last cycle, as the acceleration limit's velocity at this
  * cycle's length: 0 after a cycle that did not ramp or jumped. */
-static inline RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
+static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
     if (s->decided != RL_DECIDED_RAMP || (p->durationLimited && rl_running_time(s) >= p->durationReached) ||
         !isfinite(s->y) || !isfinite(s->yPrevious)) {
         return 0;
