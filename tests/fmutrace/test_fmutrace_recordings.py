@@ -13,7 +13,7 @@ import fmutrace
 from support.fmu_driver import BUILD_DIR
 from support.process import run as run_bounded
 
-SAMPLES = Path(__file__).parent / "recordings"
+SAMPLES = Path(__file__).parents[1] / "recordings"
 sys.path.insert(0, str(SAMPLES))
 import samples  # noqa: E402
 
@@ -128,7 +128,7 @@ def test_channels_not_of_the_fmu_are_listed_as_ignored_in_the_output_and_report(
 
 def test_from_python_with_cases_beside(tmp_path):
     campaign = fmutrace.compare(SIEMENS[3], [SAMPLES / "twincat_siemens.csv",
-                                             Path(__file__).parent / "scenarios" / "LGF_LimRateOfChangeCI"])
+                                             Path(__file__).parents[1] / "scenarios" / "LGF_LimRateOfChangeCI"])
     assert campaign.passed, campaign.summary()
     assert len(campaign.cases) > 1
     failing = fmutrace.compare(SIEMENS[3], SAMPLES / "wincc_siemens.csv", maps={"value": "DB_Ramp_value"})

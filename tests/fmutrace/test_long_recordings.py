@@ -22,7 +22,7 @@ from fmutrace.worker import run_case, worker_fmu
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
 
-SAMPLES = Path(__file__).parent / "recordings"
+SAMPLES = Path(__file__).parents[1] / "recordings"
 
 
 def outcomes(path, model, mode=Exact(), options=RecordingOptions(), head=400, block=120, version=3,

@@ -21,7 +21,7 @@ from fmutrace.traces import split_cells as split
 from fmutrace.recordings.timebase import parse_date, unit_in_name
 from support.oracle import oracle_for
 
-SAMPLES = Path(__file__).parent / "recordings"
+SAMPLES = Path(__file__).parents[1] / "recordings"
 sys.path.insert(0, str(SAMPLES))
 import samples  # noqa: E402  (the generator beside the samples)
 

@@ -2,12 +2,12 @@
 recorder exports them, written from each export's documented structure
 (see fmutrace/src/fmutrace/recordings/*.py for the sources) by this
 script, never by fmutrace. `python tests/recordings/samples.py` writes
-them beside it; tests/test_recordings.py checks that the files are what
+them beside it; tests/fmutrace/test_recordings.py checks that the files are what
 it writes.
 
 The values are worked by hand from the blocks' rules (docs/rules.md for the cycle rules, docs/fmi.md for the time model and docs/models.md for the vendor readings)
 for a 250 ms cyclic interrupt (a binary fraction: the FMU's cycle length
-is exact, and so is every value below); tests/test_recordings.py checks
+is exact, and so is every value below); tests/fmutrace/test_recordings.py checks
 them against the tests' independent oracle as well.
 
 Each row is one cycle k (0, 1, ...) as a recorder writes it: the input

@@ -58,10 +58,9 @@ PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 # pytest files, most kills per second first (the run stops at the first failure; ordered from the journal of
 # the full run's first 1,300 mutants of fmu_core.c: test_misuse.py caught 163 in 2 s of tests,
 # test_conformance.py 54 in 11 s)
-TESTS = ("test_misuse.py", "test_reference.py", "test_state.py", "test_model_exchange.py", "test_bad_arguments.py",
-         "test_conformance.py",
-         "test_vendor_interpretations.py", "test_long_runs.py", "test_model_description.py", "test_random.py",
-         "test_hostile.py")
+TESTS = ("fmu/test_misuse.py", "fmu/test_reference.py", "fmu/test_state.py", "fmu/test_model_exchange.py",
+         "fmu/test_bad_arguments.py", "fmu/test_conformance.py", "fmu/test_vendor_interpretations.py",
+         "fmu/test_long_runs.py", "repo/test_model_description.py", "fmu/test_random.py", "fmu/test_hostile.py")
 # outcomes a resumed run keeps: they depend on the sources and the build's flags alone, or (killed) stand
 # because tests are only added
 KEPT = ("stillborn", "equivalent", "killed")
