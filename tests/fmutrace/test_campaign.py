@@ -8,6 +8,7 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import fmutrace
 from fmutrace.executors import package_zip
@@ -16,6 +17,7 @@ from support.reports import without_timings
 from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
 
 
+@pytest.mark.cluster
 def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_path):
     fmus = [fmu_path(BUILD_DIR, model, version) for model in ("RateLimiter", "Ramp") for version in FMI_VERSIONS]
     cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]

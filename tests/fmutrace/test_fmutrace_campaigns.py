@@ -197,6 +197,7 @@ def test_a_second_campaign_into_the_same_report_folder_is_refused(tmp_path):
     assert code == 0  # the lock went with the first campaign
 
 
+@pytest.mark.cluster
 def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
     """SIGKILL to a Dask worker process while it works: its batches run
     again elsewhere, the campaign completes, each case once, the same
@@ -240,7 +241,8 @@ def faulty_cases(root, values):
     return step_cases(root, "Faulty", values)
 
 
-@pytest.mark.parametrize("version,jobs", [(2, 2), (3, 2), (3, 1)])
+@pytest.mark.parametrize("version,jobs", [pytest.param(2, 2, marks=pytest.mark.cluster),
+                                          pytest.param(3, 2, marks=pytest.mark.cluster), (3, 1)])
 def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, jobs, tmp_path):
     """On workers the batch that holds it kills its worker, is run again
     case by case in child processes, and only the crashing case fails; in
@@ -256,7 +258,7 @@ def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, 
     assert len(set(journal_keys(tmp_path / "report"))) == 6
 
 
-@pytest.mark.parametrize("jobs", [1, 2])
+@pytest.mark.parametrize("jobs", [1, pytest.param(2, marks=pytest.mark.cluster)])
 def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     """The hanging case is stopped once its timeout has passed (not before),
     the campaign goes on to the cases after it, and the command ends (finish
@@ -288,6 +290,7 @@ class _FailingStarts:
         return self.real(*args, **kwargs)
 
 
+@pytest.mark.cluster
 @pytest.mark.parametrize("failures", [1, 2])
 def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path, monkeypatch):
     """Once: a new cluster runs the campaign; every time: the cases run in
@@ -309,6 +312,7 @@ WORKER_LOOPS = ("(__import__('fmutrace.runner').runner.__file__, "
                 "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])")
 
 
+@pytest.mark.cluster
 def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch, recwarn):
     """A local cluster's workers share this environment: they import the
     installed fmutrace, with its compiled _steps, not an uploaded zip of
