@@ -9,6 +9,7 @@ each cycle compared, and how long each takes to reach its target.
 (tests/support/oracle.py, the rules in single and double precision)
 instead of the FMUs: the same figures, bit for bit, much slower (minutes).
 """
+
 import argparse
 import copy
 import sys
@@ -70,8 +71,19 @@ class OracleRamp:
     def __init__(self, arithmetic, start, target, rate, period):
         sys.path.insert(0, str(REPO / "tests"))
         from support.oracle import RateLimiterOracle
-        self.oracle = RateLimiterOracle({}, {"arithmetic": arithmetic, "cycleTime": CYCLE, "initMode": 1,
-                                             "initValue": start, "u": target, "rateUpPar": rate, "ratePeriod": period})
+
+        self.oracle = RateLimiterOracle(
+            {},
+            {
+                "arithmetic": arithmetic,
+                "cycleTime": CYCLE,
+                "initMode": 1,
+                "initValue": start,
+                "u": target,
+                "rateUpPar": rate,
+                "ratePeriod": period,
+            },
+        )
         self.cycles = 0
 
     def run(self, cycles):

@@ -2,13 +2,18 @@
 exported function, nValues 0 and mismatched, duplicate value references,
 stop time before start time. Each gets the right status, and the instance
 stays usable where the standard allows."""
+
 import ctypes
 from ctypes import byref, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint, c_void_p
 
 import pytest
 from fmpy import calloc, free
-from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                       fmi2CallbackLoggerTYPE)
+from fmpy.fmi2 import (
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
 from fmpy.fmi3 import fmi3LogMessageCallback
 
 from support.fmu_driver import STATE_FUNCTIONS, Instance, call_status, state_api
@@ -140,6 +145,7 @@ def test_stop_time_before_start_time_is_refused(version):
 
 # ---- the checks of every value reference, whatever its place in the array ----
 
+
 def real_accessors(fmu):
     f = fmu.fmu
     return (f.getReal, f.setReal) if fmu.version == 2 else (f.getFloat64, f.setFloat64)
@@ -163,8 +169,9 @@ def test_every_value_reference_of_an_array_is_checked_before_any_is_used(fmu):
         fmu.start()
     for vrs in ([bypass, y], [y, bypass]):  # a Boolean among Reals
         assert call_status(get, vrs) == 3, vrs
-        assert fmu.errors()[-1][2] == (f"{function[0]}: bypass (value reference {bypass}) is a Boolean "
-                                       f"variable, which {function[0]} cannot access")
+        assert fmu.errors()[-1][2] == (
+            f"{function[0]}: bypass (value reference {bypass}) is a Boolean variable, which {function[0]} cannot access"
+        )
         fmu.fmu.reset()
         fmu.start()
     for vrs in ([u, 999], [999, u]):  # nothing is set when one is refused
@@ -201,17 +208,31 @@ def test_a_start_time_that_is_not_finite_is_refused_naming_the_function(version,
 
 # ---- instantiation: refusals, and an importer without a logger ----
 
+
 def fmi3_instantiate(dll, name, token, event_mode=False, n_required=0, logging=True, log=None, environment=None):
     """log: a Python function, or an fmi3LogMessageCallback the caller keeps alive for the instance's life."""
     instantiate = dll.fmi3InstantiateCoSimulation
-    instantiate.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_bool, c_bool, c_void_p, c_size_t,
-                            c_void_p, fmi3LogMessageCallback, c_void_p]
+    instantiate.argtypes = [
+        c_char_p,
+        c_char_p,
+        c_char_p,
+        c_bool,
+        c_bool,
+        c_bool,
+        c_bool,
+        c_void_p,
+        c_size_t,
+        c_void_p,
+        fmi3LogMessageCallback,
+        c_void_p,
+    ]
     instantiate.restype = c_void_p
     required = (c_uint * 1)(1)
     if not isinstance(log, fmi3LogMessageCallback):
         log = fmi3LogMessageCallback(log) if log else fmi3LogMessageCallback()
-    return instantiate(name, token, None, False, logging, event_mode, False, required, n_required, environment,
-                       log, None)
+    return instantiate(
+        name, token, None, False, logging, event_mode, False, required, n_required, environment, log, None
+    )
 
 
 def test_fmi3_instantiation_refusals_name_the_first_problem():
@@ -260,25 +281,31 @@ def test_fmi2_instantiation_refusals_name_the_first_problem():
         callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         guid = fmu.md.guid.encode()
-        cases = [((b"", 0, b"wrong"), "instanceName is missing"),
-                 ((None, 1, guid), "instanceName is missing"),
-                 ((b"a", 0, b"wrong"), "the GUID does not match this FMU's model description"),  # Model Exchange
-                 ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description"),
-                 ((b"a", 1, None), "the GUID does not match this FMU's model description"),
-                 ((b"a", 1, guid + b"0"), "the GUID does not match this FMU's model description"),
-                 ((b"a", 1, guid[:-1]), "the GUID does not match this FMU's model description"),
-                 ((b"a", 2, guid), "fmuType is neither fmi2ModelExchange nor fmi2CoSimulation")]  # not an fmi2Type
+        cases = [
+            ((b"", 0, b"wrong"), "instanceName is missing"),
+            ((None, 1, guid), "instanceName is missing"),
+            ((b"a", 0, b"wrong"), "the GUID does not match this FMU's model description"),  # Model Exchange
+            ((b"a", 1, b"wrong"), "the GUID does not match this FMU's model description"),
+            ((b"a", 1, None), "the GUID does not match this FMU's model description"),
+            ((b"a", 1, guid + b"0"), "the GUID does not match this FMU's model description"),
+            ((b"a", 1, guid[:-1]), "the GUID does not match this FMU's model description"),
+            ((b"a", 2, guid), "fmuType is neither fmi2ModelExchange nor fmi2CoSimulation"),
+        ]  # not an fmi2Type
         for (name, kind, given), reason in cases:
             messages.clear()
             assert instantiate(name, kind, given, None, byref(callbacks), 0, 0) is None
             # a missing name is logged as "?"
-            assert messages == [(b"?" if name is None else name, 3, b"logStatusError", reason.encode())], (reason, messages)
+            assert messages == [(b"?" if name is None else name, 3, b"logStatusError", reason.encode())], (
+                reason,
+                messages,
+            )
         assert instantiate(b"a", 1, guid, None, None, 0, 0) is None  # no callbacks: nothing to allocate with
         for missing in ("allocateMemory", "freeMemory"):  # half a memory manager: nothing allocated
             partial = fmi2CallbackFunctions()
             partial.logger = callbacks.logger
-            partial.allocateMemory = callbacks.allocateMemory if missing == "freeMemory" else \
-                fmi2CallbackAllocateMemoryTYPE()
+            partial.allocateMemory = (
+                callbacks.allocateMemory if missing == "freeMemory" else fmi2CallbackAllocateMemoryTYPE()
+            )
             partial.freeMemory = callbacks.freeMemory if missing == "allocateMemory" else fmi2CallbackFreeMemoryTYPE()
             assert instantiate(b"a", 1, guid, None, byref(partial), 0, 0) is None, missing
         silent = fmi2CallbackFunctions()  # no logger: refused, nothing called
@@ -344,9 +371,11 @@ def test_fmi3_accessors_of_types_without_variables_refuse_every_value_reference(
             else:
                 function.argtypes = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t]
             function.restype = c_int
-            cases = [([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
-                     ([u, u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
-                     ([999, u], "unknown value reference 999")]
+            cases = [
+                ([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                ([u, u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                ([999, u], "unknown value reference 999"),
+            ]
             if kind == "Binary":
                 cases.append(([u], "the valueSizes array is NULL"))
             for number, (vrs, message) in enumerate(cases):
@@ -449,18 +478,21 @@ def test_a_foreign_fmu_state_is_refused_by_every_state_function(fmu):
     data = bytes(api["serialize"](good))
     api["free"](good)
     size, out = c_size_t(7), ctypes.create_string_buffer(4096)
-    calls = {names[0]: ([c_void_p, c_void_p, c_void_p], (c, foreign, byref(size))),
-             names[1]: ([c_void_p, c_void_p, c_void_p, c_size_t], (c, foreign, out, 4096)),
-             # given a state to fill, it must be one of this FMU's
-             names[2]: ([c_void_p, c_void_p], (c, byref(foreign))),
-             names[3]: ([c_void_p, c_char_p, c_size_t, c_void_p], (c, data, len(data), byref(foreign))),
-             names[4]: ([c_void_p, c_void_p], (c, byref(foreign)))}
+    calls = {
+        names[0]: ([c_void_p, c_void_p, c_void_p], (c, foreign, byref(size))),
+        names[1]: ([c_void_p, c_void_p, c_void_p, c_size_t], (c, foreign, out, 4096)),
+        # given a state to fill, it must be one of this FMU's
+        names[2]: ([c_void_p, c_void_p], (c, byref(foreign))),
+        names[3]: ([c_void_p, c_char_p, c_size_t, c_void_p], (c, data, len(data), byref(foreign))),
+        names[4]: ([c_void_p, c_void_p], (c, byref(foreign))),
+    }
     for name, (argtypes, args) in calls.items():
         function = getattr(dll, name)
         function.argtypes, function.restype = argtypes, c_int
         assert function(*args) == 3, name
-        assert fmu.errors()[-1][2].startswith(f"{name}: ") and "not an FMU state" in fmu.errors()[-1][2], \
-            fmu.errors()[-1]
+        assert fmu.errors()[-1][2].startswith(f"{name}: ") and "not an FMU state" in fmu.errors()[-1][2], fmu.errors()[
+            -1
+        ]
         fmu.fmu.reset()
         fmu.start()
     assert size.value == 7 and out.raw == bytes(4096) and foreign.value == ctypes.addressof(junk)
@@ -536,13 +568,15 @@ def test_fmi2_a_state_without_memory_is_an_error_and_nothing_is_held():
         data = ctypes.create_string_buffer(4096)
         size = c_size_t()
         assert raw(fmu, "fmi2SerializedFMUstateSize", [c_void_p, c_void_p, c_void_p], c, state, byref(size)) == 0
-        assert raw(fmu, "fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], c, state, data,
-                   size.value) == 0
+        assert (
+            raw(fmu, "fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], c, state, data, size.value) == 0
+        )
         assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0 and live == held
         memory.refuse = lambda: True
-        for name, argtypes, args in (("fmi2GetFMUstate", [c_void_p, c_void_p], ()),
-                                     ("fmi2DeSerializeFMUstate", [c_void_p, c_void_p, c_size_t, c_void_p],
-                                      (data, size.value))):
+        for name, argtypes, args in (
+            ("fmi2GetFMUstate", [c_void_p, c_void_p], ()),
+            ("fmi2DeSerializeFMUstate", [c_void_p, c_void_p, c_size_t, c_void_p], (data, size.value)),
+        ):
             messages.clear()
             empty = c_void_p()
             assert raw(fmu, name, argtypes, c, *args, byref(empty)) == 3
@@ -577,8 +611,11 @@ def test_fmi2_status_queries_answer_only_what_this_fmu_has():
             answered_real, answered_flag = kind == 2, kind == 3
             assert raw(fmu, "fmi2GetRealStatus", query, c, kind, byref(real)) == (0 if answered_real else 2), kind
             assert raw(fmu, "fmi2GetBooleanStatus", query, c, kind, byref(flag)) == (0 if answered_flag else 2), kind
-            for name, value in (("fmi2GetStatus", integer), ("fmi2GetIntegerStatus", integer),
-                                ("fmi2GetStringStatus", text)):
+            for name, value in (
+                ("fmi2GetStatus", integer),
+                ("fmi2GetIntegerStatus", integer),
+                ("fmi2GetStringStatus", text),
+            ):
                 assert raw(fmu, name, query, c, kind, byref(value)) == 2, (name, kind)
         assert real.value == 0.75 and flag.value == 0 and integer.value == 7 and text.value == b"untouched"
         assert fmu.messages == []
@@ -597,8 +634,11 @@ def test_fmi2_status_queries_answer_only_what_this_fmu_has():
 def test_the_version_functions_name_the_standard():
     fmu2, fmu3 = Instance("RateLimiter", 2), Instance("RateLimiter", 3)
     try:
-        for fmu, name, expected in ((fmu2, "fmi2GetTypesPlatform", b"default"), (fmu2, "fmi2GetVersion", b"2.0"),
-                                    (fmu3, "fmi3GetVersion", b"3.0")):
+        for fmu, name, expected in (
+            (fmu2, "fmi2GetTypesPlatform", b"default"),
+            (fmu2, "fmi2GetVersion", b"2.0"),
+            (fmu3, "fmi3GetVersion", b"3.0"),
+        ):
             function = getattr(fmu.fmu.dll, name)
             function.argtypes, function.restype = [], c_char_p
             assert function() == expected, name
@@ -619,8 +659,19 @@ def test_fmi3_a_step_with_a_null_output_pointer_is_refused_and_the_time_stays():
             flags, when = (c_bool * 3)(), c_double()
             outputs = [byref(flags, 0), byref(flags, 1), byref(flags, 2), byref(when)]
             outputs[missing] = None
-            assert raw(fmu, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4,
-                       fmu.fmu.component, 0.5, 0.5, True, *outputs) == 3, missing
+            assert (
+                raw(
+                    fmu,
+                    "fmi3DoStep",
+                    [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4,
+                    fmu.fmu.component,
+                    0.5,
+                    0.5,
+                    True,
+                    *outputs,
+                )
+                == 3
+            ), missing
             assert fmu.errors()[-1][2] == "fmi3DoStep: an output argument pointer is NULL", missing
             assert (fmu.get("time"), fmu.get("y")) == (0.5, 1.0), missing
             fmu.fmu.reset()
@@ -636,16 +687,20 @@ def test_fmi3_other_interfaces_are_refused_with_a_reason(interface):
     fmu = Instance("RateLimiter", 3)
     try:
         function = getattr(fmu.fmu.dll, f"fmi3Instantiate{interface}")
-        function.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_void_p, fmi3LogMessageCallback] + \
-            [c_void_p] * (3 if interface == "ScheduledExecution" else 0)
+        function.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_void_p, fmi3LogMessageCallback] + [
+            c_void_p
+        ] * (3 if interface == "ScheduledExecution" else 0)
         function.restype = c_void_p
         messages = []
-        log = fmi3LogMessageCallback(lambda env, status, category, message: messages.append((status, category, message)))
+        log = fmi3LogMessageCallback(
+            lambda env, status, category, message: messages.append((status, category, message))
+        )
         extra = [None] * (3 if interface == "ScheduledExecution" else 0)
         token = fmu.md.instantiationToken.encode()
         assert function(b"a", token, None, False, True, None, log, *extra) is None
-        assert messages == [(3, b"logStatusError",
-                             b"this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution")]
+        assert messages == [
+            (3, b"logStatusError", b"this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution")
+        ]
         messages.clear()
         assert function(b"a", token, None, False, False, None, log, *extra) is None
         assert function(b"a", token, None, False, True, None, fmi3LogMessageCallback(), *extra) is None
@@ -664,8 +719,10 @@ def test_fmi2_string_accessors_refuse_every_value_reference():
         texts = (c_char_p * 2)(b"a", b"b")
         for access in ("Get", "Set"):
             name = f"fmi2{access}String"
-            for vrs, message in (([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
-                                 ([999], "unknown value reference 999")):
+            for vrs, message in (
+                ([u], f"u (value reference {u}) is a Real variable, which {name} cannot access"),
+                ([999], "unknown value reference 999"),
+            ):
                 array = (c_uint * len(vrs))(*vrs)
                 assert raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, array, len(vrs), texts) == 3
                 assert fmu.errors()[-1][2] == f"{name}: {message}", (name, vrs)
@@ -735,10 +792,12 @@ def test_fmi2_a_freed_state_whose_memory_is_still_there_is_refused():
         assert raw(fmu, "fmi2FreeFMUstate", [c_void_p, c_void_p], c, byref(state)) == 0
         assert state.value is None and kept == [stale.value]
         out, size = ctypes.create_string_buffer(4096), c_size_t()
-        for name, argtypes, args in (("fmi2SetFMUstate", [c_void_p, c_void_p], (stale,)),
-                                     ("fmi2SerializedFMUstateSize", [c_void_p, c_void_p, c_void_p], (stale, byref(size))),
-                                     ("fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], (stale, out, 4096)),
-                                     ("fmi2FreeFMUstate", [c_void_p, c_void_p], (byref(stale),))):
+        for name, argtypes, args in (
+            ("fmi2SetFMUstate", [c_void_p, c_void_p], (stale,)),
+            ("fmi2SerializedFMUstateSize", [c_void_p, c_void_p, c_void_p], (stale, byref(size))),
+            ("fmi2SerializeFMUstate", [c_void_p, c_void_p, c_void_p, c_size_t], (stale, out, 4096)),
+            ("fmi2FreeFMUstate", [c_void_p, c_void_p], (byref(stale),)),
+        ):
             messages.clear()
             assert raw(fmu, name, argtypes, c, *args) == 3, name
             assert messages == [(3, f"{name}: not an FMU state of this FMU")], name
@@ -777,8 +836,11 @@ def test_fmi2_the_logger_gets_the_name_and_environment_given_and_only_what_loggi
         assert raw(fmu, "fmi2SetReal", set_real, c, rate, 1, (c_double * 1)(1.0)) == 0
         assert raw(fmu, "fmi2DoStep", [c_void_p, c_double, c_double, c_int], c, 0.0, 0.5, 1) == 0  # cleared
         assert raw(fmu, "fmi2ExitInitializationMode", [c_void_p], c) == 3  # not in Step Mode: an error
-        expected = [(0x5EED, b"pump 1", 1, "logStatusWarning"), (0x5EED, b"pump 1", 0, "logEvents"),
-                    (0x5EED, b"pump 1", 3, "logStatusError")]
+        expected = [
+            (0x5EED, b"pump 1", 1, "logStatusWarning"),
+            (0x5EED, b"pump 1", 0, "logEvents"),
+            (0x5EED, b"pump 1", 3, "logStatusError"),
+        ]
         assert messages == (expected if logging_on else [expected[0], expected[2]])
         free_instance(fmu, c)
     finally:
@@ -795,21 +857,49 @@ def test_fmi3_the_logger_gets_the_environment_given_and_nothing_when_logging_is_
     fmu = Instance("RateLimiter", 3)
     try:
         messages = []
-        log = fmi3LogMessageCallback(lambda env, status, category, message: messages.append(
-            (env, status, category.decode())))
+        log = fmi3LogMessageCallback(
+            lambda env, status, category, message: messages.append((env, status, category.decode()))
+        )
         dll = fmu.fmu.dll
-        c = fmi3_instantiate(dll, b"pump 1", fmu.md.instantiationToken.encode(), logging=logging_on, log=log,
-                             environment=0x5EED)
+        c = fmi3_instantiate(
+            dll, b"pump 1", fmu.md.instantiationToken.encode(), logging=logging_on, log=log, environment=0x5EED
+        )
         rate = (c_uint * 1)(fmu.vr("rateUpPar"))
         set_float = [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t]
         assert raw(fmu, "fmi3SetFloat64", set_float, c, rate, 1, (c_double * 1)(-1.0), 1) == 0
-        assert raw(fmu, "fmi3EnterInitializationMode", [c_void_p, c_bool, c_double, c_double, c_bool, c_double],
-                   c, False, 0.0, 0.0, False, 0.0) == 0
+        assert (
+            raw(
+                fmu,
+                "fmi3EnterInitializationMode",
+                [c_void_p, c_bool, c_double, c_double, c_bool, c_double],
+                c,
+                False,
+                0.0,
+                0.0,
+                False,
+                0.0,
+            )
+            == 0
+        )
         assert raw(fmu, "fmi3ExitInitializationMode", [c_void_p], c) == 0  # status 16#8200: OK, a warning logged
         assert raw(fmu, "fmi3SetFloat64", set_float, c, rate, 1, (c_double * 1)(1.0), 1) == 0
         flags, when = (c_bool * 3)(), c_double()
-        assert raw(fmu, "fmi3DoStep", [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4, c, 0.0, 0.5, True,
-                   byref(flags, 0), byref(flags, 1), byref(flags, 2), byref(when)) == 0  # cleared: an event
+        assert (
+            raw(
+                fmu,
+                "fmi3DoStep",
+                [c_void_p, c_double, c_double, c_bool] + [c_void_p] * 4,
+                c,
+                0.0,
+                0.5,
+                True,
+                byref(flags, 0),
+                byref(flags, 1),
+                byref(flags, 2),
+                byref(when),
+            )
+            == 0
+        )  # cleared: an event
         assert raw(fmu, "fmi3ExitInitializationMode", [c_void_p], c) == 3  # not in Step Mode: an error
         expected = [(0x5EED, 1, "logStatusWarning"), (0x5EED, 0, "logEvents"), (0x5EED, 3, "logStatusError")]
         assert messages == (expected if logging_on else [])
@@ -818,8 +908,10 @@ def test_fmi3_the_logger_gets_the_environment_given_and_nothing_when_logging_is_
         fmu.free()
 
 
-ALL_ACCESSOR_TYPES = {2: ("Real", "Integer", "Boolean", "String"),
-                      3: ("Float64", "Int32", "Int64", "Boolean") + NO_VARIABLES}
+ALL_ACCESSOR_TYPES = {
+    2: ("Real", "Integer", "Boolean", "String"),
+    3: ("Float64", "Int32", "Int64", "Boolean") + NO_VARIABLES,
+}
 
 
 def test_zero_values_with_arrays_given_reads_and_writes_nothing(fmu):

@@ -11,6 +11,7 @@ Exchange (run_trace --model-exchange: time events, event updates,
 Continuous-Time Mode) too: every scenario, with cycleTime its step, gives
 the trapped Co-Simulation run's outputs, and the hostile values trap
 nothing."""
+
 import math
 import os
 import sys
@@ -25,8 +26,9 @@ from support.run_trace import HARNESS, KINDS, reference_script, run_script, scri
 from support.scenarios import discover
 from test_hostile import HOSTILE, coerce, in_declared_range
 
-pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
-                                reason="run_trace is built in the release tree only")
+pytestmark = pytest.mark.skipif(
+    os.environ.get("RL_SANITIZED") == "1", reason="run_trace is built in the release tree only"
+)
 
 SCENARIOS = discover()
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
@@ -43,8 +45,18 @@ def staged(model, version):
 def test_scenario_runs_trapped_and_gives_its_reference(scenario, version, tmp_path):
     stage, md = staged(scenario.model, version)
     text, check = reference_script(scenario, md)
-    check(run_script(PLATFORM[version], stage, scenario.model, md.guid, text, tmp_path,
-                     f"{scenario.name} (FMI {version}) with traps", options=TRAPS[version]))
+    check(
+        run_script(
+            PLATFORM[version],
+            stage,
+            scenario.model,
+            md.guid,
+            text,
+            tmp_path,
+            f"{scenario.name} (FMI {version}) with traps",
+            options=TRAPS[version],
+        )
+    )
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -58,10 +70,20 @@ def test_model_exchange_runs_trapped_and_gives_co_simulations_outputs(scenario, 
     init = next(k for k, line in enumerate(head) if line.startswith("init"))  # after the scenario's start values
     head.insert(init, f"set F {cycle_time.valueReference} {float(scenario.options['StepSize']).hex()}")
     text = "\n".join(head + [line for block in blocks for line in block]) + "\n"
-    runs = [run_script(PLATFORM[version], stage, scenario.model, md.guid, text, tmp_path / interface,
-                       f"{scenario.name} (FMI {version}, {interface}) with traps", options=TRAPS[version] + extra)
-            for interface, extra in (("cs", []), ("me", ["--model-exchange"]))
-            if (tmp_path / interface).mkdir() is None]
+    runs = [
+        run_script(
+            PLATFORM[version],
+            stage,
+            scenario.model,
+            md.guid,
+            text,
+            tmp_path / interface,
+            f"{scenario.name} (FMI {version}, {interface}) with traps",
+            options=TRAPS[version] + extra,
+        )
+        for interface, extra in (("cs", []), ("me", ["--model-exchange"]))
+        if (tmp_path / interface).mkdir() is None
+    ]
     assert runs[0] == runs[1]
     assert len(runs[0]) == (len(blocks) + 1) * len(scenario.outputs)
 
@@ -70,23 +92,45 @@ def test_a_raised_exception_is_caught_and_named(tmp_path):
     """The traps are on: a binary whose instantiate compares a NaN by <
     (as the kernel's limit check once did) stops the harness with SIGFPE,
     reported as FE_INVALID; without --trap it runs."""
-    names = ["EnterInitializationMode", "ExitInitializationMode", "DoStep", "SetFloat64", "SetInt32", "SetInt64",
-             "SetBoolean", "GetFloat64", "GetInt32", "GetBoolean", "FreeInstance", "GetFMUState", "SetFMUState",
-             "FreeFMUState", "SerializedFMUStateSize", "SerializeFMUState", "DeserializeFMUState",
-             "InstantiateModelExchange", "UpdateDiscreteStates", "EnterContinuousTimeMode", "SetTime",
-             "EnterEventMode"]
+    names = [
+        "EnterInitializationMode",
+        "ExitInitializationMode",
+        "DoStep",
+        "SetFloat64",
+        "SetInt32",
+        "SetInt64",
+        "SetBoolean",
+        "GetFloat64",
+        "GetInt32",
+        "GetBoolean",
+        "FreeInstance",
+        "GetFMUState",
+        "SetFMUState",
+        "FreeFMUState",
+        "SerializedFMUStateSize",
+        "SerializeFMUState",
+        "DeserializeFMUState",
+        "InstantiateModelExchange",
+        "UpdateDiscreteStates",
+        "EnterContinuousTimeMode",
+        "SetTime",
+        "EnterEventMode",
+    ]
     source = tmp_path / "raise.c"
-    source.write_text("#include <math.h>\nvolatile double limit = NAN;\nstatic int instance;\n"
-                      "void *fmi3InstantiateCoSimulation(void) { return limit < 1.0 ? 0 : &instance; }\n"
-                      + "".join(f"int fmi3{name}(void) {{ return 0; }}\n" for name in names))
+    source.write_text(
+        "#include <math.h>\nvolatile double limit = NAN;\nstatic int instance;\n"
+        "void *fmi3InstantiateCoSimulation(void) { return limit < 1.0 ? 0 : &instance; }\n"
+        + "".join(f"int fmi3{name}(void) {{ return 0; }}\n" for name in names)
+    )
     library = tmp_path / "raise.so"
     built = run_bounded(["cc", "-shared", "-fPIC", str(source), "-o", str(library)], timeout=60, what="cc")
     assert built.returncode == 0, built.stderr
     (tmp_path / "empty").write_text("")
     for options, code in (([], 0), (["--trap"], 3)):
         with open(tmp_path / "empty") as empty:
-            done = run_bounded(HARNESS["x86_64-linux"] + options + [str(library), "token"], timeout=60, stdin=empty,
-                               what="run_trace")
+            done = run_bounded(
+                HARNESS["x86_64-linux"] + options + [str(library), "token"], timeout=60, stdin=empty, what="run_trace"
+            )
         assert done.returncode == code, (options, done.returncode, done.stderr)
     assert "SIGFPE, FE_INVALID raised" in done.stderr, done.stderr
 
@@ -132,7 +176,7 @@ def hostile_script(md):
     for h in (5e-324, 1e-300, sys.float_info.max):
         add("new")
         add("init 0x0p+0")
-        add(f"step {0.0.hex()} {h.hex()}")
+        add(f"step {(0.0).hex()} {h.hex()}")
         lines.extend(gets)
         input_u = next(v for v in md.modelVariables if v.causality == "input" and KINDS[v.type] == "F")
         add(value_line(input_u, 5.0))
@@ -159,8 +203,16 @@ def test_hostile_values_raise_no_floating_point_exception(model, version, interf
     stage, md = staged(model, version)
     text, must_refuse = hostile_script(md)
     extra = ["--model-exchange"] if interface == "Model Exchange" else []
-    lines = run_script(PLATFORM[version], stage, model, md.guid, text, tmp_path,
-                       f"{model} (FMI {version}, {interface}) hostile", options=TRAPS[version] + ["--keep-going"] + extra)
+    lines = run_script(
+        PLATFORM[version],
+        stage,
+        model,
+        md.guid,
+        text,
+        tmp_path,
+        f"{model} (FMI {version}, {interface}) hostile",
+        options=TRAPS[version] + ["--keep-going"] + extra,
+    )
     refused = {int(line.split()[1]) for line in lines if line.startswith("refused")}
     script_lines = text.splitlines()
     # every value outside a declared range is refused, and nothing else but
@@ -184,11 +236,27 @@ def test_a_per_cycle_limit_at_the_top_of_binary32_keeps_a_real_ramp_off_the_comm
     by_name = {v.name: v for v in md.modelVariables}
     up, down = (3e38, 1.0) if sign > 0 else (1.0, 3e38)
     inputs = [0.0, sign * 6e37, sign * 7e37]
-    lines = ["new", value_line(by_name["UpRatePar"], up), value_line(by_name["DownRatePar"], down),
-             value_line(by_name["In"], inputs[0]), "init 0x0p+0"]
+    lines = [
+        "new",
+        value_line(by_name["UpRatePar"], up),
+        value_line(by_name["DownRatePar"], down),
+        value_line(by_name["In"], inputs[0]),
+        "init 0x0p+0",
+    ]
     for k, u in enumerate(inputs):
-        lines += [value_line(by_name["In"], u), f"step {float(k).hex()} {1.0.hex()}",
-                  f"get F {by_name['Out'].valueReference}"]
-    outputs = run_script(PLATFORM[version], stage, "RateLimit", md.guid, "\n".join(lines) + "\n", tmp_path,
-                         f"RateLimit (FMI {version}) at binary32's top", options=TRAPS[version])
+        lines += [
+            value_line(by_name["In"], u),
+            f"step {float(k).hex()} {(1.0).hex()}",
+            f"get F {by_name['Out'].valueReference}",
+        ]
+    outputs = run_script(
+        PLATFORM[version],
+        stage,
+        "RateLimit",
+        md.guid,
+        "\n".join(lines) + "\n",
+        tmp_path,
+        f"RateLimit (FMI {version}) at binary32's top",
+        options=TRAPS[version],
+    )
     assert [float.fromhex(y) for y in outputs] == [float(np.float32(u)) for u in inputs]

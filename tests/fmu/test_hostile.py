@@ -3,6 +3,7 @@ subnormals, 1e308, huge and tiny rates, cycleTime of 1e-9 and 1e9. Never a
 crash or an endless step; where the status table (rules.md, Status words) applies the FMU
 agrees with the oracle bit for bit; a value outside a declared range is
 refused with an error and the last good value kept."""
+
 import math
 import sys
 
@@ -38,7 +39,7 @@ def coerce(variable, value):
     """What an importer can send for this type: integers and booleans from
     a hostile float (NaN and inf have no integer; they are skipped)."""
     if variable.type in ("Integer", "Int32", "Enumeration"):
-        return None if not math.isfinite(value) else max(min(int(value), 2**31 - 1), -2**31)
+        return None if not math.isfinite(value) else max(min(int(value), 2**31 - 1), -(2**31))
     if variable.type == "Boolean":
         return bool(value == value and value != 0)
     return value
@@ -90,8 +91,14 @@ def test_hostile_value_in_every_variable(model, version, value_index):
                 fmu.step(h)
                 expected = oracle.do_step(t, h, inputs)
                 for name in names:
-                    assert agree(fmu.get(name), expected[name]), (variable.name, value, k, name, fmu.get(name),
-                                                                  expected[name])
+                    assert agree(fmu.get(name), expected[name]), (
+                        variable.name,
+                        value,
+                        k,
+                        name,
+                        fmu.get(name),
+                        expected[name],
+                    )
         finally:
             fmu.free()
 
@@ -120,8 +127,9 @@ def test_tiny_cycle_time_runs_or_is_refused(version):
         assert fmu.get("runningTime") == expected["runningTime"]
         y = fmu.get("y")
         assert fmu.raw_step(1.0) == 3
-        assert fmu.errors()[-1][2] == (f"fmi{version}DoStep: a step of 1 s would run 1e+09 cycles of 1e-09 s; "
-                                       "at most 1e+08 per step"), fmu.messages
+        assert fmu.errors()[-1][2] == (
+            f"fmi{version}DoStep: a step of 1 s would run 1e+09 cycles of 1e-09 s; at most 1e+08 per step"
+        ), fmu.messages
         if version == 2:  # FMI 2 reads values in its Error state
             assert fmu.get("y") == y
     finally:
@@ -135,10 +143,10 @@ def test_a_step_of_exactly_the_most_cycles_runs(version):
     2^-20 per cycle, and reaches u = 1 exactly after 2^20 cycles."""
     fmu = Instance("RateLimiter", version)
     try:
-        fmu.start(cycleTime=2.0 ** -20)
+        fmu.start(cycleTime=2.0**-20)
         fmu.set(u=1.0)
-        assert fmu.raw_step(1e8 * 2.0 ** -20) == 0, fmu.messages
-        assert fmu.get("y") == 1.0 and fmu.get("time") == 1e8 * 2.0 ** -20
+        assert fmu.raw_step(1e8 * 2.0**-20) == 0, fmu.messages
+        assert fmu.get("y") == 1.0 and fmu.get("time") == 1e8 * 2.0**-20
         assert not fmu.errors()
     finally:
         fmu.free()

@@ -1,12 +1,13 @@
 """Long runs through the FMU: 48 h of 10 ms cycles in large communication
 steps end with the exact cycle count and the closed-form ramp value, and a
 259,200 s duration jumps at exactly its cycle (no drift)."""
+
 import pytest
 
 from support.fmu_driver import Instance
 
-STEP = 100.0                 # 10,000 cycles of 10 ms per communication step
-PER_CYCLE = 2.0 ** -7        # binary-exact, so the closed form is exact too
+STEP = 100.0  # 10,000 cycles of 10 ms per communication step
+PER_CYCLE = 2.0**-7  # binary-exact, so the closed form is exact too
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -19,7 +20,7 @@ def test_48_hours_of_10ms_cycles(version):
         fmu.fmu.doStep(currentCommunicationPoint=n * STEP, communicationStepSize=STEP)
     cycles = 48 * 3600 * 100
     assert cycles == 17_280_000
-    assert fmu.get("y") == cycles * PER_CYCLE          # 135000, every cycle counted once
+    assert fmu.get("y") == cycles * PER_CYCLE  # 135000, every cycle counted once
     assert fmu.get("runningTime") == 172800.0
     assert fmu.get("time") == 172800.0
     fmu.free()
@@ -33,9 +34,9 @@ def test_duration_of_48_hours_jumps_at_its_cycle(version):
     steps = int(259200 / STEP)
     for n in range(steps - 1):
         fmu.fmu.doStep(currentCommunicationPoint=n * STEP, communicationStepSize=STEP)
-    assert fmu.get("y") == (steps - 1) * 10_000 * PER_CYCLE   # still ramping one step before
+    assert fmu.get("y") == (steps - 1) * 10_000 * PER_CYCLE  # still ramping one step before
     fmu.fmu.doStep(currentCommunicationPoint=(steps - 1) * STEP, communicationStepSize=STEP)
-    assert fmu.get("y") == 1e9                                # cycle 25,920,000 ends at 259200 s
+    assert fmu.get("y") == 1e9  # cycle 25,920,000 ends at 259200 s
     assert fmu.get("runningTime") == 259200.0
     fmu.free()
 

@@ -1,6 +1,7 @@
 """fmi.md, FMI behaviour: every misuse gets an error status and one log message
 naming the function; the instance keeps its last good state, refuses
 further calls until recovered (FMU state or reset), then runs on."""
+
 import ctypes
 import math
 
@@ -21,8 +22,10 @@ def set_raw(fmu, vr, value, kind="Real"):
 
 def get_raw(fmu, vr, kind):
     f = fmu.fmu
-    names = {2: {"Real": "getReal", "Integer": "getInteger", "Boolean": "getBoolean"},
-             3: {"Real": "getFloat64", "Integer": "getInt32", "Boolean": "getBoolean"}}
+    names = {
+        2: {"Real": "getReal", "Integer": "getInteger", "Boolean": "getBoolean"},
+        3: {"Real": "getFloat64", "Integer": "getInt32", "Boolean": "getBoolean"},
+    }
     getter = getattr(f, names[fmu.version][kind])
     return call_status(getter, [vr])
 
@@ -46,12 +49,14 @@ def null_in_state_call(fmu, case):
     data = bytes(api["serialize"](state))
     size = ctypes.c_size_t()
     p, n = ctypes.c_void_p, ctypes.c_size_t
-    calls = {"get": ("get", [p, p], (None,)),
-             "set": ("set", [p, p], (None,)),
-             "size of NULL": ("size", [p, p, p], (None, ctypes.byref(size))),
-             "size pointer": ("size", [p, p, p], (state, None)),
-             "byte array": ("serialize", [p, p, p, n], (state, None, len(data))),
-             "deserialize": ("deserialize", [p, ctypes.c_char_p, n, p], (data, len(data), None))}
+    calls = {
+        "get": ("get", [p, p], (None,)),
+        "set": ("set", [p, p], (None,)),
+        "size of NULL": ("size", [p, p, p], (None, ctypes.byref(size))),
+        "size pointer": ("size", [p, p, p], (state, None)),
+        "byte array": ("serialize", [p, p, p, n], (state, None, len(data))),
+        "deserialize": ("deserialize", [p, ctypes.c_char_p, n, p], (data, len(data), None)),
+    }
     which, argtypes, args = calls[case]
     function = getattr(fmu.fmu.dll, STATE_FUNCTIONS[fmu.version][which])
     function.argtypes, function.restype = argtypes, ctypes.c_int
@@ -62,31 +67,48 @@ def null_in_state_call(fmu, case):
 
 # name: (misuse, words the log message must contain)
 MISUSES = {
-    "step size zero": (lambda f: call_status(f.fmu.doStep, f.t, 0.0),
-                       "DoStep: communicationStepSize must be finite and > 0, not 0"),
-    "step size negative": (lambda f: call_status(f.fmu.doStep, f.t, -0.5),
-                           "DoStep: communicationStepSize must be finite and > 0, not -0.5"),
-    "step size NaN": (lambda f: call_status(f.fmu.doStep, f.t, math.nan),
-                      "DoStep: communicationStepSize must be finite and > 0, not nan"),
-    "step size infinite": (lambda f: call_status(f.fmu.doStep, f.t, math.inf),
-                           "DoStep: communicationStepSize must be finite and > 0, not inf"),
-    "communication point not the FMU's time": (lambda f: call_status(f.fmu.doStep, f.t + 0.1, 0.5), "currentCommunicationPoint"),
+    "step size zero": (
+        lambda f: call_status(f.fmu.doStep, f.t, 0.0),
+        "DoStep: communicationStepSize must be finite and > 0, not 0",
+    ),
+    "step size negative": (
+        lambda f: call_status(f.fmu.doStep, f.t, -0.5),
+        "DoStep: communicationStepSize must be finite and > 0, not -0.5",
+    ),
+    "step size NaN": (
+        lambda f: call_status(f.fmu.doStep, f.t, math.nan),
+        "DoStep: communicationStepSize must be finite and > 0, not nan",
+    ),
+    "step size infinite": (
+        lambda f: call_status(f.fmu.doStep, f.t, math.inf),
+        "DoStep: communicationStepSize must be finite and > 0, not inf",
+    ),
+    "communication point not the FMU's time": (
+        lambda f: call_status(f.fmu.doStep, f.t + 0.1, 0.5),
+        "currentCommunicationPoint",
+    ),
     "communication point NaN": (lambda f: call_status(f.fmu.doStep, math.nan, 0.5), "currentCommunicationPoint"),
     "unknown value reference": (lambda f: set_raw(f, 999, 1.0), "unknown value reference 999"),
     "wrong type (get)": (lambda f: get_raw(f, f.vr("y"), "Integer"), "Real variable"),
     "wrong type (set)": (lambda f: set_raw(f, f.vr("u"), True, "Boolean"), "Real variable"),
     "setting an output": (lambda f: set_raw(f, f.vr("y"), 1.0), "output"),
-    "fixed parameter after initialisation": (lambda f: set_raw(f, f.vr("cycleTime"), 0.1),
-                                             ": cycleTime is a fixed parameter and cannot be set after initialization"),
+    "fixed parameter after initialisation": (
+        lambda f: set_raw(f, f.vr("cycleTime"), 0.1),
+        ": cycleTime is a fixed parameter and cannot be set after initialization",
+    ),
     # the ZeroRate items are hold = 1 and noLimit = 2
-    "enumeration out of range": (lambda f: set_raw(f, f.vr("zeroRate"), 7, "Integer"),
-                                 ": zeroRate = 7 is outside its range [1, 2]"),
+    "enumeration out of range": (
+        lambda f: set_raw(f, f.vr("zeroRate"), 7, "Integer"),
+        ": zeroRate = 7 is outside its range [1, 2]",
+    ),
     "null arrays": (null_arrays, "NULL"),
     "call in the wrong state": (lambda f: call_status(f.fmu.exitInitializationMode), "not allowed in Step Mode"),
     "foreign FMU state": (foreign_state, "not an FMU state"),
     "FMU state pointer NULL (get)": (lambda f: null_in_state_call(f, "get"), ": the FMU state pointer is NULL"),
-    "FMU state pointer NULL (deserialize)": (lambda f: null_in_state_call(f, "deserialize"),
-                                             ": the FMU state pointer is NULL"),
+    "FMU state pointer NULL (deserialize)": (
+        lambda f: null_in_state_call(f, "deserialize"),
+        ": the FMU state pointer is NULL",
+    ),
     "FMU state NULL (set)": (lambda f: null_in_state_call(f, "set"), ": the FMU state is NULL"),
     "FMU state NULL (serialized size)": (lambda f: null_in_state_call(f, "size of NULL"), ": the FMU state is NULL"),
     "size pointer NULL": (lambda f: null_in_state_call(f, "size pointer"), ": the size pointer is NULL"),
@@ -100,7 +122,7 @@ def test_misuse_is_an_error_and_the_instance_recovers(version, misuse):
     fmu = Instance("RateLimiter", version)
     fmu.start(rateUpPar=2.0)
     fmu.set(u=5.0)
-    fmu.step(0.5)                                   # y = 1
+    fmu.step(0.5)  # y = 1
     api = state_api(fmu)
     good, t = api["get"](), fmu.t
     action, words = MISUSES[misuse]
@@ -150,7 +172,8 @@ def test_reset_is_as_good_as_a_new_instance(version):
     fmu.start(start_time=1.0, rateUpPar=-1.0)
     fmu.step(0.5)
     assert [m[2] for m in fmu.messages if "status" in m[2]] == [
-        "status 16#8200: a rate is negative (rateUpPar = -1); the output holds"]
+        "status 16#8200: a rate is negative (rateUpPar = -1); the output holds"
+    ]
     fmu.fmu.reset()
     fmu.messages.clear()
     if version == 2:
@@ -174,7 +197,7 @@ def test_nan_values_in_a_set_of_several_are_all_or_nothing(version):
     setter = f.setReal if version == 2 else f.setFloat64
     assert call_status(setter, [fmu.vr("rateUpPar"), 999], [5.0, 1.0]) == 3
     if version == 2:
-        assert fmu.get("rateUpPar") == 1.0         # the valid first value was not applied either
+        assert fmu.get("rateUpPar") == 1.0  # the valid first value was not applied either
     fmu.free()
 
 
@@ -201,11 +224,20 @@ def test_status_change_is_a_warning_logged_once(version):
 def test_wrong_guid_is_refused_with_a_message():
     unzipdir = unzipped("RateLimiter", 2)
     messages = []
-    fmu = FMU2Slave(guid="{00000000-0000-0000-0000-000000000000}", unzipDirectory=unzipdir,
-                    modelIdentifier="RateLimiter", instanceName="wrong")
+    fmu = FMU2Slave(
+        guid="{00000000-0000-0000-0000-000000000000}",
+        unzipDirectory=unzipdir,
+        modelIdentifier="RateLimiter",
+        instanceName="wrong",
+    )
     from fmpy import calloc, free
-    from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                           fmi2CallbackLoggerTYPE)
+    from fmpy.fmi2 import (
+        fmi2CallbackAllocateMemoryTYPE,
+        fmi2CallbackFreeMemoryTYPE,
+        fmi2CallbackFunctions,
+        fmi2CallbackLoggerTYPE,
+    )
+
     callbacks = fmi2CallbackFunctions()
     callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append(m.decode()))
     callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
@@ -238,12 +270,12 @@ def test_fmi3_error_leaves_terminated_with_values_states_and_reset():
     fmu = Instance("RateLimiter", 3)
     fmu.start(rateUpPar=2.0)
     fmu.set(u=5.0)
-    fmu.step(0.5)                                   # y = 1, ramping
+    fmu.step(0.5)  # y = 1, ramping
     last_good = {n: fmu.get(n) for n in ("y", "rampActive", "runningTime", "status", "time")}
     assert call_status(fmu.fmu.doStep, fmu.t, -1.0) == 3
     assert {n: fmu.get(n) for n in last_good} == last_good
     api = state_api(fmu)
-    state = api["get"]()                            # allowed in Terminated
+    state = api["get"]()  # allowed in Terminated
     data = bytes(api["serialize"](state))
     assert data[:4] == b"RLFS"
     assert call_status(fmu.fmu.doStep, fmu.t, 0.5) == 3
@@ -259,14 +291,14 @@ def test_communication_point_within_a_relative_1e_9_of_the_time(version):
     fmu = Instance("RateLimiter", version)
     fmu.start(rateUpPar=1.0)
     fmu.set(u=1e15)
-    fmu.step(0.1)                                   # the FMU's time is 0.1
+    fmu.step(0.1)  # the FMU's time is 0.1
     assert call_status(fmu.fmu.doStep, 1000.0, 1e12) == 3
     assert "currentCommunicationPoint 1000 is not the FMU's time 0.10000000000000001" in fmu.errors()[-1][2]
     fmu.fmu.reset()
     fmu.start(rateUpPar=1.0)
     fmu.set(u=1e15)
     fmu.step(0.1)
-    inside = 0.1 * (1 + 0.9e-9)                     # the step runs from there
+    inside = 0.1 * (1 + 0.9e-9)  # the step runs from there
     assert fmu.raw_step_at(inside, 0.1) == 0
     assert fmu.get("time") == inside + 0.1
     outside = fmu.get("time") * (1 + 1.1e-9)
@@ -321,17 +353,18 @@ def just_outside(time):
 def test_status_messages_say_what_the_status_means(version):
     fmu = Instance("RateLimiter", version)
     fmu.start()
-    for settings, code, text in (({"rateUpPar": -1.0}, "16#8200", "a rate is negative (rateUpPar = -1)"),
-                                 ({"rateUpPar": 1.0, "yMin": 3.0, "yMax": 2.0}, "16#8204", "yMin is above yMax (yMin = 3)"),
-                                 ({"yMin": math.nan, "ratePeriod": -1.0}, "16#8202",
-                                  "ratePeriod is negative or not finite (ratePeriod = -1)")):
+    for settings, code, text in (
+        ({"rateUpPar": -1.0}, "16#8200", "a rate is negative (rateUpPar = -1)"),
+        ({"rateUpPar": 1.0, "yMin": 3.0, "yMax": 2.0}, "16#8204", "yMin is above yMax (yMin = 3)"),
+        ({"yMin": math.nan, "ratePeriod": -1.0}, "16#8202", "ratePeriod is negative or not finite (ratePeriod = -1)"),
+    ):
         fmu.set(**settings)
         fmu.step(0.5)
         warning = [m for m in fmu.messages if m[0] == 1][-1]
         assert warning[1] == "logStatusWarning"
         assert warning[2] == f"status {code}: {text}; the output holds", warning
     fmu.set(ratePeriod=1.0, yMax=math.nan)
-    fmu.step(0.5)                                   # cleared: an event, not a warning
+    fmu.step(0.5)  # cleared: an event, not a warning
     assert fmu.messages[-1][1:] == ("logEvents", "status 16#0000: no error")
     fmu.free()
 
@@ -345,15 +378,23 @@ def test_wrong_type_messages_name_the_types(version):
     get_real = "fmi2GetReal" if version == 2 else "fmi3GetFloat64"
     set_boolean = "fmi2SetBoolean" if version == 2 else "fmi3SetBoolean"
     for call, message in (
-            (lambda: get_raw(fmu, fmu.vr("y"), "Integer"), f"y (value reference 17) is a Real variable, which "
-                                                           f"{get_integer} cannot access"),
-            (lambda: set_raw(fmu, fmu.vr("zeroRate"), True, "Boolean"), f"zeroRate (value reference 12) is an "
-                                                                        f"Enumeration variable, which {set_boolean} "
-                                                                        "cannot access"),
-            (lambda: get_raw(fmu, fmu.vr("status"), "Real"), f"status (value reference {fmu.vr('status')}) is an "
-                                                             f"Integer variable, which {get_real} cannot access"),
-            (lambda: get_raw(fmu, fmu.vr("bypass"), "Real"), f"bypass (value reference {fmu.vr('bypass')}) is a "
-                                                             f"Boolean variable, which {get_real} cannot access")):
+        (
+            lambda: get_raw(fmu, fmu.vr("y"), "Integer"),
+            f"y (value reference 17) is a Real variable, which {get_integer} cannot access",
+        ),
+        (
+            lambda: set_raw(fmu, fmu.vr("zeroRate"), True, "Boolean"),
+            f"zeroRate (value reference 12) is an Enumeration variable, which {set_boolean} cannot access",
+        ),
+        (
+            lambda: get_raw(fmu, fmu.vr("status"), "Real"),
+            f"status (value reference {fmu.vr('status')}) is an Integer variable, which {get_real} cannot access",
+        ),
+        (
+            lambda: get_raw(fmu, fmu.vr("bypass"), "Real"),
+            f"bypass (value reference {fmu.vr('bypass')}) is a Boolean variable, which {get_real} cannot access",
+        ),
+    ):
         assert call() == 3, message
         assert fmu.errors()[-1][2].endswith(": " + message), fmu.errors()[-1]
         fmu.fmu.reset()
@@ -381,9 +422,12 @@ def test_debug_logging_categories_choose_what_is_logged(version):
     every = ["logEvents", "logStatusError", "logStatusWarning"]
     assert logged_categories(version, True, []) == every
     assert logged_categories(version, True, ["logEvents"]) == (
-        ["logEvents", "logStatusError", "logStatusWarning"] if version == 2 else ["logEvents"])
+        ["logEvents", "logStatusError", "logStatusWarning"] if version == 2 else ["logEvents"]
+    )
     assert logged_categories(version, True, ["logStatusWarning", "logStatusError"]) == [
-        "logStatusError", "logStatusWarning"]
+        "logStatusError",
+        "logStatusWarning",
+    ]
     # FMI 2 always says why a call failed and warns; FMI 3 follows loggingOn
     assert logged_categories(version, False, []) == (["logStatusError", "logStatusWarning"] if version == 2 else [])
     fmu = Instance("RateLimiter", version)
@@ -418,30 +462,60 @@ def cs_state_into(fmu):
 
 # Model Exchange, in Continuous-Time Mode after the event at 0.5 s: name: (misuse, words of the message)
 ME_MISUSES = {
-    "time before the last event": (lambda f: me_raw(f, "SetTime", [ctypes.c_double], 0.25),
-                                   "SetTime: time 0.25 is not finite or before the last event at 0.5"),
+    "time before the last event": (
+        lambda f: me_raw(f, "SetTime", [ctypes.c_double], 0.25),
+        "SetTime: time 0.25 is not finite or before the last event at 0.5",
+    ),
     "time NaN": (lambda f: me_raw(f, "SetTime", [ctypes.c_double], math.nan), "SetTime: time nan is not finite"),
-    **{f"{function} with n = {n}": (
-        lambda f, function=function, n=n: me_raw(
-            f, function if f.version == 3 or function != "GetContinuousStateDerivatives" else "GetDerivatives",
-            [ctypes.c_void_p, ctypes.c_size_t], (ctypes.c_double * n)(), n),
-        f"this FMU has no {what}; n = {n}, not 0")
-       for function, what, n in (("SetContinuousStates", "continuous states", 1),
-                                 ("GetContinuousStates", "continuous states", 1),
-                                 ("GetContinuousStateDerivatives", "continuous states", 2),
-                                 ("GetNominalsOfContinuousStates", "continuous states", 3),
-                                 ("GetEventIndicators", "event indicators", 2))},
+    **{
+        f"{function} with n = {n}": (
+            lambda f, function=function, n=n: me_raw(
+                f,
+                function if f.version == 3 or function != "GetContinuousStateDerivatives" else "GetDerivatives",
+                [ctypes.c_void_p, ctypes.c_size_t],
+                (ctypes.c_double * n)(),
+                n,
+            ),
+            f"this FMU has no {what}; n = {n}, not 0",
+        )
+        for function, what, n in (
+            ("SetContinuousStates", "continuous states", 1),
+            ("GetContinuousStates", "continuous states", 1),
+            ("GetContinuousStateDerivatives", "continuous states", 2),
+            ("GetNominalsOfContinuousStates", "continuous states", 3),
+            ("GetEventIndicators", "event indicators", 2),
+        )
+    },
     "event update in Continuous-Time Mode": (
-        lambda f: me_raw(f, "NewDiscreteStates" if f.version == 2 else "UpdateDiscreteStates",
-                         [ctypes.c_void_p] * (1 if f.version == 2 else 6), *([None] * (1 if f.version == 2 else 6))),
-        "DiscreteStates: not allowed in Continuous-Time Mode"),
-    "a Co-Simulation step": (lambda f: me_raw(f, "DoStep", [ctypes.c_double, ctypes.c_double] + (
-        [ctypes.c_int] if f.version == 2 else [ctypes.c_bool] + [ctypes.c_void_p] * 4), 0.5, 0.5, 1,
-        *([] if f.version == 2 else [None] * 4)), "DoStep: not allowed in Continuous-Time Mode"),
-    "fixed parameter after initialisation": (lambda f: set_raw(f, f.vr("cycleTime"), 0.1),
-                                             ": cycleTime is a fixed parameter and cannot be set after initialization"),
-    "a Co-Simulation instance's FMU state": (cs_state_into, "an FMU state of Step Mode, which this Model Exchange "
-                                                            "instance cannot be in"),
+        lambda f: me_raw(
+            f,
+            "NewDiscreteStates" if f.version == 2 else "UpdateDiscreteStates",
+            [ctypes.c_void_p] * (1 if f.version == 2 else 6),
+            *([None] * (1 if f.version == 2 else 6)),
+        ),
+        "DiscreteStates: not allowed in Continuous-Time Mode",
+    ),
+    "a Co-Simulation step": (
+        lambda f: me_raw(
+            f,
+            "DoStep",
+            [ctypes.c_double, ctypes.c_double]
+            + ([ctypes.c_int] if f.version == 2 else [ctypes.c_bool] + [ctypes.c_void_p] * 4),
+            0.5,
+            0.5,
+            1,
+            *([] if f.version == 2 else [None] * 4),
+        ),
+        "DoStep: not allowed in Continuous-Time Mode",
+    ),
+    "fixed parameter after initialisation": (
+        lambda f: set_raw(f, f.vr("cycleTime"), 0.1),
+        ": cycleTime is a fixed parameter and cannot be set after initialization",
+    ),
+    "a Co-Simulation instance's FMU state": (
+        cs_state_into,
+        "an FMU state of Step Mode, which this Model Exchange instance cannot be in",
+    ),
 }
 
 

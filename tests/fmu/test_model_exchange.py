@@ -6,12 +6,19 @@ before it was left, so Model Exchange gives Co-Simulation's outputs at
 every cycle end (the reference: the same scenario through the same FMU as
 Co-Simulation with the same cycleTime, itself checked against the
 hand-worked references by test_reference.py)."""
+
 import math
 from ctypes import c_bool, c_double, c_int, c_size_t, c_void_p
 
 import pytest
-from fmpy.fmi2 import FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, \
-    fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.fmi2 import (
+    FMU2Model,
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 from fmpy import calloc, free, read_model_description
 
@@ -24,8 +31,11 @@ SCENARIOS = discover()
 def cycle_ends(result, start, h):
     """The rows of a result at the cycle ends start + n*h (a Co-Simulation
     result also has rows at the input changes between)."""
-    return {round((t - start) / h): row for t, row in zip(result["time"], result)
-            if math.isclose((t - start) / h, round((t - start) / h), abs_tol=1e-9)}
+    return {
+        round((t - start) / h): row
+        for t, row in zip(result["time"], result)
+        if math.isclose((t - start) / h, round((t - start) / h), abs_tol=1e-9)
+    }
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -76,10 +86,15 @@ class MeInstance:
             self.messages = self.log.messages
         else:
             self.messages = []
-            self.fmu = FMU3Model(guid=md.instantiationToken, unzipDirectory=unzipdir, modelIdentifier=identifier,
-                                 instanceName="me")
-            self.fmu.instantiate(loggingOn=True, logMessage=lambda env, status, category, message:
-                                 self.messages.append((status, category.decode(), message.decode())))
+            self.fmu = FMU3Model(
+                guid=md.instantiationToken, unzipDirectory=unzipdir, modelIdentifier=identifier, instanceName="me"
+            )
+            self.fmu.instantiate(
+                loggingOn=True,
+                logMessage=lambda env, status, category, message: self.messages.append(
+                    (status, category.decode(), message.decode())
+                ),
+            )
 
     def set(self, **values):
         for name, value in values.items():
@@ -87,19 +102,24 @@ class MeInstance:
             if v.type == "Boolean":
                 self.fmu.setBoolean([v.valueReference], [bool(value)])
             elif v.type in ("Integer", "Int32"):
-                self.fmu.setInteger([v.valueReference], [int(value)]) if self.version == 2 else \
-                    self.fmu.setInt32([v.valueReference], [int(value)])
+                self.fmu.setInteger([v.valueReference], [int(value)]) if self.version == 2 else self.fmu.setInt32(
+                    [v.valueReference], [int(value)]
+                )
             elif v.type == "Enumeration":
-                self.fmu.setInteger([v.valueReference], [int(value)]) if self.version == 2 else \
-                    self.fmu.setInt64([v.valueReference], [int(value)])
+                self.fmu.setInteger([v.valueReference], [int(value)]) if self.version == 2 else self.fmu.setInt64(
+                    [v.valueReference], [int(value)]
+                )
             else:
                 (self.fmu.setReal if self.version == 2 else self.fmu.setFloat64)([v.valueReference], [float(value)])
 
     def get(self, name):
         v = self.vrs[name]
         if v.type in ("Integer", "Int32", "Enumeration"):
-            getter = self.fmu.getInteger if self.version == 2 else \
-                (self.fmu.getInt64 if v.type == "Enumeration" else self.fmu.getInt32)
+            getter = (
+                self.fmu.getInteger
+                if self.version == 2
+                else (self.fmu.getInt64 if v.type == "Enumeration" else self.fmu.getInt32)
+            )
         elif v.type == "Boolean":
             getter = self.fmu.getBoolean
         else:
@@ -266,8 +286,10 @@ def test_a_state_of_model_exchange_restores_the_latched_inputs_and_the_cycle_cou
     fmu = MeInstance("RateLimiter", version)
     f = fmu.fmu
     get, set_, serialize, deserialize, free_state = (
-        (f.getFMUstate, f.setFMUstate, f.serializeFMUstate, f.deSerializeFMUstate, f.freeFMUstate) if version == 2
-        else (f.getFMUState, f.setFMUState, f.serializeFMUState, f.deserializeFMUState, f.freeFMUState))
+        (f.getFMUstate, f.setFMUstate, f.serializeFMUstate, f.deSerializeFMUstate, f.freeFMUstate)
+        if version == 2
+        else (f.getFMUState, f.setFMUState, f.serializeFMUState, f.deserializeFMUState, f.freeFMUState)
+    )
     try:
         fmu.start(cycleTime=0.1, rateUpPar=100.0)  # 10 a cycle: y reaches u in one
         fmu.update()
@@ -318,13 +340,26 @@ def test_misuse_in_model_exchange_is_refused_with_a_reason(version):
         for call, text in (
             (lambda c: raw(fmu, f"{p}SetTime", [c_void_p, c_double], c, 0.5), "before the last event"),
             (lambda c: raw(fmu, f"{p}SetTime", [c_void_p, c_double], c, math.nan), "not finite"),
-            (lambda c: raw(fmu, f"{p}GetContinuousStates", [c_void_p, c_void_p, c_size_t], c,
-                           (c_double * 1)(), 1), "this FMU has no continuous states; n = 1, not 0"),
-            (lambda c: raw(fmu, f"{p}GetEventIndicators", [c_void_p, c_void_p, c_size_t], c,
-                           (c_double * 2)(), 2), "this FMU has no event indicators; n = 2, not 0"),
-            (lambda c: raw(fmu, f"{p}CompletedIntegratorStep", [c_void_p, c_int if version == 2 else c_bool,
-                                                                c_void_p, c_void_p], c, 1, None, None),
-             "an output argument pointer is NULL"),
+            (
+                lambda c: raw(fmu, f"{p}GetContinuousStates", [c_void_p, c_void_p, c_size_t], c, (c_double * 1)(), 1),
+                "this FMU has no continuous states; n = 1, not 0",
+            ),
+            (
+                lambda c: raw(fmu, f"{p}GetEventIndicators", [c_void_p, c_void_p, c_size_t], c, (c_double * 2)(), 2),
+                "this FMU has no event indicators; n = 2, not 0",
+            ),
+            (
+                lambda c: raw(
+                    fmu,
+                    f"{p}CompletedIntegratorStep",
+                    [c_void_p, c_int if version == 2 else c_bool, c_void_p, c_void_p],
+                    c,
+                    1,
+                    None,
+                    None,
+                ),
+                "an output argument pointer is NULL",
+            ),
         ):
             fmu.start(cycleTime=0.1)
             fmu.update()
@@ -355,13 +390,18 @@ def test_a_state_of_a_co_simulation_instance_is_refused_in_model_exchange(versio
     unzipdir = unzipped("RateLimiter", version)
     md = read_model_description(unzipdir)
     if version == 2:
-        cs = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="cs")
+        cs = FMU2Slave(
+            guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="cs"
+        )
         cs.instantiate()
         cs.setupExperiment(startTime=0.0)
     else:
-        cs = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzipdir,
-                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="cs")
+        cs = FMU3Slave(
+            guid=md.instantiationToken,
+            unzipDirectory=unzipdir,
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName="cs",
+        )
         cs.instantiate()
     try:
         cs.enterInitializationMode(**({} if version == 2 else {"startTime": 0.0}))
@@ -375,8 +415,7 @@ def test_a_state_of_a_co_simulation_instance_is_refused_in_model_exchange(versio
         assert raw(fmu, name, [c_void_p, c_void_p], fmu.fmu.component, state) == 3
         errors = [m for m in fmu.messages if m[0] >= 3]
         assert len(errors) == 1, fmu.messages
-        assert errors[0][2] == (f"{name}: an FMU state of Step Mode, which this Model Exchange instance "
-                                "cannot be in")
+        assert errors[0][2] == (f"{name}: an FMU state of Step Mode, which this Model Exchange instance cannot be in")
         (cs.freeFMUstate if version == 2 else cs.freeFMUState)(state)
     finally:
         fmu.free()

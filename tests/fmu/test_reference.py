@@ -3,6 +3,7 @@ and the oracle against the same hand-worked references (so that the oracle
 the random tests rely on is itself checked), bit for bit: a reference holds
 the doubles the PLC's LREAL arithmetic gives (three steps of 0.1 make
 0.30000000000000004)."""
+
 import math
 
 import pytest
@@ -55,8 +56,9 @@ def inputs_at(scenario, t, booleans):
         return {}
     rows = [r for r in scenario.inputs if r["time"] < t or math.isclose(r["time"], t)]
     row = rows[-1] if rows else scenario.inputs[0]
-    return {name: (bool(row[name]) if name in booleans else float(row[name]))
-            for name in scenario.inputs.dtype.names[1:]}
+    return {
+        name: (bool(row[name]) if name in booleans else float(row[name])) for name in scenario.inputs.dtype.names[1:]
+    }
 
 
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)

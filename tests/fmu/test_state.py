@@ -1,5 +1,6 @@
 """FMU states: rollback with get/set, and serialize / deserialize into a new
 process, continue bit-identically; bad serialized bytes are refused."""
+
 import json
 import math
 import struct
@@ -14,8 +15,18 @@ from support.fmu_driver import MODELS, STATE_FUNCTIONS, TESTS, Instance, call_st
 from support.process import run as run_bounded
 
 # inputs and step sizes of a run: ramps, a change, NaN, sub-cycling steps
-STEPS = [(0.25, {"u": 10.0}), (0.25, {}), (0.5, {"u": -3.0}), (0.3, {}), (0.25, {"u": float("nan")}),
-         (0.5, {"u": 4.0}), (0.1, {}), (0.75, {"rateUp": 0.5}), (0.25, {}), (1.0, {"u": 100.0})] * 3
+STEPS = [
+    (0.25, {"u": 10.0}),
+    (0.25, {}),
+    (0.5, {"u": -3.0}),
+    (0.3, {}),
+    (0.25, {"u": float("nan")}),
+    (0.5, {"u": 4.0}),
+    (0.1, {}),
+    (0.75, {"rateUp": 0.5}),
+    (0.25, {}),
+    (1.0, {"u": 100.0}),
+] * 3
 START = {"rateUpPar": 3.0, "rateDownPar": 1.5, "cycleTime": 0.05, "durationPar": 2.0}
 
 
@@ -145,9 +156,20 @@ def test_serialized_state_continues_bit_identically_in_a_new_process(version, tm
     (tmp_path / "state.bin").write_bytes(bytes(api["serialize"](state)))
     uninterrupted = run_steps(fmu, STEPS[12:])
     fmu.free()
-    out = run_bounded([sys.executable, "-m", "support.continue_from_state", str(version),
-                       str(tmp_path / "state.bin"), json.dumps(STEPS[12:])],
-                      check=True, cwd=TESTS, timeout=120, what="the run continued in a new process")
+    out = run_bounded(
+        [
+            sys.executable,
+            "-m",
+            "support.continue_from_state",
+            str(version),
+            str(tmp_path / "state.bin"),
+            json.dumps(STEPS[12:]),
+        ],
+        check=True,
+        cwd=TESTS,
+        timeout=120,
+        what="the run continued in a new process",
+    )
     assert json.loads(out.stdout.strip().splitlines()[-1]) == uninterrupted
 
 
@@ -157,7 +179,7 @@ def reseal(data):
 
 
 def value_at(d, offset, packed):
-    return reseal(d[:offset] + packed + d[offset + len(packed):])
+    return reseal(d[:offset] + packed + d[offset + len(packed) :])
 
 
 def values_end(d):
@@ -204,7 +226,9 @@ BAD_BYTES = {
     "header alone": lambda d: d[:16],
     "header one byte short": lambda d: d[:15],
     "magic alone": lambda d: d[:4],
-    "payload size wrong, resealed": lambda d: value_at(d, 12, struct.pack("<I", struct.unpack_from("<I", d, 12)[0] + 8)),
+    "payload size wrong, resealed": lambda d: value_at(
+        d, 12, struct.pack("<I", struct.unpack_from("<I", d, 12)[0] + 8)
+    ),
     "boolean -1": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", -1.0)),  # bypass
     "boolean one half": lambda d: value_at(d, 20 + 8 * 4, struct.pack("<d", 0.5)),
     "integer -2^31 - 1": lambda d: value_at(d, 20 + 8 * 21, struct.pack("<d", -2147483649.0)),
@@ -226,7 +250,9 @@ BAD_BYTES = {
     "older version": lambda d: reseal(d[:4] + struct.pack("<I", struct.unpack_from("<I", d, 4)[0] - 1) + d[8:]),
     "model one below": lambda d: value_at(d, 8, struct.pack("<I", (struct.unpack_from("<I", d, 8)[0] - 1) % 2**32)),
     "model one above": lambda d: value_at(d, 8, struct.pack("<I", (struct.unpack_from("<I", d, 8)[0] + 1) % 2**32)),
-    "payload size short, resealed": lambda d: value_at(d, 12, struct.pack("<I", struct.unpack_from("<I", d, 12)[0] - 8)),
+    "payload size short, resealed": lambda d: value_at(
+        d, 12, struct.pack("<I", struct.unpack_from("<I", d, 12)[0] - 8)
+    ),
     "checksum one more": lambda d: d[:-4] + struct.pack("<I", (zlib.crc32(d[:-4]) + 1) % 2**32),
     "checksum one less": lambda d: d[:-4] + struct.pack("<I", (zlib.crc32(d[:-4]) - 1) % 2**32),
 }
@@ -234,29 +260,54 @@ BAD_BYTES = {
 
 # each refused for its own reason
 REASONS = {
-    "truncated": "bytes; expected", "empty": "no header", "padded": "bytes; expected", "corrupted": "checksum",
-    "foreign magic": "no header", "future version": "format version 99", "another model": "another model",
-    "invalid mode": "invalid mode", "enumeration NaN": "impossible value nan for zeroRate",
-    "boolean 2": "impossible value 2 for bypass", "start time infinite": "impossible time",
-    "cycle count 2^60": "impossible time or cycle count", "running time period NaN": "impossible time",
-    "running time base negative": "impossible time", "deciding rule unknown": "invalid rule 7",
-    "integer 2^31": "impossible value 2.14748e+09 for status", "integer not whole": "impossible value 0.5 for status",
-    "truncated, resealed": "bytes; expected", "foreign magic, resealed": "no header",
-    "foreign magic below, resealed": "no header", "cycle count 2^53 + 1": "impossible time or cycle count",
+    "truncated": "bytes; expected",
+    "empty": "no header",
+    "padded": "bytes; expected",
+    "corrupted": "checksum",
+    "foreign magic": "no header",
+    "future version": "format version 99",
+    "another model": "another model",
+    "invalid mode": "invalid mode",
+    "enumeration NaN": "impossible value nan for zeroRate",
+    "boolean 2": "impossible value 2 for bypass",
+    "start time infinite": "impossible time",
+    "cycle count 2^60": "impossible time or cycle count",
+    "running time period NaN": "impossible time",
+    "running time base negative": "impossible time",
+    "deciding rule unknown": "invalid rule 7",
+    "integer 2^31": "impossible value 2.14748e+09 for status",
+    "integer not whole": "impossible value 0.5 for status",
+    "truncated, resealed": "bytes; expected",
+    "foreign magic, resealed": "no header",
+    "foreign magic below, resealed": "no header",
+    "cycle count 2^53 + 1": "impossible time or cycle count",
     "running cycle count 2^53 + 1": "impossible time or cycle count",
     "enumeration below its range": "impossible value 0 for zeroRate",
     "enumeration above its range": "impossible value 3 for zeroRate",
-    "mode 0": "invalid mode 0", "mode 3": "invalid mode 3", "mode -1": "invalid mode -1",
-    "running time period -0.5": "impossible time", "running time base -0.5": "impossible time",
-    "variable count one more": "wrong number of variables", "variable count one fewer": "wrong number of variables",
-    "magic's last byte wrong, resealed": "no header", "older version": "format version 2",
-    "model one below": "another model", "model one above": "another model",
-    "payload size short, resealed": "bytes; expected", "checksum one more": "checksum", "checksum one less": "checksum",
-    "header alone": "16 bytes; expected", "header one byte short": "(15 bytes, no header)",
-    "magic alone": "(4 bytes, no header)", "payload size wrong, resealed": "bytes; expected",
-    "boolean -1": "impossible value -1 for bypass", "boolean one half": "impossible value 0.5 for bypass",
-    "integer -2^31 - 1": "impossible value -2.14748e+09 for status", "time infinite": "impossible time",
-    "running time period infinite": "impossible time", "running time base infinite": "impossible time",
+    "mode 0": "invalid mode 0",
+    "mode 3": "invalid mode 3",
+    "mode -1": "invalid mode -1",
+    "running time period -0.5": "impossible time",
+    "running time base -0.5": "impossible time",
+    "variable count one more": "wrong number of variables",
+    "variable count one fewer": "wrong number of variables",
+    "magic's last byte wrong, resealed": "no header",
+    "older version": "format version 2",
+    "model one below": "another model",
+    "model one above": "another model",
+    "payload size short, resealed": "bytes; expected",
+    "checksum one more": "checksum",
+    "checksum one less": "checksum",
+    "header alone": "16 bytes; expected",
+    "header one byte short": "(15 bytes, no header)",
+    "magic alone": "(4 bytes, no header)",
+    "payload size wrong, resealed": "bytes; expected",
+    "boolean -1": "impossible value -1 for bypass",
+    "boolean one half": "impossible value 0.5 for bypass",
+    "integer -2^31 - 1": "impossible value -2.14748e+09 for status",
+    "time infinite": "impossible time",
+    "running time period infinite": "impossible time",
+    "running time base infinite": "impossible time",
 }
 
 
@@ -377,8 +428,10 @@ def test_bad_serialized_state_is_refused_and_the_instance_recovers(version, dama
 
 
 # values at the ends of their variable's range: accepted (one past them is refused, above)
-RANGE_ENDS = {"status": (21, (2147483647, -2147483648)),  # an Integer: the int32 range
-              "zeroRate": (12, (1, 2))}  # an Enumeration: hold, no limit
+RANGE_ENDS = {
+    "status": (21, (2147483647, -2147483648)),  # an Integer: the int32 range
+    "zeroRate": (12, (1, 2)),
+}  # an Enumeration: hold, no limit
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -404,10 +457,15 @@ def test_counts_and_running_time_at_the_ends_of_their_range_in_a_state_are_accep
     fmu = started(version)
     api = state_api(fmu)
     data = bytes(api["serialize"](api["get"]()))
-    ends = [(values_end(data) + BLOCK + 16, struct.pack("<Q", 1 << 53)),  # cycles
-            (values_end(data) + 25, struct.pack("<Q", 1 << 53))]  # running cycles
-    ends += [(values_end(data) + offset, struct.pack("<d", value))  # running period, base
-             for offset in (33, 41) for value in (0.0, sys.float_info.max)]
+    ends = [
+        (values_end(data) + BLOCK + 16, struct.pack("<Q", 1 << 53)),  # cycles
+        (values_end(data) + 25, struct.pack("<Q", 1 << 53)),
+    ]  # running cycles
+    ends += [
+        (values_end(data) + offset, struct.pack("<d", value))  # running period, base
+        for offset in (33, 41)
+        for value in (0.0, sys.float_info.max)
+    ]
     for offset, packed in ends:
         state = api["deserialize"](value_at(data, offset, packed))
         api["free"](state)
@@ -461,8 +519,9 @@ def test_a_state_in_event_mode_at_a_time_other_than_its_events_is_refused(versio
     name = STATE_FUNCTIONS[version]["deserialize"]
     for time in (0.4, 0.1):
         assert call_status(api["deserialize"], value_at(in_event, time_at, struct.pack("<d", time))) == 3
-        assert fmu.errors()[-1][2] == (f"{name}: serialized state is in Event Mode at time {time:.17g}, "
-                                       "not at its event's 0.25")
+        assert fmu.errors()[-1][2] == (
+            f"{name}: serialized state is in Event Mode at time {time:.17g}, not at its event's 0.25"
+        )
         fmu.restore(good, 0.25)
     assert len(fmu.errors()) == 2
     for data in (in_event, in_continuous):
@@ -477,7 +536,7 @@ def test_a_state_in_event_mode_at_a_time_other_than_its_events_is_refused(versio
 def fnv1a(text):
     h = 2166136261
     for byte in text.encode():
-        h = ((h ^ byte) * 16777619) % 2 ** 32
+        h = ((h ^ byte) * 16777619) % 2**32
     return h
 
 

@@ -1,5 +1,6 @@
 """fmi.md, FMI behaviour: instances are independent and run concurrently on
 different threads (ctypes releases the GIL inside every FMI call)."""
+
 import math
 from concurrent.futures import ThreadPoolExecutor
 
@@ -35,4 +36,4 @@ def test_threaded_instances_match_serial_runs(version):
     for fmu, _ in results:
         fmu.release()
     assert [trace for _, trace in results] == serial
-    assert len({tuple(t[-1]) for t in serial}) > 1   # the runs really differ
+    assert len({tuple(t[-1]) for t in serial}) > 1  # the runs really differ

@@ -1,5 +1,6 @@
 """The choices made where the vendor documents are silent (models.md,
 Vendor interpretations), each checked."""
+
 import math
 
 import pytest
@@ -35,8 +36,9 @@ def test_siemens_nan_rate_is_status_8201_naming_set_change_rate(version):
 
 
 def test_siemens_non_finite_default_value_is_not_output(version):
-    fmu = started("LGF_LimRateOfChangeCI", version, value=3.0, setChangeRate=1.0,
-                  defaultOutValue=math.inf, enDefaultOutValue=True)
+    fmu = started(
+        "LGF_LimRateOfChangeCI", version, value=3.0, setChangeRate=1.0, defaultOutValue=math.inf, enDefaultOutValue=True
+    )
     fmu.step(1.0)
     assert fmu.get("delayedValue") == 3.0
     fmu.free()
@@ -58,15 +60,18 @@ def test_irmn4_negative_rate_holds_and_logs_a_warning(version):
     fmu.free()
 
 
-@pytest.mark.parametrize("model,name,value", [
-    ("RateLimit", "DurationPar", 259201.0),
-    ("RateLimit", "DurationPar", -1.0),
-    ("Ramp", "rVariation", 100.5),
-    ("Ramp", "rVariation", -1.0),
-    ("Ramp", "tTime", -0.1),
-    ("Ramp", "tTime", math.inf),
-    ("Ramp", "tInitDelay", math.nan),
-])
+@pytest.mark.parametrize(
+    "model,name,value",
+    [
+        ("RateLimit", "DurationPar", 259201.0),
+        ("RateLimit", "DurationPar", -1.0),
+        ("Ramp", "rVariation", 100.5),
+        ("Ramp", "rVariation", -1.0),
+        ("Ramp", "tTime", -0.1),
+        ("Ramp", "tTime", math.inf),
+        ("Ramp", "tInitDelay", math.nan),
+    ],
+)
 def test_values_outside_the_vendor_range_are_refused(model, name, value, version):
     fmu = Instance(model, version)
     setter = fmu.fmu.setReal if version == 2 else fmu.fmu.setFloat64
@@ -79,5 +84,5 @@ def test_ramp_range_limits_themselves_are_accepted(version):
     fmu = started("Ramp", version, rVariation=100.0, tTime=0.0, rIn=0.0)
     fmu.set(rIn=1000.0)
     fmu.step(0.5)
-    assert fmu.get("rOut") == 100.0          # tTime 0: 100 per cycle
+    assert fmu.get("rOut") == 100.0  # tTime 0: 100 per cycle
     fmu.free()

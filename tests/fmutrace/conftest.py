@@ -1,5 +1,6 @@
 """The fmutrace tier: a test that starts a Dask cluster says so with the
 marker cluster, which the fast lane leaves out (docs/testing.md)."""
+
 import pytest
 
 

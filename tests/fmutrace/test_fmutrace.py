@@ -6,6 +6,7 @@ computed by an oracle in this file, never taken from an FMU's output.
 PassThrough: y(t + h) = u(t), y = 0 before the first step.
 FirstOrderLag: x(t + h) = c + (x(t) - c) * exp(-h / tau), demand = Kp * (setpoint - x).
 """
+
 import json
 import math
 import re
@@ -29,8 +30,9 @@ RATE_LIMITER = {v: BUILD_DIR / f"fmi{v}" / "RateLimiter.fmu" for v in (2, 3)}
 
 
 def fmutrace_cli(*args, cwd=None):
-    return run_bounded([str(FMUTRACE), *map(str, args)], timeout=600, what="fmutrace " + " ".join(map(str, args[:2])),
-                       cwd=cwd)
+    return run_bounded(
+        [str(FMUTRACE), *map(str, args)], timeout=600, what="fmutrace " + " ".join(map(str, args[:2])), cwd=cwd
+    )
 
 
 def write_case(folder, model, ref, inputs=None, opt=None, start=None):
@@ -70,8 +72,13 @@ def test_each_csv_dialect_on_a_foreign_fmu(dialect, version, tmp_path):
 
 
 def test_the_dialect_of_the_reference_too(tmp_path):
-    write_case(tmp_path / "step", "PassThrough", '"Time";"y"\n0;0\n0,1;1\n\n0,2;1\n0,3;3\n0,4;3\n0,5;3',
-               "time,u\n0,1\n0.2,3\n", STEP_OPT)
+    write_case(
+        tmp_path / "step",
+        "PassThrough",
+        '"Time";"y"\n0;0\n0,1;1\n\n0,2;1\n0,3;3\n0,4;3\n0,5;3',
+        "time,u\n0,1\n0.2,3\n",
+        STEP_OPT,
+    )
     assert fmutrace_cli("compare", PASS_THROUGH[3], tmp_path).returncode == 0
 
 
@@ -167,8 +174,10 @@ def test_exact_mode_passes_bit_for_bit_and_fails_on_one_ulp(version, tmp_path):
     assert "1 of 21 samples outside" in done.stdout
 
 
-@pytest.mark.parametrize("flag,allowed,too_small,off", [("--rel-tol", 1e-6, 1e-8, lambda x: x * (1 + 1e-7)),
-                                                        ("--abs-tol", 1e-3, 1e-5, lambda x: x + 1e-4)])
+@pytest.mark.parametrize(
+    "flag,allowed,too_small,off",
+    [("--rel-tol", 1e-6, 1e-8, lambda x: x * (1 + 1e-7)), ("--abs-tol", 1e-3, 1e-5, lambda x: x + 1e-4)],
+)
 def test_tolerance_modes(flag, allowed, too_small, off, tmp_path):
     lag_case(tmp_path / "lag", lambda t, x: off(x) if t > 0 else x)
     assert fmutrace_cli("compare", LAG[3], tmp_path).returncode == 1  # exact: differs
@@ -204,8 +213,9 @@ def test_tube_checks_the_result_where_the_reference_says_something(tmp_path):
     case = recorder_case(tmp_path / "recorder")
     ref = case / "FirstOrderLag_ref.csv"
     ref.write_text("".join(line for line in ref.read_text().splitlines(keepends=True)[:6]))  # 0 .. 1 s
-    done = fmutrace_cli("compare", LAG[3], tmp_path, "--tube-time", 0.1, "--tube-value", 0.001, "--report",
-                        tmp_path / "report")
+    done = fmutrace_cli(
+        "compare", LAG[3], tmp_path, "--tube-time", 0.1, "--tube-value", 0.001, "--report", tmp_path / "report"
+    )
     assert done.returncode == 0, done.stdout
     outcome = json.loads((tmp_path / "report" / "results.json").read_text())["cases"][0]
     assert outcome["status"] == "pass"
@@ -213,8 +223,9 @@ def test_tube_checks_the_result_where_the_reference_says_something(tmp_path):
 
 def test_tube_fails_where_the_result_leaves_it_and_says_by_how_much(tmp_path):
     recorder_case(tmp_path / "recorder", start="tau,1.0\n")  # twice as fast: leaves the tube at once
-    done = fmutrace_cli("compare", LAG[3], tmp_path, "--tube-time", 0.1, "--tube-value", 0.001,
-                        "--report", tmp_path / "report")
+    done = fmutrace_cli(
+        "compare", LAG[3], tmp_path, "--tube-time", 0.1, "--tube-value", 0.001, "--report", tmp_path / "report"
+    )
     assert done.returncode == 1
     # at t = 0.1, x = 5 (1 - e^-0.1); the window [0, 0.2] of the reference's
     # polyline rises from 0 at t = 0 towards its sample at 0.25: its top is
@@ -232,53 +243,97 @@ def test_tube_fails_where_the_result_leaves_it_and_says_by_how_much(tmp_path):
 
 def test_the_tube_needs_both_widths_and_no_tolerance_beside_it(tmp_path):
     recorder_case(tmp_path / "recorder")
-    for args, message in [(("--tube-time", 0.1), "needs both"),
-                          (("--tube-time", 0.1, "--tube-value", 0.1, "--rel-tol", 1e-3), "not both")]:
+    for args, message in [
+        (("--tube-time", 0.1), "needs both"),
+        (("--tube-time", 0.1, "--tube-value", 0.1, "--rel-tol", 1e-3), "not both"),
+    ]:
         done = fmutrace_cli("compare", LAG[3], tmp_path, *args)
         assert done.returncode == 2 and message in done.stderr
 
 
 # ---- bad input: exit 2, the file, line and column ---------------------------
 
+
 def good_case(folder):
-    return write_case(folder, "RateLimiter", "time,y\n0,0\n0.5,0\n1,0.5\n", "time,u\n0,0\n0.5,10\n",
-                      "StartTime,0\nStopTime,1\nStepSize,0.5\n", "rateUpPar,1\n")
+    return write_case(
+        folder,
+        "RateLimiter",
+        "time,y\n0,0\n0.5,0\n1,0.5\n",
+        "time,u\n0,0\n0.5,10\n",
+        "StartTime,0\nStopTime,1\nStepSize,0.5\n",
+        "rateUpPar,1\n",
+    )
 
 
 BAD = {
-    "unknown column": ("RateLimiter_in.csv", "time,u,speed\n0,0,1\n",
-                       "RateLimiter_in.csv, line 1, column 3: unknown column 'speed'"),
-    "output as input column": ("RateLimiter_in.csv", "time,u,y\n0,0,1\n",
-                               "RateLimiter_in.csv, line 1, column 3: column 'y' is a discrete output"),
-    "non-numeric cell": ("RateLimiter_in.csv", "time,u\n0,0\n0.5,ten\n",
-                         "RateLimiter_in.csv, line 3, column 2: 'ten' in column 'u' is not a number"),
-    "empty cell": ("RateLimiter_in.csv", "time,u\n0,0\n0.5,\n",
-                   "RateLimiter_in.csv, line 3, column 2: an empty cell in column 'u'"),
+    "unknown column": (
+        "RateLimiter_in.csv",
+        "time,u,speed\n0,0,1\n",
+        "RateLimiter_in.csv, line 1, column 3: unknown column 'speed'",
+    ),
+    "output as input column": (
+        "RateLimiter_in.csv",
+        "time,u,y\n0,0,1\n",
+        "RateLimiter_in.csv, line 1, column 3: column 'y' is a discrete output",
+    ),
+    "non-numeric cell": (
+        "RateLimiter_in.csv",
+        "time,u\n0,0\n0.5,ten\n",
+        "RateLimiter_in.csv, line 3, column 2: 'ten' in column 'u' is not a number",
+    ),
+    "empty cell": (
+        "RateLimiter_in.csv",
+        "time,u\n0,0\n0.5,\n",
+        "RateLimiter_in.csv, line 3, column 2: an empty cell in column 'u'",
+    ),
     "short row": ("RateLimiter_in.csv", "time,u\n0\n", "RateLimiter_in.csv, line 2, column 2: 1 cells"),
-    "time going backwards": ("RateLimiter_in.csv", "time,u\n0,0\n0.5,10\n0.25,3\n",
-                             "RateLimiter_in.csv, line 4, column 1: time goes backwards: 0.25 after 0.5"),
+    "time going backwards": (
+        "RateLimiter_in.csv",
+        "time,u\n0,0\n0.5,10\n0.25,3\n",
+        "RateLimiter_in.csv, line 4, column 1: time goes backwards: 0.25 after 0.5",
+    ),
     "empty file": ("RateLimiter_in.csv", "", "RateLimiter_in.csv: empty file"),
     "header only": ("RateLimiter_ref.csv", "time,y\n", "RateLimiter_ref.csv, line 1: no samples"),
-    "no time column": ("RateLimiter_ref.csv", "seconds,y\n0,0\n",
-                       "RateLimiter_ref.csv, line 1, column 1: no time column"),
-    "reference column not a variable": ("RateLimiter_ref.csv", "time,y,yFiltered\n0,0,0\n",
-                                        "RateLimiter_ref.csv, line 1, column 3: column 'yFiltered' is not a "
-                                        "variable of RateLimiter (FMI 3)"),
-    "start value below its minimum": ("RateLimiter_start.csv", "rateUpPar,1\ninitDelay,-1\n",
-                                      "RateLimiter_start.csv, line 2, column 2: initDelay = -1 is outside its range "
-                                      "[0, inf]"),
-    "enumeration value that does not exist": ("RateLimiter_start.csv", "zeroRate,7\n",
-                                              "RateLimiter_start.csv, line 1, column 2: zeroRate is an enumeration "
-                                              "ZeroRate: 7 is not one of its values"),
-    "enumeration value not whole": ("RateLimiter_start.csv", "zeroRate,1.5\n",
-                                    "RateLimiter_start.csv, line 1, column 2: zeroRate is an Enumeration: '1.5' is not "
-                                    "a whole number"),
-    "start value of an unknown variable": ("RateLimiter_start.csv", "rateUpPr,1\n",
-                                           "RateLimiter_start.csv, line 1, column 1: 'rateUpPr' is not a variable"),
-    "Boolean start value": ("RateLimiter_start.csv", "bypass,yes\n",
-                            "RateLimiter_start.csv, line 1, column 2: bypass is a Boolean: 'yes' is not true, false"),
-    "unknown option": ("RateLimiter_ref.opt", "StartTime,0\nStoptime,1\n",
-                       "RateLimiter_ref.opt, line 2, column 1: unknown option 'Stoptime'"),
+    "no time column": (
+        "RateLimiter_ref.csv",
+        "seconds,y\n0,0\n",
+        "RateLimiter_ref.csv, line 1, column 1: no time column",
+    ),
+    "reference column not a variable": (
+        "RateLimiter_ref.csv",
+        "time,y,yFiltered\n0,0,0\n",
+        "RateLimiter_ref.csv, line 1, column 3: column 'yFiltered' is not a variable of RateLimiter (FMI 3)",
+    ),
+    "start value below its minimum": (
+        "RateLimiter_start.csv",
+        "rateUpPar,1\ninitDelay,-1\n",
+        "RateLimiter_start.csv, line 2, column 2: initDelay = -1 is outside its range [0, inf]",
+    ),
+    "enumeration value that does not exist": (
+        "RateLimiter_start.csv",
+        "zeroRate,7\n",
+        "RateLimiter_start.csv, line 1, column 2: zeroRate is an enumeration ZeroRate: 7 is not one of its values",
+    ),
+    "enumeration value not whole": (
+        "RateLimiter_start.csv",
+        "zeroRate,1.5\n",
+        "RateLimiter_start.csv, line 1, column 2: zeroRate is an Enumeration: '1.5' is not a whole number",
+    ),
+    "start value of an unknown variable": (
+        "RateLimiter_start.csv",
+        "rateUpPr,1\n",
+        "RateLimiter_start.csv, line 1, column 1: 'rateUpPr' is not a variable",
+    ),
+    "Boolean start value": (
+        "RateLimiter_start.csv",
+        "bypass,yes\n",
+        "RateLimiter_start.csv, line 1, column 2: bypass is a Boolean: 'yes' is not true, false",
+    ),
+    "unknown option": (
+        "RateLimiter_ref.opt",
+        "StartTime,0\nStoptime,1\n",
+        "RateLimiter_ref.opt, line 2, column 1: unknown option 'Stoptime'",
+    ),
 }
 
 
@@ -299,22 +354,30 @@ def test_bad_input_exits_2_naming_file_line_and_column(bad, tmp_path):
     assert [(c["case"], c["status"]) for c in results["cases"]] == [("one", "invalid"), ("two", "pass")]
 
 
-@pytest.mark.parametrize("args,message", [
-    (("run", "{fmu}", "--set", "initDelay=-1"), "initDelay = -1 is outside its range [0, inf]"),
-    (("run", "{fmu}", "--set", "y=1"), "'y' is a discrete output of RateLimiter (FMI 3): only parameters and inputs"),
-    (("run", "{fmu}", "--set", "nosuch=1"), "'nosuch' is not a variable of RateLimiter (FMI 3)"),
-    (("run", "{fmu}", "--output", "nosuch"), "output 'nosuch' is not a variable"),
-    (("run", "{fmu}", "--step-size", "0.1", "--output-interval", "0.25", "--stop-time", "1"),
-     "must be a whole multiple of the step size"),
-    (("run", "{fmu}", "--set", "rateUpPar"), "expected NAME=VALUE"),
-    (("run", "missing.fmu"), "missing.fmu: no such FMU file"),
-    (("compare", "{fmu}"), "no case folder given"),
-    (("compare", "{cases}"), "no FMU given"),
-    (("compare", "{fmu}", "{nothing}"), "no such folder"),
-    (("compare", "{lag}", "{cases}"), "no case of FirstOrderLag (FMI 3) (no FirstOrderLag_ref.csv)"),
-    (("compare", "{fmu}", "{cases}", "--rel-tol", "-1"), "-1 must be >= 0"),
-    (("frobnicate",), "invalid choice"),
-])
+@pytest.mark.parametrize(
+    "args,message",
+    [
+        (("run", "{fmu}", "--set", "initDelay=-1"), "initDelay = -1 is outside its range [0, inf]"),
+        (
+            ("run", "{fmu}", "--set", "y=1"),
+            "'y' is a discrete output of RateLimiter (FMI 3): only parameters and inputs",
+        ),
+        (("run", "{fmu}", "--set", "nosuch=1"), "'nosuch' is not a variable of RateLimiter (FMI 3)"),
+        (("run", "{fmu}", "--output", "nosuch"), "output 'nosuch' is not a variable"),
+        (
+            ("run", "{fmu}", "--step-size", "0.1", "--output-interval", "0.25", "--stop-time", "1"),
+            "must be a whole multiple of the step size",
+        ),
+        (("run", "{fmu}", "--set", "rateUpPar"), "expected NAME=VALUE"),
+        (("run", "missing.fmu"), "missing.fmu: no such FMU file"),
+        (("compare", "{fmu}"), "no case folder given"),
+        (("compare", "{cases}"), "no FMU given"),
+        (("compare", "{fmu}", "{nothing}"), "no such folder"),
+        (("compare", "{lag}", "{cases}"), "no case of FirstOrderLag (FMI 3) (no FirstOrderLag_ref.csv)"),
+        (("compare", "{fmu}", "{cases}", "--rel-tol", "-1"), "-1 must be >= 0"),
+        (("frobnicate",), "invalid choice"),
+    ],
+)
 def test_usage_errors_exit_2(args, message, tmp_path):
     good_case(tmp_path / "cases" / "one")
     names = {"fmu": RATE_LIMITER[3], "cases": tmp_path / "cases", "nothing": tmp_path / "nothing", "lag": LAG[3]}
@@ -325,11 +388,28 @@ def test_usage_errors_exit_2(args, message, tmp_path):
 
 # ---- run, the report, JUnit, the API --------------------------------------
 
+
 def test_run_writes_the_result_and_reads_back_bit_for_bit(tmp_path):
     (tmp_path / "in.csv").write_text("time;u\n0;0\n0,5;10\n")
     out = tmp_path / "out.csv"
-    done = fmutrace_cli("run", RATE_LIMITER[3], "--input", tmp_path / "in.csv", "--set", "rateUpPar=3",
-                        "--step-size", 0.1, "--stop-time", 2, "--output", "y", "--output", "rampActive", "-o", out)
+    done = fmutrace_cli(
+        "run",
+        RATE_LIMITER[3],
+        "--input",
+        tmp_path / "in.csv",
+        "--set",
+        "rateUpPar=3",
+        "--step-size",
+        0.1,
+        "--stop-time",
+        2,
+        "--output",
+        "y",
+        "--output",
+        "rampActive",
+        "-o",
+        out,
+    )
     assert done.returncode == 0, done.stderr
     assert "21 samples of 2 signals" in done.stdout
     result = fmutrace.read_trace(out)
@@ -337,8 +417,14 @@ def test_run_writes_the_result_and_reads_back_bit_for_bit(tmp_path):
     # u = 10 from t = 0.5 on: 3 per s, 0.3 per cycle from the step at 0.5
     assert list(result["y"]) == pytest.approx([0.0] * 6 + [0.3 * k for k in range(1, 16)], rel=1e-12, abs=0)
     assert list(result["rampActive"]) == [0.0] * 6 + [1.0] * 15
-    api = fmutrace.simulate(RATE_LIMITER[3], input=tmp_path / "in.csv", start_values={"rateUpPar": "3"},
-                            step_size=0.1, stop_time=2, outputs=["y", "rampActive"])
+    api = fmutrace.simulate(
+        RATE_LIMITER[3],
+        input=tmp_path / "in.csv",
+        start_values={"rateUpPar": "3"},
+        step_size=0.1,
+        stop_time=2,
+        outputs=["y", "rampActive"],
+    )
     assert np.array_equal(api["y"], result["y"])
     assert np.array_equal(api["time"], result["time"])
 
@@ -356,8 +442,9 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
     lag_case(tmp_path / "cases" / "lag_off", lambda t, x: x + 0.01 if t >= 1 else x)
     write_case(tmp_path / "cases" / "step", "PassThrough", STEP_REF, DIALECTS["comma"], STEP_OPT)
     report, junit = tmp_path / "report", tmp_path / "ci" / "junit.xml"
-    done = fmutrace_cli("compare", LAG[2], LAG[3], PASS_THROUGH[3], tmp_path / "cases", "--report", report,
-                        "--junit", junit)
+    done = fmutrace_cli(
+        "compare", LAG[2], LAG[3], PASS_THROUGH[3], tmp_path / "cases", "--report", report, "--junit", junit
+    )
     assert done.returncode == 1
     assert "3 of 5 cases pass, 2 differ" in done.stdout
     assert "FAIL  lag_off on FirstOrderLag (FMI 2)" in done.stdout
@@ -389,8 +476,10 @@ def test_api_compare_returns_the_outcomes(tmp_path):
     lag_case(tmp_path / "lag")
     campaign = fmutrace.compare([LAG[2], LAG[3]], tmp_path / "lag", rel_tol=1e-12, report=tmp_path / "report")
     assert campaign.passed and campaign.exit_code == 0
-    assert [(o.case, o.fmu) for o in campaign.cases] == [("lag", "FirstOrderLag (FMI 2)"),
-                                                          ("lag", "FirstOrderLag (FMI 3)")]
+    assert [(o.case, o.fmu) for o in campaign.cases] == [
+        ("lag", "FirstOrderLag (FMI 2)"),
+        ("lag", "FirstOrderLag (FMI 3)"),
+    ]
     assert campaign.cases[0].result["x"][-1] == lag_oracle(LAG_INPUT)[-1][1]
     with pytest.raises(fmutrace.InputError, match="no such folder"):
         fmutrace.compare(LAG[3], tmp_path / "nothing")
@@ -427,8 +516,10 @@ def test_a_simulation_that_fails_is_an_error_case_not_a_crash(version, tmp_path)
     assert done.returncode == 1
     assert f"ERROR  refused on RateLimiter (FMI {version})" in done.stdout
     setter = "fmi2SetInteger" if version == 2 else "fmi3SetInt64"
-    assert f"the simulation failed: {setter} failed with status 3 (error); the FMU said: {setter}: zeroRate = 7 is " \
-           "outside its range [1, 2]" in done.stdout
+    assert (
+        f"the simulation failed: {setter} failed with status 3 (error); the FMU said: {setter}: zeroRate = 7 is "
+        "outside its range [1, 2]" in done.stdout
+    )
     assert "1 of 2 cases pass, 0 differ, 1 failed to simulate" in done.stdout
 
 
@@ -466,8 +557,12 @@ def test_the_readme_pytest_example_runs(tmp_path):
     run's build folder."""
     code = readme_example().replace('"build/', f'"{BUILD_DIR.as_posix()}/')
     (tmp_path / "test_my_traces.py").write_text(code)
-    done = run_bounded([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(tmp_path)], timeout=600,
-                       what="the README's pytest example", cwd=REPO)
+    done = run_bounded(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(tmp_path)],
+        timeout=600,
+        what="the README's pytest example",
+        cwd=REPO,
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     assert re.search(r"\b[1-9]\d* passed", done.stdout)
 
@@ -490,6 +585,7 @@ def test_find_cases_names_each_case_folder_once(tmp_path):
     given itself takes its own name; a name found below two folders given
     is prefixed with the second one's name; linked folders are followed,
     each folder once, and a link loop ends."""
+
     def case(folder):
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "M_ref.csv").write_text("time,y\n0,0\n")
@@ -509,11 +605,18 @@ def test_find_cases_names_each_case_folder_once(tmp_path):
     (one / "a" / "not_a_case").mkdir()
     found = fmutrace.find_cases([one, two], "M")
     assert [(str(folder.relative_to(tmp_path)), name) for folder, name in found] == [
-        ("one/0_link_to_c", "0_link_to_c"), ("one/a", "a"), ("one/a/deep", "a/deep"), ("one/b", "b"),
-        ("two/b", "two/b")]
+        ("one/0_link_to_c", "0_link_to_c"),
+        ("one/a", "a"),
+        ("one/a/deep", "a/deep"),
+        ("one/b", "b"),
+        ("two/b", "two/b"),
+    ]
     assert [name for _, name in fmutrace.find_cases([two / "c"], "M")] == ["c"]  # a case folder itself
     # case folders given themselves, two of one name: the second is prefixed with its own name
     assert fmutrace.find_cases([two / "c", one / "b", two / "b"], "M")[:] == [
-        (one / "b", "b"), (two / "b", "b/b"), (two / "c", "c")]
+        (one / "b", "b"),
+        (two / "b", "b/b"),
+        (two / "c", "c"),
+    ]
     assert found[-1] == (two / "b", "two/b") and found[2:4] == [(one / "a" / "deep", "a/deep"), (one / "b", "b")]
     assert len(fmutrace.find_cases([tmp_path / "other"], "M")) == 0

@@ -1,6 +1,7 @@
 """Campaigns that lose nothing: results journaled as each case finishes, a
 killed client resumed without recomputing, a second campaign into the same
 report folder refused, a Dask worker killed in the middle."""
+
 import contextlib
 import json
 import os
@@ -41,8 +42,13 @@ def pass_through_cases(root, count):
 
 
 def start(args):
-    return subprocess.Popen([str(FMUTRACE), *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+    return subprocess.Popen(
+        [str(FMUTRACE), *map(str, args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
 
 
 def finish(process):
@@ -80,8 +86,9 @@ def comparable(report):
 def test_a_killed_client_resumes_without_recomputing(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 40)
     undisturbed = tmp_path / "undisturbed"
-    code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", undisturbed, "--jobs", 1,
-                                 "--plots", "all"]))
+    code, out, _ = finish(
+        start(["compare", PASS_THROUGH, cases, "--report", undisturbed, "--jobs", 1, "--plots", "all"])
+    )
     assert code == 0, out
 
     report = tmp_path / "report"
@@ -92,16 +99,18 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
     done = journal_keys(report)
     assert 5 <= len(done) < 40 and len(set(done)) == len(done)
 
-    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots",
-                                   "all", "--resume"]))
+    code, out, err = finish(
+        start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all", "--resume"])
+    )
     assert code == 0, out + err
     assert f"({len(done)} cases from the journal)" in out
     keys = journal_keys(report)
     assert len(keys) == 40 and len(set(keys)) == 40  # every case exactly once: nothing done twice
-    assert keys[:len(done)] == done
+    assert keys[: len(done)] == done
     assert comparable(report) == comparable(undisturbed)
-    assert without_timings((report / "summary.md").read_text()) == \
-        without_timings((undisturbed / "summary.md").read_text())
+    assert without_timings((report / "summary.md").read_text()) == without_timings(
+        (undisturbed / "summary.md").read_text()
+    )
 
     code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume"]))
     assert code == 0 and "on the journal" in out  # all done: nothing runs
@@ -122,8 +131,10 @@ def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp
     failing = ["PassThrough-fmi3/case_07", "PassThrough-fmi3/case_300"]
     assert sorted(str(p.relative_to(report)) for p in report.rglob("*.png")) == [f"{c}.png" for c in failing]
     assert sorted(str(p.relative_to(report)) for p in report.rglob("*_out.csv")) == [f"{c}_out.csv" for c in failing]
-    assert [c["case"] for c in json.loads((report / "results.json").read_text())["cases"] if "plot" in c] == \
-        ["case_07", "case_300"]
+    assert [c["case"] for c in json.loads((report / "results.json").read_text())["cases"] if "plot" in c] == [
+        "case_07",
+        "case_300",
+    ]
 
 
 def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_path):
@@ -138,8 +149,9 @@ def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_pat
     assert [o.case for o in campaign.cases] == [f"case_{k:02d}" for k in range(6)]
     keys = journal_keys(report)
     assert len(keys) == 6 and len(set(keys)) == 6
-    assert [json.loads(c)["counts"] for c in [(report / "results.json").read_text()]] == \
-        [{"pass": 6, "fail": 0, "error": 0, "invalid": 0}]
+    assert [json.loads(c)["counts"] for c in [(report / "results.json").read_text()]] == [
+        {"pass": 6, "fail": 0, "error": 0, "invalid": 0}
+    ]
 
 
 def test_a_journaled_campaign_gives_its_outcomes_and_results_back(tmp_path):
@@ -174,8 +186,7 @@ def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 3)
     report = tmp_path / "report"
     assert finish(start(["compare", PASS_THROUGH, cases, "--report", report]))[0] == 0
-    code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume", "--rel-tol",
-                                 "1e-3"]))
+    code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume", "--rel-tol", "1e-3"]))
     assert code == 2 and "made by a campaign with other FMUs or options" in err
     code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--resume"]))
     assert code == 2 and "give it with --report" in err
@@ -208,8 +219,12 @@ def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
     cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
     report = tmp_path / "killed"
     result = {}
-    campaign = threading.Thread(target=lambda: result.setdefault("campaign", fmutrace.compare(
-        fmus, cases, report=report, scheduler=cluster, cluster_timeout=600, plots="all")))
+    campaign = threading.Thread(
+        target=lambda: result.setdefault(
+            "campaign",
+            fmutrace.compare(fmus, cases, report=report, scheduler=cluster, cluster_timeout=600, plots="all"),
+        )
+    )
     campaign.start()
     wait_for(lambda: (report / "results.jsonl").exists() and len(journal_keys(report)) >= 3, "three finished cases")
     with Client(cluster, timeout=WAIT) as client:
@@ -241,8 +256,10 @@ def faulty_cases(root, values):
     return step_cases(root, "Faulty", values)
 
 
-@pytest.mark.parametrize("version,jobs", [pytest.param(2, 2, marks=pytest.mark.cluster),
-                                          pytest.param(3, 2, marks=pytest.mark.cluster), (3, 1)])
+@pytest.mark.parametrize(
+    "version,jobs",
+    [pytest.param(2, 2, marks=pytest.mark.cluster), pytest.param(3, 2, marks=pytest.mark.cluster), (3, 1)],
+)
 def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, jobs, tmp_path):
     """On workers the batch that holds it kills its worker, is run again
     case by case in child processes, and only the crashing case fails; in
@@ -252,8 +269,10 @@ def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, 
     args = ["compare", FAULTY[version], cases, "--report", tmp_path / "report", "--jobs", jobs]
     code, out, err = finish(start(args + (["--case-timeout", 60] if jobs == 1 else [])))
     assert code == 1, out + err
-    assert f"ERROR  case_13 on Faulty (FMI {version})\n      the simulation's process was {CRASH} while running " \
-           "this case" in out
+    assert (
+        f"ERROR  case_13 on Faulty (FMI {version})\n      the simulation's process was {CRASH} while running "
+        "this case" in out
+    )
     assert "5 of 6 cases pass, 0 differ, 1 failed to simulate" in out
     assert len(set(journal_keys(tmp_path / "report"))) == 6
 
@@ -265,8 +284,9 @@ def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     bounds the wait)."""
     cases = faulty_cases(tmp_path / "cases", [1, 17, 3, 13, 5])
     report = tmp_path / "report"
-    code, out, err = finish(start(["compare", FAULTY[3], cases, "--jobs", jobs, "--case-timeout", 3,
-                                   "--report", report]))
+    code, out, err = finish(
+        start(["compare", FAULTY[3], cases, "--jobs", jobs, "--case-timeout", 3, "--report", report])
+    )
     assert code == 1, out + err
     assert "ERROR  case_17 on Faulty (FMI 3)\n      stopped after the per-case timeout of 3 s" in out
     assert f"ERROR  case_13 on Faulty (FMI 3)\n      the simulation's process was {CRASH}" in out
@@ -308,8 +328,10 @@ def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path
 
 
 # evaluated in each worker: where its fmutrace comes from, and each Runner's loop and fast runs
-WORKER_LOOPS = ("(__import__('fmutrace.runner').runner.__file__, "
-                "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])")
+WORKER_LOOPS = (
+    "(__import__('fmutrace.runner').runner.__file__, "
+    "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])"
+)
 
 
 @pytest.mark.cluster

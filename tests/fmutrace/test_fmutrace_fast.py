@@ -12,6 +12,7 @@
 - NumPy's reader of plain CSV bodies and pyarrow's chunked reader
   (trace_chunks) against the cell-by-cell reader, on random texts.
 """
+
 import math
 
 import numpy as np
@@ -47,9 +48,17 @@ def same_bits(a, b):
 
 def both(model, version, start, stop, step, inputs, start_values, outputs, tolerance=None):
     fast = runner(model, version).run(start, stop, step, inputs, start_values, outputs, tolerance)
-    plain = run_fmpy(str(fmu_path(BUILD_DIR, model, version)), None, start_time=start, stop_time=stop,
-                     step_size=step, inputs=inputs, start_values=start_values, outputs=outputs,
-                     relative_tolerance=tolerance)
+    plain = run_fmpy(
+        str(fmu_path(BUILD_DIR, model, version)),
+        None,
+        start_time=start,
+        stop_time=stop,
+        step_size=step,
+        inputs=inputs,
+        start_values=start_values,
+        outputs=outputs,
+        relative_tolerance=tolerance,
+    )
     return fast, plain
 
 
@@ -59,8 +68,17 @@ def test_every_reference_scenario_bit_for_bit(version):
     fast_before = sum(x.fast_runs for x in r.values())
     for s in SCENARIOS:
         o = s.options
-        fast, plain = both(s.model, version, o["StartTime"], o["StopTime"], o["StepSize"], s.inputs, s.start_values,
-                           s.outputs, o["RelTol"])
+        fast, plain = both(
+            s.model,
+            version,
+            o["StartTime"],
+            o["StopTime"],
+            o["StepSize"],
+            s.inputs,
+            s.start_values,
+            s.outputs,
+            o["RelTol"],
+        )
         assert same_bits(fast, plain), s.name
     # the fast loop ran (not only fmpy's): all but the off-grid scenarios
     assert sum(x.fast_runs for x in r.values()) - fast_before >= len(SCENARIOS) - 4
@@ -88,11 +106,17 @@ def test_a_trace_whose_inputs_need_fmpy_leaves_the_instance_to_the_next_trace():
 
 
 NAMES = {
-    "RateLimiter": (["u", "rateUp", "bypass", "hold", "yMax", "zeroRate"], ["y", "rampActive", "status", "dydt"],
-                    {"rateUpPar": (0.1, 5.0), "rateDownPar": (0.1, 5.0), "ratePeriod": (0.5, 2.0)}),
+    "RateLimiter": (
+        ["u", "rateUp", "bypass", "hold", "yMax", "zeroRate"],
+        ["y", "rampActive", "status", "dydt"],
+        {"rateUpPar": (0.1, 5.0), "rateDownPar": (0.1, 5.0), "ratePeriod": (0.5, 2.0)},
+    ),
     "Ramp": (["rIn", "tTime"], ["rOut", "xRampActive"], {"rVariation": (0.1, 20.0)}),
-    "LGF_LimRateOfChangeAdvancedCI": (["autoValue", "manOp", "manualValue", "track"],
-                                      ["outputValue", "status", "highLim"], {}),
+    "LGF_LimRateOfChangeAdvancedCI": (
+        ["autoValue", "manOp", "manualValue", "track"],
+        ["outputValue", "status", "highLim"],
+        {},
+    ),
 }
 
 
@@ -192,8 +216,11 @@ def test_a_package_build_uses_the_pinned_setuptools():
 
     project = tomllib.loads((REPO / "fmutrace" / "pyproject.toml").read_text())
     assert "ext-modules" in project["tool"]["setuptools"]
-    pins = [line for line in (REPO / "fmutrace" / "requirements.txt").read_text().splitlines()
-            if line.startswith("setuptools==")]
+    pins = [
+        line
+        for line in (REPO / "fmutrace" / "requirements.txt").read_text().splitlines()
+        if line.startswith("setuptools==")
+    ]
     assert project["build-system"]["requires"] == pins and len(pins) == 1
     assert tuple(map(int, pins[0].split("==")[1].split(".")[:2])) >= (74, 1)
 
@@ -242,11 +269,14 @@ def test_both_step_loops_stop_at_a_failing_call_as_fmpy_does():
 def chunked(model, version, start, stop, step, inputs, start_values, outputs, steps, rows, tolerance=None):
     """run_chunks' result, joined, in chunks of steps steps and of rows input rows; None where it refuses."""
     inputs = held_to(inputs, stop)
-    pieces = None if inputs is None else iter([inputs[i:i + rows] for i in range(0, len(inputs), rows)])
+    pieces = None if inputs is None else iter([inputs[i : i + rows] for i in range(0, len(inputs), rows)])
     names = () if inputs is None else inputs.dtype.names[1:]
     try:
-        chunks = list(runner(model, version).run_chunks(start, stop, step, pieces, names, start_values, outputs,
-                                                        tolerance, steps_per_chunk=steps))
+        chunks = list(
+            runner(model, version).run_chunks(
+                start, stop, step, pieces, names, start_values, outputs, tolerance, steps_per_chunk=steps
+            )
+        )
     except FastLoopFailed:
         return None
     assert all(len(c) <= steps for c in chunks[1:]) and len(chunks[0]) <= steps + 1
@@ -294,10 +324,13 @@ def test_random_traces_run_chunked_mostly():
 
 
 @settings(max_examples=300, deadline=None)
-@given(t=st.lists(st.sampled_from([0.0, 0.1, 0.2, 0.2, 0.30000000000000004, 0.3, 1.0]), min_size=1, max_size=8),
-       times=st.lists(st.sampled_from([0.0, 0.1, 0.2, 0.3, 0.30000000000000004, 0.5, 1.0, 2.0, -1.0]), min_size=1,
-                      max_size=6),
-       after_event=st.booleans())
+@given(
+    t=st.lists(st.sampled_from([0.0, 0.1, 0.2, 0.2, 0.30000000000000004, 0.3, 1.0]), min_size=1, max_size=8),
+    times=st.lists(
+        st.sampled_from([0.0, 0.1, 0.2, 0.3, 0.30000000000000004, 0.5, 1.0, 2.0, -1.0]), min_size=1, max_size=6
+    ),
+    after_event=st.booleans(),
+)
 def test_input_rows_as_fmpy_interpolates_them(t, times, after_event):
     t = np.array(sorted(t))
     table = np.arange(len(t), dtype=float)[np.newaxis, :]
@@ -309,14 +342,46 @@ def test_input_rows_as_fmpy_interpolates_them(t, times, after_event):
 
 # ---- the CSV reader's two paths ---------------------------------------------
 
-TOKENS = ["0", "1", "-2.5", "1e-3", "1E+300", "nan", "NaN", "inf", "-inf", "Infinity", "0.1", ".5", "5.", "+3",
-          " 7", "8 ", "true", "FALSE", "", "x", "1,5", '"4"', "0x10", "1_000", "1d5", "--1", "1e", "#", "1.0e-400"]
+TOKENS = [
+    "0",
+    "1",
+    "-2.5",
+    "1e-3",
+    "1E+300",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "Infinity",
+    "0.1",
+    ".5",
+    "5.",
+    "+3",
+    " 7",
+    "8 ",
+    "true",
+    "FALSE",
+    "",
+    "x",
+    "1,5",
+    '"4"',
+    "0x10",
+    "1_000",
+    "1d5",
+    "--1",
+    "1e",
+    "#",
+    "1.0e-400",
+]
 
 
 @settings(max_examples=400, deadline=None)
-@given(rows=st.lists(st.lists(st.sampled_from(TOKENS), min_size=2, max_size=2), min_size=0, max_size=5),
-       times=st.lists(st.sampled_from(["0", "1", "2", "0.5", "nan", "-1"]), min_size=5, max_size=5),
-       ending=st.sampled_from(["\n", "\r\n", ""]), blank=st.booleans())
+@given(
+    rows=st.lists(st.lists(st.sampled_from(TOKENS), min_size=2, max_size=2), min_size=0, max_size=5),
+    times=st.lists(st.sampled_from(["0", "1", "2", "0.5", "nan", "-1"]), min_size=5, max_size=5),
+    ending=st.sampled_from(["\n", "\r\n", ""]),
+    blank=st.booleans(),
+)
 def test_plain_reader_equals_the_general_reader(rows, times, ending, blank, tmp_path_factory):
     lines = ["time,a,b"] + [",".join([t] + r) for t, r in zip(times, rows)]
     if blank and len(lines) > 2:

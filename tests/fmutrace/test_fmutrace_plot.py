@@ -3,6 +3,7 @@ figure per layout in a process and only clears and refills it) is the
 picture a freshly built figure gives, pixel for pixel: cases of each
 layout drawn one after the other in the same process, a layout reused by
 a case with other lines, limits, band, zoom and texts than the case before."""
+
 import io
 
 import numpy as np
@@ -29,28 +30,48 @@ def ramp_case(title, signals=1, inputs=True, zoom=False, band=False, steps=200, 
         name = f"y{k}"
         offset = (k + 1) * 1e-3 * scale
         result = reference + np.where(t > 0.8, offset, 0.0)
-        shown.append((name, (t, reference + k), (t, result + k),
-                      (t, reference + k - 0.05, reference + k + 0.05) if band else None))
+        shown.append(
+            (
+                name,
+                (t, reference + k),
+                (t, result + k),
+                (t, reference + k - 0.05, reference + k + 0.05) if band else None,
+            )
+        )
         devs.append((name, t, result - reference))
         window = slice(60, 101)
-        zoomed.append((name, t[window], result[window], reference[window] - 1e-4, reference[window] + 1e-4,
-                       (result - reference)[window]))
-    return plot.Figure(title, case_inputs, shown, devs if deviations else [],
-                       (float(t[81]), zoomed) if zoom else None)
+        zoomed.append(
+            (
+                name,
+                t[window],
+                result[window],
+                reference[window] - 1e-4,
+                reference[window] + 1e-4,
+                (result - reference)[window],
+            )
+        )
+    return plot.Figure(title, case_inputs, shown, devs if deviations else [], (float(t[81]), zoomed) if zoom else None)
 
 
 CASES = [
     ("passing, one signal", ramp_case("ramp on FMI 2.0"), Exact()),
     ("another passing case of the same layout", ramp_case("ramp x10 on FMI 2.0", scale=10.0, steps=120), Exact()),
     ("failing with its zoom", ramp_case("failing ramp on FMI 3.0", zoom=True), Exact()),
-    ("three panels, failing with its zoom", ramp_case("three outputs on FMI 3.0", signals=3, zoom=True),
-     Tolerance(rel_tol=1e-9)),
+    (
+        "three panels, failing with its zoom",
+        ramp_case("three outputs on FMI 3.0", signals=3, zoom=True),
+        Tolerance(rel_tol=1e-9),
+    ),
     ("another failing case with its zoom", ramp_case("failing ramp x5", zoom=True, scale=5.0, steps=140), Exact()),
     ("three panels, band drawn, zoom", ramp_case("tube, failing", signals=3, band=True, zoom=True), TUBE),
     ("three panels, band drawn", ramp_case("tube on FMI 2.0", signals=3, band=True, scale=-2.0), TUBE),
     ("no input, zoom", ramp_case("no input", inputs=False, zoom=True, steps=150), Exact()),
     ("no input, one signal", ramp_case("no input again", inputs=False, scale=3.0), Exact()),
-    ("no input, no deviation to draw (an empty axis)", ramp_case("nothing compared", inputs=False, deviations=False), Exact()),
+    (
+        "no input, no deviation to draw (an empty axis)",
+        ramp_case("nothing compared", inputs=False, deviations=False),
+        Exact(),
+    ),
     ("the first case again", ramp_case("ramp on FMI 2.0"), Exact()),
 ]
 

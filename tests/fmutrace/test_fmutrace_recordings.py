@@ -3,6 +3,7 @@ script and the built FMUs (the Siemens block and RateLimiter), on the
 sample recordings of tests/recordings (written from each export's
 documented structure, values worked by hand: tests/recordings/samples.py)
 and on variants of them written here: perturbed, coarsely sampled, bad."""
+
 import json
 import sys
 from pathlib import Path
@@ -20,8 +21,14 @@ import samples  # noqa: E402
 FMUTRACE = Path(sys.executable).parent / "fmutrace"
 SIEMENS = {v: BUILD_DIR / f"fmi{v}" / "LGF_LimRateOfChangeCI.fmu" for v in (2, 3)}
 RATE_LIMITER = {v: BUILD_DIR / f"fmi{v}" / "RateLimiter.fmu" for v in (2, 3)}
-WINCC_MAPS = ["--map", "value=DB_Ramp_value", "--map", "setChangeRate=DB_Ramp_setChangeRate",
-              "--map", "delayedValue=DB_Ramp_delayedValue"]
+WINCC_MAPS = [
+    "--map",
+    "value=DB_Ramp_value",
+    "--map",
+    "setChangeRate=DB_Ramp_setChangeRate",
+    "--map",
+    "delayedValue=DB_Ramp_delayedValue",
+]
 
 
 def compare(*args):
@@ -84,8 +91,10 @@ def test_a_perturbed_value_fails_naming_the_first_deviation(tmp_path):
     # cycle 8's output is the FMU's at (8 + 1) * 0.25 s
     assert "delayedValue leaves the band first at t=2.25: 2.5, expected 2.5000001" in done.stdout
     assert "2 of 14 samples outside" in done.stdout
-    assert (f"delayedValue first differs at the recording's sample of cycle 8 ({tmp_path / 'perturbed.csv'}, line 15, "
-            "t=2 s from its first sample): recorded 2.5000001, the FMU gives 2.5") in done.stdout
+    assert (
+        f"delayedValue first differs at the recording's sample of cycle 8 ({tmp_path / 'perturbed.csv'}, line 15, "
+        "t=2 s from its first sample): recorded 2.5000001, the FMU gives 2.5"
+    ) in done.stdout
 
 
 def test_the_other_timing_convention_is_an_option(tmp_path):
@@ -127,8 +136,9 @@ def test_channels_not_of_the_fmu_are_listed_as_ignored_in_the_output_and_report(
 
 
 def test_from_python_with_cases_beside(tmp_path):
-    campaign = fmutrace.compare(SIEMENS[3], [SAMPLES / "twincat_siemens.csv",
-                                             Path(__file__).parents[1] / "scenarios" / "LGF_LimRateOfChangeCI"])
+    campaign = fmutrace.compare(
+        SIEMENS[3], [SAMPLES / "twincat_siemens.csv", Path(__file__).parents[1] / "scenarios" / "LGF_LimRateOfChangeCI"]
+    )
     assert campaign.passed, campaign.summary()
     assert len(campaign.cases) > 1
     failing = fmutrace.compare(SIEMENS[3], SAMPLES / "wincc_siemens.csv", maps={"value": "DB_Ramp_value"})
@@ -147,15 +157,20 @@ def bad(tmp_path, name, text, *options, encoding="utf-8"):
 def test_a_file_of_no_known_format_says_which_formats_were_tried(tmp_path):
     said = bad(tmp_path, "notes.txt", "Commissioning notes\nthe ramp looked fine\n")
     assert "notes.txt: no known recording format; tried ASAM MDF4: not MDF" in said
-    for name in ("Beckhoff TwinCAT Scope View CSV: no channel header block", "WinCC data log CSV: no header",
-                 "Niagara history export: no header", "CODESYS 2.3 trace (ASCII file): ",
-                 "table (TIA Portal trace CSV, CODESYS V3 export, CSV/TSV): no header line with a time column"):
+    for name in (
+        "Beckhoff TwinCAT Scope View CSV: no channel header block",
+        "WinCC data log CSV: no header",
+        "Niagara history export: no header",
+        "CODESYS 2.3 trace (ASCII file): ",
+        "table (TIA Portal trace CSV, CODESYS V3 export, CSV/TSV): no header line with a time column",
+    ):
         assert name in said
 
 
 def test_a_value_that_is_none_names_its_line_and_column(tmp_path):
-    said = bad(tmp_path, "cell.csv", "time [ms];value;setChangeRate;delayedValue;status\n0;0;4;0;16#0000\n"
-                                     "250;0;4;0;16#00G0\n")
+    said = bad(
+        tmp_path, "cell.csv", "time [ms];value;setChangeRate;delayedValue;status\n0;0;4;0;16#0000\n250;0;4;0;16#00G0\n"
+    )
     assert "cell.csv, line 3, column 5: '16#00G0' in column 'status' is not a number" in said
 
 
@@ -165,8 +180,10 @@ def test_a_counter_read_as_seconds_is_refused_naming_the_unit_and_filetime_is_kn
     assert "with its time read as seconds (assumed: column 'time' names no unit)" in said and "--time-unit" in said
     assert compare(SIEMENS[3], tmp_path / "counter.csv", "--time-unit", "us").returncode == 0
     path = tmp_path / "filetime.csv"
-    path.write_text("time;value;setChangeRate;delayedValue\n" + "".join(
-        f"{134081208000000000 + k * 2500000};0;4;0\n" for k in range(5)))
+    path.write_text(
+        "time;value;setChangeRate;delayedValue\n"
+        + "".join(f"{134081208000000000 + k * 2500000};0;4;0\n" for k in range(5))
+    )
     done = compare(SIEMENS[3], path)
     assert done.returncode == 0 and "time as FILETIME" in done.stdout
 
@@ -177,15 +194,24 @@ def test_milliseconds_read_as_seconds_against_the_cycle_are_refused(tmp_path):
     assert "would take 1.3e+04 steps for 14 samples" in said
 
 
-@pytest.mark.parametrize("name, text, message", [
-    ("backwards.csv", "time,value,delayedValue\n0,1,0\n0.5,1,0\n0.25,1,0\n",
-     "backwards.csv, line 4, column 1: time goes backwards"),
-    ("long_row.csv", "time,value,delayedValue\n0,1,0\n0.25,1,0,7\n", "long_row.csv, line 3, column 4: 4 cells"),
-    ("twice.csv", "time,MAIN.a.value,MAIN.b.value,delayedValue\n0,1,2,0\n",
-     "twice.csv) and 'MAIN.b.value' (column 3 of"),
-    ("no_output.csv", "time,value\n0,1\n0.25,1\n", "no channel is an output of LGF_LimRateOfChangeCI (FMI 3)"),
-    ("empty.csv", "", "empty.csv: empty file"),
-])
+@pytest.mark.parametrize(
+    "name, text, message",
+    [
+        (
+            "backwards.csv",
+            "time,value,delayedValue\n0,1,0\n0.5,1,0\n0.25,1,0\n",
+            "backwards.csv, line 4, column 1: time goes backwards",
+        ),
+        ("long_row.csv", "time,value,delayedValue\n0,1,0\n0.25,1,0,7\n", "long_row.csv, line 3, column 4: 4 cells"),
+        (
+            "twice.csv",
+            "time,MAIN.a.value,MAIN.b.value,delayedValue\n0,1,2,0\n",
+            "twice.csv) and 'MAIN.b.value' (column 3 of",
+        ),
+        ("no_output.csv", "time,value\n0,1\n0.25,1\n", "no channel is an output of LGF_LimRateOfChangeCI (FMI 3)"),
+        ("empty.csv", "", "empty.csv: empty file"),
+    ],
+)
 def test_bad_recordings_exit_2_with_their_message(tmp_path, name, text, message):
     assert message in bad(tmp_path, name, text)
 
@@ -198,8 +224,10 @@ def test_two_samples_on_one_cycle_are_refused(tmp_path):
 def test_set_gives_the_fmus_start_values(tmp_path):
     """rateUpPar 2 per second: 0.5 a 250 ms cycle, worked by hand; the default (1) gives 0.25."""
     path = tmp_path / "faster.csv"
-    path.write_text("time,u,y\n" + "".join(f"{k * 0.25},{u},{y}\n" for k, (u, y) in
-                                          enumerate(zip([0, 2, 2, 2, 2, 2], [0, 0.5, 1, 1.5, 2, 2]))))
+    path.write_text(
+        "time,u,y\n"
+        + "".join(f"{k * 0.25},{u},{y}\n" for k, (u, y) in enumerate(zip([0, 2, 2, 2, 2, 2], [0, 0.5, 1, 1.5, 2, 2])))
+    )
     assert compare(RATE_LIMITER[3], path, "--set", "rateUpPar=2").returncode == 0
     done = compare(RATE_LIMITER[3], path)
     assert done.returncode == 1 and "y leaves the band first at t=0.5: 0.25, expected 0.5" in done.stdout
@@ -213,15 +241,20 @@ def test_recordings_on_every_executor_and_niagara_histories_given_as_files(tmp_p
         done = compare(SIEMENS[3], SAMPLES / "twincat_siemens.csv", *histories, *options)
         assert done.returncode == 0, done.stdout + done.stderr
         assert "2 of 2 cases pass" in done.stdout and "PASS  niagara_siemens on" in done.stdout
-    resumed = compare(SIEMENS[3], SAMPLES / "twincat_siemens.csv", *histories, "--report", tmp_path / "report",
-                      "--resume")
+    resumed = compare(
+        SIEMENS[3], SAMPLES / "twincat_siemens.csv", *histories, "--report", tmp_path / "report", "--resume"
+    )
     assert resumed.returncode == 0 and "on the journal" in resumed.stdout
 
 
 def test_the_readmes_recording_command_passes():
     from support.fmu_driver import REPO
-    [line] = [line for line in (REPO / "README.md").read_text().splitlines()
-              if line.startswith("build/venv/bin/fmutrace compare") and "tests/recordings/" in line]
+
+    [line] = [
+        line
+        for line in (REPO / "README.md").read_text().splitlines()
+        if line.startswith("build/venv/bin/fmutrace compare") and "tests/recordings/" in line
+    ]
     command, fmu, recording = line.split()[1:]
     assert command == "compare"
     done = compare(BUILD_DIR / Path(fmu).relative_to("build"), REPO / recording)

@@ -6,6 +6,7 @@ references made to fail (one ulp off, a sample the result lacks, a
 repeated time), exact and with a tolerance. `fmutrace run` on a long
 input writes what it writes on a short one. Its progress shows on a
 terminal only."""
+
 import io
 import re
 import shutil
@@ -30,8 +31,9 @@ def outcomes(folder, version, mode, steps, chunk_bytes):
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
     whole = run_case(folder, folder.name, None, runner, fmu, labels, mode, "none")
-    long = run_long_case(folder, folder.name, runner, fmu, labels, mode, "none", steps_per_chunk=steps,
-                         chunk_bytes=chunk_bytes)
+    long = run_long_case(
+        folder, folder.name, runner, fmu, labels, mode, "none", steps_per_chunk=steps, chunk_bytes=chunk_bytes
+    )
     return whole, long
 
 
@@ -91,8 +93,9 @@ def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
     out = tmp_path / "out.csv"
-    long = run_long_case(folder, "ulp", runner, fmu, labels, Exact(), "failed", result_file=out, steps_per_chunk=2,
-                         chunk_bytes=16)
+    long = run_long_case(
+        folder, "ulp", runner, fmu, labels, Exact(), "failed", result_file=out, steps_per_chunk=2, chunk_bytes=16
+    )
     assert not long.passed and long.png.startswith(b"\x89PNG")
     whole = run_case(folder, "ulp", None, runner, fmu, labels, Exact(), "failed")
     write_trace(tmp_path / "whole.csv", whole.result)
@@ -107,8 +110,9 @@ def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
     path = fmu_path(BUILD_DIR, "RateLimiter", 3)
     start = {"rateUpPar": "2.0", "rateDownPar": "0.5"}
     with open(tmp_path / "long.csv", "w") as out:
-        written = simulate_long(path, scenario / "RateLimiter_in.csv", out, start, 0.0, 8.0, 0.5, None,
-                                steps_per_chunk=3, chunk_bytes=8)
+        written = simulate_long(
+            path, scenario / "RateLimiter_in.csv", out, start, 0.0, 8.0, 0.5, None, steps_per_chunk=3, chunk_bytes=8
+        )
     whole = simulate(path, scenario / "RateLimiter_in.csv", start, 0.0, 8.0, 0.5)
     write_trace(tmp_path / "whole.csv", whole)
     assert written == len(whole)
@@ -146,8 +150,11 @@ def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
     from fmutrace.longcase import _last_time
 
     names = ["time"] + [f"s{i}" for i in range(width // 10)]
-    lines = [",".join(names), ",".join(["0.5"] + ["1.25"] * (len(names) - 1)),
-             ",".join(["7.75"] + ["0.123456789"] * (len(names) - 1))]
+    lines = [
+        ",".join(names),
+        ",".join(["0.5"] + ["1.25"] * (len(names) - 1)),
+        ",".join(["7.75"] + ["0.123456789"] * (len(names) - 1)),
+    ]
     path = tmp_path / "wide.csv"
     path.write_text("\n".join(lines) + "\n\n")
     assert _last_time(path) == 7.75

@@ -6,6 +6,7 @@ On the table exports of tests/recordings and variants of them written
 here (perturbed, off-cycle stamps, the other timing, a tolerance, a
 printed 10 ms ramp), with a head and blocks of a few lines so that every
 boundary occurs; and what the streamed path leaves to the in-memory one."""
+
 from pathlib import Path
 
 import numpy as np
@@ -25,8 +26,7 @@ from support.scenarios import fmu_path
 SAMPLES = Path(__file__).parents[1] / "recordings"
 
 
-def outcomes(path, model, mode=Exact(), options=RecordingOptions(), head=400, block=120, version=3,
-             monkeypatch=None):
+def outcomes(path, model, mode=Exact(), options=RecordingOptions(), head=400, block=120, version=3, monkeypatch=None):
     """(in memory, streamed) outcomes of the recording at path; streamed is None where the stream refused."""
     fmu_file = fmu_path(BUILD_DIR, model, version)
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
@@ -34,8 +34,9 @@ def outcomes(path, model, mode=Exact(), options=RecordingOptions(), head=400, bl
     monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
     whole = run_case(str(path), path.name, None, runner, fmu, labels, mode, "none", options)
     monkeypatch.setattr(stream, "HEAD_BYTES", head)
-    streamed = stream.run_long_recording(str(path), path.name, runner, fmu, labels, mode, "none", options,
-                                         block_bytes=block, steps_per_chunk=3)
+    streamed = stream.run_long_recording(
+        str(path), path.name, runner, fmu, labels, mode, "none", options, block_bytes=block, steps_per_chunk=3
+    )
     return whole, streamed
 
 
@@ -54,17 +55,18 @@ def copy(tmp_path, name, edit=None, encoding="utf-8-sig"):
     return path
 
 
-TABLES = [("codesys_v3_ratelimiter.csv", "RateLimiter", "utf-8-sig"),
-          ("plain_ratelimiter.tsv", "RateLimiter", "utf-8"),
-          ("tia_portal_siemens.csv", "LGF_LimRateOfChangeCI", "cp1252")]
+TABLES = [
+    ("codesys_v3_ratelimiter.csv", "RateLimiter", "utf-8-sig"),
+    ("plain_ratelimiter.tsv", "RateLimiter", "utf-8"),
+    ("tia_portal_siemens.csv", "LGF_LimRateOfChangeCI", "cp1252"),
+]
 
 
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("name, model, encoding", TABLES, ids=[t[0] for t in TABLES])
 @pytest.mark.parametrize("head, block", [(400, 40), (400, 1 << 20), (1 << 20, 1)])
 def test_table_exports_streamed_as_in_memory(name, model, encoding, head, block, version, monkeypatch):
-    whole, streamed = outcomes(SAMPLES / name, model, head=head, block=block, version=version,
-                               monkeypatch=monkeypatch)
+    whole, streamed = outcomes(SAMPLES / name, model, head=head, block=block, version=version, monkeypatch=monkeypatch)
     same(whole, streamed)
     assert whole.passed
 
@@ -89,12 +91,14 @@ def off_cycle(lines):
 @pytest.mark.parametrize("timing", ["cycle", "fmi"])
 def test_failing_and_noted_recordings_streamed_as_in_memory(edit, mode, timing, tmp_path, monkeypatch):
     path = copy(tmp_path, "tia_portal_siemens.csv", edit, encoding="cp1252")
-    whole, streamed = outcomes(path, "LGF_LimRateOfChangeCI", mode, RecordingOptions(timing=timing),
-                               monkeypatch=monkeypatch)
+    whole, streamed = outcomes(
+        path, "LGF_LimRateOfChangeCI", mode, RecordingOptions(timing=timing), monkeypatch=monkeypatch
+    )
     same(whole, streamed)
     if edit is perturbed and timing == "cycle" and isinstance(mode, Exact):
-        assert not whole.passed and any("first differs at the recording's sample of cycle 8" in m and
-                                        "line 15" in m for m in whole.messages)
+        assert not whole.passed and any(
+            "first differs at the recording's sample of cycle 8" in m and "line 15" in m for m in whole.messages
+        )
     if edit is off_cycle:
         assert any("off a cycle end" in m for m in whole.messages)
 
@@ -114,6 +118,7 @@ def test_a_printed_10_ms_ramp_streamed_as_in_memory(tmp_path, monkeypatch):
 def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
     """A skipped cycle, an empty cell, a blank line inside, a step the head does not show: the stream
     refuses before anything is reported; the in-memory path reads or explains them."""
+
     def skipped(lines):
         return lines[:10] + lines[11:]
 
@@ -136,11 +141,11 @@ def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
     assert streamed is None
 
 
-def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_run_is_closed(tmp_path,
-                                                                                               monkeypatch):
+def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_run_is_closed(tmp_path, monkeypatch):
     """Through run_case, streamed first as a long recording is: an empty
     cell found after the FMU ran gives the in-memory path's outcome, and
     the stream's run (run_chunks, suspended at its last chunk) is closed."""
+
     def empty(lines):
         lines[12] = lines[12].replace(";4;", ";;")
         return lines
@@ -173,6 +178,7 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
     time column refuses the file before the FMU is instantiated (no run,
     no result file), and run_case gives the in-memory outcome, which names
     the file, line and column."""
+
     def skipped(lines):
         return lines[:16] + lines[17:]
 
@@ -193,8 +199,18 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
         fmu = Fmu(str(fmu_file), runner.md)
         labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
         written = tmp_path / "result.csv"
-        streamed = stream.run_long_recording(str(path), path.name, runner, fmu, labels, Exact(), "all",
-                                             RecordingOptions(), result_file=str(written), block_bytes=120)
+        streamed = stream.run_long_recording(
+            str(path),
+            path.name,
+            runner,
+            fmu,
+            labels,
+            Exact(),
+            "all",
+            RecordingOptions(),
+            result_file=str(written),
+            block_bytes=120,
+        )
         return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not written.exists()
 
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
@@ -209,8 +225,9 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
     outcome = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
     assert (outcome.status, outcome.streamed, runner.fmu, runner.fast_runs) == ("invalid", False, None, 0)
-    assert outcome.messages == [f"{path}, line 17, column 2: '12x' in column 'Time [ms]' is not a number, TRUE/FALSE "
-                                "or an IEC literal (16#...)"]
+    assert outcome.messages == [
+        f"{path}, line 17, column 2: '12x' in column 'Time [ms]' is not a number, TRUE/FALSE or an IEC literal (16#...)"
+    ]
     # the head's rows every 10 ms, the rest every 20 ms: the whole file's median interval is 20 ms
     rows = [(k * 10, 1.0) for k in range(12)] + [(120 + k * 20, 1.0) for k in range(40)]
     path = tmp_path / "two_steps.csv"

@@ -4,6 +4,7 @@
 structure) and on small files written here for each rule and each bad
 input. The samples' values are worked by hand (samples.py) and checked
 here against the tests' independent oracle; none comes from an FMU."""
+
 import math
 import sys
 from pathlib import Path
@@ -13,8 +14,7 @@ import numpy as np
 import pytest
 
 from fmutrace import InputError, TraceError
-from fmutrace.recordings import (FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file,
-                                 read_recording)
+from fmutrace.recordings import FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file, read_recording
 from fmutrace.recordings.align import align
 from fmutrace.recordings.text import decode, numbers
 from fmutrace.traces import split_cells as split
@@ -44,15 +44,22 @@ def test_the_sample_files_are_what_their_generator_writes():
         assert (SAMPLES / name).read_bytes() == samples.sample_bytes(name), name
 
 
-@pytest.mark.parametrize("model, table, inputs, outputs", [
-    ("LGF_LimRateOfChangeCI", samples.SIEMENS, ("value", "setChangeRate"), ("delayedValue", "status")),
-    ("RateLimiter", samples.RATE_LIMITER, ("u",), ("y", "rampActive")),
-])
+@pytest.mark.parametrize(
+    "model, table, inputs, outputs",
+    [
+        ("LGF_LimRateOfChangeCI", samples.SIEMENS, ("value", "setChangeRate"), ("delayedValue", "status")),
+        ("RateLimiter", samples.RATE_LIMITER, ("u",), ("y", "rampActive")),
+    ],
+)
 def test_the_hand_worked_tables_agree_with_the_oracle(model, table, inputs, outputs):
     """Each row is one cycle: the oracle steps from k*h with the row's inputs and its outputs after the
     step are the row's outputs (the recorder's convention)."""
-    vr = {name: i for i, name in enumerate(list(table) + ["rateUp", "rateDown", "bypassValue", "duration",
-                                                          "callOB", "cycleTime", "setChangeRate"])}
+    vr = {
+        name: i
+        for i, name in enumerate(
+            list(table) + ["rateUp", "rateDown", "bypassValue", "duration", "callOB", "cycleTime", "setChangeRate"]
+        )
+    }
     first = {name: float(table[name][0]) for name in inputs}
     oracle = oracle_for(model, vr, first)
     for k in range(len(table[inputs[0]])):
@@ -93,12 +100,15 @@ def test_twincat_for_each_sampletime_with_filetime_keeps_each_groups_time_base()
     assert delayed.lines.tolist() == [13, 16, 19, 22, 25]
 
 
-@pytest.mark.parametrize("name, label, unit, options", [
-    ("codesys23_ratelimiter.txt", "CODESYS 2.3 trace (ASCII file)", "cycles", {"step_size": CYCLE}),
-    ("codesys_v3_ratelimiter.csv", "CODESYS V3 trace export", "us", {}),
-    ("plain_ratelimiter.tsv", "CSV/TSV table", "s", {}),
-    ("plain_ratelimiter_spaces.txt", "CSV/TSV table", "s", {}),
-])
+@pytest.mark.parametrize(
+    "name, label, unit, options",
+    [
+        ("codesys23_ratelimiter.txt", "CODESYS 2.3 trace (ASCII file)", "cycles", {"step_size": CYCLE}),
+        ("codesys_v3_ratelimiter.csv", "CODESYS V3 trace export", "us", {}),
+        ("plain_ratelimiter.tsv", "CSV/TSV table", "s", {}),
+        ("plain_ratelimiter_spaces.txt", "CSV/TSV table", "s", {}),
+    ],
+)
 def test_every_cycle_recordings_of_rate_limiter_read_as_written(name, label, unit, options):
     recording = read_one(SAMPLES / name, **options)
     assert (recording.format, recording.time_unit, recording.step_size) == (label, unit, CYCLE)
@@ -113,8 +123,11 @@ def test_every_cycle_recordings_of_rate_limiter_read_as_written(name, label, uni
 def test_mdf4_channels_keep_their_groups_time_bases(tmp_path):
     recording = read_one(samples.write_mdf(tmp_path / "ramp.mf4", outputs_every=3))
     assert recording.format == "ASAM MDF4" and recording.time_unit == "s"
-    assert [c.name for c in recording.channels] == ["MAIN.fbRamp.value", "MAIN.fbRamp.setChangeRate",
-                                                    "MAIN.fbRamp.delayedValue"]
+    assert [c.name for c in recording.channels] == [
+        "MAIN.fbRamp.value",
+        "MAIN.fbRamp.setChangeRate",
+        "MAIN.fbRamp.delayedValue",
+    ]
     assert channel(recording, "delayedValue").times.tolist() == [0.0, 0.75, 1.5, 2.25, 3.0]
     assert channel(recording, "value").values.tolist() == samples.SIEMENS["value"]
 
@@ -162,8 +175,10 @@ def test_a_twincat_eof_line_ends_the_table():
 
 # -- time ---------------------------------------------------------------------------------
 def test_units_named_in_a_column():
-    assert [unit_in_name(n) for n in ("Time [ms]", "Zeit (ms)", "Time_ms", "time/s", "Timestamp [µs]", "t",
-                                      "cycle [cycles]")] == ["ms", "ms", "ms", "s", "us", None, "cycles"]
+    assert [
+        unit_in_name(n)
+        for n in ("Time [ms]", "Zeit (ms)", "Time_ms", "time/s", "Timestamp [µs]", "t", "cycle [cycles]")
+    ] == ["ms", "ms", "ms", "s", "us", None, "cycles"]
 
 
 def test_dates_as_recorders_print_them():
@@ -215,11 +230,15 @@ def test_a_stamp_off_its_cycle_is_reported_and_two_on_one_cycle_refused(tmp_path
     assert recording.step_size == 0.01
     variables = variables_of(u="input", y="output")
     aligned = align(recording, plan(recording, variables, "M"))
-    assert any("u: 1 of its 4 time stamps are more than 0.1 of a cycle" in n and "line 4: t=0.023" in n
-               for n in aligned.notes)
+    assert any(
+        "u: 1 of its 4 time stamps are more than 0.1 of a cycle" in n and "line 4: t=0.023" in n for n in aligned.notes
+    )
     recording = normalise(read_recording(path)[0], step_size=0.02)
-    with pytest.raises(InputError, match=r"line 4: samples of u at t=0.0100004 s and t=0.023 s fall on the same "
-                                         r"cycle of 0.02 s"):
+    with pytest.raises(
+        InputError,
+        match=r"line 4: samples of u at t=0.0100004 s and t=0.023 s fall on the same "
+        r"cycle of 0.02 s",
+    ):
         align(recording, plan(recording, variables, "M"))
 
 
@@ -271,23 +290,37 @@ def variables_of(**causalities):
     def variable(causality):
         kind, _, variability = causality.partition(":")
         return SimpleNamespace(causality=kind, variability=variability or "continuous")
+
     return {name: variable(c) for name, c in causalities.items()}
 
 
-SIEMENS_VARIABLES = variables_of(value="input", setChangeRate="input", delayedValue="output", status="output",
-                                 callOB="parameter:fixed", cycleTime="parameter:fixed")
+SIEMENS_VARIABLES = variables_of(
+    value="input",
+    setChangeRate="input",
+    delayedValue="output",
+    status="output",
+    callOB="parameter:fixed",
+    cycleTime="parameter:fixed",
+)
 
 
 def test_channels_mean_the_variable_of_their_last_name_component():
-    assert [last_component(n) for n in ("MAIN.fbRamp.delayedValue", '"DB_Ramp".delayedValue',
-                                        "Application.PLC_PRG.fbRamp.delayedValue", '"DB.Ramp".x')] == \
-        ["delayedValue", "delayedValue", "delayedValue", "x"]
+    assert [
+        last_component(n)
+        for n in (
+            "MAIN.fbRamp.delayedValue",
+            '"DB_Ramp".delayedValue',
+            "Application.PLC_PRG.fbRamp.delayedValue",
+            '"DB.Ramp".x',
+        )
+    ] == ["delayedValue", "delayedValue", "delayedValue", "x"]
     recording = read_one(SAMPLES / "tia_portal_siemens.csv")
     result = plan(recording, SIEMENS_VARIABLES, "LGF_LimRateOfChangeCI")
     assert [v for v, _ in result.drives] == ["value", "setChangeRate"]
     assert [v for v, _ in result.compares] == ["delayedValue", "status"]
     assert [(c.name, why) for c, why in result.ignored] == [
-        ('"DB_Ramp".enDefaultOutValue', "no variable of LGF_LimRateOfChangeCI is named 'enDefaultOutValue'")]
+        ('"DB_Ramp".enDefaultOutValue', "no variable of LGF_LimRateOfChangeCI is named 'enDefaultOutValue'")
+    ]
 
 
 def test_map_names_a_channel_for_a_variable_and_roles_follow_the_variable():
@@ -316,8 +349,11 @@ def test_two_channels_meaning_one_variable_are_refused(tmp_path):
     path = tmp_path / "twice.csv"
     path.write_text("time,MAIN.a.value,MAIN.b.value,delayedValue\n0,1,2,0\n")
     recording = read_recording(path)[0]
-    with pytest.raises(InputError, match=r"'MAIN.a.value' \(column 2 of .*twice.csv\) and 'MAIN.b.value' "
-                                         r"\(column 3 of .* both mean value: .*--map"):
+    with pytest.raises(
+        InputError,
+        match=r"'MAIN.a.value' \(column 2 of .*twice.csv\) and 'MAIN.b.value' "
+        r"\(column 3 of .* both mean value: .*--map",
+    ):
         plan(recording, SIEMENS_VARIABLES, "M")
 
 
@@ -339,8 +375,9 @@ def test_a_row_drives_its_cycle_and_its_output_is_that_cycles_result():
 def test_inputs_sampled_coarser_than_the_step_are_explained_with_a_tolerance(tmp_path):
     path = tmp_path / "coarse.csv"
     rows = [(k, samples.SIEMENS["value"][k], samples.SIEMENS["delayedValue"][k]) for k in range(0, 14, 3)]
-    path.write_text("time [ms];value;setChangeRate;delayedValue\n" +
-                    "".join(f"{k * 250};{v};4;{y}\n" for k, v, y in rows))
+    path.write_text(
+        "time [ms];value;setChangeRate;delayedValue\n" + "".join(f"{k * 250};{v};4;{y}\n" for k, v, y in rows)
+    )
     recording = normalise(read_recording(path)[0], step_size=CYCLE)
     aligned = align(recording, plan(recording, SIEMENS_VARIABLES, "M"))
     assert "value every 3 cycles" in aligned.coarse and "by up to 2 cycles" in aligned.coarse
@@ -365,8 +402,10 @@ def test_a_recording_is_columnar():
 
 def test_a_table_of_absolute_time_stamps(tmp_path):
     path = tmp_path / "dates.csv"
-    path.write_text("Timestamp;u;y\n2026-11-20T14:00:00.000+01:00;0;0\n2026-11-20T14:00:00.250+01:00;2;0,25\n"
-                    "2026-11-20T13:00:00.500Z;2;0,5\n")
+    path.write_text(
+        "Timestamp;u;y\n2026-11-20T14:00:00.000+01:00;0;0\n2026-11-20T14:00:00.250+01:00;2;0,25\n"
+        "2026-11-20T13:00:00.500Z;2;0,5\n"
+    )
     recording = read_one(path)
     assert (recording.time_unit, recording.step_size) == ("date", 0.25)
     assert channel(recording, "y").times.tolist() == [0.0, 0.25, 0.5]
@@ -376,9 +415,11 @@ def test_a_table_of_absolute_time_stamps(tmp_path):
 def test_twincat_without_time_columns_takes_the_time_from_the_sample_time(tmp_path):
     """Timelines 'None', ',' as the separator (so a decimal point): row k is at k * SampleTime."""
     path = tmp_path / "none.csv"
-    path.write_text("Name,Scope\nFile,none.csv\n\n\nName,value,delayedValue\nData-Type,REAL64,REAL64\n"
-                    "SampleTime[ms],250,250\nSymbolName,MAIN.fbRamp.value,MAIN.fbRamp.delayedValue\n\n"
-                    "0,0\n3.5,1\n3.5,2\n")
+    path.write_text(
+        "Name,Scope\nFile,none.csv\n\n\nName,value,delayedValue\nData-Type,REAL64,REAL64\n"
+        "SampleTime[ms],250,250\nSymbolName,MAIN.fbRamp.value,MAIN.fbRamp.delayedValue\n\n"
+        "0,0\n3.5,1\n3.5,2\n"
+    )
     recording = read_one(path)
     assert (recording.format, recording.time_unit) == ("Beckhoff TwinCAT Scope View CSV export", "ms")
     assert channel(recording, "value").times.tolist() == [0.0, 0.25, 0.5]
@@ -393,12 +434,16 @@ def test_codesys23_with_a_time_column_in_milliseconds(tmp_path):
     assert channel(recording, "y").values.tolist() == [0.0, 0.25, 0.5]
 
 
-@pytest.mark.parametrize("body", [
-    "0;1,5;TRUE\n0,25; 2 ;FALSE\n0,5;3;16#00FF\n",          # blanks around cells, decimal commas, literals
-    "0\t1\t2\n1\t\t3\nEOF\n\n",                                # an empty cell, the EOF tag, trailing blank lines
-])
+@pytest.mark.parametrize(
+    "body",
+    [
+        "0;1,5;TRUE\n0,25; 2 ;FALSE\n0,5;3;16#00FF\n",  # blanks around cells, decimal commas, literals
+        "0\t1\t2\n1\t\t3\nEOF\n\n",  # an empty cell, the EOF tag, trailing blank lines
+    ],
+)
 def test_the_one_split_of_a_plain_body_equals_the_line_by_line_reading(tmp_path, body):
     from fmutrace.recordings import grid, text as texts
+
     separator = ";" if ";" in body else "\t"
     path = tmp_path / "t.csv"
     path.write_text(f"time{separator}a{separator}b\n" + body)
@@ -411,6 +456,7 @@ def test_the_one_split_of_a_plain_body_equals_the_line_by_line_reading(tmp_path,
 @pytest.mark.parametrize("body", ['0;"1";2\n', "0;1;2\n\n1;2;3\n", "0;1\n", "0;1;2;3\n"])
 def test_bodies_the_one_split_cannot_read_go_line_by_line(tmp_path, body):
     from fmutrace.recordings import grid, text as texts
+
     path = tmp_path / "t.csv"
     path.write_text("time;a;b\n" + body)
     assert grid.uniform_table(texts.read(path), 1, ";", 3) is None
@@ -421,13 +467,18 @@ def test_twincat_sample_time_with_a_decimal_comma_in_a_comma_separated_export(tm
     one channel's group of two cells is one number; where that cannot be told, the row is named."""
     head = "Name,Scope\nFile,x.csv\n\n\n"
     path = tmp_path / "comma.csv"
-    path.write_text(head + "Name,fast,Name,slow,other\nSampleTime[ms],0,2,SampleTime[ms],1,1\n"
-                           "SymbolName,MAIN.fast,SymbolName,MAIN.slow,MAIN.other\n\n0,1,0,5,6\n0.2,2\n0.4,3\n")
+    path.write_text(
+        head + "Name,fast,Name,slow,other\nSampleTime[ms],0,2,SampleTime[ms],1,1\n"
+        "SymbolName,MAIN.fast,SymbolName,MAIN.slow,MAIN.other\n\n0,1,0,5,6\n0.2,2\n0.4,3\n"
+    )
     recording = read_one(path)
     assert recording.sample_time == 0.0002
     assert channel(recording, "fast").times.tolist() == [0.0, 0.0002, 0.0004]
     assert channel(recording, "slow").values.tolist() == [5.0]
     path.write_text(head + "Name,fast,Name,slow,other\nSampleTime[ms],0,2,SampleTime[ms],1,1,5\n\n0,1,0,5,6\n")
-    with pytest.raises(TraceError, match=r"line 6, column 4: the row 'SampleTime\[ms\]' has 3 cells for 2 channels "
-                                         r"\(a decimal comma, ',' separating\?\)"):
+    with pytest.raises(
+        TraceError,
+        match=r"line 6, column 4: the row 'SampleTime\[ms\]' has 3 cells for 2 channels "
+        r"\(a decimal comma, ',' separating\?\)",
+    ):
         read_file(path)

@@ -5,6 +5,7 @@ scenario of every model driven by the same script (tests/c/run_trace.c)
 prints the same bits as the x86_64 binary, and an FMU state serialized by
 one platform's binary is restored by the other's and continues bit for
 bit."""
+
 import os
 import zipfile
 
@@ -16,8 +17,9 @@ from support.process import run as run_bounded
 from support.run_trace import QEMU, halves, run_script, script
 from support.scenarios import discover
 
-pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
-                                reason="sanitizer build: no cross builds; the release build runs these")
+pytestmark = pytest.mark.skipif(
+    os.environ.get("RL_SANITIZED") == "1", reason="sanitizer build: no cross builds; the release build runs these"
+)
 
 CROSS = BUILD_DIR / "aarch64"
 SCENARIOS = discover()
@@ -32,8 +34,11 @@ def test_every_fmi3_fmu_carries_an_aarch64_binary():
 
 
 def test_lifecycle_harness_under_emulation():
-    done = run_bounded(QEMU + [str(CROSS / "test_lifecycle"), "3", str(BUILD_DIR / "stage" / "fmi3" / "RateLimiter"),
-                               "2000", "200"], timeout=600, what="test_lifecycle under qemu-aarch64")
+    done = run_bounded(
+        QEMU + [str(CROSS / "test_lifecycle"), "3", str(BUILD_DIR / "stage" / "fmi3" / "RateLimiter"), "2000", "200"],
+        timeout=600,
+        what="test_lifecycle under qemu-aarch64",
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "FMI 3: passed" in done.stdout
 
@@ -43,8 +48,10 @@ def test_scenario_gives_the_same_bits_on_aarch64(scenario, tmp_path):
     stage = BUILD_DIR / "stage" / "fmi3" / scenario.model
     md = read_model_description(str(stage / "modelDescription.xml"))
     text = script(scenario, md)
-    native, emulated = (run_script(platform, stage, scenario.model, md.guid, text, tmp_path, f"{scenario.name} on {platform}")
-                        for platform in ("x86_64-linux", "aarch64-linux"))
+    native, emulated = (
+        run_script(platform, stage, scenario.model, md.guid, text, tmp_path, f"{scenario.name} on {platform}")
+        for platform in ("x86_64-linux", "aarch64-linux")
+    )
     o = scenario.options
     assert len(native) == (round((o["StopTime"] - o["StartTime"]) / o["StepSize"]) + 1) * len(scenario.outputs)
     assert emulated == native
@@ -61,8 +68,16 @@ def test_the_harness_gives_the_reference(tmp_path):
 
 
 @pytest.mark.parametrize("saved_on,restored_on", [("x86_64-linux", "aarch64-linux"), ("aarch64-linux", "x86_64-linux")])
-@pytest.mark.parametrize("name", ["RateLimiter/asymmetric", "RateLimiter/duration_jump", "Ramp/ttime_tuned_in_run",
-                                  "LGF_LimRateOfChangeAdvancedCI/inverted_limits", "RateLimit/duration_48h"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "RateLimiter/asymmetric",
+        "RateLimiter/duration_jump",
+        "Ramp/ttime_tuned_in_run",
+        "LGF_LimRateOfChangeAdvancedCI/inverted_limits",
+        "RateLimit/duration_48h",
+    ],
+)
 def test_a_state_serialized_on_one_platform_continues_on_the_other(name, saved_on, restored_on, tmp_path):
     scenario = next(s for s in SCENARIOS if s.name == name)
     stage = BUILD_DIR / "stage" / "fmi3" / scenario.model

@@ -10,6 +10,7 @@ package and runs it, with a master of its own (it does not apply the
 components' parameter bindings, and it steps and records in another
 order): its run is checked for what it is. The package's XML is valid
 against the SSP 1.0 schemas fmpy ships."""
+
 import math
 import os
 import sys
@@ -27,8 +28,15 @@ from support.fmu_driver import BUILD_DIR, REPO, TESTS, fmu_file
 from support.process import run as run_bounded
 from support.oracle import oracle_for
 
-RUNS = [("fmpy", 2), ("fmpy", 3), ("ecospy", 2), ("ecospy", 3), ("libcosimpy", 2), ("ssp-ecospy", 2),
-        ("ssp-libcosimpy", 2)]
+RUNS = [
+    ("fmpy", 2),
+    ("fmpy", 3),
+    ("ecospy", 2),
+    ("ecospy", 3),
+    ("libcosimpy", 2),
+    ("ssp-ecospy", 2),
+    ("ssp-libcosimpy", 2),
+]
 
 
 def oracle_loop():
@@ -58,9 +66,13 @@ def test_closed_loop_agrees_with_the_oracle(importer, version, tmp_path):
         # size mismatch inside Ecos's own ecos::load_ssp (libecosc.so, not
         # ours); the FMUs' checks stay on
         environment["ASAN_OPTIONS"] += ":new_delete_type_mismatch=0"
-    process = run_bounded([sys.executable, "-m", "support.closed_loop", importer, str(version), str(BUILD_DIR),
-                           str(out)], timeout=300, what=f"the closed loop in {importer} (FMI {version})", cwd=TESTS,
-                          env=environment)
+    process = run_bounded(
+        [sys.executable, "-m", "support.closed_loop", importer, str(version), str(BUILD_DIR), str(out)],
+        timeout=300,
+        what=f"the closed loop in {importer} (FMI {version})",
+        cwd=TESTS,
+        env=environment,
+    )
     assert process.returncode == 0, (process.stdout + process.stderr)[-3000:]
     result = np.atleast_1d(read_csv(str(out)))
     expected = oracle_loop()
@@ -82,11 +94,18 @@ def test_the_ssp_package_is_valid_against_the_ssp_schemas():
     package = BUILD_DIR / "ssp" / "RateLimiterLoop.ssp"
     with zipfile.ZipFile(package) as z:
         names = set(z.namelist())
-        assert {"SystemStructure.ssd", "resources/RateLimiter.fmu", "resources/FirstOrderLag.fmu",
-                "resources/rl.ssv", "resources/plant.ssv"} <= names
-        for name, schema in [("SystemStructure.ssd", "SystemStructureDescription.xsd"),
-                             ("resources/rl.ssv", "SystemStructureParameterValues.xsd"),
-                             ("resources/plant.ssv", "SystemStructureParameterValues.xsd")]:
+        assert {
+            "SystemStructure.ssd",
+            "resources/RateLimiter.fmu",
+            "resources/FirstOrderLag.fmu",
+            "resources/rl.ssv",
+            "resources/plant.ssv",
+        } <= names
+        for name, schema in [
+            ("SystemStructure.ssd", "SystemStructureDescription.xsd"),
+            ("resources/rl.ssv", "SystemStructureParameterValues.xsd"),
+            ("resources/plant.ssv", "SystemStructureParameterValues.xsd"),
+        ]:
             validator = etree.XMLSchema(etree.parse(str(schemas / schema)))
             document = etree.fromstring(z.read(name))
             assert validator.validate(document), (name, validator.error_log)
@@ -103,11 +122,16 @@ def test_the_ssp_package_names_omsimulators_master_algorithm():
 
     with zipfile.ZipFile(BUILD_DIR / "ssp" / "RateLimiterLoop.ssp") as z:
         ssd = etree.fromstring(z.read("SystemStructure.ssd"))
-    ns = {"ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
-          "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
-          "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"}
-    masters = ssd.findall("ssd:System/ssd:Annotations/ssc:Annotation[@type='org.openmodelica']/oms:Annotations/"
-                          "oms:SimulationInformation/oms:FixedStepMaster", ns)
+    ns = {
+        "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+        "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+        "oms": "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd",
+    }
+    masters = ssd.findall(
+        "ssd:System/ssd:Annotations/ssc:Annotation[@type='org.openmodelica']/oms:Annotations/"
+        "oms:SimulationInformation/oms:FixedStepMaster",
+        ns,
+    )
     system = tomllib.loads((REPO / "modelDescription" / "systems" / "RateLimiterLoop.toml").read_text())["system"]
     assert len(masters) == 1 and masters[0].get("description") == "oms-ma"
     assert float(masters[0].get("stepSize")) == system["stepSize"]
@@ -140,15 +164,24 @@ def test_fmpy_reads_the_ssp_package_and_runs_it_its_own_way(tmp_path):
     package = str(BUILD_DIR / "ssp" / "RateLimiterLoop.ssp")
     ssd = read_ssd(package)
     assert sorted(e.name for e in ssd.system.elements) == ["plant", "rl"]
-    assert sorted((c.startElement, c.startConnector, c.endElement, c.endConnector) for c in ssd.system.connections) \
-        == [("plant", "demand", "rl", "u"), ("rl", "y", "plant", "command")]
+    assert sorted((c.startElement, c.startConnector, c.endElement, c.endConnector) for c in ssd.system.connections) == [
+        ("plant", "demand", "rl", "u"),
+        ("rl", "y", "plant", "command"),
+    ]
     for element in ssd.system.elements:
-        values = {p.name: float(p.value) for b in element.parameterBindings
-                  for p in read_ssv(package, resource=b.source).parameters}
+        values = {
+            p.name: float(p.value)
+            for b in element.parameterBindings
+            for p in read_ssv(package, resource=b.source).parameters
+        }
         assert values == (LIMITER if element.name == "rl" else PLANT)
     out = tmp_path / "loop.csv"
-    process = run_bounded([sys.executable, "-m", "support.closed_loop", "ssp-fmpy", "2", str(BUILD_DIR), str(out)],
-                          timeout=300, what="the SSP package in fmpy", cwd=TESTS)
+    process = run_bounded(
+        [sys.executable, "-m", "support.closed_loop", "ssp-fmpy", "2", str(BUILD_DIR), str(out)],
+        timeout=300,
+        what="the SSP package in fmpy",
+        cwd=TESTS,
+    )
     assert process.returncode == 0, (process.stdout + process.stderr)[-3000:]
     result = np.atleast_1d(read_csv(str(out)))
     assert len(result) == N

@@ -13,6 +13,7 @@ What an importer cannot do is asserted, not skipped:
 - both step on a fixed grid: a scenario whose inputs change between grid
   points (fmpy adds communication points there) is compared, bit for bit,
   with fmpy's low-level API making the same calls on the same grid."""
+
 import sys
 
 import numpy as np
@@ -40,9 +41,20 @@ def enumerations_set(scenario, version):
 
 def run(importer, scenario, version, tmp_path):
     out = tmp_path / "result.csv"
-    process = run_bounded([sys.executable, "-m", "support.importers", importer, str(scenario.folder),
-                           str(fmu_path(BUILD_DIR, scenario.model, version)), str(out)],
-                          timeout=300, what=f"{scenario.name} through {importer} (FMI {version})", cwd=TESTS)
+    process = run_bounded(
+        [
+            sys.executable,
+            "-m",
+            "support.importers",
+            importer,
+            str(scenario.folder),
+            str(fmu_path(BUILD_DIR, scenario.model, version)),
+            str(out),
+        ],
+        timeout=300,
+        what=f"{scenario.name} through {importer} (FMI {version})",
+        cwd=TESTS,
+    )
     assert process.returncode == 0, process.stderr[-3000:]
     return np.atleast_1d(read_csv(str(out))), process.stdout + process.stderr
 

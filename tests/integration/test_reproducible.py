@@ -2,6 +2,7 @@
 files again, copied elsewhere (new access and change times), with other
 permission bits (umask) and, where the test may, another owner, gives the
 same bytes. Without zip_normalize they differ (the control)."""
+
 import os
 import re
 import shutil
@@ -51,10 +52,18 @@ def repackage(model, version, tmp_path, normalize):
     # as the build runs them: without the sanitizer tree's preloaded runtime
     # (under it cmake -E tar hangs), which an instrumented tool links anyway
     env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
-    run_bounded([cmake_command(), "-E", "tar", "cf", str(out), "--format=zip", f"--mtime={zip_mtime()}", "--",
-                 *names], cwd=stage, env=env, check=True, timeout=120, what="cmake -E tar (packaging)")
+    run_bounded(
+        [cmake_command(), "-E", "tar", "cf", str(out), "--format=zip", f"--mtime={zip_mtime()}", "--", *names],
+        cwd=stage,
+        env=env,
+        check=True,
+        timeout=120,
+        what="cmake -E tar (packaging)",
+    )
     if normalize:
-        run_bounded([str(BUILD_DIR / "zip_normalize"), str(out)], env=env, check=True, timeout=120, what="zip_normalize")
+        run_bounded(
+            [str(BUILD_DIR / "zip_normalize"), str(out)], env=env, check=True, timeout=120, what="zip_normalize"
+        )
     return built.read_bytes(), out.read_bytes()
 
 
@@ -82,13 +91,19 @@ def test_normalized_entries_carry_no_machine_or_user_data():
                 # local header: "UT" times all equal the modification time, "ux" owner 0/0
                 z.fp.seek(info.header_offset)
                 header = z.fp.read(30)
-                name_length, extra_length = int.from_bytes(header[26:28], "little"), int.from_bytes(header[28:30], "little")
+                name_length, extra_length = (
+                    int.from_bytes(header[26:28], "little"),
+                    int.from_bytes(header[28:30], "little"),
+                )
                 extra = z.fp.read(name_length + extra_length)[name_length:]
                 fields = {}
                 at = 0
                 while at + 4 <= len(extra):
-                    tag, size = int.from_bytes(extra[at:at + 2], "little"), int.from_bytes(extra[at + 2:at + 4], "little")
-                    fields[tag] = extra[at + 4:at + 4 + size]
+                    tag, size = (
+                        int.from_bytes(extra[at : at + 2], "little"),
+                        int.from_bytes(extra[at + 2 : at + 4], "little"),
+                    )
+                    fields[tag] = extra[at + 4 : at + 4 + size]
                     at += 4 + size
                 times = fields[0x5455][1:]
                 assert len(times) == 12 and times[0:4] == times[4:8] == times[8:12], info.filename

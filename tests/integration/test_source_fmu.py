@@ -5,6 +5,7 @@ and every model of an FMI version linked into one executable, each with
 its own function prefix, as tools that compile source FMUs link them
 (docs/fmi.md, Source FMUs). Each build runs the model's reference
 scenarios and gives their hand-worked references."""
+
 import os
 import sys
 import xml.etree.ElementTree as ET
@@ -33,8 +34,9 @@ STRICT = ["-pedantic-errors", "-Wall", "-Wextra", "-Werror"]
 # attributes sees them), and as C++
 LANGUAGES = {"C99": ["cc", "-std=c99"], "C++11": [os.environ.get("RL_CXX") or "g++", "-x", "c++", "-std=c++11"]}
 BUILDS = [("C99", False), ("C99", True), ("C++11", False)]
-sanitized = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
-                               reason="run_trace is built in the release tree only")
+sanitized = pytest.mark.skipif(
+    os.environ.get("RL_SANITIZED") == "1", reason="run_trace is built in the release tree only"
+)
 
 
 def strip_binaries(source, target):
@@ -75,10 +77,16 @@ def compile_command(language, folder, version, model, portable=False, prefix=Non
         definitions = dict(definitions, **{f"FMI{version}_FUNCTION_PREFIX": prefix})
     if portable:
         definitions = dict(definitions, FMU_PORTABLE="1")
-    return (LANGUAGES[language] + STRICT + ["-O2", "-ffp-contract=off", "-fPIC"]
-            + [f"-D{name}" if value is None else f"-D{name}={value}" for name, value in definitions.items()]
-            + [f"-I{sources / d}" for d in includes] + [f"-I{sources}"] + [f"-I{h}" for h in headers]
-            + [str(sources / f) for f in files])
+    return (
+        LANGUAGES[language]
+        + STRICT
+        + ["-O2", "-ffp-contract=off", "-fPIC"]
+        + [f"-D{name}" if value is None else f"-D{name}={value}" for name, value in definitions.items()]
+        + [f"-I{sources / d}" for d in includes]
+        + [f"-I{sources}"]
+        + [f"-I{h}" for h in headers]
+        + [str(sources / f) for f in files]
+    )
 
 
 def run_scenarios(model, version, md, harness, library, tmp_path, prefix=None):
@@ -91,8 +99,13 @@ def run_scenarios(model, version, md, harness, library, tmp_path, prefix=None):
         text, check = reference_script(scenario, md)
         (tmp_path / "script").write_text(text)
         with open(tmp_path / "script") as script_file:
-            done = run_bounded([str(harness)] + options + [str(library), md.guid], timeout=300, stdin=script_file,
-                               what=f"{scenario.name} (FMI {version})", cwd=tmp_path)
+            done = run_bounded(
+                [str(harness)] + options + [str(library), md.guid],
+                timeout=300,
+                stdin=script_file,
+                what=f"{scenario.name} (FMI {version})",
+                cwd=tmp_path,
+            )
         assert done.returncode == 0, done.stderr
         check([line.strip() for line in done.stdout.splitlines()])
 
@@ -105,8 +118,13 @@ def test_compiled_source_fmu_matches_shipped_binary(model, version, tmp_path):
     strip_binaries(shipped, source_only)
     with zipfile.ZipFile(source_only) as z:
         assert not any(n.startswith("binaries/") for n in z.namelist())
-    run_bounded([sys.executable, "-m", "fmpy", "compile", str(source_only)], check=True, cwd=tmp_path,
-                timeout=300, what="fmpy compile (the source FMU)")
+    run_bounded(
+        [sys.executable, "-m", "fmpy", "compile", str(source_only)],
+        check=True,
+        cwd=tmp_path,
+        timeout=300,
+        what="fmpy compile (the source FMU)",
+    )
     with zipfile.ZipFile(source_only) as z:
         assert any(n.startswith("binaries/") and n.endswith(".so") for n in z.namelist())
     scenarios = [s for s in SCENARIOS if s.model == model]
@@ -144,8 +162,12 @@ def test_compiled_from_its_description_gives_the_references(model, version, lang
     the model to its hand-worked reference (through the C harness run_trace)."""
     folder, md = unpacked(model, version, tmp_path / "fmu")
     library = tmp_path / "lib.so"
-    done = run_bounded(compile_command(language, folder, version, model, portable)
-                       + ["-shared", "-Wl,-z,defs", "-lm", "-o", str(library)], timeout=300, what=language)
+    done = run_bounded(
+        compile_command(language, folder, version, model, portable)
+        + ["-shared", "-Wl,-z,defs", "-lm", "-o", str(library)],
+        timeout=300,
+        what=language,
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     symbols = defined_globals(library, dynamic=True, strong=True)
     assert symbols and all(name.startswith(f"fmi{version}") for name in symbols), symbols
@@ -155,8 +177,9 @@ def test_compiled_from_its_description_gives_the_references(model, version, lang
 def defined_globals(binary, dynamic=False, strong=False):
     """{name: nm type} of the symbols binary defines with external linkage (dynamic: exported); strong:
     without C++'s vague linkage (weak template instances that any number of units may define)."""
-    out = run_bounded(["nm", "--defined-only", "-g"] + (["-D"] if dynamic else []) + [str(binary)],
-                      timeout=60, what="nm", check=True).stdout
+    out = run_bounded(
+        ["nm", "--defined-only", "-g"] + (["-D"] if dynamic else []) + [str(binary)], timeout=60, what="nm", check=True
+    ).stdout
     symbols = {line.split()[-1]: line.split()[-2] for line in out.splitlines() if line.strip()}
     return {n: t for n, t in symbols.items() if not (strong and t in "WVuv")}
 
@@ -173,19 +196,38 @@ def test_every_model_links_into_one_binary(version, language, tmp_path):
     for model in MODELS:
         folder, descriptions[model] = unpacked(model, version, tmp_path / model)
         obj = tmp_path / f"{model}.o"
-        done = run_bounded(compile_command(language, folder, version, model, prefix=f"{model}_")
-                           + ["-c", "-o", str(obj)], timeout=300, what=f"{language} {model}")
+        done = run_bounded(
+            compile_command(language, folder, version, model, prefix=f"{model}_") + ["-c", "-o", str(obj)],
+            timeout=300,
+            what=f"{language} {model}",
+        )
         assert done.returncode == 0, done.stdout + done.stderr
         symbols = defined_globals(obj, strong=True)
         assert symbols and all(n.startswith(f"{model}_fmi{version}") for n in symbols), symbols
         objects.append(str(obj))
     harness = tmp_path / "run_trace.o"
-    run_bounded(["cc", "-std=c99", "-O2", "-c", f"-I{FMPY_HEADERS}", str(REPO / "tests" / "c" / "run_trace.c"),
-                 "-o", str(harness)], timeout=120, what="cc run_trace", check=True)
+    run_bounded(
+        [
+            "cc",
+            "-std=c99",
+            "-O2",
+            "-c",
+            f"-I{FMPY_HEADERS}",
+            str(REPO / "tests" / "c" / "run_trace.c"),
+            "-o",
+            str(harness),
+        ],
+        timeout=120,
+        what="cc run_trace",
+        check=True,
+    )
     binary = tmp_path / "one_binary"
     linker = LANGUAGES[language][0]  # C++ units may need the C++ runtime
-    done = run_bounded([linker, "-rdynamic", str(harness), *objects, "-ldl", "-lm", "-o", str(binary)],
-                       timeout=120, what="linking one binary")
+    done = run_bounded(
+        [linker, "-rdynamic", str(harness), *objects, "-ldl", "-lm", "-o", str(binary)],
+        timeout=120,
+        what="linking one binary",
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     symbols = defined_globals(binary, strong=True)
     ours = {n for n in symbols if n.startswith(("rl_", "fmu_", "fmuModel", "fmi"))}

@@ -4,6 +4,7 @@ the FMU with only its win64 binary, fmpy's TCP client in its place on
 linux64 and the server under wine (support/wine.py says why we start the
 server ourselves); the numbers equal the linux64 binary's bit for bit, and
 the reference."""
+
 import os
 import sys
 import zipfile
@@ -20,12 +21,21 @@ from support.process import run
 from support.run_trace import halves, run_script
 from support.wine import RemotingServer, environment, make_prefix, remoting_copy
 
-pytestmark = pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
-                                reason="the sanitizer build makes Linux binaries only; the release build runs this")
+pytestmark = pytest.mark.skipif(
+    os.environ.get("RL_SANITIZED") == "1",
+    reason="the sanitizer build makes Linux binaries only; the release build runs this",
+)
 WINE_DIR = os.environ.get("RL_WINE_DIR", "/usr/lib/wine")
-SCENARIOS = ["RateLimiter/step_up", "RateLimiter/cycle_steps_of_10", "RateLimiter/status_errors",
-             "LGF_LimRateOfChangeCI/rate_100ms", "RateLimit/duration_jump", "Ramp/ttime_10s_both_ways",
-             "RateLimiter/neg_rates_rising", "LGF_LimRateOfChangeAdvancedCI/quadrant_flags"]
+SCENARIOS = [
+    "RateLimiter/step_up",
+    "RateLimiter/cycle_steps_of_10",
+    "RateLimiter/status_errors",
+    "LGF_LimRateOfChangeCI/rate_100ms",
+    "RateLimit/duration_jump",
+    "Ramp/ttime_10s_both_ways",
+    "RateLimiter/neg_rates_rising",
+    "LGF_LimRateOfChangeAdvancedCI/quadrant_flags",
+]
 CLIENT_SECONDS = 120  # a run takes under 1 s idle, a few on a busy machine
 
 
@@ -40,8 +50,13 @@ def wine():
 
 def simulate(env, fmu_dir, scenario, out, what):
     """importers.py fmpy-fixed on an extracted FMU, bounded."""
-    done = run([sys.executable, "-m", "support.importers", "fmpy-fixed", str(scenario.folder), str(fmu_dir), str(out)],
-               timeout=CLIENT_SECONDS, what=what, env=env, cwd=TESTS)
+    done = run(
+        [sys.executable, "-m", "support.importers", "fmpy-fixed", str(scenario.folder), str(fmu_dir), str(out)],
+        timeout=CLIENT_SECONDS,
+        what=what,
+        env=env,
+        cwd=TESTS,
+    )
     return done
 
 
@@ -56,8 +71,9 @@ def windows_and_linux(wine, scenario, tmp_path):
     server_exe = windows_only / "binaries" / "win64" / "server_tcp.exe"
     with RemotingServer(wine, WINE_DIR, server_exe, dll, tmp_path / "server.log") as server:
         try:
-            done = simulate(wine, windows_only, scenario, tmp_path / "win64.csv",
-                            "fmpy's remoting client on the win64 binary")
+            done = simulate(
+                wine, windows_only, scenario, tmp_path / "win64.csv", "fmpy's remoting client on the win64 binary"
+            )
         except AssertionError as failure:
             raise AssertionError(f"{failure}\nthe server under wine printed:\n{server.output()}") from None
         assert done.returncode == 0, f"{done.stdout}{done.stderr}\nthe server printed:\n{server.output()}"
@@ -86,16 +102,18 @@ def test_a_run_longer_than_the_servers_lock_file_poll(wine, tmp_path):
     for f in (SCENARIO_ROOT / "RateLimiter/step_up").iterdir():
         text = f.read_text()
         if f.name.endswith("_ref.opt"):
-            text = "".join("StopTime,200.0\n" if line.startswith("StopTime") else line
-                           for line in text.splitlines(keepends=True))
+            text = "".join(
+                "StopTime,200.0\n" if line.startswith("StopTime") else line for line in text.splitlines(keepends=True)
+            )
         (folder / f.name).write_text(text)
     result = windows_and_linux(wine, load(folder), tmp_path)
     assert len(result) == 401 and result["time"][-1] == 200.0
     assert np.all(result["y"][result["time"] >= 6.0] == 10.0)
 
 
-@pytest.mark.parametrize("saved_on,restored_on", [("x86_64-linux", "x86_64-windows"),
-                                                  ("x86_64-windows", "aarch64-linux")])
+@pytest.mark.parametrize(
+    "saved_on,restored_on", [("x86_64-linux", "x86_64-windows"), ("x86_64-windows", "aarch64-linux")]
+)
 @pytest.mark.parametrize("name", ["RateLimiter/asymmetric", "LGF_LimRateOfChangeAdvancedCI/inverted_limits"])
 def test_a_state_serialized_on_one_platform_continues_on_another(name, saved_on, restored_on, wine, tmp_path):
     """FMI 3 states are portable: half a run on one platform's binary, its
@@ -109,7 +127,8 @@ def test_a_state_serialized_on_one_platform_continues_on_another(name, saved_on,
     env = dict(wine, WINE_DIR=WINE_DIR)
     whole = run_script("x86_64-linux", stage, scenario.model, md.guid, whole_script, tmp_path, "whole run")
     before = run_script(saved_on, stage, scenario.model, md.guid, first, tmp_path, f"first half on {saved_on}", env)
-    after = run_script(restored_on, stage, scenario.model, md.guid, second, tmp_path, f"second half on {restored_on}",
-                       env)
+    after = run_script(
+        restored_on, stage, scenario.model, md.guid, second, tmp_path, f"second half on {restored_on}", env
+    )
     assert len(whole) > len(before) > 0
     assert before + after == whole

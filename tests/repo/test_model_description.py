@@ -1,6 +1,7 @@
 """The FMUs as an importer sees them: fmpy validate, the declared
 capabilities, the TOML single source of truth against both model
 descriptions and the compiled-in C table, exported symbols, sources."""
+
 import math
 import os
 import re
@@ -105,16 +106,20 @@ def test_the_cycle_input_takes_any_real_and_the_output_is_a_real_output(model):
     names = dict(zip(("input", "output"), found[0]))
     variables = {v["name"]: v for v in toml(model)["variable"]}
     u, y = variables[names["input"]], variables[names["output"]]
-    assert (u["type"], u["causality"], u["variability"]) in {("Real", "input", "discrete"),
-                                                             ("Real", "input", "continuous")}, u
+    assert (u["type"], u["causality"], u["variability"]) in {
+        ("Real", "input", "discrete"),
+        ("Real", "input", "continuous"),
+    }, u
     assert "min" not in u and "max" not in u, u
     assert (y["type"], y["causality"]) == ("Real", "output"), y
 
 
 @pytest.mark.parametrize("version,platform", [(2, "linux64"), (3, "x86_64-linux"), (3, "aarch64-linux")])
 @pytest.mark.parametrize("model", MODELS)
-@pytest.mark.skipif(os.environ.get("RL_SANITIZED") == "1",
-                    reason="sanitizer build: its binaries need libasan by design; the release build is checked")
+@pytest.mark.skipif(
+    os.environ.get("RL_SANITIZED") == "1",
+    reason="sanitizer build: its binaries need libasan by design; the release build is checked",
+)
 def test_binary_exports_fmi_only_and_needs_libc_only(model, version, platform):
     binary = f"{unzipped(model, version)}/binaries/{platform}/{model}.so"
     symbols = run_bounded(["nm", "-D", "--defined-only", binary], timeout=60, what="nm", check=True)
@@ -217,13 +222,18 @@ def test_the_largest_finite_limits_are_no_limits():
 
 def test_generator_refuses_an_infinite_start(tmp_path):
     toml_file = tmp_path / "Probe.toml"
-    toml_file.write_text('[model]\nidentifier = "Probe"\ndescription = "probe"\n'
-                         '[[variable]]\nname = "time"\nvr = 0\ntype = "Real"\ncausality = "independent"\n'
-                         'variability = "continuous"\n'
-                         '[[variable]]\nname = "limit"\nvr = 1\ntype = "Real"\ncausality = "parameter"\n'
-                         'variability = "tunable"\nstart = inf\n')
-    done = run_bounded([sys.executable, str(REPO / "modelDescription" / "generate.py"), str(toml_file),
-                        str(tmp_path / "gen")], timeout=60, what="generate.py")
+    toml_file.write_text(
+        '[model]\nidentifier = "Probe"\ndescription = "probe"\n'
+        '[[variable]]\nname = "time"\nvr = 0\ntype = "Real"\ncausality = "independent"\n'
+        'variability = "continuous"\n'
+        '[[variable]]\nname = "limit"\nvr = 1\ntype = "Real"\ncausality = "parameter"\n'
+        'variability = "tunable"\nstart = inf\n'
+    )
+    done = run_bounded(
+        [sys.executable, str(REPO / "modelDescription" / "generate.py"), str(toml_file), str(tmp_path / "gen")],
+        timeout=60,
+        what="generate.py",
+    )
     assert done.returncode != 0 and "infinite start value" in done.stderr
 
 
@@ -231,8 +241,11 @@ def test_docs_tables_are_generated_from_the_toml_files():
     """docs/models.md restates each model's variables: its tables must be
     what modelDescription/tables.py makes from the TOML files today."""
     tomls = [str(REPO / "modelDescription" / f"{m}.toml") for m in MODELS]
-    done = run_bounded([sys.executable, str(REPO / "modelDescription" / "tables.py"), str(REPO / "docs" / "models.md"),
-                        *tomls], timeout=60, what="tables.py (docs/models.md)")
+    done = run_bounded(
+        [sys.executable, str(REPO / "modelDescription" / "tables.py"), str(REPO / "docs" / "models.md"), *tomls],
+        timeout=60,
+        what="tables.py (docs/models.md)",
+    )
     assert done.returncode == 0, done.stdout + done.stderr
     text = (REPO / "docs" / "models.md").read_text()
     for model in MODELS:
@@ -243,13 +256,18 @@ def generator_run(tmp_path, variables):
     """generate.py on a model of the given (name, causality) variables."""
     lines = ['[model]\nidentifier = "Probe"\ndescription = "probe"\n']
     for vr, (name, causality) in enumerate(variables):
-        lines.append(f'[[variable]]\nname = "{name}"\nvr = {vr}\ntype = "Real"\ncausality = "{causality}"\n'
-                     f'variability = "{"continuous" if causality == "independent" else "discrete"}"\n'
-                     + ('start = 0.0\n' if causality == "input" else ""))
+        lines.append(
+            f'[[variable]]\nname = "{name}"\nvr = {vr}\ntype = "Real"\ncausality = "{causality}"\n'
+            f'variability = "{"continuous" if causality == "independent" else "discrete"}"\n'
+            + ("start = 0.0\n" if causality == "input" else "")
+        )
     toml = tmp_path / "Probe.toml"
     toml.write_text("\n".join(lines))
-    return run_bounded([sys.executable, str(REPO / "modelDescription" / "generate.py"), str(toml), str(tmp_path / "gen")],
-                       timeout=60, what="generate.py")
+    return run_bounded(
+        [sys.executable, str(REPO / "modelDescription" / "generate.py"), str(toml), str(tmp_path / "gen")],
+        timeout=60,
+        what="generate.py",
+    )
 
 
 def test_generator_refuses_a_model_without_time_at_value_reference_0(tmp_path):

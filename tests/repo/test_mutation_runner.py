@@ -2,6 +2,7 @@
 list of equivalent mutants names a mutant, what a resumed run keeps from
 the journal, and how mutants with the same object code share an outcome.
 The runs themselves: ctest mutation_sample."""
+
 import json
 
 import pytest
@@ -34,8 +35,9 @@ def test_an_entry_names_a_mutant_by_its_line_or_also_by_the_lines_above(tmp_path
     assert len(equivalents) == 2
     assert mutant("  x = 0;", "  x = 1;", ["anything"]).proof(equivalents) == "plain entry."
     assert mutant("x = 0;", "x = 2;").proof(equivalents) is None
-    assert mutant("} else {", "}  {", ["b = 2;", "a = 1;", "z"]).proof(equivalents) == \
-        "named by the two lines above it."
+    assert (
+        mutant("} else {", "}  {", ["b = 2;", "a = 1;", "z"]).proof(equivalents) == "named by the two lines above it."
+    )
     assert mutant("} else {", "}  {", ["b = 2;", "other"]).proof(equivalents) is None  # another line like it
     assert mutant("} else {", "}  {", ["b = 2;"]).proof(equivalents) is None
 
@@ -82,8 +84,9 @@ def test_a_resumed_run_keeps_kills_always_and_survivors_of_the_same_tests(tmp_pa
     other = Journal(path, resume=True, tests="tests-2")
     other.close()
     assert set(other.kept) == {"k", "x"}  # a survivor meets the new tests
-    records = [json.loads(line) for line in path.read_text().splitlines() if line.startswith("{") and
-               line.endswith("}")]
+    records = [
+        json.loads(line) for line in path.read_text().splitlines() if line.startswith("{") and line.endswith("}")
+    ]
     assert [r["identity"] for r in records] == ["k", "s", "x"] and records[1]["tests"] == "tests-1"
     fresh = Journal(path, resume=False, tests="tests-1")  # not resumed: a new journal
     fresh.close()
@@ -101,9 +104,9 @@ def test_mutants_with_the_same_object_code_share_the_tested_ones_outcome(tmp_pat
         return members
 
     plain = group("killed", "x = 2;", "x = 3;")
-    survived_listed = group("survived", "x = 2;", "x = 1;")     # a later member is on the list
+    survived_listed = group("survived", "x = 2;", "x = 1;")  # a later member is on the list
     killed_listed = group("killed", "x = 2;", "x = 1;")
-    listed_first = group("listed", "x = 1;", "x = 2;")          # listed, not tested
+    listed_first = group("listed", "x = 1;", "x = 2;")  # listed, not tested
     settle([plain, survived_listed, killed_listed, listed_first], equivalents)
     assert [m.outcome for m in plain] == ["killed", "killed"]
     assert plain[1].detail == "same object code as fmu_core.c:10: x = 0;  =>  x = 2;: FAILED test_y"
@@ -123,4 +126,5 @@ def test_survivors_and_wrongly_listed_mutants_are_printed_and_counted(capsys):
     assert report_failures(mutants) == 2
     assert capsys.readouterr().out.splitlines() == [
         "SURVIVED fmu_core.c:10: x = 0;  =>  x = 1;",
-        "WRONGLY LISTED fmu_core.c:10: x = 0;  =>  x = 3;: why wrongly listed"]
+        "WRONGLY LISTED fmu_core.c:10: x = 0;  =>  x = 3;: why wrongly listed",
+    ]

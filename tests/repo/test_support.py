@@ -2,6 +2,7 @@
 grandchild holding its output, ends the wait within its bound with a
 message saying what was waited for; a remoting server that dies, never
 listens, or finds its port taken is reported with what it printed."""
+
 import os
 import socket
 import stat
@@ -17,8 +18,9 @@ def test_a_hanging_child_and_its_grandchild_are_stopped_at_the_bound(tmp_path):
     marker = tmp_path / "grandchild.pid"
     with pytest.raises(Timeout, match="waiting for sleepers: no end within 1 s"):
         # the grandchild inherits stdout: subprocess.run would wait for it
-        run(["sh", "-c", f"sleep 300 & echo $! > {marker}; echo started; wait"], timeout=1,
-            what="waiting for sleepers")  # only the bound raises Timeout: the sleeper would end with status 0
+        run(
+            ["sh", "-c", f"sleep 300 & echo $! > {marker}; echo started; wait"], timeout=1, what="waiting for sleepers"
+        )  # only the bound raises Timeout: the sleeper would end with status 0
     grandchild = int(marker.read_text())
     deadline = time.monotonic() + 30  # SIGKILL was sent; a loaded machine may take a moment to end it
     while not gone(grandchild):

@@ -1,5 +1,6 @@
 """Helper process for fmu/test_state.py: deserialize an FMU state into a fresh
 instance, continue a run, print the outputs as exact hex floats (JSON)."""
+
 import json
 import sys
 

@@ -7,6 +7,7 @@ fails one test, not the suite.
 
     python -m support.importers <ecospy|libcosimpy|fmpy-fixed[-no-enumerations]> <scenario folder> <fmu> <result.csv>
 """
+
 import sys
 from pathlib import Path
 
@@ -176,8 +177,12 @@ def run_fmpy_fixed(scenario, fmu, drop_enumerations=False):
     return rows
 
 
-IMPORTERS = {"ecospy": run_ecospy, "libcosimpy": run_libcosimpy, "fmpy-fixed": run_fmpy_fixed,
-             "fmpy-fixed-no-enumerations": lambda s, f: run_fmpy_fixed(s, f, drop_enumerations=True)}
+IMPORTERS = {
+    "ecospy": run_ecospy,
+    "libcosimpy": run_libcosimpy,
+    "fmpy-fixed": run_fmpy_fixed,
+    "fmpy-fixed-no-enumerations": lambda s, f: run_fmpy_fixed(s, f, drop_enumerations=True),
+}
 
 
 def main(importer, folder, fmu, out):
