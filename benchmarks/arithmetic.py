@@ -164,8 +164,8 @@ def main():
         else:  # the largest difference is where one of them ends
             gaps = []
             for at in sorted({real_cycles, lreal_cycles}):
-                a = value_at(lambda: make(True, ramp), real_end, real_cycles, at)
-                b = value_at(lambda: make(False, ramp), lreal_end, lreal_cycles, at)
+                a = value_at(lambda ramp=ramp: make(True, ramp), real_end, real_cycles, at)
+                b = value_at(lambda ramp=ramp: make(False, ramp), lreal_end, lreal_cycles, at)
                 gaps.append((abs(a - b), abs(a - b) / abs(b), at))
             absolute, relative, at = max(gaps)
             gap = f"{absolute:.6g} ({relative:.1%}) at cycle {at:,}"

@@ -215,7 +215,8 @@ def main():
     ratio = rate / jobs / plain_rate
     lines = [
         f"Campaign benchmark: {len(folders)} cases of {args.steps} steps, {MODEL} FMI 3, {jobs} cores "
-        f"({platform.machine()}, Python {platform.python_version()}){' (SMOKE: figures meaningless)' if args.smoke else ''}",
+        f"({platform.machine()}, Python {platform.python_version()})"
+        f"{' (SMOKE: figures meaningless)' if args.smoke else ''}",
         f"  cases generated in {generated:.1f} s" if generated else "  cases from an earlier run",
         f"  (a) plain fmpy.simulate_fmu loop, 1 process: {plain * 1e3:.1f} ms per trace, {plain_rate:.1f} traces/s "
         f"({len(sample)} traces)",

@@ -112,7 +112,7 @@ def main():
         f"{' (SMOKE: figures meaningless)' if args.smoke else ''}",
         f"  cases generated in {generated:.0f} s" if generated else "  cases from an earlier run",
     ]
-    for name, f in figures.items():
+    for f in figures.values():
         lines.append(
             f"  {f['cases']} cases ({f['passed']} pass) in {f['seconds']:.0f} s: client (with the scheduler) "
             f"{f['client']:.0f} MB, workers {', '.join(f'{w:.0f}' for w in f['workers'])} MB"

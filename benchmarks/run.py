@@ -158,7 +158,7 @@ def fmpy_time(fmu, steps, repeats):
     h = 1e-3
     t = np.arange(steps + 1) * h
     signal = np.array(
-        list(zip(t, np.where((np.arange(steps + 1) // 4096) % 2, -1000.0, 1000.0))),
+        list(zip(t, np.where((np.arange(steps + 1) // 4096) % 2, -1000.0, 1000.0), strict=True)),
         dtype=[("time", np.float64), ("u", np.float64)],
     )
     times = []
@@ -245,9 +245,8 @@ def table(results, smoke, commands):
             ) and results[3].get("allocations_in_10_steps") == results[3].get("allocations_in_1000000_steps")
             met = ["yes" if same else "NO"]
         anchor = " / ".join(str(ANCHORS[v].get(key, "")) for v in (2, 3)) if key in ANCHORS[2] else ""
-        lines.append(
-            f"| {label} | {cells[0]} | {cells[1]} | {target} | {'NO' if 'NO' in met else ('yes' if met else '')} | {anchor} |"
-        )
+        verdict = "NO" if "NO" in met else ("yes" if met else "")
+        lines.append(f"| {label} | {cells[0]} | {cells[1]} | {target} | {verdict} | {anchor} |")
     header = [
         f"Machine: {platform.processor() or platform.machine()}, {platform.node()}, "
         f"Python {platform.python_version()}{' (SMOKE: figures meaningless)' if smoke else ''}",

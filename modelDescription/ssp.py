@@ -76,7 +76,8 @@ def package(system_toml, build_dir, out):
         files[ssv_name] = "\n".join(
             [
                 '<?xml version="1.0" encoding="UTF-8"?>',
-                f'<ssv:ParameterSet xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" version="1.0" name={quoteattr(system["name"])}>',
+                f'<ssv:ParameterSet xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" version="1.0"'
+                f" name={quoteattr(system['name'])}>",
                 "  <ssv:Parameters>",
             ]
             + [parameter_value(variables[n], v) for n, v in component["parameters"].items()]

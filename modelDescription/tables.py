@@ -113,7 +113,11 @@ def main():
             args.document.write_text(fresh, encoding="utf-8")
         return 0
     if fresh != text:
-        stale = [m.group(2) for m, n in zip(MARKER.finditer(text), MARKER.finditer(fresh)) if m.group(0) != n.group(0)]
+        stale = [
+            m.group(2)
+            for m, n in zip(MARKER.finditer(text), MARKER.finditer(fresh), strict=False)
+            if m.group(0) != n.group(0)
+        ]
         stale += sorted(set(models) - {m.group(2) for m in MARKER.finditer(text)})
         print(f"{args.document}: stale tables {stale}; run cmake --build build --target docs")
         return 1

@@ -45,7 +45,7 @@ def cluster(tmp_path):
             time.sleep(0.1)
         address = json.loads(scheduler_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
-        for name, log in zip(("worker-a", "worker-b"), logs[1:]):
+        for name, log in zip(("worker-a", "worker-b"), logs[1:], strict=True):
             processes.append(
                 start(
                     ["worker", address, "--nworkers", "1", "--nthreads", "1", "--name", name, "--host", "127.0.0.1"],

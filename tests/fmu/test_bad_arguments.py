@@ -250,9 +250,10 @@ def test_fmi3_instantiation_refusals_name_the_first_problem():
             ((b"a", token, True, 1), "this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"),
             ((b"a", token, False, 1), "this FMU provides no intermediate update"),
         ]
+        messages = []
+        log = lambda env, status, category, message: messages.append((status, category, message))  # noqa: E731
         for (name, given, event_mode, n_required), reason in cases:
-            messages = []
-            log = lambda env, status, category, message: messages.append((status, category, message))  # noqa: E731
+            messages.clear()
             assert fmi3_instantiate(fmu.fmu.dll, name, given, event_mode, n_required, log=log) is None
             assert messages == [(3, b"logStatusError", reason.encode())], (reason, messages)
             # without loggingOn, or without a logger: refused, nothing said, nothing called
@@ -429,7 +430,7 @@ def test_fmi2_instantiation_with_memory_refused_returns_null_and_frees_what_it_g
         instantiate = fmi2_instantiate_function(fmu.fmu.dll)
         for failing in (1, 2):
             memory = ImporterMemory()
-            memory.refuse = lambda: len(memory.calls) == failing
+            memory.refuse = lambda memory=memory, failing=failing: len(memory.calls) == failing
             assert instantiate(b"a", 1, fmu.md.guid.encode(), None, byref(memory.callbacks), 0, 0) is None, failing
             assert len(memory.calls) == 2 and memory.live == set(), (failing, memory.calls, memory.live)
     finally:

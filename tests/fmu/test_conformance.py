@@ -26,7 +26,7 @@ from support.fmu_driver import Instance, call_status
 
 STATES = ["Instantiated", "Initialization Mode", "Step Mode", "Terminated", "Error"]
 ALL = set(STATES)
-I, N, S, T, E = STATES
+I, N, S, T, E = STATES  # noqa: E741 (the initials the tables below are written in)
 # Model Exchange's own states
 EV, C = "Event Mode", "Continuous-Time Mode"
 ME_STATES = [I, N, EV, C, T, E]

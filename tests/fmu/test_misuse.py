@@ -6,6 +6,7 @@ import ctypes
 import math
 
 import pytest
+from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
 from support.fmu_driver import STATE_FUNCTIONS, Instance, call_status, state_api, unzipped
@@ -242,7 +243,7 @@ def test_wrong_guid_is_refused_with_a_message():
     callbacks.logger = fmi2CallbackLoggerTYPE(lambda e, n, s, c, m: messages.append(m.decode()))
     callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
     callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-    with pytest.raises(Exception):
+    with pytest.raises(Exception, match="Failed to instantiate model"):  # fmpy's words for a NULL instance
         fmu.instantiate(callbacks=callbacks)
     assert messages and "GUID" in messages[0]
     fmu.freeLibrary()
@@ -431,7 +432,7 @@ def test_debug_logging_categories_choose_what_is_logged(version):
     # FMI 2 always says why a call failed and warns; FMI 3 follows loggingOn
     assert logged_categories(version, False, []) == (["logStatusError", "logStatusWarning"] if version == 2 else [])
     fmu = Instance("RateLimiter", version)
-    with pytest.raises(Exception):
+    with pytest.raises(FMICallException):
         fmu.fmu.setDebugLogging(True, ["logNoSuchCategory"])
     assert 'unknown log category "logNoSuchCategory"' in fmu.errors()[-1][2]
     fmu.free()

@@ -33,7 +33,7 @@ def cycle_ends(result, start, h):
     result also has rows at the input changes between)."""
     return {
         round((t - start) / h): row
-        for t, row in zip(result["time"], result)
+        for t, row in zip(result["time"], result, strict=True)
         if math.isclose((t - start) / h, round((t - start) / h), abs_tol=1e-9)
     }
 

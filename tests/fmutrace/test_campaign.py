@@ -33,7 +33,7 @@ def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_pa
         (o.case, o.fmu, o.status, o.messages) for o in serial.cases
     ]
     assert distributed.passed
-    for a, b in zip(distributed.cases, serial.cases):
+    for a, b in zip(distributed.cases, serial.cases, strict=True):
         for name in a.result.dtype.names:
             assert np.array_equal(a.result[name], b.result[name], equal_nan=True)
         assert a.png == b.png  # the same plot, byte for byte

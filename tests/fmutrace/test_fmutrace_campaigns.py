@@ -162,7 +162,7 @@ def test_a_journaled_campaign_gives_its_outcomes_and_results_back(tmp_path):
     in_memory = fmutrace.compare(PASS_THROUGH, cases, jobs=1)
     journaled = fmutrace.compare(PASS_THROUGH, cases, jobs=1, plots="all", report=tmp_path / "report")
     assert len(journaled.cases) == len(in_memory.cases) == 2
-    for k, kept, read in zip((3, 4), in_memory.cases, journaled.cases):
+    for k, kept, read in zip((3, 4), in_memory.cases, journaled.cases, strict=True):
         assert (read.case, read.fmu, read.status, read.messages) == (kept.case, kept.fmu, kept.status, kept.messages)
         assert list(read.result["time"]) == pytest.approx([0, 0.1, 0.2, 0.3, 0.4], abs=1e-15)
         assert list(read.result["y"]) == [0, 0, 0, k, k]

@@ -335,7 +335,7 @@ def test_input_rows_as_fmpy_interpolates_them(t, times, after_event):
     t = np.array(sorted(t))
     table = np.arange(len(t), dtype=float)[np.newaxis, :]
     rows = discrete_rows(t, np.array(times), after_event)
-    for time, row in zip(times, rows):
+    for time, row in zip(times, rows, strict=True):
         values, _ = Input.interpolate(time, t, table, discrete=True, after_event=after_event)
         assert values[0] == row
 
@@ -383,7 +383,7 @@ TOKENS = [
     blank=st.booleans(),
 )
 def test_plain_reader_equals_the_general_reader(rows, times, ending, blank, tmp_path_factory):
-    lines = ["time,a,b"] + [",".join([t] + r) for t, r in zip(times, rows)]
+    lines = ["time,a,b"] + [",".join([t] + r) for t, r in zip(times, rows, strict=False)]  # as many rows as drawn
     if blank and len(lines) > 2:
         lines.insert(2, "")
     text = ending.join(lines) + ending
@@ -397,7 +397,7 @@ def test_plain_reader_equals_the_general_reader(rows, times, ending, blank, tmp_
     else:
         assert str(plain) == str(general)
     for chunk_bytes in (8, 1 << 20):  # pyarrow's reader reads what the general reader reads, or leaves it to it
-        chunks = _attempt(lambda: list(trace_chunks(path, chunk_bytes=chunk_bytes)))
+        chunks = _attempt(lambda size=chunk_bytes: list(trace_chunks(path, chunk_bytes=size)))
         if isinstance(chunks, NotPlain):
             continue
         assert isinstance(general, np.ndarray), (text, chunks)

@@ -104,7 +104,9 @@ def test_the_other_timing_convention_is_an_option(tmp_path):
     outputs = [0.0] + table["y"]  # at t = k*h: the output of cycle k-1, the initial one first
     inputs = table["u"] + [table["u"][-1]]
     path = tmp_path / "fmi_convention.csv"
-    path.write_text("time,u,y\n" + "".join(f"{k * 0.25},{u},{y}\n" for k, (u, y) in enumerate(zip(inputs, outputs))))
+    path.write_text(
+        "time,u,y\n" + "".join(f"{k * 0.25},{u},{y}\n" for k, (u, y) in enumerate(zip(inputs, outputs, strict=True)))
+    )
     assert compare(RATE_LIMITER[3], path, "--timing", "fmi").returncode == 0
     assert compare(RATE_LIMITER[3], path).returncode == 1
     done = compare(RATE_LIMITER[3], SAMPLES / "plain_ratelimiter.tsv", "--timing", "fmi")
@@ -226,7 +228,10 @@ def test_set_gives_the_fmus_start_values(tmp_path):
     path = tmp_path / "faster.csv"
     path.write_text(
         "time,u,y\n"
-        + "".join(f"{k * 0.25},{u},{y}\n" for k, (u, y) in enumerate(zip([0, 2, 2, 2, 2, 2], [0, 0.5, 1, 1.5, 2, 2])))
+        + "".join(
+            f"{k * 0.25},{u},{y}\n"
+            for k, (u, y) in enumerate(zip([0, 2, 2, 2, 2, 2], [0, 0.5, 1, 1.5, 2, 2], strict=True))
+        )
     )
     assert compare(RATE_LIMITER[3], path, "--set", "rateUpPar=2").returncode == 0
     done = compare(RATE_LIMITER[3], path)

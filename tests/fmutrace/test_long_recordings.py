@@ -26,8 +26,11 @@ from support.scenarios import fmu_path
 SAMPLES = Path(__file__).parents[1] / "recordings"
 
 
-def outcomes(path, model, mode=Exact(), options=RecordingOptions(), head=400, block=120, version=3, monkeypatch=None):
-    """(in memory, streamed) outcomes of the recording at path; streamed is None where the stream refused."""
+def outcomes(path, model, mode=None, options=None, head=400, block=120, version=3, monkeypatch=None):
+    """(in memory, streamed) outcomes of the recording at path (exact, the default options unless given);
+    streamed is None where the stream refused."""
+    mode = Exact() if mode is None else mode
+    options = RecordingOptions() if options is None else options
     fmu_file = fmu_path(BUILD_DIR, model, version)
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}

@@ -77,7 +77,7 @@ def test_closed_loop_agrees_with_the_oracle(importer, version, tmp_path):
     result = np.atleast_1d(read_csv(str(out)))
     expected = oracle_loop()
     assert len(result) == len(expected) == N
-    for row, (t, y, x) in zip(result, expected):
+    for row, (t, y, x) in zip(result, expected, strict=True):
         assert row["time"] == pytest.approx(t, rel=1e-12)
         assert row["y"] == pytest.approx(y, rel=1e-12, abs=1e-12), (t, row["y"], y)
         assert row["x"] == pytest.approx(x, rel=1e-12, abs=1e-12), (t, row["x"], x)

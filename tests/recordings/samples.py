@@ -5,7 +5,8 @@ script, never by fmutrace. `python tests/recordings/samples.py` writes
 them beside it; tests/fmutrace/test_recordings.py checks that the files are what
 it writes.
 
-The values are worked by hand from the blocks' rules (docs/rules.md for the cycle rules, docs/fmi.md for the time model and docs/models.md for the vendor readings)
+The values are worked by hand from the blocks' rules (docs/rules.md for the cycle
+rules, docs/fmi.md for the time model and docs/models.md for the vendor readings)
 for a 250 ms cyclic interrupt (a binary fraction: the FMU's cycle length
 is exact, and so is every value below); tests/fmutrace/test_recordings.py checks
 them against the tests' independent oracle as well.

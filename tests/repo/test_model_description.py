@@ -59,7 +59,7 @@ def test_model_description_is_the_toml(model, version):
     md = read_model_description(str(fmu_file(model, version)))
     variables = md.modelVariables
     assert [v.name for v in variables] == [v["name"] for v in source["variable"]]
-    for v, s in zip(variables, source["variable"]):
+    for v, s in zip(variables, source["variable"], strict=True):
         assert v.valueReference == s["vr"]
         assert v.causality == s["causality"]
         assert v.variability == s["variability"]
@@ -103,7 +103,7 @@ def test_the_cycle_input_takes_any_real_and_the_output_is_a_real_output(model):
         source = (REPO / "fmu_src" / "models" / "unified.h").read_text()
     found = re.findall(r"^\s*FMU_MODEL\(VR_(\w+), VR_(\w+),", source, re.MULTILINE)
     assert len(found) == 1, found
-    names = dict(zip(("input", "output"), found[0]))
+    names = dict(zip(("input", "output"), found[0], strict=True))
     variables = {v["name"]: v for v in toml(model)["variable"]}
     u, y = variables[names["input"]], variables[names["output"]]
     assert (u["type"], u["causality"], u["variability"]) in {

@@ -121,7 +121,7 @@ def test_mutants_with_the_same_object_code_share_the_tested_ones_outcome(tmp_pat
 def test_survivors_and_wrongly_listed_mutants_are_printed_and_counted(capsys):
     outcomes = ("killed", "survived", "listed", "wrongly listed", "stillborn", "untested")
     mutants = [mutant("x = 0;", f"x = {i};") for i in range(len(outcomes))]
-    for m, outcome in zip(mutants, outcomes):
+    for m, outcome in zip(mutants, outcomes, strict=True):
         m.outcome, m.detail = outcome, f"why {outcome}"
     assert report_failures(mutants) == 2
     assert capsys.readouterr().out.splitlines() == [

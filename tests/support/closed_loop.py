@@ -173,7 +173,10 @@ def run_ssp_fmpy(build, version):
     parameter_set = read_ssv(str(ssp_path(build)), resource=ssd.system.elements[0].parameterBindings[0].source)
     parameter_set.parameters = parameters
     result = simulate_ssp(str(ssp_path(build)), stop_time=N * H, step_size=H, parameter_set=parameter_set)
-    return [(float(t), float(y), float(x)) for t, y, x in zip(result["time"], result["rl.y"], result["plant.x"])][1:]
+    return [
+        (float(t), float(y), float(x))
+        for t, y, x in zip(result["time"], result["rl.y"], result["plant.x"], strict=True)
+    ][1:]
 
 
 RUNNERS = {

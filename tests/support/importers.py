@@ -9,6 +9,7 @@ fails one test, not the suite.
 """
 
 import sys
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -78,7 +79,7 @@ def run_ecospy(scenario, fmu):
 
     simulation.init(o["StartTime"], "initial")
     rows = [(times[0], *[get(n) for n in scenario.outputs])]
-    for t, end in zip(times[:-1], times[1:]):
+    for t, end in pairwise(times):
         for name, value in input_values(scenario, t).items():
             set_value(name, value)
         simulation.step()
@@ -140,7 +141,7 @@ def run_libcosimpy(scenario, fmu):
     # libcosim initialises the slave in its first step and offers no
     # reading before it: the row at StartTime is not observable here
     rows = []
-    for t, end in zip(times[:-1], times[1:]):
+    for t, end in pairwise(times):
         for name, value in input_values(scenario, t).items():
             set_value(name, value)
         execution.step(1)
@@ -169,7 +170,7 @@ def run_fmpy_fixed(scenario, fmu, drop_enumerations=False):
     keep = (lambda k: variables[k].type != "Enumeration") if drop_enumerations else (lambda k: True)
     fmu_instance.start(start_time=times[0], **{k: typed(variables[k], v) for k, v in initial.items() if keep(k)})
     rows = [(times[0], *[fmu_instance.get(n) for n in scenario.outputs])]
-    for t, end in zip(times[:-1], times[1:]):
+    for t, end in pairwise(times):
         fmu_instance.set(**{k: typed(variables[k], v) for k, v in input_values(scenario, t).items() if keep(k)})
         fmu_instance.step(end - t)
         rows.append((end, *[fmu_instance.get(n) for n in scenario.outputs]))

@@ -176,7 +176,7 @@ def generate(file, work, venv_bin):
         changed = text.splitlines(keepends=True)
         if len(changed) != len(lines):
             continue  # universalmutator changes one line; anything else is not one of ours
-        diff = [i for i, (a, b) in enumerate(zip(lines, changed)) if a != b]
+        diff = [i for i, (a, b) in enumerate(zip(lines, changed, strict=True)) if a != b]
         if len(diff) == 1:
             i = diff[0]
             mutants.append(

@@ -3,6 +3,7 @@ built for each platform: natively on x86_64 Linux (with floating-point
 traps too), under qemu-user for aarch64 Linux, under wine for Windows."""
 
 import os
+from itertools import pairwise
 
 from support.fmu_driver import BUILD_DIR
 from support.importers import input_values
@@ -46,7 +47,7 @@ def script_parts(scenario, md, times=None):
         [set_line(name, value) for name, value in input_values(scenario, t).items()]
         + [f"step {t.hex()} {(end - t).hex()}"]
         + gets
-        for t, end in zip(times, times[1:])
+        for t, end in pairwise(times)
     ]
     return head, blocks
 
