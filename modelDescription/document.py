@@ -19,6 +19,7 @@ import sys
 import textwrap
 import tomllib
 from pathlib import Path
+from xml.etree import ElementTree
 
 import matplotlib
 
@@ -42,8 +43,11 @@ def status_codes(source):
 
 
 def signal_names(model):
-    variables = model["variable"]
-    first = lambda causality: next(v["name"] for v in variables if v["causality"] == causality and v["type"] == "Real")
+    """The first Real input and the first Real output: the ramp plot's signals."""
+
+    def first(causality):
+        return next(v["name"] for v in model["variable"] if v["causality"] == causality and v["type"] == "Real")
+
     return first("input"), first("output")
 
 
@@ -51,7 +55,9 @@ def ramp_plot(model, stage, path):
     u, y = signal_names(model)
     times = [0.0, 1.0, 5.0]
     values = [0.0, 2.0, -1.0]
-    signal = np.array(list(zip(times, values)) + [(8.0, -1.0)], dtype=[("time", np.float64), (u, np.float64)])
+    signal = np.array(
+        list(zip(times, values, strict=True)) + [(8.0, -1.0)], dtype=[("time", np.float64), (u, np.float64)]
+    )
     start = dict(model.get("documentation", {}).get("example", {}))
     with contextlib.redirect_stdout(io.StringIO()):  # fmpy's notes on inputs left at their start values
         result = simulate_fmu(
@@ -102,8 +108,27 @@ def cell(value):
     return html.escape(str(value)) if value is not None else ""
 
 
-def page(model, version, codes):
+def licence(stage):
+    """The copyright and licence the staged model description names (modelDescription/generate.py writes
+    them), as HTML."""
+    root = ElementTree.parse(stage / "modelDescription.xml").getroot()
+    return (
+        f"<p>{html.escape(root.get('copyright'))}. Licence: {html.escape(root.get('license'))}; "
+        '<a href="licenses/license.txt">its text</a>.</p>'
+    )
+
+
+def page(model, version, codes, licence_html):
     m = model["model"]
+    style = (
+        "body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}\n"
+        "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.2em .5em;text-align:left;"
+        "vertical-align:top}"
+    )
+    header = "".join(
+        f"<th>{name}</th>"
+        for name in ("name", "value reference", "causality", "variability", "type", "start", "unit", "description")
+    )
     rows = "\n".join(
         f"<tr><td><code>{cell(v['name'])}</code></td><td>{v['vr']}</td><td>{v['causality']}</td>"
         f"<td>{v['variability']}</td><td>{cell(v.get('declaredType', v['type']))}</td><td>{cell(v.get('start'))}</td>"
@@ -134,8 +159,7 @@ def page(model, version, codes):
     de = m.get("defaultExperiment", {})
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{html.escape(m["identifier"])}</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}}
-table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:.2em .5em;text-align:left;vertical-align:top}}</style>
+<style>{style}</style>
 </head><body>
 <h1>{html.escape(m["identifier"])}</h1>
 <p>{html.escape(m.get("description", ""))}. FMI {version}.0 Co-Simulation.</p>
@@ -147,7 +171,7 @@ block runs whole PLC cycles of that length inside each communication step; time 
 so long runs do not drift.</p>
 <p><img src="ramp.png" alt="A typical ramp: the output follows a step of the input at the limited rates"></p>
 <h2>Variables</h2>
-<table><tr><th>name</th><th>value reference</th><th>causality</th><th>variability</th><th>type</th><th>start</th><th>unit</th><th>description</th></tr>
+<table><tr>{header}</tr>
 {rows}
 </table>
 {enums}
@@ -159,6 +183,8 @@ so long runs do not drift.</p>
 step size that is not finite and positive, a communication point that is not the FMU's time) returns an error
 with one log message naming the function and the reason; the instance keeps its last good values and can be
 recovered with a saved FMU state or reset.</p>
+<h2>Licence</h2>
+{licence_html}
 </body></html>
 """
 
@@ -168,7 +194,9 @@ def main(toml, stage, version, status_source):
     stage = Path(stage).resolve()
     docs = stage / "documentation"
     docs.mkdir(parents=True, exist_ok=True)
-    (docs / "index.html").write_text(page(model, int(version), status_codes(status_source)), encoding="utf-8")
+    (docs / "index.html").write_text(
+        page(model, int(version), status_codes(status_source), licence(stage)), encoding="utf-8"
+    )
     ramp_plot(model, stage, docs / "ramp.png")
     if int(version) == 2:
         icon(model, stage / "model.png")

@@ -21,7 +21,21 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 GENERATION_TOOL = "rate-limiter-fmus modelDescription/generate.py"
-MODEL_HEADER = Path(__file__).resolve().parent.parent / "fmu_src" / "model.h"
+REPO = Path(__file__).resolve().parent.parent
+MODEL_HEADER = REPO / "fmu_src" / "model.h"
+# the licence: LICENSE ships in every FMU as documentation/licenses/license.txt (cmake/Fmu.cmake), the entry
+# point the FMI 3 standard names; both versions' descriptions name it
+LICENSE = REPO / "LICENSE"
+LICENSE_IN_FMU = "documentation/licenses/license.txt"
+
+
+def licence_attributes():
+    """copyright and license of fmiModelDescription (FMI 2 and FMI 3), from the LICENSE file."""
+    text = LICENSE.read_text(encoding="utf-8")
+    if not text.startswith("BSD 2-Clause License\n"):
+        sys.exit(f"{LICENSE}: not the BSD 2-Clause licence that generate.py names")
+    copyright_line = next(line for line in text.splitlines() if line.startswith("Copyright (c) "))
+    return {"copyright": copyright_line, "license": f"BSD-2-Clause (the text: {LICENSE_IN_FMU})"}
 
 
 def max_variables():
@@ -110,6 +124,23 @@ def attributes(**pairs):
     )
 
 
+def variable_attributes(v):
+    """A variable's own attributes (FMI 2's ScalarVariable; FMI 3's variable element begins with them)."""
+    return dict(
+        name=v["name"],
+        valueReference=v["vr"],
+        description=v.get("description"),
+        causality=v["causality"],
+        variability=v["variability"],
+    )
+
+
+def type_attributes(v):
+    """Its type's attributes (FMI 2's type element; FMI 3's variable element ends with them)."""
+    keys = ("declaredType", "unit", "min", "max", "start")
+    return {key: v.get(key) for key in keys}
+
+
 def used_units(model):
     return sorted({v["unit"] for v in model["variable"] if v.get("unit")})
 
@@ -127,8 +158,9 @@ def common_head(model, version):
     if enums:
         out.append("  <TypeDefinitions>")
         for name, enum in enums.items():
+            indent = "        " if version == 2 else "      "
             items = "".join(
-                f"\n{'      ' if version == 2 else '    '}  <Item{attributes(name=i['name'], value=i['value'], description=i.get('description'))}/>"
+                f"\n{indent}<Item{attributes(name=i['name'], value=i['value'], description=i.get('description'))}/>"
                 for i in enum["items"]
             )
             if version == 2:
@@ -136,48 +168,43 @@ def common_head(model, version):
                 out.append(f"      <Enumeration>{items}\n      </Enumeration>")
                 out.append("    </SimpleType>")
             else:
-                out.append(
-                    f"    <EnumerationType{attributes(name=name, description=enum.get('description'))}>{items}\n    </EnumerationType>"
-                )
+                enumeration = attributes(name=name, description=enum.get("description"))
+                out.append(f"    <EnumerationType{enumeration}>{items}\n    </EnumerationType>")
         out.append("  </TypeDefinitions>")
     out.append("  <LogCategories>")
     for name, description in LOG_CATEGORIES:
         out.append(f"    <Category{attributes(name=name, description=description)}/>")
     out.append("  </LogCategories>")
     de = m.get("defaultExperiment", {})
-    out.append(
-        f"  <DefaultExperiment{attributes(startTime=de.get('startTime'), stopTime=de.get('stopTime'), stepSize=de.get('stepSize'))}/>"
-    )
+    experiment = attributes(startTime=de.get("startTime"), stopTime=de.get("stopTime"), stepSize=de.get("stepSize"))
+    out.append(f"  <DefaultExperiment{experiment}/>")
     return out
 
 
 def fmi2_description(model, guid, sources):
     m = model["model"]
+    root = attributes(modelName=m["identifier"], guid=guid, description=m["description"], **licence_attributes())
+    states = 'canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false"'
+    identifier = attributes(modelIdentifier=m["identifier"])
     out = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<fmiModelDescription fmiVersion="2.0"{attributes(modelName=m["identifier"], guid=guid, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat" numberOfEventIndicators="0">',
+        f'<fmiModelDescription fmiVersion="2.0"{root}{attributes(generationTool=GENERATION_TOOL)}'
+        ' variableNamingConvention="flat" numberOfEventIndicators="0">',
         # Model Exchange (docs/fmi.md): no states, no event indicators, the cycle ends are time events
-        f'  <ModelExchange{attributes(modelIdentifier=m["identifier"])} completedIntegratorStepNotNeeded="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">',
+        f'  <ModelExchange{identifier} completedIntegratorStepNotNeeded="true" {states}>',
     ]
     source_files = (
         ["    <SourceFiles>"] + [f"      <File{attributes(name=s)}/>" for s in sources] + ["    </SourceFiles>"]
     )
     out += source_files + ["  </ModelExchange>"]
-    out += [
-        f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">'
-    ]
+    out += [f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}>']
     out += source_files + ["  </CoSimulation>"]
     out += common_head(model, 2)
     out.append("  <ModelVariables>")
     for index, v in enumerate(model["variable"], start=1):
         out.append(f"    <!-- index {index} -->")
-        out.append(
-            f"    <ScalarVariable{attributes(name=v['name'], valueReference=v['vr'], description=v.get('description'), causality=v['causality'], variability=v['variability'])}>"
-        )
-        element = v["type"]
-        out.append(
-            f"      <{element}{attributes(declaredType=v.get('declaredType'), unit=v.get('unit'), min=v.get('min'), max=v.get('max'), start=v.get('start'))}/>"
-        )
+        out.append(f"    <ScalarVariable{attributes(**variable_attributes(v))}>")
+        out.append(f"      <{v['type']}{attributes(**type_attributes(v))}/>")
         out.append("    </ScalarVariable>")
     out.append("  </ModelVariables>")
     outputs = [i for i, v in enumerate(model["variable"], start=1) if v["causality"] == "output"]
@@ -195,19 +222,27 @@ def fmi2_description(model, guid, sources):
 
 def fmi3_description(model, instantiation_token):
     m = model["model"]
+    root = attributes(
+        modelName=m["identifier"],
+        instantiationToken=instantiation_token,
+        description=m["description"],
+        **licence_attributes(),
+    )
+    states = 'canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false"'
+    identifier = attributes(modelIdentifier=m["identifier"])
     out = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<fmiModelDescription fmiVersion="3.0"{attributes(modelName=m["identifier"], instantiationToken=instantiation_token, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat">',
-        f'  <ModelExchange{attributes(modelIdentifier=m["identifier"])} needsCompletedIntegratorStep="false" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false"/>',
-        f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false" hasEventMode="false" providesIntermediateUpdate="false"/>',
+        f'<fmiModelDescription fmiVersion="3.0"{root}{attributes(generationTool=GENERATION_TOOL)}'
+        ' variableNamingConvention="flat">',
+        f'  <ModelExchange{identifier} needsCompletedIntegratorStep="false" {states}/>',
+        f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}'
+        ' hasEventMode="false" providesIntermediateUpdate="false"/>',
     ]
     out += common_head(model, 3)
     out.append("  <ModelVariables>")
     for v in model["variable"]:
         element = FMI3_ELEMENT[v["type"]]
-        out.append(
-            f"    <{element}{attributes(name=v['name'], valueReference=v['vr'], description=v.get('description'), causality=v['causality'], variability=v['variability'], declaredType=v.get('declaredType'), unit=v.get('unit'), min=v.get('min'), max=v.get('max'), start=v.get('start'))}/>"
-        )
+        out.append(f"    <{element}{attributes(**variable_attributes(v), **type_attributes(v))}/>")
     out.append("  </ModelVariables>")
     outputs = [v["vr"] for v in model["variable"] if v["causality"] == "output"]
     out.append("  <ModelStructure>")
