@@ -110,6 +110,7 @@ def tiny_cycle_oracle(vr_items, start_items):
     return oracle.do_step(0.0, 1e-3, {"u": 1.0})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("version", [2, 3])
 def test_tiny_cycle_time_runs_or_is_refused(version):
     """cycleTime 1e-9: a 1 ms step runs its 1,000,000 cycles, bit for bit as

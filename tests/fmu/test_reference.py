@@ -61,6 +61,7 @@ def inputs_at(scenario, t, booleans):
     }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda s: s.name)
 def test_oracle_matches_reference(scenario):
     md = read_model_description(unzipped(scenario.model, 2))

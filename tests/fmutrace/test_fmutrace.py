@@ -337,6 +337,7 @@ BAD = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("bad", BAD)
 def test_bad_input_exits_2_naming_file_line_and_column(bad, tmp_path):
     file, text, message = BAD[bad]
@@ -552,6 +553,7 @@ def readme_example():
     return block.group(1)
 
 
+@pytest.mark.cluster  # its 32 scenarios run on a local cluster, as compare does from 20 cases on
 def test_the_readme_pytest_example_runs(tmp_path):
     """The example as a user copies it into a test file; 'build/' is this
     run's build folder."""

@@ -83,6 +83,7 @@ def comparable(report):
     return [(c["case"], c["fmu"], c["status"], c["messages"], c.get("plot")) for c in results["cases"]]
 
 
+@pytest.mark.slow
 def test_a_killed_client_resumes_without_recomputing(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 40)
     undisturbed = tmp_path / "undisturbed"
@@ -116,6 +117,7 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
     assert code == 0 and "on the journal" in out  # all done: nothing runs
 
 
+@pytest.mark.cluster  # 501 cases: the command starts a local cluster
 def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp_path):
     """The command's default is the documented one: a plot and a result CSV
     for every case up to 500 (test_fmutrace.py's report test: every case
@@ -192,6 +194,7 @@ def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
     assert code == 2 and "give it with --report" in err
 
 
+@pytest.mark.slow
 def test_a_second_campaign_into_the_same_report_folder_is_refused(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 30)
     report = tmp_path / "report"
