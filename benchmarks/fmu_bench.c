@@ -57,7 +57,9 @@ void *realloc(void *pointer, size_t size) {
     return __libc_realloc(pointer, size);
 }
 
-void free(void *pointer) { __libc_free(pointer); }
+void free(void *pointer) {
+    __libc_free(pointer);
+}
 
 static size_t callbackCalls, callbackBytes;
 
@@ -67,7 +69,9 @@ static void *count_allocate(size_t count, size_t size) {
     return __libc_calloc(count, size);
 }
 
-static void count_free(void *pointer) { __libc_free(pointer); }
+static void count_free(void *pointer) {
+    __libc_free(pointer);
+}
 
 static void log2_message(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
                          fmi2String message, ...) {
@@ -125,13 +129,22 @@ static void load(const char *path) {
         exit(2);
     }
     if (F.version == 2) {
-        LOAD(fmi2Instantiate); LOAD(fmi2FreeInstance); LOAD(fmi2SetupExperiment);
-        LOAD(fmi2EnterInitializationMode); LOAD(fmi2ExitInitializationMode);
-        LOAD(fmi2SetReal); LOAD(fmi2GetReal); LOAD(fmi2DoStep);
+        LOAD(fmi2Instantiate);
+        LOAD(fmi2FreeInstance);
+        LOAD(fmi2SetupExperiment);
+        LOAD(fmi2EnterInitializationMode);
+        LOAD(fmi2ExitInitializationMode);
+        LOAD(fmi2SetReal);
+        LOAD(fmi2GetReal);
+        LOAD(fmi2DoStep);
     } else {
-        LOAD(fmi3InstantiateCoSimulation); LOAD(fmi3FreeInstance);
-        LOAD(fmi3EnterInitializationMode); LOAD(fmi3ExitInitializationMode);
-        LOAD(fmi3SetFloat64); LOAD(fmi3GetFloat64); LOAD(fmi3DoStep);
+        LOAD(fmi3InstantiateCoSimulation);
+        LOAD(fmi3FreeInstance);
+        LOAD(fmi3EnterInitializationMode);
+        LOAD(fmi3ExitInitializationMode);
+        LOAD(fmi3SetFloat64);
+        LOAD(fmi3GetFloat64);
+        LOAD(fmi3DoStep);
     }
 }
 
@@ -144,9 +157,9 @@ static void must(int status, const char *what) {
 
 static void *instantiate(void) {
     void *c = F.version == 2
-        ? F.fmi2Instantiate("bench", fmi2CoSimulation, F.token, "", &callbacks, fmi2False, fmi2False)
-        : F.fmi3InstantiateCoSimulation("bench", F.token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
-                                        NULL, log3_message, NULL);
+                  ? F.fmi2Instantiate("bench", fmi2CoSimulation, F.token, "", &callbacks, fmi2False, fmi2False)
+                  : F.fmi3InstantiateCoSimulation("bench", F.token, NULL, fmi3False, fmi3False, fmi3False, fmi3False,
+                                                  NULL, 0, NULL, log3_message, NULL);
     if (!c) {
         fprintf(stderr, "fmu_bench: instantiation failed\n");
         exit(1);
@@ -177,12 +190,15 @@ static void start(void *c, double cycleTime) {
 }
 
 static void release(void *c) {
-    if (F.version == 2) F.fmi2FreeInstance(c); else F.fmi3FreeInstance(c);
+    if (F.version == 2) F.fmi2FreeInstance(c);
+    else F.fmi3FreeInstance(c);
 }
 
 /* The input: a square wave of +-1000 every 4096 steps, so that the output
  * ramps (rule 6 with its limits) on every step. */
-static double input(uint64_t i) { return (i & 4096) ? -1000.0 : 1000.0; }
+static double input(uint64_t i) {
+    return (i & 4096) ? -1000.0 : 1000.0;
+}
 
 #define H 0.001
 
@@ -278,7 +294,8 @@ static double loop_fmu(uint64_t steps, double cycleTime, int setAndGet, const ch
             u = input(i);
             if (setAndGet) setFloat64(c, &uVr, 1, &u, 1);
             if (doStep(c, (double)i * H, H, fmi3True, &eventHandlingNeeded, &terminateSimulation, &earlyReturn,
-                       &lastSuccessfulTime) != fmi3OK) exit(1);
+                       &lastSuccessfulTime) != fmi3OK)
+                exit(1);
             if (setAndGet) getFloat64(c, &yVr, 1, &y, 1);
             *(volatile double *)&sink = y;
         }
@@ -317,7 +334,8 @@ static double loop_instances(uint64_t steps, double cycleTime) {
             } else {
                 F.fmi3SetFloat64(c[k], &uVr, 1, &u, 1);
                 if (F.fmi3DoStep(c[k], (double)i * H, H, fmi3True, &eventHandlingNeeded, &terminateSimulation,
-                                 &earlyReturn, &lastSuccessfulTime) != fmi3OK) exit(1);
+                                 &earlyReturn, &lastSuccessfulTime) != fmi3OK)
+                    exit(1);
                 F.fmi3GetFloat64(c[k], &yVr, 1, &y, 1);
             }
             *(volatile double *)&sink = y;
@@ -329,10 +347,18 @@ static double loop_instances(uint64_t steps, double cycleTime) {
     return (t1 - t0) * (double)steps / (double)(points * INSTANCES);
 }
 
-static double loop_step(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "step"); }
-static double loop_do_step(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 0, "doStep"); }
-static double loop_cycle_1(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "cycles1"); }
-static double loop_cycle_n(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "cyclesN"); }
+static double loop_step(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 1, "step");
+}
+static double loop_do_step(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 0, "doStep");
+}
+static double loop_cycle_1(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 1, "cycles1");
+}
+static double loop_cycle_n(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 1, "cyclesN");
+}
 
 static int compare(const void *a, const void *b) {
     const double x = *(const double *)a, y = *(const double *)b;
@@ -379,7 +405,8 @@ static void allocations(void) {
                 F.fmi3GetFloat64(c, &F.yVr, 1, &y, 1);
             }
         }
-        printf("allocations_in_%llu_steps %zu calls\n", (unsigned long long)runs[k], mallocCalls + callbackCalls - before);
+        printf("allocations_in_%llu_steps %zu calls\n", (unsigned long long)runs[k],
+               mallocCalls + callbackCalls - before);
         release(c);
     }
 }

@@ -16,6 +16,7 @@ in binary64 is that operation correctly rounded in binary32: binary64 has
 more than twice binary32's precision plus two bits, so the double rounding
 is innocuous (test_oracle.py checks it against numpy's float32 scalars).
 """
+
 import copy
 import functools
 import hashlib
@@ -67,19 +68,52 @@ def time_ms(seconds):
     exact and ties to even, as C's nearbyint), used as ms / 1000."""
     return round(seconds * 1000.0) / 1000.0
 
+
 PARAMETER_DEFAULTS = {
-    "rateUpPar": 1.0, "rateDownPar": 1.0, "bypassValuePar": math.nan, "durationPar": 0.0,
-    "ratePeriod": 1.0, "zeroRate": 1, "cycleTime": 0.0, "initMode": 2, "initValue": 0.0, "initDelay": 0.0,
-    "yMaxPar": sys.float_info.max, "yMinPar": -sys.float_info.max, "arithmetic": LREAL,
-    "accelMax": 0.0, "decelMax": 0.0,
+    "rateUpPar": 1.0,
+    "rateDownPar": 1.0,
+    "bypassValuePar": math.nan,
+    "durationPar": 0.0,
+    "ratePeriod": 1.0,
+    "zeroRate": 1,
+    "cycleTime": 0.0,
+    "initMode": 2,
+    "initValue": 0.0,
+    "initDelay": 0.0,
+    "yMaxPar": sys.float_info.max,
+    "yMinPar": -sys.float_info.max,
+    "arithmetic": LREAL,
+    "accelMax": 0.0,
+    "decelMax": 0.0,
 }
 INPUT_DEFAULTS = {
-    "u": 0.0, "rateUp": math.nan, "rateDown": math.nan, "bypass": False, "bypassValue": math.nan,
-    "duration": math.nan, "rateUpNeg": math.nan, "rateDownNeg": math.nan, "yMax": math.nan, "yMin": math.nan,
+    "u": 0.0,
+    "rateUp": math.nan,
+    "rateDown": math.nan,
+    "bypass": False,
+    "bypassValue": math.nan,
+    "duration": math.nan,
+    "rateUpNeg": math.nan,
+    "rateDownNeg": math.nan,
+    "yMax": math.nan,
+    "yMin": math.nan,
     "hold": False,
 }
-OUTPUTS = ("y", "rampActive", "runningTime", "error", "status", "subFunctionStatus", "dydt", "limitingUp",
-           "limitingDown", "highLimit", "lowLimit", "remainingTime", "d2ydt2")
+OUTPUTS = (
+    "y",
+    "rampActive",
+    "runningTime",
+    "error",
+    "status",
+    "subFunctionStatus",
+    "dydt",
+    "limitingUp",
+    "limitingDown",
+    "highLimit",
+    "lowLimit",
+    "remainingTime",
+    "d2ydt2",
+)
 
 
 def finite(x):
@@ -123,7 +157,7 @@ class RateLimiterOracle:
         self.y = y
         self.yp = y
         self.u_prev = u
-        self.decided_by = None          # rule that decided the last cycle: "1-5", "5b", "6"
+        self.decided_by = None  # rule that decided the last cycle: "1-5", "5b", "6"
         self.jumped = False
         self.T = math.nan
         self.rates_used = (math.nan, math.nan)
@@ -165,22 +199,28 @@ class RateLimiterOracle:
         return Resolved(self.real(value), name)
 
     def rates(self):
-        return (self.resolve("rateUp"), self.resolve("rateDown"), self.resolve_neg("rateUpNeg"),
-                self.resolve_neg("rateDownNeg"))
+        return (
+            self.resolve("rateUp"),
+            self.resolve("rateDown"),
+            self.resolve_neg("rateUpNeg"),
+            self.resolve_neg("rateDownNeg"),
+        )
 
     def limits(self):
         """yMin and yMax after fallback; NaN, an infinity or the largest
         finite double (its negative for yMin) means no limit (rules.md, rule 0)."""
         low, high = self.resolve("yMin").value, self.resolve("yMax").value
-        return (-math.inf if math.isnan(low) or low <= -sys.float_info.max else low,
-                math.inf if math.isnan(high) or high >= sys.float_info.max else high)
+        return (
+            -math.inf if math.isnan(low) or low <= -sys.float_info.max else low,
+            math.inf if math.isnan(high) or high >= sys.float_info.max else high,
+        )
 
     def evaluate_status(self):
         rates = self.rates()
         period = self.rate_period()
         duration = self.resolve_time("duration")
         cycle = self.values["cycleTime"]
-        for rate in rates:                       # rateUp, rateDown, rateUpNeg, rateDownNeg
+        for rate in rates:  # rateUp, rateDown, rateUpNeg, rateDownNeg
             if rate.value < 0:
                 return 0x8200, rate.name
         for rate in rates:
@@ -265,25 +305,25 @@ class RateLimiterOracle:
         self.yp, self.T = yp, T
         self.jumped = False
         decided_by = "1-5"
-        if not self.compare_only and not finite(u):                      # rule 1
+        if not self.compare_only and not finite(u):  # rule 1
             y = u
             self.running_reset()
-        elif v["bypass"]:                                                # rule 2
+        elif v["bypass"]:  # rule 2
             bypass_value = self.resolve("bypassValue").value
             y = bypass_value if finite(bypass_value) else u
             self.running_reset()
         elif v["initMode"] == 3 and elapsed <= v["initDelay"] + TOL * T:  # rule 3
             y = u
             self.running_reset()
-        elif not finite(yp) and finite(u):                               # rule 4
+        elif not finite(yp) and finite(u):  # rule 4
             y = u
             self.running_reset()
-        elif self.status >= 0x8000:                                      # rule 5
+        elif self.status >= 0x8000:  # rule 5
             y = yp
-        elif v["hold"]:                                                  # rule 5b
+        elif v["hold"]:  # rule 5b
             y = yp
             decided_by = "5b"
-        else:                                                            # rule 6
+        else:  # rule 6
             decided_by = "6"
             uc = self.target(u)
             up, down, up_neg, down_neg = self.rates()
@@ -302,7 +342,8 @@ class RateLimiterOracle:
                 self.jumped = True
             elif self.accelerating():
                 limits = (max_up, max_down) + tuple(
-                    self.per_cycle_limit(rate.value, T) for rate in ((up_neg, down_neg) if yp >= 0 else (up, down)))
+                    self.per_cycle_limit(rate.value, T) for rate in ((up_neg, down_neg) if yp >= 0 else (up, down))
+                )
                 if yp < 0:  # (maxUp, maxDown) of yp >= 0, then those of yp < 0
                     limits = (limits[2], limits[3], limits[0], limits[1])
                 a, b = self.cycle_steps(T)
@@ -346,16 +387,20 @@ class RateLimiterOracle:
         the other; each leg's length / rate per second."""
         up, down, up_neg, down_neg = self.rates()
         if uc > y:
-            legs = [(min(uc, 0.0) - y, up_neg.value) if y < 0 else (0.0, up_neg.value),
-                    (uc - max(y, 0.0), up.value) if uc > 0 else (0.0, up.value)]
+            legs = [
+                (min(uc, 0.0) - y, up_neg.value) if y < 0 else (0.0, up_neg.value),
+                (uc - max(y, 0.0), up.value) if uc > 0 else (0.0, up.value),
+            ]
         else:
-            legs = [(min(y, 0.0) - uc, down_neg.value) if uc < 0 else (0.0, down_neg.value),
-                    (y - max(uc, 0.0), down.value) if y > 0 else (0.0, down.value)]
+            legs = [
+                (min(y, 0.0) - uc, down_neg.value) if uc < 0 else (0.0, down_neg.value),
+                (y - max(uc, 0.0), down.value) if y > 0 else (0.0, down.value),
+            ]
         period = self.rate_period()
         total = 0.0
         for length, rate in legs:
             if length <= 0:
-                continue                         # not part of the way
+                continue  # not part of the way
             if rate == 0:
                 total += math.inf if self.values["zeroRate"] == 1 else 0.0
                 continue
@@ -388,7 +433,7 @@ class RateLimiterOracle:
         ahead.values["bypass"] = False
         cycles = 0
         T = self.T
-        while ahead.y != uc and cycles < 2 ** 26:
+        while ahead.y != uc and cycles < 2**26:
             before = ahead.y
             at_rest = ahead.decided_by != "6" or ahead.y == ahead.yp
             ahead.cycle(T, math.inf)
@@ -434,7 +479,8 @@ class RateLimiterOracle:
             "remainingTime": remaining,
             "d2ydt2": self.d2ydt2(dydt) if by_rule_6 and finite(dydt) else 0.0,
             # what a vendor mapping needs of the same cycle
-            "_yp": yp, "_mode": self.values.get("mode"),
+            "_yp": yp,
+            "_mode": self.values.get("mode"),
         }
 
 
@@ -446,15 +492,32 @@ def siemens(v):
     ob = v["callOB"]
     ob_valid = 30 <= ob <= 38 or ob >= 123
     unified = {
-        "u": v["value"], "rateUp": v["setChangeRate"], "rateDown": v["setChangeRate"],
-        "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
-        "bypass": v["enDefaultOutValue"], "bypassValue": v["defaultOutValue"], "bypassValuePar": nan,
+        "u": v["value"],
+        "rateUp": v["setChangeRate"],
+        "rateDown": v["setChangeRate"],
+        "rateUpPar": nan,
+        "rateDownPar": nan,
+        "ratePeriod": 1.0,
+        "zeroRate": 1,
+        "bypass": v["enDefaultOutValue"],
+        "bypassValue": v["defaultOutValue"],
+        "bypassValuePar": nan,
         # an invalid callOB is reported by the status; the cycles are still cycleTime's
-        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"], "cycleValid": ob_valid,
-        "initMode": 1, "initValue": 0.0, "initDelay": 0.0,
+        "duration": 0.0,
+        "durationPar": 0.0,
+        "cycleTime": v["cycleTime"],
+        "cycleValid": ob_valid,
+        "initMode": 1,
+        "initValue": 0.0,
+        "initDelay": 0.0,
     }
-    culprits = {"rateUp": "setChangeRate", "rateDown": "setChangeRate", "rateUpPar": "setChangeRate",
-                "rateDownPar": "setChangeRate", "cycleTime": "cycleTime" if ob_valid else "callOB"}
+    culprits = {
+        "rateUp": "setChangeRate",
+        "rateDown": "setChangeRate",
+        "rateUpPar": "setChangeRate",
+        "rateDownPar": "setChangeRate",
+        "cycleTime": "cycleTime" if ob_valid else "callOB",
+    }
     return unified, culprits
 
 
@@ -463,27 +526,55 @@ def irmn4(v):
     duration = v["Duration"]
     duration_par = v["DurationPar"]
     unified = {
-        "u": v["In"], "rateUp": v["UpRate"], "rateDown": v["DownRate"], "rateUpPar": v["UpRatePar"],
-        "rateDownPar": v["DownRatePar"], "ratePeriod": 1.0, "zeroRate": 2,
-        "bypass": v["EnableBypass"], "bypassValue": v["BypassValue"], "bypassValuePar": v["BypassValuePar"],
+        "u": v["In"],
+        "rateUp": v["UpRate"],
+        "rateDown": v["DownRate"],
+        "rateUpPar": v["UpRatePar"],
+        "rateDownPar": v["DownRatePar"],
+        "ratePeriod": 1.0,
+        "zeroRate": 2,
+        "bypass": v["EnableBypass"],
+        "bypassValue": v["BypassValue"],
+        "bypassValuePar": v["BypassValuePar"],
         # the block's range: a longer Duration is 259200 s
         "duration": min(duration, 259200.0) if not math.isnan(duration) else nan,
-        "durationPar": min(duration_par, 259200.0), "cycleTime": v["cycleTime"],
-        "initMode": 1 if restart else 2, "initValue": v["SavedOut"], "initDelay": 0.0,
+        "durationPar": min(duration_par, 259200.0),
+        "cycleTime": v["cycleTime"],
+        "initMode": 1 if restart else 2,
+        "initValue": v["SavedOut"],
+        "initDelay": 0.0,
         "arithmetic": REAL,  # the IRMN4 family's analog pins are 32-bit floats
     }
-    culprits = {"rateUp": "UpRate", "rateDown": "DownRate", "rateUpPar": "UpRatePar",
-                "rateDownPar": "DownRatePar", "duration": "Duration", "durationPar": "DurationPar",
-                "cycleTime": "cycleTime"}
+    culprits = {
+        "rateUp": "UpRate",
+        "rateDown": "DownRate",
+        "rateUpPar": "UpRatePar",
+        "rateDownPar": "DownRatePar",
+        "duration": "Duration",
+        "durationPar": "DurationPar",
+        "cycleTime": "cycleTime",
+    }
     return unified, culprits
 
 
 def codesys(v):
     unified = {
-        "u": v["rIn"], "rateUp": v["rVariation"], "rateDown": v["rVariation"], "rateUpPar": nan,
-        "rateDownPar": nan, "ratePeriod": time_ms(v["tTime"]), "zeroRate": 1, "bypass": False, "bypassValue": nan,
-        "bypassValuePar": nan, "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"],
-        "initMode": v["eInitial"], "initValue": v["rInitValue"], "initDelay": time_ms(v["tInitDelay"]),
+        "u": v["rIn"],
+        "rateUp": v["rVariation"],
+        "rateDown": v["rVariation"],
+        "rateUpPar": nan,
+        "rateDownPar": nan,
+        "ratePeriod": time_ms(v["tTime"]),
+        "zeroRate": 1,
+        "bypass": False,
+        "bypassValue": nan,
+        "bypassValuePar": nan,
+        "duration": 0.0,
+        "durationPar": 0.0,
+        "cycleTime": v["cycleTime"],
+        "initMode": v["eInitial"],
+        "initValue": v["rInitValue"],
+        "initDelay": time_ms(v["tInitDelay"]),
         "arithmetic": REAL,  # REAL pins, TIME in milliseconds
     }
     culprits = {"rateUp": "rVariation", "rateDown": "rVariation", "ratePeriod": "tTime", "cycleTime": "cycleTime"}
@@ -507,18 +598,44 @@ def siemens_advanced(v):
     else:
         mode, value = "ramp", nan
     unified = {
-        "u": v["autoValue"], "rateUp": v["setPosUpRateLim"], "rateDown": v["setPosDownRateLim"],
+        "u": v["autoValue"],
+        "rateUp": v["setPosUpRateLim"],
+        "rateDown": v["setPosDownRateLim"],
         # quadrants by the output's magnitude: negUp falls below 0, negDown rises
-        "rateDownNeg": v["setNegUpRateLim"], "rateUpNeg": v["setNegDownRateLim"],
-        "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
-        "yMax": v["setHighLim"], "yMin": v["setLowLim"], "yMaxPar": nan, "yMinPar": nan, "hold": False,
-        "bypass": mode != "ramp", "bypassValue": value, "bypassValuePar": nan,
-        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"], "cycleValid": ob_valid,
-        "initMode": 1, "initValue": 0.0, "initDelay": 0.0, "mode": mode,
+        "rateDownNeg": v["setNegUpRateLim"],
+        "rateUpNeg": v["setNegDownRateLim"],
+        "rateUpPar": nan,
+        "rateDownPar": nan,
+        "ratePeriod": 1.0,
+        "zeroRate": 1,
+        "yMax": v["setHighLim"],
+        "yMin": v["setLowLim"],
+        "yMaxPar": nan,
+        "yMinPar": nan,
+        "hold": False,
+        "bypass": mode != "ramp",
+        "bypassValue": value,
+        "bypassValuePar": nan,
+        "duration": 0.0,
+        "durationPar": 0.0,
+        "cycleTime": v["cycleTime"],
+        "cycleValid": ob_valid,
+        "initMode": 1,
+        "initValue": 0.0,
+        "initDelay": 0.0,
+        "mode": mode,
     }
-    culprits = {"rateUp": "setPosUpRateLim", "rateDown": "setPosDownRateLim", "rateUpNeg": "setNegDownRateLim",
-                "rateDownNeg": "setNegUpRateLim", "rateUpPar": "setPosUpRateLim", "rateDownPar": "setPosDownRateLim",
-                "yMin": "setLowLim", "yMinPar": "setLowLim", "cycleTime": "cycleTime" if ob_valid else "callOB"}
+    culprits = {
+        "rateUp": "setPosUpRateLim",
+        "rateDown": "setPosDownRateLim",
+        "rateUpNeg": "setNegDownRateLim",
+        "rateDownNeg": "setNegUpRateLim",
+        "rateUpPar": "setPosUpRateLim",
+        "rateDownPar": "setPosDownRateLim",
+        "yMin": "setLowLim",
+        "yMinPar": "setLowLim",
+        "cycleTime": "cycleTime" if ob_valid else "callOB",
+    }
     return unified, culprits
 
 
@@ -532,7 +649,7 @@ def unified_static(v):
 
 
 def siemens_advanced_outputs(out, unified):
-    negative = out["_yp"] < 0          # the quadrant the rate was picked by
+    negative = out["_yp"] < 0  # the quadrant the rate was picked by
     reset = out["_mode"] == "reset"
     return {
         "outputValue": out["y"],
@@ -542,30 +659,55 @@ def siemens_advanced_outputs(out, unified):
         "negDownRateLim": out["limitingUp"] and negative,
         "highLim": out["highLimit"] and not reset,
         "lowLim": out["lowLimit"] and not reset,
-        "error": out["error"], "status": out["status"], "subfunctionStatus": out["subFunctionStatus"],
+        "error": out["error"],
+        "status": out["status"],
+        "subfunctionStatus": out["subFunctionStatus"],
     }
 
 
 VENDORS = {
     "RateLimiterStatic": {
-        "translate": unified_static, "compare_only": False, "outputs": {name: name for name in OUTPUTS},
+        "translate": unified_static,
+        "compare_only": False,
+        "outputs": {name: name for name in OUTPUTS},
     },
     "LGF_LimRateOfChangeCI": {
-        "translate": siemens, "compare_only": True,
-        "outputs": {"delayedValue": "y", "error": "error", "status": "status", "subFunctionStatus": "subFunctionStatus"},
+        "translate": siemens,
+        "compare_only": True,
+        "outputs": {
+            "delayedValue": "y",
+            "error": "error",
+            "status": "status",
+            "subFunctionStatus": "subFunctionStatus",
+        },
     },
     "RateLimit": {
-        "translate": irmn4, "compare_only": False,
+        "translate": irmn4,
+        "compare_only": False,
         "outputs": {"Out": "y", "RunningTime": "runningTime"},
     },
     "LGF_LimRateOfChangeAdvancedCI": {
-        "translate": siemens_advanced, "compare_only": True, "neg_fallback": False, "limit_initial": False,
+        "translate": siemens_advanced,
+        "compare_only": True,
+        "neg_fallback": False,
+        "limit_initial": False,
         "outputs": siemens_advanced_outputs,
-        "output_names": ["outputValue", "posUpRateLim", "posDownRateLim", "negUpRateLim", "negDownRateLim",
-                         "highLim", "lowLim", "error", "status", "subfunctionStatus"],
+        "output_names": [
+            "outputValue",
+            "posUpRateLim",
+            "posDownRateLim",
+            "negUpRateLim",
+            "negDownRateLim",
+            "highLim",
+            "lowLim",
+            "error",
+            "status",
+            "subfunctionStatus",
+        ],
     },
     "Ramp": {
-        "translate": codesys, "compare_only": False,
+        "translate": codesys,
+        "compare_only": False,
         "outputs": {"rOut": "y", "xRampActive": "rampActive"},
     },
 }
@@ -580,8 +722,11 @@ def start_values(model):
     file (the single source of every variable)."""
     with open(MODEL_DESCRIPTIONS / f"{model}.toml", "rb") as f:
         variables = tomllib.load(f)["variable"]
-    return {v["name"]: bool(v.get("start", False)) if v["type"] == "Boolean" else v.get("start", 0.0)
-            for v in variables if v["causality"] in ("input", "parameter")}
+    return {
+        v["name"]: bool(v.get("start", False)) if v["type"] == "Boolean" else v.get("start", 0.0)
+        for v in variables
+        if v["causality"] in ("input", "parameter")
+    }
 
 
 class VendorOracle:
@@ -594,10 +739,14 @@ class VendorOracle:
         self.values = dict(start_values(model))
         self.values.update(start or {})
         unified, culprits = self.spec["translate"](self.values)
-        self.unified = RateLimiterOracle(self.culprit_vrs(culprits), unified, start_time,
-                                         compare_only=self.spec["compare_only"],
-                                         neg_fallback=self.spec.get("neg_fallback", True),
-                                         limit_initial=self.spec.get("limit_initial", True))
+        self.unified = RateLimiterOracle(
+            self.culprit_vrs(culprits),
+            unified,
+            start_time,
+            compare_only=self.spec["compare_only"],
+            neg_fallback=self.spec.get("neg_fallback", True),
+            limit_initial=self.spec.get("limit_initial", True),
+        )
 
     def culprit_vrs(self, culprits):
         return {name: self.vendor_vr[vendor] for name, vendor in culprits.items()}
@@ -633,6 +782,7 @@ def kept(function):
     """function's results kept for its arguments; with RL_ORACLE_CACHE (a folder; the mutation runner
     sets it) also on disk between processes, under the hash of this file, the name and the arguments,
     so that a slow oracle run is worked once for many runs of the same tests."""
+
     @functools.lru_cache(maxsize=None)
     def wrapper(*args):
         folder = os.environ.get("RL_ORACLE_CACHE")
@@ -648,6 +798,7 @@ def kept(function):
         partial.write_text(json.dumps(result))
         os.replace(partial, path)  # a reader sees the whole result or none
         return result
+
     return wrapper
 
 
@@ -667,7 +818,7 @@ class Arithmetic:
         self.binary32 = real is f32
         self.mant_dig, self.min_exp = (24, -125) if self.binary32 else (53, -1021)
         self.largest = f32(3.4028234663852886e38) if self.binary32 else sys.float_info.max
-        self.roundoff = 2.0 ** -self.mant_dig
+        self.roundoff = 2.0**-self.mant_dig
         self.counted = 2.0 ** (self.mant_dig // 2)  # below this many cycles of braking, counts are exact
 
     def ulp(self, x):
@@ -711,7 +862,7 @@ def stops_within(A, s, b, e):
     """s + B(s) <= e: exactly in the rules' range, else as written"""
     if not s > b or math.isinf(b):
         return s <= e
-    if s < 1e300 and e < 1e300 and b > 1e-290 and A.div(s, b) < 2.0 ** 26:
+    if s < 1e300 and e < 1e300 and b > 1e-290 and A.div(s, b) < 2.0**26:
         S, B, E = Fraction(s), Fraction(b), Fraction(e)
         n = math.floor(S / B)
         return (n + 1) * S - B * (n * (n + 1) // 2) - E <= 0
@@ -779,29 +930,29 @@ def accel_step(A, yp, uc, v, a, b, limits):
     (maxUp, maxDown, maxUpNeg, maxDownNeg) per cycle."""
     max_up, max_down, max_up_neg, max_down_neg = limits
     e = A.add(uc, -yp)
-    up = e > 0 or (e == 0 and v > 0)                                   # 1
+    up = e > 0 or (e == 0 and v > 0)  # 1
     distance = e if up else -e
     if math.isinf(distance):
         distance = A.largest
     moving = v if up else -v
     negative = yp < 0
     limit = (max_up_neg if negative else max_up) if up else (max_down_neg if negative else max_down)
-    if moving < 0 and -moving > b:                                     # 2
+    if moving < 0 and -moving > b:  # 2
         step = A.add(moving, b)
     else:
-        if moving >= 0:                                                # 3
+        if moving >= 0:  # 3
             fastest = A.add(moving, a)
         else:
             fastest = a if math.isinf(b) else A.mul(a, A.div(A.add(b, moving), b))
         fastest = min(fastest, limit)
-        zone_ahead = (negative and not uc < 0) if up else (not negative and uc < 0)   # 4
+        zone_ahead = (negative and not uc < 0) if up else (not negative and uc < 0)  # 4
         if zone_ahead:
             zone_limit = max_up if up else max_down_neg
             z = -yp if negative else yp
             z = A.add(z, -A.add(A.mul(z, 8 * A.roundoff), 2 * A.ulp(z) if up else 0.0))
             if zone_limit < fastest:
                 fastest = zone_limit if z < 0 else min(fastest, zone_step(A, z, zone_limit, b))
-        if not stops_within(A, fastest, b, distance):                  # 5
+        if not stops_within(A, fastest, b, distance):  # 5
             stoppable = stoppable_step(A, distance, b)
             for _ in range(8):
                 if not (stoppable > 0 and not stops_within(A, stoppable, b, distance)):
@@ -813,7 +964,7 @@ def accel_step(A, yp, uc, v, a, b, limits):
             step = braked if fastest < braked else fastest
         else:
             step = fastest
-    scale = uc if abs(uc) > abs(yp) else yp                            # 6
+    scale = uc if abs(uc) > abs(yp) else yp  # 6
     if abs(A.add(step, -distance)) <= 4 * A.ulp(scale):
         return uc
     return advance(A, yp, step if up else -step)
