@@ -53,8 +53,8 @@ def case_inputs(seed, steps):
 
 def write_case(args):
     """One case folder with its reference from fmutrace's runner."""
-    from fmutrace.runner import Runner
-    from fmutrace.traces import write_trace
+    from fmutrace._runner import Runner
+    from fmutrace._traces import write_trace
 
     folder, seed, steps, fmu = args
     inputs, start = case_inputs(seed, steps)

@@ -33,7 +33,7 @@ def child(fmu, cases, report, jobs):
     import dask
     from dask.distributed import Client, LocalCluster
     import fmutrace
-    from fmutrace.executors import LOCAL_CLUSTER, SHORT_LOGS
+    from fmutrace._executors import LOCAL_CLUSTER, SHORT_LOGS
 
     started = time.perf_counter()
     with dask.config.set({**SHORT_LOGS, **LOCAL_CLUSTER}), \

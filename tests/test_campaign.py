@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 import fmutrace
-from fmutrace.executors import package_zip
+from fmutrace._executors import package_zip
 from support.fmu_driver import BUILD_DIR, REPO
 from support.reports import without_timings
 from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path

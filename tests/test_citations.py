@@ -52,7 +52,7 @@ def test_nothing_shipped_cites_a_document_outside_the_repository():
 def test_the_outside_check_reads_every_kind_of_file_shipped():
     shipped = {str(p.relative_to(REPO)) for p in SOURCES}
     for path in ("README.md", "docs/rules.md", "fmu_src/fmu_core.c", "modelDescription/Ramp.toml",
-                 "fmutrace/src/fmutrace/runner.py", "tests/scenarios/Ramp/real_slow_ramp/README.md",
+                 "fmutrace/src/fmutrace/_runner.py", "tests/scenarios/Ramp/real_slow_ramp/README.md",
                  "tests/support/oracle.py", "benchmarks/fmu_bench.c", "CMakeLists.txt"):
         assert path in shipped, path
     assert OUTSIDE.search("as " + "SPEC section 8 has it") and OUTSIDE.search("Seed" + " 002: quoted")

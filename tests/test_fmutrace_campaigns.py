@@ -305,8 +305,8 @@ def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path
 
 
 # evaluated in each worker: where its fmutrace comes from, and each Runner's loop and fast runs
-WORKER_LOOPS = ("(__import__('fmutrace.runner').runner.__file__, "
-                "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])")
+WORKER_LOOPS = ("(__import__('fmutrace._runner')._runner.__file__, "
+                "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace._worker')._worker._fmus.values()])")
 
 
 def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch, recwarn):
@@ -315,7 +315,7 @@ def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeyp
     its Python sources (where the C loop cannot be imported). Its
     scheduler starts no dashboard and leaves port 8787 alone (held here
     while it runs): no warning that the port is in use."""
-    from fmutrace import executors
+    from fmutrace import _executors as executors
 
     reports = {}
     run = executors.Dask._run

@@ -20,12 +20,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fmutrace import read_trace, write_trace
-from fmutrace import runner as runner_module
-from fmutrace.runner import FastLoopFailed, Runner, discrete_rows
-from fmutrace.simulation import run_fmpy
-from fmutrace import traces as trace_module
-from fmutrace.simulation import held_to
-from fmutrace.traces import NotPlain, trace_chunks
+from fmutrace import _runner as runner_module
+from fmutrace._runner import FastLoopFailed, Runner, discrete_rows
+from fmutrace._fmpy import run_fmpy
+from fmutrace import _traces as trace_module
+from fmutrace._fmpy import held_to
+from fmutrace._traces import NotPlain, trace_chunks
 from fmpy.simulation import Input
 from support.fmu_driver import BUILD_DIR, MODELS, REPO
 from support.scenarios import discover, fmu_path

@@ -1,4 +1,4 @@
-"""A long case run chunk by chunk (fmutrace.longcase) gives the in-memory
+"""A long case run chunk by chunk (fmutrace._longcase) gives the in-memory
 path's outcome (worker.run_case), bit for bit: status, messages and every
 failing signal's deviation, on every reference scenario (in chunks of a
 few steps and a few rows, so every boundary case occurs) and on
@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance, read_trace, write_trace
-from fmutrace.longcase import run_long_case, simulate_long
-from fmutrace.progress import SampleProgress
-from fmutrace.simulation import simulate
-from fmutrace.worker import run_case, worker_fmu
+from fmutrace._longcase import run_long_case, simulate_long
+from fmutrace._progress import SampleProgress
+from fmutrace._simulation import simulate
+from fmutrace._worker import run_case, worker_fmu
 from support.scenarios import SCENARIO_ROOT, fmu_path
 from support.fmu_driver import BUILD_DIR
 
@@ -100,7 +100,7 @@ def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
 
 
 def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
-    import fmutrace.longcase as longcase
+    import fmutrace._longcase as longcase
 
     monkeypatch.setattr(longcase, "LONG_CASE_BYTES", 0)
     scenario = SCENARIO_ROOT / "RateLimiter" / "asymmetric"
@@ -143,7 +143,7 @@ def test_a_long_case_shows_its_progress_on_a_terminal_only(terminal, monkeypatch
 
 @pytest.mark.parametrize("width", [10, 5000, 100_000])
 def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
-    from fmutrace.longcase import _last_time
+    from fmutrace._longcase import _last_time
 
     names = ["time"] + [f"s{i}" for i in range(width // 10)]
     lines = [",".join(names), ",".join(["0.5"] + ["1.25"] * (len(names) - 1)),
@@ -155,7 +155,7 @@ def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
 
 @pytest.mark.parametrize("parts", [1, 2, 7])
 def test_a_verdict_given_in_chunks_is_the_verdict_on_the_whole(parts):
-    from fmutrace.comparison import Band, Verdict, _verdict
+    from fmutrace._comparison import Band, Verdict, _verdict
 
     rng = np.random.default_rng(parts)
     times = np.arange(50) * 0.1

@@ -12,13 +12,14 @@ import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance
-from fmutrace import worker
-from fmutrace.fmu import Fmu
-from fmutrace.longcase import LONG_CASE_BYTES
-from fmutrace.recordings import stream, timebase
-from fmutrace.recordings.case import RecordingOptions
-from fmutrace.runner import Runner
-from fmutrace.worker import run_case, worker_fmu
+from fmutrace import _worker as worker
+from fmutrace._fmu import Fmu
+from fmutrace._longcase import LONG_CASE_BYTES
+from fmutrace import _longrecording as stream
+from fmutrace.recordings import timebase
+from fmutrace.recordings.options import RecordingOptions
+from fmutrace._runner import Runner
+from fmutrace._worker import run_case, worker_fmu
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
 

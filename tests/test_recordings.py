@@ -17,7 +17,7 @@ from fmutrace.recordings import (FORMAT_NAMES, is_recording, last_component, nor
                                  read_recording)
 from fmutrace.recordings.align import align
 from fmutrace.recordings.text import decode, numbers
-from fmutrace.traces import split_cells as split
+from fmutrace._traces import split_cells as split
 from fmutrace.recordings.timebase import parse_date, unit_in_name
 from support.oracle import oracle_for
 

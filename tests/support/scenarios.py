@@ -5,7 +5,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from fmutrace import Exact, Fmu, compare_traces, load_case
-from fmutrace.simulation import run_fmpy
+from fmutrace._fmpy import run_fmpy
 
 from support.fmu_driver import BUILD_DIR
 

@@ -11,17 +11,17 @@ import contextlib
 import sys
 
 from . import __version__
-from .campaign import compare
-from .errors import ExitStatus, InputError, SimulationError
-from .fmu import Fmu, is_fmu_file
-from .longcase import simulate_long
-from .outcome import Status
+from ._campaign import compare
+from ._errors import ExitStatus, InputError, SimulationError
+from ._fmu import Fmu, is_fmu_file
+from ._longcase import simulate_long
+from ._outcome import Status
 from .recordings import is_recording
 from .recordings.align import TIMINGS
-from .recordings.case import TIME_UNITS
-from .simulation import simulate
-from .traces import write_trace
-from .worker import PLOT_ALL_UP_TO, PLOTS
+from .recordings.options import TIME_UNITS
+from ._simulation import simulate
+from ._traces import write_trace
+from ._worker import PLOT_ALL_UP_TO, PLOTS
 
 EXAMPLES = """examples:
   fmutrace run build/fmi3/RateLimiter.fmu --input u.csv --set rateUpPar=2 --step-size 0.1 -o y.csv

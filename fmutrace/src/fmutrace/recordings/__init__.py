@@ -14,8 +14,9 @@ fits reads the file):
 A file none of them fits is a TraceError that says, for each, why not.
 """
 import os
+from pathlib import Path
 
-from ..errors import InputError, TraceError
+from .._errors import InputError, TraceError
 from . import mdf, tables, text as texts, twincat, vendors
 from .matching import Plan, last_component, plan
 from .model import Channel, Recording
@@ -103,3 +104,33 @@ def is_recording(path):
                 return False
         return True
     return False
+
+
+def recording_paths(paths):
+    """The recordings among paths given to compare: [(path, name)], where
+    path is one file or folder, or several single-point files (Niagara)
+    joined by os.pathsep: together they make one recording."""
+    items, points = [], []
+    for path in paths:
+        path = os.fspath(path)
+        if os.path.isfile(path) and _is_single_point(path):
+            points.append(path)
+        else:
+            items.append((path, Path(path).name))
+    if points:
+        name = Path(points[0]).parent.name if len(points) > 1 else Path(points[0]).name
+        items.append((os.pathsep.join(points), name))
+    return items
+
+
+def _is_single_point(path):
+    try:
+        with open(path, "rb") as file:
+            head = file.read(4096)
+    except OSError:
+        return False
+    try:
+        decoded, _ = texts.decode(path, head)
+    except InputError:
+        return False
+    return vendors.sniff_niagara(texts.Text(path, decoded, "")) is None

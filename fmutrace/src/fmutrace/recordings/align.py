@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from .._errors import InputError
 from .timebase import OFF_CYCLE, cycles
 
 TIMINGS = ("cycle", "fmi")

@@ -6,7 +6,7 @@ import operator
 
 import numpy as np
 
-from ..traces import split_cells
+from .._traces import split_cells
 from . import text as texts
 from .model import Channel
 

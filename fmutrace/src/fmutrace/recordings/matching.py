@@ -9,7 +9,7 @@ or a tunable parameter drives the FMU, one of an output is compared, any
 other is listed as ignored with the reason."""
 from dataclasses import dataclass, field
 
-from ..errors import InputError
+from .._errors import InputError
 
 
 def components(name):

@@ -4,7 +4,7 @@ base, so no value is invented). Master (time) channels are the stamps,
 in seconds; channels of text or byte arrays are listed as ignored."""
 import numpy as np
 
-from ..errors import TraceError
+from .._errors import TraceError
 from .model import Channel, Recording
 
 MAGIC = b"MDF     "

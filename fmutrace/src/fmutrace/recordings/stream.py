@@ -1,5 +1,5 @@
 """A long one-file recording (a table export: CSV/TSV, TIA Portal, CODESYS
-V3) read in blocks of lines into the long-case path (longcase.stream_case),
+V3) read in blocks of lines (_longrecording runs it through _longcase.stream_case),
 in memory that does not grow with its length.
 
 The file's head (its first HEAD_BYTES) is read as the in-memory path reads
@@ -9,7 +9,7 @@ same functions (grid.uniform_table, grid.numeric_stamps, text.values), so
 each sample has the in-memory path's bits. Each row is a cycle: its inputs
 drive the step from its cycle, its outputs are compared as align.py lays
 them. Before anything runs, one pass over the time column alone applies
-the whole file's rules (_time_column_pass): the step is the head's finest
+the whole file's rules (time_column_pass): the step is the head's finest
 interval and must be the whole file's (timebase.Intervals, the rule
 normalise applies in memory), the length one normalise takes, every row
 the cycle after the one before; notes and the failing signals' recorded
@@ -26,21 +26,18 @@ column shows before the FMU runs, a bad cell of another column when its
 block is read, after the FMU ran the cycles before it.
 """
 import io
-import os
 from dataclasses import dataclass
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pcsv
 
-from ..errors import InputError, TraceError
-from ..longcase import LONG_CASE_BYTES, stream_case
-from ..traces import UNUSUAL_LINE_BREAKS, NotPlain
+from .._errors import TraceError
+from .._traces import UNUSUAL_LINE_BREAKS, NotPlain
 from . import TEXT_FORMATS, mdf, tables
 from . import grid as grids
 from . import text as texts
 from . import timebase
-from .align import off_cycle_note
-from .case import first_differs
-from .matching import plan
 
 HEAD_BYTES = 1 << 20      # read as the in-memory path reads a whole file
 BLOCK_BYTES = 1 << 22     # of text per block of lines after the head
@@ -49,15 +46,7 @@ _CODECS = {"UTF-8": "utf-8", "UTF-8 (with BOM)": "utf-8", "Windows-1252": "cp125
 _UNITS = {"filetime": "FILETIME"}
 
 
-def is_long_recording(path) -> bool:
-    """Whether the recording at path is one file large enough to be streamed."""
-    try:
-        return os.path.isfile(path) and os.path.getsize(path) >= LONG_CASE_BYTES
-    except OSError:
-        return False
-
-
-class _Table:
+class Table:
     """A table export's layout from its head, and its body in blocks of rows."""
 
     def __init__(self, path, fmu, options):
@@ -141,9 +130,6 @@ class _Table:
         the same bits. Left to the cells: NaN (its sign and payload), time
         stamps beyond 1e15 (grid.numeric_stamps may read those as
         integers), a line of other cells, blanks, quotes, an empty line."""
-        import pyarrow as pa
-        import pyarrow.csv as pcsv
-
         if b"\r" in block and block.count(b"\r") != block.count(b"\r\n"):
             return None
         names = [f"c{j}" for j in range(self.width)]
@@ -210,7 +196,7 @@ def _unusual_breaks(text):
 
 
 @dataclass
-class _Cycles:
+class Cycles:
     """What the pre-pass over a streamed recording's time column found."""
     rows: int
     last: int               # the last row's cycle
@@ -218,7 +204,7 @@ class _Cycles:
     first_off: tuple        # (line, seconds) of the first of them, or None
 
 
-def _time_column_pass(table, step, block_bytes=None):
+def time_column_pass(table, step, block_bytes=None):
     """The whole file's time column read once, before anything runs (only
     its cells converted), by the rules normalise applies to a whole
     recording: the step its intervals give (unless one was given) is the
@@ -244,112 +230,4 @@ def _time_column_pass(table, step, block_bytes=None):
         raise NotPlain("the whole file's interval is another step than its head's")
     if timebase.too_long(span) or timebase.too_many_steps(span / step, rows, recording.time_source):
         raise NotPlain("the in-memory path refuses the length")
-    return _Cycles(rows, expected - 1, off, first_off)
-
-
-def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, result_file=None, progress=None,
-                       block_bytes=None, steps_per_chunk=None):
-    """The CaseOutcome of the one-file recording at path, streamed; None
-    if this path cannot take it (the in-memory path then reads it)."""
-    from ..comparison import Pointwise
-    from ..runner import STEPS_PER_CHUNK
-
-    if not isinstance(mode, Pointwise):
-        return None
-    try:
-        table = _Table(path, fmu, options)
-        recording = table.recording
-        matched = plan(recording, fmu.variables, fmu.label, options.maps)
-        if not matched.compares:
-            return None
-        step = recording.step_size
-        shift = 1 if options.timing == "cycle" else 0
-        cycles = _time_column_pass(table, step, block_bytes)
-        start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
-    except (NotPlain, InputError, OSError, ValueError):
-        return None
-    drives, compares = matched.drives, matched.compares
-    stop = max(cycles.last + shift, 1) * step
-    pending = {"inputs": [], "refs": []}
-    row = 0  # the next block's first row, which is its cycle (_time_column_pass)
-
-    def parse():
-        """Reads the next block into both queues; False at the end."""
-        nonlocal row
-        block = next(blocks, None)
-        if block is None:
-            return False
-        _, cells, line_numbers, times = block
-        index = np.arange(row, row + len(times))
-        row += len(times)
-        if drives:
-            chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
-            chunk["time"] = index * step
-            for variable, channel in drives:
-                chunk[variable] = table.values(cells, line_numbers, channel.name)
-            pending["inputs"].append(chunk)
-        chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in compares])
-        chunk["time"] = (index + shift) * step
-        for variable, channel in compares:
-            chunk[variable] = table.values(cells, line_numbers, channel.name)
-        pending["refs"].append(chunk)
-        return True
-
-    def queue(kind):
-        while True:
-            if pending[kind]:
-                yield pending[kind].pop(0)
-            elif not parse():
-                while pending[kind]:
-                    yield pending[kind].pop(0)
-                return
-
-    blocks = table.blocks(block_bytes)
-
-    def more_messages(passed, deviations):
-        notes = []
-        if cycles.off:
-            line, time = cycles.first_off
-            notes = [off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
-                     for _, channel in drives + compares]
-        notes += matched.describe()
-        unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
-        description = (f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
-                       f"step {step:g} s ({recording.step_source})")
-        if passed:
-            return [description] + notes
-        return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
-
-    title = f"{name} on {labels['fmu']}: {recording.format}"
-    return stream_case(name, labels, mode, plots, runner,
-                       {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6}, start_values,
-                       tuple(v for v, _ in drives), queue("inputs") if drives else None, queue("refs"),
-                       [v for v, _ in compares], stop, title, result_file, steps_per_chunk or STEPS_PER_CHUNK,
-                       progress, more_messages)
-
-
-def _explain(table, deviations, channels, step, shift):
-    """RecordedCase.explain's messages: each failing signal's recorded sample at its first deviation."""
-    wanted = {}
-    for deviation in deviations:
-        if deviation.name in channels and deviation.time is not None:
-            wanted[deviation.name] = int(round(deviation.time / step)) - shift
-    found = {}
-    row = 0
-    if wanted:
-        for _, cells, line_numbers, times in table.blocks():
-            for name, cycle in wanted.items():
-                if name not in found and row <= cycle < row + len(times):
-                    i = cycle - row
-                    value = table.values(cells, line_numbers, channels[name].name)[i]
-                    found[name] = (int(line_numbers[i]), float(times[i]), float(value))
-            row += len(times)
-            if len(found) == len(wanted):
-                break
-    messages = []
-    for deviation in deviations:
-        if deviation.name in found:
-            line, time, value = found[deviation.name]
-            messages.append(first_differs(deviation, wanted[deviation.name], f"{table.path}, line {line}", time,
-                                          value))
-    return messages
+    return Cycles(rows, expected - 1, off, first_off)

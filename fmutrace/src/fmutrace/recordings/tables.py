@@ -12,7 +12,7 @@ the index counts cycles) and the channels. No public sample of TIA
 Portal's export is known, so it is read by these general rules."""
 import numpy as np
 
-from ..traces import split_cells
+from .._traces import split_cells
 from . import grid as grids
 from . import text as texts
 from . import timebase

@@ -18,8 +18,8 @@ import re
 
 import numpy as np
 
-from ..errors import TraceError
-from ..traces import counts_outside_quotes, parse_number
+from .._errors import TraceError
+from .._traces import counts_outside_quotes, parse_number
 
 SEPARATORS = ("\t", ";", ",", " ")
 _IEC_BASED = re.compile(r"^(?:[A-Za-z_]+#)?([+-]?)(2|8|16)#([0-9A-Fa-f_]+)$")

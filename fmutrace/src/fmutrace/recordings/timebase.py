@@ -17,7 +17,7 @@ from datetime import datetime, timedelta, timezone
 
 import numpy as np
 
-from ..errors import InputError, TraceError
+from .._errors import InputError, TraceError
 from .model import TIME_FACTORS
 
 OFF_CYCLE = 0.1          # a stamp more than this fraction of a cycle from a cycle end is reported

@@ -20,7 +20,7 @@ its cells are blank (or the row is shorter). An 'EOF' line may close the
 file."""
 import numpy as np
 
-from ..traces import split_cells
+from .._traces import split_cells
 from . import grid as grids
 from . import text as texts
 from .model import Recording

@@ -26,7 +26,7 @@ import os
 
 import numpy as np
 
-from ..traces import split_cells
+from .._traces import split_cells
 from . import grid as grids
 from . import text as texts
 from . import timebase

@@ -27,8 +27,10 @@ from os import PathLike
 from typing import TextIO
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pcsv
 
-from .errors import TraceError
+from ._errors import TraceError
 
 TIME_NAMES = ("time", "t", "Time")
 UNUSUAL_LINE_BREAKS = "\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
@@ -227,6 +229,7 @@ def _read_rows(path, lines, names, order, time_index, separator, dtype, header_l
 
 
 CHUNK_BYTES = 1 << 22  # of CSV text per chunk of trace_chunks
+LONG_CASE_BYTES = 32 << 20  # a case or recording whose file is larger runs chunk by chunk
 
 
 def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None = None,
@@ -238,9 +241,6 @@ def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None
     times read_trace would refuse, raises NotPlain at the chunk where that
     shows, and read_trace reads or explains it. Both readers convert a
     number correctly rounded: the same bits (a test checks it)."""
-    import pyarrow as pa
-    import pyarrow.csv as pcsv
-
     try:
         with open(path, encoding="utf-8-sig") as file:
             header = file.readline()
@@ -346,9 +346,6 @@ class TraceWriter:
         out.write(",".join(f'"{name}"' for name in self.names) + "\n")
 
     def write(self, trace: np.ndarray):
-        import pyarrow as pa
-        import pyarrow.csv as pcsv
-
         for begin in range(0, len(trace), WRITE_ROWS):
             block = trace[begin:begin + WRITE_ROWS]
             table = pa.table({name: np.asarray(block[name], dtype=np.float64) for name in self.names})

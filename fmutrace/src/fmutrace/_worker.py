@@ -6,17 +6,18 @@ import os
 import tempfile
 import time
 
-from .cases import load_case
-from .comparison import Comparison, Mode
-from .errors import InputError, SimulationError
-from .fmu import Fmu
-from .longcase import is_long, run_long_case
-from .outcome import CaseOutcome, Status
-from .plot import load_plotting, plot_case
+from ._cases import load_case
+from ._comparison import Comparison, Mode
+from ._errors import InputError, SimulationError
+from ._fmu import Fmu
+from ._longcase import is_long, run_long_case
+from ._longrecording import is_long_recording, run_long_recording
+from ._outcome import CaseOutcome, Status
+from ._plot import load_plotting, plot_case
+from ._recorded import recorded_case
 from .recordings import is_recording
-from .recordings.case import RecordingOptions, recorded_case
-from .recordings.stream import is_long_recording, run_long_recording
-from .runner import Runner
+from .recordings.options import RecordingOptions
+from ._runner import Runner
 
 PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV
 PLOT_ALL_UP_TO = 500               # the default: all for campaigns up to so many cases, else the failed ones
@@ -59,7 +60,7 @@ def run_case(folder, name, texts, runner: Runner, fmu: Fmu, labels: dict, mode: 
         o = case.options
         result = runner.run(o["StartTime"], o["StopTime"], o["StepSize"], case.inputs, case.start_values,
                             case.outputs, o["RelTol"])
-        comparison = case.compare(result, mode)
+        comparison = case.comparison(result, mode)
         outcome.status = Status.PASS if comparison.passed else Status.FAIL
     except SimulationError as error:
         result, outcome.status = None, Status.ERROR

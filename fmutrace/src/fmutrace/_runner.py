@@ -34,6 +34,7 @@ values; the tests check the results against fmpy's on every reference
 scenario and on random traces.
 """
 import contextlib
+import importlib.util
 import io
 import itertools
 import math
@@ -44,8 +45,8 @@ import numpy as np
 from fmpy.simulation import apply_start_values, instantiate_fmu, settable_in_initialization_mode, \
     settable_in_instantiated
 
-from .fmu import REAL_TYPES, unpacked
-from .simulation import held_to, run_fmpy
+from ._fmu import REAL_TYPES, unpacked
+from ._fmpy import held_to, run_fmpy
 
 # per FMI type: the C type's dtype (fmpy's Input tables and getters) and the
 # recorded column's dtype (fmpy's Recorder)
@@ -111,11 +112,15 @@ FFI.cdef("\n".join(
 
 
 def _load_c_steps():
-    """fmutrace_steps from the compiled _steps module; None if it was not built (the Python loop then)."""
+    """fmutrace_steps from the compiled _steps extension (found, not
+    imported: it is a plain library to cffi); None if it was not built (the
+    Python loop then)."""
+    spec = importlib.util.find_spec(f"{__package__}._steps")
+    if spec is None or spec.origin is None:
+        return None
     try:
-        from . import _steps
-        return FFI.dlopen(_steps.__file__).fmutrace_steps
-    except (ImportError, OSError, AttributeError):
+        return FFI.dlopen(spec.origin).fmutrace_steps
+    except (OSError, AttributeError):
         return None
 
 

@@ -13,7 +13,7 @@ import threading
 
 import numpy as np
 
-from .comparison import Comparison, Mode
+from ._comparison import Comparison, Mode
 
 WIDTH_INCHES, DPI = 8.0, 80
 COLUMNS = 600        # pixel columns of an axis (the figure is 640 pixels wide)

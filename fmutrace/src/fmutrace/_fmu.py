@@ -12,8 +12,8 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from .errors import InputError
-from .traces import BOOLEAN_WORDS
+from ._errors import InputError
+from ._traces import BOOLEAN_WORDS
 
 INTEGER_RANGES = {
     "Integer": (-2**31, 2**31 - 1), "Int8": (-2**7, 2**7 - 1), "UInt8": (0, 2**8 - 1),

@@ -1,46 +1,24 @@
 """A recording as a case of a campaign: read, matched to the FMU, laid on
-its steps (align.py), and compared signal by signal, each on its own
-samples; a failing comparison names the recording's file and line of its
-first deviation and, where the inputs were sampled coarser than the step,
-what that means."""
+its steps (recordings.align), and compared signal by signal, each on its
+own samples; a failing comparison names the recording's file and line of
+its first deviation and, where the inputs were sampled coarser than the
+step, what that means."""
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..cases import Case
-from ..comparison import Comparison, compare_traces
-from ..errors import InputError
-from . import read_recording, text as texts, vendors
-from .align import TIMINGS, align
-from .matching import plan
-from .timebase import UNIT_NAMES, normalise
+from ._cases import Case
+from ._comparison import Comparison, compare_traces
+from ._errors import InputError
+from .recordings import read_recording
+from .recordings.align import align
+from .recordings.matching import plan
+from .recordings.options import RecordingOptions
+from .recordings.timebase import UNIT_NAMES, normalise
 
-TIME_UNITS = ("s", "ms", "us", "ns", "cycles", "filetime")
 _UNITS = {"filetime": "FILETIME"}
-
-
-@dataclass(frozen=True)
-class RecordingOptions:
-    """How the recordings of a command are read (the same for all)."""
-    step_size: float = None
-    time_unit: str = None           # one of TIME_UNITS, None: the recording's own
-    timing: str = "cycle"           # align.TIMINGS
-    maps: tuple = ()                # (VARIABLE, CHANNEL) pairs
-    start_values: tuple = ()        # (NAME, VALUE) pairs
-
-    def __post_init__(self):
-        if self.time_unit is not None and self.time_unit not in TIME_UNITS:
-            raise InputError(f"--time-unit must be one of {', '.join(TIME_UNITS)}, not {self.time_unit!r}")
-        if self.timing not in TIMINGS:
-            raise InputError(f"--timing must be one of {', '.join(TIMINGS)}, not {self.timing!r}")
-        if self.step_size is not None and not self.step_size > 0:
-            raise InputError(f"--step-size must be greater than 0, not {self.step_size!r}")
-
-    def settings(self) -> dict:
-        return {"step_size": self.step_size, "time_unit": self.time_unit, "timing": self.timing,
-                "maps": [list(m) for m in self.maps], "start_values": [list(s) for s in self.start_values]}
 
 
 @dataclass
@@ -51,7 +29,7 @@ class RecordedCase(Case):
     coarse: str = ""                                # why an exact comparison cannot hold
     shift: int = 1                                  # steps from a row's time to its output's (timing)
 
-    def compare(self, result, mode) -> Comparison:
+    def comparison(self, result, mode) -> Comparison:
         """Every compared signal on its own samples."""
         merged = Comparison()
         for reference in self.references:
@@ -85,36 +63,6 @@ def first_differs(deviation, cycle, where, time, recorded):
     """Where a failing signal's first deviation is in the recording."""
     return (f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={time:.9g} s "
             f"from its first sample): recorded {recorded!r}, the FMU gives {deviation.value!r}")
-
-
-def recording_paths(paths):
-    """The recordings among paths given to compare: [(path, name)], where
-    path is one file or folder, or several single-point files (Niagara)
-    joined by os.pathsep: together they make one recording."""
-    items, points = [], []
-    for path in paths:
-        path = os.fspath(path)
-        if os.path.isfile(path) and _is_single_point(path):
-            points.append(path)
-        else:
-            items.append((path, Path(path).name))
-    if points:
-        name = Path(points[0]).parent.name if len(points) > 1 else Path(points[0]).name
-        items.append((os.pathsep.join(points), name))
-    return items
-
-
-def _is_single_point(path):
-    try:
-        with open(path, "rb") as file:
-            head = file.read(4096)
-    except OSError:
-        return False
-    try:
-        decoded, _ = texts.decode(path, head)
-    except InputError:
-        return False
-    return vendors.sniff_niagara(texts.Text(path, decoded, "")) is None
 
 
 def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:

@@ -8,8 +8,8 @@ import shutil
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
-from .outcome import CampaignResult, CaseOutcome, Status
-from .traces import write_trace
+from ._outcome import CampaignResult, CaseOutcome, Status
+from ._traces import write_trace
 
 RESULTS_FORMAT = 1
 

@@ -6,8 +6,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
 
-from .comparison import Deviation, Mode
-from .errors import ExitStatus
+from ._comparison import Deviation, Mode
+from ._errors import ExitStatus
 
 
 class Status(StrEnum):

@@ -24,11 +24,11 @@ import threading
 import time
 from pathlib import Path
 
-from .outcome import CaseOutcome, Status
-from .worker import run_cases
+from ._outcome import CaseOutcome, Status
+from ._worker import run_cases
 
 HEADER = struct.Struct("!Q")
-CHILD = "import sys, fmutrace.isolated; sys.exit(fmutrace.isolated.main())"
+CHILD = "import sys, fmutrace._isolated; sys.exit(fmutrace._isolated.main())"
 
 
 def _package_root():

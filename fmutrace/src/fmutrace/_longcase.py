@@ -24,17 +24,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .cases import read_options, read_start_values
-from .comparison import Band, Mode, Pointwise, Verdict, aligned
-from .errors import InputError, SimulationError
-from .fmu import Fmu
-from .outcome import CaseOutcome, Status
-from .plot import ZOOM_SAMPLES, Envelope, Figure, draw
-from .progress import SampleProgress
-from .runner import STEPS_PER_CHUNK, FastLoopFailed, Runner
-from .traces import CHUNK_BYTES, NotPlain, TraceWriter, read_text, trace_chunks
-
-LONG_CASE_BYTES = 32 << 20  # a case whose reference file is larger runs chunk by chunk
+from ._cases import read_options, read_start_values
+from ._comparison import Band, Mode, Pointwise, Verdict, aligned
+from ._errors import InputError, SimulationError
+from ._fmu import Fmu
+from ._outcome import CaseOutcome, Status
+from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
+from ._progress import SampleProgress
+from ._runner import STEPS_PER_CHUNK, FastLoopFailed, Runner
+from ._traces import CHUNK_BYTES, LONG_CASE_BYTES, NotPlain, TraceWriter, read_text, trace_chunks
 
 
 def is_long(folder, model, texts) -> bool:
@@ -165,10 +163,10 @@ def stream_case(name, labels, mode, plots, runner, options, start_values, input_
                 if held is not None:
                     chunk = np.concatenate([held, chunk])
                 held = chunk[-1:]
-                _compare(chunk[:-1], chunk["time"][-1], start, step, n, mode, outputs, signals, envelopes, window,
+                _compare_rows(chunk[:-1], chunk["time"][-1], start, step, n, mode, outputs, signals, envelopes, window,
                          result_until, absent, zoom, recent)
             if held is not None:
-                _compare(held, np.nan, start, step, n, mode, outputs, signals, envelopes, window, result_until,
+                _compare_rows(held, np.nan, start, step, n, mode, outputs, signals, envelopes, window, result_until,
                          absent, zoom, recent)
             result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
             if reached != n + 1:
@@ -197,7 +195,7 @@ def stream_case(name, labels, mode, plots, runner, options, start_values, input_
     return outcome
 
 
-def _compare(rows, next_time, start, step, n, mode, outputs, signals, envelopes, window, result_until, absent, zoom,
+def _compare_rows(rows, next_time, start, step, n, mode, outputs, signals, envelopes, window, result_until, absent, zoom,
              recent):
     """Compares reference rows (next_time: the time of the row after the
     last, NaN if none) with the result, as Pointwise.bands does on the

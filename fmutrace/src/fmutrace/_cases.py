@@ -18,10 +18,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from .comparison import Comparison, Mode, compare_traces
-from .errors import InputError, TraceError
-from .fmu import Fmu
-from .traces import data_lines, parse_number, read_text, read_trace, split_cells
+from ._comparison import Comparison, Mode, compare_traces
+from ._errors import InputError, TraceError
+from ._fmu import Fmu
+from ._traces import data_lines, parse_number, read_text, read_trace, split_cells
 
 OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
 FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
@@ -43,7 +43,7 @@ class Case:
         """The reference's signals: what is recorded and compared."""
         return [n for n in self.reference.dtype.names if n != "time"]
 
-    def compare(self, result, mode: Mode) -> Comparison:
+    def comparison(self, result, mode: Mode) -> Comparison:
         """The FMU's result against the reference, in mode (a recording
         compares each signal on its own samples)."""
         return compare_traces(result, self.reference, mode)

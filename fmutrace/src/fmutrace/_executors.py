@@ -25,14 +25,14 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from .cases import case_texts
-from .comparison import Mode
-from .isolated import run_isolated
-from .outcome import CaseOutcome, Status
+from ._cases import case_texts
+from ._comparison import Mode
+from ._isolated import run_isolated
+from ._outcome import CaseOutcome, Status
 from .recordings import is_recording
-from .recordings.case import RecordingOptions
-from .runner import Runner
-from .worker import run_case, run_cases
+from .recordings.options import RecordingOptions
+from ._runner import Runner
+from ._worker import run_case, run_cases
 
 BATCH_CASES = 256              # cases per Dask task at most
 BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent

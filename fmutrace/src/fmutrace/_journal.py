@@ -8,24 +8,48 @@ The first line describes the campaign (comparison, plots, the FMUs by
 content hash); a resumed campaign must be the same campaign. A line cut
 short by a kill is ignored (its case runs again).
 """
-import fcntl
 import hashlib
 import json
 import os
+import sys
 from pathlib import Path
 
-from .comparison import Mode
-from .errors import InputError
-from .outcome import CaseOutcome, Outcomes
-from .traces import read_trace
+from ._comparison import Mode
+from ._errors import InputError
+from ._outcome import CaseOutcome, Outcomes
+from ._traces import read_trace
 
 JOURNAL = "results.jsonl"
 LOCK = ".fmutrace.lock"
 
 
+if sys.platform == "win32":
+    import msvcrt
+
+    def _try_lock(file):
+        """Locks the file's first byte without waiting; OSError if another process holds it."""
+        file.seek(0)
+        msvcrt.locking(file.fileno(), msvcrt.LK_NBLCK, 1)
+
+    def _unlock(file):
+        file.seek(0)
+        msvcrt.locking(file.fileno(), msvcrt.LK_UNLCK, 1)
+else:
+    import fcntl
+
+    def _try_lock(file):
+        """Locks the file without waiting; OSError if another process holds it."""
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+    def _unlock(file):
+        fcntl.flock(file, fcntl.LOCK_UN)
+
+
 class ReportLock:
-    """An exclusive lock on a report folder (flock on a file in it: the
-    lock goes with the process that holds it, however it ends)."""
+    """An exclusive lock on a report folder, on a file in it (flock on
+    POSIX, a locked byte on Windows): the lock goes with the process that
+    holds it, however it ends. The holder's pid is written after the
+    locked byte (Windows refuses a read of a byte another process locked)."""
 
     def __init__(self, folder):
         self.folder = Path(folder)
@@ -33,23 +57,23 @@ class ReportLock:
         self.path = self.folder / LOCK
         self.file = open(self.path, "a+")
         try:
-            fcntl.flock(self.file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            _try_lock(self.file)
         except OSError:
-            self.file.seek(0)
+            self.file.seek(1)
             holder = self.file.read().strip() or "another process"
             self.file.close()
             raise InputError(f"{self.folder}: another campaign is writing this report folder ({holder}); wait for "
                              "it to finish or choose another folder") from None
         self.file.seek(0)
         self.file.truncate()
-        self.file.write(f"pid {os.getpid()}\n")
+        self.file.write(f" pid {os.getpid()}\n")
         self.file.flush()
 
     def release(self):
         if not self.file.closed:
-            self.file.seek(0)
+            self.file.seek(1)
             self.file.truncate()
-            fcntl.flock(self.file, fcntl.LOCK_UN)
+            _unlock(self.file)
             self.file.close()
 
 

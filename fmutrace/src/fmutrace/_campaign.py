@@ -1,7 +1,7 @@
 """Campaigns: every case of every FMU run, compared with its reference
 and reported (`compare`, the API of the `fmutrace compare` command).
 
-The cases are planned here (every FMU's cases, found under the folders
+The cases are indexed here (every FMU's cases, found under the folders
 given), run by an executor (executors.py), recorded as they finish (in
 memory, or in the report's journal) and reported at the end.
 """
@@ -14,18 +14,18 @@ from os import PathLike
 from pathlib import Path
 from typing import TextIO
 
-from .cases import find_cases
-from .comparison import Mode, comparison_mode
-from .errors import InputError
-from .executors import Work, executor_for
-from .fmu import Fmu
-from .journal import Journal, JournaledOutcomes, ReportLock, campaign_key, case_key
-from .outcome import CampaignResult, KeptOutcomes, Status
-from .progress import Progress
-from .recordings import is_recording
-from .recordings.case import RecordingOptions, recording_paths
-from .report import write_case_files, write_junit, write_report
-from .worker import PLOTS, default_plots
+from ._cases import find_cases
+from ._comparison import Mode, comparison_mode
+from ._errors import InputError
+from ._executors import Work, executor_for
+from ._fmu import Fmu
+from ._journal import Journal, JournaledOutcomes, ReportLock, campaign_key, case_key
+from ._outcome import CampaignResult, KeptOutcomes, Status
+from ._progress import Progress
+from .recordings import is_recording, recording_paths
+from .recordings.options import RecordingOptions
+from ._report import write_case_files, write_junit, write_report
+from ._worker import PLOTS, default_plots
 
 Paths = str | PathLike | Iterable[str | PathLike]  # one path, or several
 
@@ -91,7 +91,7 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
     loaded = [Fmu(path) for path in fmu_paths]
     recording = RecordingOptions(step_size, time_unit, timing, tuple(dict(maps).items()),
                                  tuple((start_values or {}).items()))
-    work = plan(loaded, case_paths)
+    work = index_cases(loaded, case_paths)
     plots = (plots or default_plots(len(work))) if report else "none"
     folders = _report_folders(loaded)
     job = Work(fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
@@ -173,7 +173,7 @@ def _report_folders(fmus):
     return folders
 
 
-class Plan(Sequence):
+class CaseIndex(Sequence):
     """(fmu, folder, name) of every FMU's cases, one after the other: the
     FMUs' case lists (CaseList) indexed through, not copied; folders as text."""
 
@@ -196,7 +196,7 @@ class Plan(Sequence):
 
 
 class Todo:
-    """The cases still to run, by their place in the plan: (i, fmu, folder, name)."""
+    """The cases still to run, by their place in the CaseIndex: (i, fmu, folder, name)."""
 
     def __init__(self, work, indices):
         self.work, self.indices = work, indices
@@ -209,8 +209,8 @@ class Todo:
             yield (i, *self.work[i])
 
 
-def plan(fmus, paths):
-    """A Plan of every FMU's cases under the case folders among paths,
+def index_cases(fmus, paths):
+    """A CaseIndex of every FMU's cases under the case folders among paths,
     and of the recordings among them (every FMU's too); InputError for an
     FMU with neither."""
     folders = [p for p in paths if not is_recording(p)]
@@ -221,7 +221,7 @@ def plan(fmus, paths):
         if not found and not recordings:
             raise InputError(f"no case of {fmu.label} (no {fmu.model}_ref.csv) under {', '.join(map(str, paths))}")
         parts += [(fmu, found)] * bool(found) + [(fmu, recordings)] * bool(recordings)
-    return Plan(parts)
+    return CaseIndex(parts)
 
 
 class RecordingList(Sequence):

@@ -28,7 +28,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .errors import InputError
+from ._errors import InputError
 
 TIME_MATCH = 1e-9  # seconds below |t| = 1 s, relative above
 
