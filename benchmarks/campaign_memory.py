@@ -39,8 +39,9 @@ def child(fmu, cases, report, jobs):
     with dask.config.set({**SHORT_LOGS, **LOCAL_CLUSTER}), \
             LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             Client(cluster) as client:
-        campaign = fmutrace.compare(fmu, cases, report=report, plots="failed", scheduler=cluster.scheduler_address,
-                                    shared_files=True, cluster_timeout=7200)
+        campaign = fmutrace.compare(fmu, cases, report=report, plots="failed",
+                                    run=fmutrace.RunOptions(scheduler=cluster.scheduler_address, shared_files=True,
+                                                            cluster_timeout=7200))
         workers = sorted(client.run(peak_megabytes).values())
         counts = campaign.counts()
     print(json.dumps({"cases": sum(counts.values()), "passed": counts["pass"], "client": peak_megabytes(),

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance, read_trace, write_trace
-from fmutrace._longcase import run_long_case, simulate_long
+from fmutrace._longcase import Streaming, run_long_case, simulate_long
 from fmutrace._progress import SampleProgress
-from fmutrace._simulation import simulate
-from fmutrace._worker import run_case, worker_fmu
+from fmutrace._simulation import SimulationOptions, simulate
+from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
 from support.scenarios import SCENARIO_ROOT, fmu_path
 from support.fmu_driver import BUILD_DIR
 
@@ -29,9 +29,9 @@ def outcomes(folder, version, mode, steps, chunk_bytes):
     path = fmu_path(BUILD_DIR, folder.parent.name, version)
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
-    whole = run_case(folder, folder.name, None, runner, fmu, labels, mode, "none")
-    long = run_long_case(folder, folder.name, runner, fmu, labels, mode, "none", steps_per_chunk=steps,
-                         chunk_bytes=chunk_bytes)
+    whole = run_case(folder, folder.name, None, Target(runner, fmu, labels), CaseSettings(mode, "none"))
+    long = run_long_case(folder, folder.name, Target(runner, fmu, labels), CaseSettings(mode, "none"),
+                         Streaming(steps_per_chunk=steps, chunk_bytes=chunk_bytes))
     return whole, long
 
 
@@ -91,10 +91,10 @@ def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
     out = tmp_path / "out.csv"
-    long = run_long_case(folder, "ulp", runner, fmu, labels, Exact(), "failed", result_file=out, steps_per_chunk=2,
-                         chunk_bytes=16)
+    long = run_long_case(folder, "ulp", Target(runner, fmu, labels), CaseSettings(Exact(), "failed"),
+                         Streaming(result_file=out, steps_per_chunk=2, chunk_bytes=16))
     assert not long.passed and long.png.startswith(b"\x89PNG")
-    whole = run_case(folder, "ulp", None, runner, fmu, labels, Exact(), "failed")
+    whole = run_case(folder, "ulp", None, Target(runner, fmu, labels), CaseSettings(Exact(), "failed"))
     write_trace(tmp_path / "whole.csv", whole.result)
     assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
 
@@ -107,9 +107,10 @@ def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
     path = fmu_path(BUILD_DIR, "RateLimiter", 3)
     start = {"rateUpPar": "2.0", "rateDownPar": "0.5"}
     with open(tmp_path / "long.csv", "w") as out:
-        written = simulate_long(path, scenario / "RateLimiter_in.csv", out, start, 0.0, 8.0, 0.5, None,
-                                steps_per_chunk=3, chunk_bytes=8)
-    whole = simulate(path, scenario / "RateLimiter_in.csv", start, 0.0, 8.0, 0.5)
+        written = simulate_long(path, scenario / "RateLimiter_in.csv", out, SimulationOptions(start, 0.0, 8.0, 0.5),
+                                Streaming(steps_per_chunk=3, chunk_bytes=8))
+    whole = simulate(path, scenario / "RateLimiter_in.csv", start_values=start, start_time=0.0, stop_time=8.0,
+                     step_size=0.5)
     write_trace(tmp_path / "whole.csv", whole)
     assert written == len(whole)
     assert (tmp_path / "long.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()

@@ -8,7 +8,7 @@ memory, or in the report's journal) and reported at the end.
 import time
 from array import array
 from bisect import bisect_right
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, MutableSequence, Sequence
 from itertools import accumulate
 from os import PathLike
 from pathlib import Path
@@ -17,27 +17,24 @@ from typing import TextIO
 from ._cases import find_cases
 from ._comparison import Mode, comparison_mode
 from ._errors import InputError
-from ._executors import Work, executor_for
+from ._executors import RunOptions, Work, executor_for
 from ._fmu import Fmu
-from ._journal import Journal, JournaledOutcomes, ReportLock, campaign_key, case_key
+from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key
 from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
 from .recordings import is_recording, recording_paths
 from .recordings.options import RecordingOptions
 from ._report import write_case_files, write_junit, write_report
-from ._worker import PLOTS, default_plots
+from ._worker import PLOTS, CaseSettings, FmuFile, default_plots
 
 Paths = str | PathLike | Iterable[str | PathLike]  # one path, or several
 
 
-def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
-            mode: Mode | None = None, rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float | None = None,
-            tube_value: float | None = None, junit: str | PathLike | None = None, jobs: int | None = None,
-            scheduler: str | None = None, shared_files: bool = False, plots: str | None = None,
-            case_timeout: float | None = None, cluster_timeout: float | None = None, resume: bool = False,
-            progress: TextIO | None = None, step_size: float | None = None, maps: Iterable = (),
-            start_values: dict | None = None, time_unit: str | None = None,
-            timing: str = "cycle") -> CampaignResult:
+def compare(fmus: Paths, cases: Paths, *, mode: Mode | None = None, rel_tol: float | None = None,
+            abs_tol: float | None = None, tube_time: float | None = None, tube_value: float | None = None,
+            report: str | PathLike | None = None, junit: str | PathLike | None = None, plots: str | None = None,
+            resume: bool = False, progress: TextIO | None = None, run: RunOptions = RunOptions(),
+            recording: RecordingOptions = RecordingOptions()) -> CampaignResult:
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
@@ -46,74 +43,93 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
                 files carry (<Model>_ref.csv). A file (or a folder without
                 cases) is a recording as a recorder exports it
                 (docs/recordings.md): it is run on every FMU
+    mode        a comparison mode: fmutrace.Exact() (bit for bit),
+                Tolerance(rel_tol, abs_tol), Tube(time, value); or, instead
+                of mode, rel_tol/abs_tol or tube_time/tube_value; none of
+                them: exact
     report      folder for index.html, summary.md, results.json, the
                 results and plots (None: no files)
-    mode        a comparison mode (fmutrace.Exact(), Tolerance(rel_tol,
-                abs_tol), Tube(time, value)), or rel_tol/abs_tol, or
-                tube_time/tube_value; none of them: exact, bit for bit
     junit       file for JUnit XML
-    jobs        1: in this process; N: a local Dask cluster of N processes;
-                None: one per core for 20 cases or more, else 1
-    scheduler   address of a Dask scheduler (instead of a local cluster)
-    shared_files  the scheduler's workers see the case folders at the same
-                paths (they read the files; else they are sent the texts)
     plots       which cases get a plot and a result CSV in the report:
                 'all', 'failed' or 'none'; None: all for up to 500 cases,
                 else the failed ones
-    case_timeout  seconds a case may run (None: no bound): a case over it
-                is stopped and reported (cases then run in child processes)
-    cluster_timeout  seconds to wait for a cluster's results (None: no bound)
     resume      take the cases the report's journal (results.jsonl) holds
                 from it, run the others (after a campaign was stopped)
     progress    the stream of the progress bar (default: standard error;
                 drawn on a terminal only)
-    step_size   recordings: the PLC's cycle (default: the recording's
-                sample time, else its finest interval between samples)
-    maps        recordings: (VARIABLE, CHANNEL) pairs, or {VARIABLE: CHANNEL}
-    start_values  recordings: {name: value} of the FMU's start values
-    time_unit   recordings: s, ms, us, ns, cycles or filetime, instead of
-                the recording's own
-    timing      recordings: 'cycle' (a row is one cycle's input and
-                output, as recorders write it) or 'fmi' (a row's output is
-                the output at its time, as fmpy writes it)
+    run         where and how long the cases run: RunOptions(jobs=1,
+                scheduler=None, shared_files=False, case_timeout=None,
+                cluster_timeout=None); by default in this process
+    recording   how recordings are read: RecordingOptions(step_size,
+                time_unit, timing, maps, start_values); case folders carry
+                their own settings, so recording options are refused for
+                them alone
 
     Returns a CampaignResult (.passed, .cases, .summary(), .exit_code).
-    Raises InputError for a bad FMU, folder or option; a case whose files
-    are bad is reported as 'invalid' (exit code 2) and the others run.
+    Raises InputError for a bad FMU, folder or option, or settings that
+    contradict each other; a case whose files are bad is reported as
+    'invalid' (exit code 2) and the others run.
     """
-    mode = mode or comparison_mode(rel_tol, abs_tol, tube_time, tube_value)
+    widths = {"rel_tol": rel_tol, "abs_tol": abs_tol, "tube_time": tube_time, "tube_value": tube_value}
+    given = [name for name, value in widths.items() if value is not None]
+    if mode is not None and given:
+        raise InputError(f"give mode or {', '.join(given)}, not both")
+    if mode is None:
+        mode = comparison_mode(rel_tol or 0.0, abs_tol or 0.0, tube_time, tube_value)
     if plots not in (None, *PLOTS):
         raise InputError(f"plots must be {', '.join(PLOTS[:-1])} or {PLOTS[-1]}, not {plots!r}")
+    if resume and not report:
+        raise InputError("resume continues the campaign of a report folder: give the report folder")
     fmu_paths = [fmus] if isinstance(fmus, (str, PathLike)) else list(fmus)
     case_paths = [cases] if isinstance(cases, (str, PathLike)) else list(cases)
     if not fmu_paths or not case_paths:
         raise InputError("give at least one FMU and one case folder")
+    has_recordings = any(is_recording(p) for p in case_paths)
+    if recording != RecordingOptions() and not has_recordings:
+        raise InputError("recording options apply to recordings, and only case folders are given: a case folder "
+                         "carries its own settings (<Model>_ref.opt, <Model>_start.csv)")
     loaded = [Fmu(path) for path in fmu_paths]
-    recording = RecordingOptions(step_size, time_unit, timing, tuple(dict(maps).items()),
-                                 tuple((start_values or {}).items()))
-    work = index_cases(loaded, case_paths)
-    plots = (plots or default_plots(len(work))) if report else "none"
+    cases_of = index_cases(loaded, case_paths)
+    plots = (plots or default_plots(len(cases_of))) if report else "none"
     folders = _report_folders(loaded)
-    job = Work(fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
-               labels={f.path: {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]}
-                       for f in loaded},
-               mode=mode, plots=plots, case_timeout=case_timeout, recording=recording)
-    executor = executor_for(len(work), jobs, scheduler, shared_files, case_timeout, cluster_timeout)
-
+    work = Work(fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
+                fmus={f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path),
+                                                    "fmu_folder": folders[f.path]}) for f in loaded},
+                settings=CaseSettings(mode, plots, recording, run.case_timeout))
+    executor = executor_for(len(cases_of), run)
+    key = campaign_key(work.fmu_bytes, mode, plots, recording.settings() if has_recordings else None)
     started = time.perf_counter()
-    # with a report, the outcomes live in its journal and this process keeps their offsets there
-    outcomes = array("q", bytes(8 * len(work))) if report else [None] * len(work)
-    counts = dict.fromkeys(Status, 0)
-    lock = journal = None
-    if report:
-        lock = ReportLock(report)
-    try:
+    lock = ReportLock(report) if report else None
+    try:  # the report folder stays locked until its last file is written
+        outcomes, counts, where = _run(cases_of, work, executor, (report, key, resume), progress)
+        kept = JournaledOutcomes(report, Path(report) / JOURNAL, outcomes,
+                                 {str(f.path): folders[f.path] for f in loaded}) if report else KeptOutcomes(outcomes)
+        result = CampaignResult(kept, mode, where, time.perf_counter() - started, Path(report) if report else None,
+                                counts)
         if report:
-            journal = Journal(report, campaign_key(job.fmu_bytes, mode, plots, recording.settings()
-                                                   if any(is_recording(p) for p in case_paths) else None), resume)
+            write_report(result, report)
+        if junit:
+            write_junit(result, junit)
+    finally:
+        if lock:
+            lock.release()
+    return result
+
+
+def _run(cases_of, work, executor, journal_of, progress):
+    """(outcomes, counts by status, where they ran) of the campaign's cases;
+    journal_of: (report folder or None, campaign key, resume). With a
+    report the outcomes live in its journal and this process keeps their
+    offsets there."""
+    report, key, resume = journal_of
+    outcomes: MutableSequence = array("q", bytes(8 * len(cases_of))) if report else [None] * len(cases_of)
+    counts = dict.fromkeys(Status, 0)
+    journal = Journal(report, key, resume) if report else None
+    try:
+        indices: Sequence[int]
         if journal and journal.done:
             indices = array("q")
-            for i, (fmu, folder, name) in enumerate(work):
+            for i, (fmu, folder, _) in enumerate(cases_of):
                 offset = journal.done.get(case_key(fmu.path, folder))
                 if offset is not None:  # finished by the campaign resumed
                     outcomes[i] = offset
@@ -122,15 +138,15 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
                     indices.append(i)
             journal.done = None  # read: not needed any more
         else:
-            indices = range(len(work))
-        todo = Todo(work, indices)
-        bar = Progress(len(work), progress)
+            indices = range(len(cases_of))
+        todo = Todo(cases_of, indices)
+        bar = Progress(len(cases_of), progress)
 
         def finished(i, outcome):
             counts[outcome.status] += 1
-            if report:
+            if journal:
                 write_case_files(outcome, report)
-                fmu, folder, _ = work[i]
+                fmu, folder, _ = cases_of[i]
                 outcomes[i] = journal.record(case_key(fmu.path, folder), outcome.to_json())
             else:
                 outcomes[i] = outcome
@@ -138,32 +154,22 @@ def compare(fmus: Paths, cases: Paths, report: str | PathLike | None = None,
 
         try:
             if len(todo):
-                executor.run(todo, job, finished)
+                executor.run(todo, work, finished)
         finally:
             bar.close()
     finally:
         if journal:
             journal.close()
-        if lock:
-            lock.release()
     where = executor.where if len(todo) else "the journal"
-    resumed = len(work) - len(todo)
+    resumed = len(cases_of) - len(todo)
     if resumed and len(todo):
         where += f" ({resumed} cases from the journal)"
-    kept = JournaledOutcomes(report, journal.path, outcomes, {str(f.path): folders[f.path] for f in loaded}) \
-        if report else KeptOutcomes(outcomes)
-    result = CampaignResult(kept, mode, where, time.perf_counter() - started, Path(report) if report else None,
-                            counts)
-    if report:
-        write_report(result, report)
-    if junit:
-        write_junit(result, junit)
-    return result
+    return outcomes, counts, where
 
 
 def _report_folders(fmus):
     """Each FMU's folder in the report: <model>-fmi<version>, numbered if two are alike."""
-    folders = {}
+    folders: dict[Path, str] = {}
     for fmu in fmus:
         folder = f"{fmu.model}-fmi{fmu.fmi_version}"
         n = 2

@@ -18,6 +18,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ._comparison import Comparison, Mode, compare_traces
 from ._errors import InputError, TraceError
 from ._fmu import Fmu
@@ -34,14 +36,14 @@ class Case:
     folder: Path
     options: dict           # StartTime, StopTime, StepSize, RelTol
     start_values: dict      # name -> value of the variable's type
-    inputs: object          # structured array, or None
-    reference: object       # structured array
+    inputs: np.ndarray | None  # structured array, or None
+    reference: np.ndarray      # structured array
     description: str = ""
 
     @property
     def outputs(self):
         """The reference's signals: what is recorded and compared."""
-        return [n for n in self.reference.dtype.names if n != "time"]
+        return [n for n in self.reference.dtype.names or () if n != "time"]
 
     def comparison(self, result, mode: Mode) -> Comparison:
         """The FMU's result against the reference, in mode (a recording
@@ -175,9 +177,11 @@ def find_cases(paths: Sequence[str | PathLike], model: str) -> CaseList:
     too, each folder once), sorted by name: the folder's path below the one
     searched (its own name for a case folder given itself). A CaseList."""
     target = f"{model}_ref.csv"
-    seen = set()
-    names, root_of, folders, roots = [], array("H"), {}, []
-    taken = set() if len(paths) > 1 else None  # names: only folders searched together can give one twice
+    seen: set[tuple[int, int]] = set()
+    names: list[str] = []
+    root_of, folders, roots = array("H"), {}, []
+    # names: only folders searched together can give one twice
+    taken: set[str] | None = set() if len(paths) > 1 else None
     for path in paths:
         root = os.fspath(path)
         if not os.path.isdir(root):

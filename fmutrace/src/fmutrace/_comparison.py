@@ -24,7 +24,7 @@ result sample at its time fails.
 """
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -53,13 +53,13 @@ class Deviation:
     passed: bool
     compared: int = 0
     failed: int = 0
-    time: float = None
-    value: float = None
-    lower: float = None
-    upper: float = None
-    excess: float = None
-    largest_excess: float = None
-    largest_at: float = None
+    time: float | None = None
+    value: float | None = None
+    lower: float | None = None
+    upper: float | None = None
+    excess: float | None = None
+    largest_excess: float | None = None
+    largest_at: float | None = None
     note: str = ""
 
     NUMBERS: ClassVar[tuple] = ("time", "value", "lower", "upper", "excess", "largest_excess", "largest_at")
@@ -81,7 +81,9 @@ class Deviation:
 
     @classmethod
     def from_json(cls, entry: dict) -> "Deviation":
-        return cls(**{k: float(v) if k in cls.NUMBERS and isinstance(v, str) else v for k, v in entry.items()})
+        fields: dict[str, Any] = {k: float(v) if k in cls.NUMBERS and isinstance(v, str) else v
+                                  for k, v in entry.items()}
+        return cls(**fields)
 
 
 @dataclass
@@ -228,14 +230,14 @@ def _check_widths(mode, **options):
 EXACT = Exact()
 
 
-def comparison_mode(rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float = None,
-                    tube_value: float = None) -> Mode:
+def comparison_mode(rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float | None = None,
+                    tube_value: float | None = None) -> Mode:
     """The mode the command's options (and compare's arguments of the same
     names) choose: a tube, a tolerance, else exact. InputError if they do
     not make one."""
     if (tube_time is None) != (tube_value is None):
         raise InputError("a tube needs both its time and its value tolerance (--tube-time and --tube-value)")
-    if tube_time is not None:
+    if tube_time is not None and tube_value is not None:
         if rel_tol or abs_tol:
             raise InputError("choose a tube or a relative/absolute tolerance, not both")
         return Tube(tube_time, tube_value)

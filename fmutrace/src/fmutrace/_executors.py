@@ -26,13 +26,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._cases import case_texts
-from ._comparison import Mode
+from ._errors import InputError
 from ._isolated import run_isolated
 from ._outcome import CaseOutcome, Status
-from .recordings import is_recording
-from .recordings.options import RecordingOptions
 from ._runner import Runner
-from ._worker import run_case, run_cases
+from ._worker import CaseSettings, FmuFile, Target, run_case, run_cases
+from .recordings import is_recording
 
 BATCH_CASES = 256              # cases per Dask task at most
 BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
@@ -46,15 +45,48 @@ SHORT_LOGS = {"distributed.admin.low-level-log-length": 16}
 LOCAL_CLUSTER = {"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}
 
 
+AUTO_JOBS_FROM = 20  # RunOptions(jobs=None): a local cluster of one process per core from so many cases on
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Where and how long a campaign's cases run.
+
+    jobs             1: in this process (the default); N: a local Dask
+                     cluster of N processes; None: one per core for
+                     AUTO_JOBS_FROM cases or more, else 1 (the command's
+                     default)
+    scheduler        address of a Dask scheduler to run on (instead of
+                     this process or a local cluster)
+    shared_files     the scheduler's workers see the case folders at the
+                     same paths (they read the files; else they are sent
+                     the texts)
+    case_timeout     seconds a case may run (None: no bound): a case over
+                     it is stopped and reported (cases then run in child
+                     processes)
+    cluster_timeout  seconds to wait for a cluster's results (None: no bound)
+    """
+    jobs: int | None = 1
+    scheduler: str | None = None
+    shared_files: bool = False
+    case_timeout: float | None = None
+    cluster_timeout: float | None = None
+
+    def __post_init__(self):
+        if self.jobs is not None and (not isinstance(self.jobs, int) or self.jobs < 1):
+            raise InputError(f"jobs must be a whole number of at least 1, or None, not {self.jobs!r}")
+        for name in ("case_timeout", "cluster_timeout"):
+            value = getattr(self, name)
+            if value is not None and not value >= 0:
+                raise InputError(f"{name} must be >= 0 seconds, or None, not {value!r}")
+
+
 @dataclass(frozen=True)
 class Work:
     """What every case of a campaign is run with."""
     fmu_bytes: dict            # FMU path -> the file's bytes
-    labels: dict               # FMU path -> the CaseOutcome fields that name the FMU
-    mode: Mode
-    plots: str                 # "all", "failed" or "none"
-    case_timeout: float = None
-    recording: RecordingOptions = None  # how recordings are read (None: with their own settings)
+    fmus: dict                 # FMU path -> its FmuFile
+    settings: CaseSettings
 
 
 class Executor:
@@ -74,8 +106,8 @@ class InProcess(Executor):
             for i, fmu, folder, name in todo:
                 if fmu.path not in runners:
                     runners[fmu.path] = Runner(work.fmu_bytes[fmu.path])
-                finished(i, run_case(folder, name, None, runners[fmu.path], fmu, work.labels[fmu.path], work.mode,
-                                     work.plots, work.recording))
+                target = Target(runners[fmu.path], fmu, work.fmus[fmu.path].labels)
+                finished(i, run_case(folder, name, None, target, work.settings))
         finally:
             for runner in runners.values():
                 runner.close()
@@ -85,24 +117,23 @@ class ChildProcesses(Executor):
     where = "1 process at a time (isolated)"
 
     def run(self, todo, work, finished):
-        by_fmu = {}
+        by_fmu: dict = {}  # Fmu -> [(i, folder, name)]
         for i, fmu, folder, name in todo:
             by_fmu.setdefault(fmu, []).append((i, folder, name))
         for fmu, cases in by_fmu.items():
             arrived = iter(cases)
             run_isolated([(str(folder), name, None) for _, folder, name in cases], work.fmu_bytes[fmu.path],
-                         str(fmu.path), work.labels[fmu.path], work.mode, work.plots, work.case_timeout,
-                         recording=work.recording,
-                         on_outcome=lambda outcome: finished(next(arrived)[0], outcome))
+                         work.fmus[fmu.path], work.settings,
+                         on_outcome=lambda outcome, arrived=arrived: finished(next(arrived)[0], outcome))
 
 
-def run_batch(items, fmu_bytes, path, labels, mode, plots, isolate, case_timeout, recording=None):
+def run_batch(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, isolate: bool):
     """A Dask task: the outcomes of the cases [(folder, name, texts or
     None)] of one FMU, run in this worker, or (isolate) in child processes
     of it."""
     if isolate:
-        return run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, recording=recording)
-    return list(run_cases(items, fmu_bytes, path, labels, mode, plots, recording))
+        return run_isolated(items, fmu_bytes, fmu, settings)
+    return list(run_cases(items, fmu_bytes, fmu, settings))
 
 
 class Dask(Executor):
@@ -112,9 +143,9 @@ class Dask(Executor):
     the same files (shared_files), read the cases themselves; others get
     the files' texts. cluster_timeout bounds the wait for the cluster."""
 
-    def __init__(self, jobs: int, scheduler: str = None, shared_files: bool = False, cluster_timeout: float = None):
-        self.jobs, self.scheduler, self.shared_files, self.cluster_timeout = jobs, scheduler, shared_files, \
-            cluster_timeout
+    def __init__(self, jobs: int, options: RunOptions):
+        self.jobs, self.scheduler, self.shared_files, self.cluster_timeout = jobs, options.scheduler, \
+            options.shared_files, options.cluster_timeout
 
     def run(self, todo, work, finished):
         import dask
@@ -187,14 +218,14 @@ class Dask(Executor):
         def submit(fmu, batch, isolated, attempt):
             self.submitted = True
             items = [(folder, name, texts) for _, folder, name, texts in batch]
-            future = client.submit(run_batch, items, shared[fmu.path], str(fmu.path), work.labels[fmu.path],
-                                   work.mode, work.plots, isolated, work.case_timeout, work.recording, pure=False)
+            future = client.submit(run_batch, items, shared[fmu.path], work.fmus[fmu.path], work.settings, isolated,
+                                   pure=False)
             submitted[future] = fmu, batch, isolated, attempt
             in_flight.add(future)
 
         def submit_next():
             for fmu, batch in batches:  # with a per-case timeout every batch runs isolated: a hang needs a process
-                submit(fmu, batch, work.case_timeout is not None, 1)  # to kill
+                submit(fmu, batch, work.settings.case_timeout is not None, 1)  # to kill
                 return
 
         for _ in range(3 * workers):
@@ -213,24 +244,24 @@ class Dask(Executor):
                     shared[fmu.path] = client.scatter(work.fmu_bytes[fmu.path], broadcast=True)
                     submit(fmu, batch, True, attempt + 1)  # isolated: a crashing case fails alone
                     continue
-                outcomes = [CaseOutcome(name, **work.labels[fmu.path], status=Status.ERROR,
+                outcomes = [CaseOutcome(name, **work.fmus[fmu.path].labels, status=Status.ERROR,
                                         messages=[f"lost with its Dask worker {attempt} times: {type(error).__name__}: "
                                                   f"{error}"]) for _, _, name, _ in batch]
-            for (i, _, _, _), outcome in zip(batch, outcomes):
+            for (i, _, _, _), outcome in zip(batch, outcomes, strict=True):
                 finished(i, outcome)
             del outcomes
             submit_next()
         return workers
 
 
-def executor_for(cases: int, jobs: int = None, scheduler: str = None, shared_files: bool = False,
-                 case_timeout: float = None, cluster_timeout: float = None) -> Executor:
-    """The executor compare's options choose for so many cases."""
+def executor_for(cases: int, options: RunOptions) -> Executor:
+    """The executor the run options choose for so many cases."""
+    jobs = options.jobs
     if jobs is None:  # a local cluster takes seconds to start: worth it for many cases only
-        jobs = os.cpu_count() if cases >= 20 else 1
-    if scheduler is None and jobs <= 1:
-        return InProcess() if case_timeout is None else ChildProcesses()
-    return Dask(jobs, scheduler, shared_files, cluster_timeout)
+        jobs = (os.cpu_count() or 1) if cases >= AUTO_JOBS_FROM else 1
+    if options.scheduler is None and jobs <= 1:
+        return InProcess() if options.case_timeout is None else ChildProcesses()
+    return Dask(jobs, options)
 
 
 @functools.cache
@@ -259,7 +290,8 @@ def _batches(todo, size, ship_texts):
     """Consecutive runs of one FMU's cases, [(fmu, [(i, folder, name, texts)])]:
     at most size cases, and with their files' texts (ship_texts) at most
     BATCH_TEXT_BYTES of them, so that a worker's queue stays small."""
-    batch, current, volume = [], None, 0
+    batch: list[tuple] = []
+    current, volume = None, 0
     for i, fmu, folder, name in todo:
         texts = case_texts(folder, fmu.model) if ship_texts and not is_recording(folder) else None
         if batch and (fmu is not current or len(batch) == size or volume >= BATCH_TEXT_BYTES):

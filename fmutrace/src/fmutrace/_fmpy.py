@@ -3,11 +3,32 @@ Runner's fast loop cannot replay: its result as a structured array, a
 failure as a SimulationError that quotes what the FMU said."""
 import contextlib
 import io
+from dataclasses import dataclass
 
 import numpy as np
 from fmpy import simulate_fmu
 
 from ._errors import SimulationError
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A simulation's time frame, as an FMU's DefaultExperiment gives it:
+    from start to stop in communication steps of step."""
+    start: float
+    stop: float
+    step: float
+    relative_tolerance: float | None = None
+
+
+@dataclass(frozen=True)
+class Signals:
+    """What a simulation is fed and records: inputs (a structured array,
+    time first, or None; or consecutive such arrays where a run takes
+    chunks), start values {name: value} and the outputs' names."""
+    inputs: object
+    start_values: dict
+    outputs: list
 
 
 def held_to(inputs, stop_time):
@@ -20,8 +41,8 @@ def held_to(inputs, stop_time):
     return np.concatenate([inputs, last])
 
 
-def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_size, inputs, start_values, outputs,
-             relative_tolerance=None, debug_logging=False, fmi_type="CoSimulation"):
+def run_fmpy(fmu_location, model_description, experiment: Experiment, signals: Signals, fmi_type="CoSimulation",
+             debug_logging=False):
     """One simulation: the result as a structured array ('time' first). A
     failure is a SimulationError that quotes the FMU's warnings and errors:
     an FMI 3 FMU logs nothing unless logging is on, so a failed run that
@@ -31,6 +52,7 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
     # FMI 2 loggers keeps the last one registered for the whole process,
     # and the callback simulate_fmu makes of it dies when simulate_fmu returns.
     printed = io.StringIO()
+    start_time, stop_time, step_size = experiment.start, experiment.stop, experiment.step
     try:
         with contextlib.redirect_stdout(printed), np.errstate(invalid="ignore"):  # fmpy's notes; inf - inf in
             # fmpy's search for input events
@@ -40,10 +62,10 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
                 start_time=start_time,
                 stop_time=stop_time,
                 output_interval=step_size,
-                relative_tolerance=relative_tolerance,
-                input=held_to(inputs, stop_time),
-                start_values=dict(start_values),
-                output=list(outputs),
+                relative_tolerance=experiment.relative_tolerance,
+                input=held_to(signals.inputs, stop_time),
+                start_values=dict(signals.start_values),
+                output=list(signals.outputs),
                 fmi_type=fmi_type,
                 debug_logging=debug_logging,
                 # Model Exchange: no continuous states, so the solver only
@@ -56,9 +78,7 @@ def run_fmpy(fmu_location, model_description, *, start_time, stop_time, step_siz
         said = fmu_messages(printed.getvalue())
         if not said and not debug_logging:
             try:
-                run_fmpy(fmu_location, model_description, start_time=start_time, stop_time=stop_time,
-                         step_size=step_size, inputs=inputs, start_values=start_values, outputs=outputs,
-                         relative_tolerance=relative_tolerance, debug_logging=True, fmi_type=fmi_type)
+                run_fmpy(fmu_location, model_description, experiment, signals, fmi_type, debug_logging=True)
             except SimulationError as again:
                 raise again from error
         told = f"; the FMU said: {' | '.join(said[-3:])}" if said else ""

@@ -131,7 +131,7 @@ def _float(value):
     return float(value)
 
 
-_unpacked = {}
+_unpacked: dict[str, tuple] = {}
 
 
 def unpacked(fmu_bytes):

@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 from ._outcome import CaseOutcome, Status
-from ._worker import run_cases
+from ._worker import CaseSettings, FmuFile, run_cases
 
 HEADER = struct.Struct("!Q")
 CHILD = "import sys, fmutrace._isolated; sys.exit(fmutrace._isolated.main())"
@@ -62,11 +62,12 @@ def _reader(stream, out):
         out.put(None)
 
 
-def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_outcome=None, recording=None):
+def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outcome=None):
     """[outcome] of items [(folder, name, texts)], the cases in a child
-    process; a crash or a case over case_timeout seconds (None: no bound)
-    fails that case only. on_outcome(outcome), if given, hears of each as
-    it arrives."""
+    process; a crash or a case over settings.case_timeout seconds (None:
+    no bound) fails that case only. on_outcome(outcome), if given, hears
+    of each as it arrives."""
+    labels, case_timeout = fmu.labels, settings.case_timeout
     outcomes = []
     remaining = list(items)
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
@@ -75,9 +76,10 @@ def run_isolated(items, fmu_bytes, path, labels, mode, plots, case_timeout, on_o
         said = tempfile.TemporaryFile()  # the child's last words, if it dies
         child = subprocess.Popen([sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                  stderr=said, env=environment)
-        child.stdin.write(pickle.dumps((remaining, fmu_bytes, path, labels, mode, plots, recording)))
+        assert child.stdin is not None  # (a pipe: stdin=PIPE)
+        child.stdin.write(pickle.dumps((remaining, fmu_bytes, fmu, settings)))
         child.stdin.close()
-        arrived = queue.Queue()
+        arrived: queue.Queue = queue.Queue()
         threading.Thread(target=_reader, args=(child.stdout, arrived), daemon=True).start()
         for index, (_, name, _) in enumerate(remaining):
             started, running = time.monotonic(), False
@@ -121,7 +123,8 @@ def main():
         out.write(HEADER.pack(0))
         out.flush()
 
-    for outcome in run_cases(*pickle.loads(sys.stdin.buffer.read()), on_start=started):
+    items, fmu_bytes, fmu, settings = pickle.loads(sys.stdin.buffer.read())
+    for outcome in run_cases(items, fmu_bytes, fmu, settings, on_start=started):
         data = pickle.dumps(outcome)
         out.write(HEADER.pack(len(data)) + data)
         out.flush()

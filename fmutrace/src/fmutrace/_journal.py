@@ -98,7 +98,7 @@ class Journal:
 
     def __init__(self, folder, key, resume):
         self.path = Path(folder) / JOURNAL
-        self.done = {}  # key -> offset of the case's line, of a campaign resumed
+        self.done: dict[str, int] | None = {}  # key -> offset of the case's line, of a campaign resumed
         if resume and self.path.exists():
             with open(self.path, "rb") as journal:
                 header = _parse(journal.readline())

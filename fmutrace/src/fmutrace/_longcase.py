@@ -20,18 +20,23 @@ reported.
 import contextlib
 import os
 import time
+from collections.abc import Callable, Iterator
+from typing import TextIO
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ._cases import read_options, read_start_values
-from ._comparison import Band, Mode, Pointwise, Verdict, aligned
+from ._comparison import Band, Pointwise, Verdict, aligned
 from ._errors import InputError, SimulationError
+from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
 from ._outcome import CaseOutcome, Status
 from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK, FastLoopFailed, Runner
+from ._simulation import SimulationOptions
 from ._traces import CHUNK_BYTES, LONG_CASE_BYTES, NotPlain, TraceWriter, read_text, trace_chunks
 
 
@@ -43,6 +48,11 @@ def is_long(folder, model, texts) -> bool:
         return os.path.getsize(os.path.join(folder, f"{model}_ref.csv")) >= LONG_CASE_BYTES
     except OSError:
         return False
+
+
+def _signal_names(trace: np.ndarray) -> tuple[str, ...]:
+    """The names of a trace's columns after its time."""
+    return tuple(trace.dtype.names or ())[1:]
 
 
 def _last_time(path):
@@ -60,15 +70,44 @@ def _last_time(path):
             size *= 4
 
 
-def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mode, plots: str, result_file=None,
-                  steps_per_chunk: int = STEPS_PER_CHUNK, chunk_bytes: int = CHUNK_BYTES, progress=None):
-    """The CaseOutcome of the case in folder, chunk by chunk; None if this
-    path cannot take it (the in-memory path then runs it). result_file: a
-    path the result is written to as it is made (for the report), or None."""
-    if not isinstance(mode, Pointwise):  # (a tube looks around each sample: the in-memory path)
+@dataclass(frozen=True)
+class Streaming:
+    """How a long case streams: where its result goes, the size of its
+    pieces (tests make them small), its progress bar."""
+    result_file: str | None = None          # the result written here as it is made (for the report), or None
+    steps_per_chunk: int = STEPS_PER_CHUNK  # steps run between two result chunks
+    chunk_bytes: int = CHUNK_BYTES          # CSV text per chunk of a case's files
+    block_bytes: int | None = None          # text per block of a recording's lines (None: recordings.stream's)
+    progress: SampleProgress | None = None  # (None: one on standard error)
+
+
+@dataclass
+class ChunkedCase:
+    """A case given as chunks: input_chunks (None: no inputs) and
+    ref_chunks are consecutive structured arrays, time first."""
+    name: str
+    title: str                  # the figure's
+    options: dict               # StartTime, StopTime, StepSize, RelTol
+    start_values: dict
+    input_names: tuple
+    input_chunks: Iterator | None
+    ref_chunks: Iterator
+    outputs: list
+    t_end: float                # the figure's last time
+    # what the outcome's messages add after the comparison's: more_messages(passed, deviations)
+    more_messages: Callable | None = None
+    started: float = field(default_factory=time.perf_counter)
+
+
+def run_long_case(folder, name, target, settings, streaming: Streaming = Streaming()):
+    """The CaseOutcome of the case in folder on target (a _worker.Target),
+    chunk by chunk; None if this path cannot take it (the in-memory path
+    then runs it)."""
+    if not isinstance(settings.mode, Pointwise):  # (a tube looks around each sample: the in-memory path)
         return None
     started = time.perf_counter()
     folder = Path(folder)
+    fmu, labels = target.fmu, target.labels
     model = fmu.model
     ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
     try:
@@ -81,179 +120,198 @@ def run_long_case(folder, name, runner: Runner, fmu: Fmu, labels: dict, mode: Mo
         bounds["time"] = [first_ref["time"][0], _last_time(ref_path)]
         options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
         start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
-        input_names = ()
+        input_names: tuple[str, ...] = ()
         if in_path.exists():
             first_in = next(trace_chunks(in_path, fmu.input_problem, chunk_bytes=1 << 16))
-            input_names = first_in.dtype.names[1:]
+            input_names = _signal_names(first_in)
             if len(first_in) < 2:
                 return None
     except (InputError, NotPlain, OSError, ValueError, StopIteration):
         return None
-    outputs = list(first_ref.dtype.names[1:])
+    outputs = list(_signal_names(first_ref))
     stop = options["StopTime"]
     readme = (texts.get("README.md") or "").strip().splitlines()
     description = readme[0].lstrip("# ").strip() if readme else ""
 
     def inputs():
-        yield from trace_chunks(in_path, fmu.input_problem, chunk_bytes=chunk_bytes)
+        yield from trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
 
     title = f"{name} on {labels['fmu']}" + (f": {description}" if description else "")
-    return stream_case(name, labels, mode, plots, runner, options, start_values, input_names,
-                       inputs() if input_names else None,
-                       trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=chunk_bytes), outputs,
-                       max(stop, bounds["time"][1]), title, result_file, steps_per_chunk, progress, started=started)
+    case = ChunkedCase(name, title, options, start_values, input_names, inputs() if input_names else None,
+                       trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes), outputs,
+                       max(stop, bounds["time"][1]), started=started)
+    return stream_case(case, target, settings, streaming)
 
 
-def stream_case(name, labels, mode, plots, runner, options, start_values, input_names, input_chunks, ref_chunks,
-                outputs, t_end, title, result_file=None, steps_per_chunk=STEPS_PER_CHUNK, progress=None,
-                more_messages=None, started=None):
-    """The CaseOutcome of a case given as chunks: input_chunks (None: no
-    inputs) and ref_chunks are consecutive structured arrays, time first;
-    options: StartTime, StopTime, StepSize, RelTol. None if this path
-    cannot take it (a chunk raises NotPlain, the fast loop cannot replay
-    it), before anything is reported. more_messages(passed, deviations):
-    what the outcome's messages add after the comparison's."""
-    started = time.perf_counter() if started is None else started
+def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Streaming()):
+    """The CaseOutcome of a case given as chunks on target (a
+    _worker.Target); None if this path cannot take it (a chunk raises
+    NotPlain, the fast loop cannot replay it), before anything is
+    reported."""
+    if not isinstance(settings.mode, Pointwise):  # (a tube looks around each sample: the in-memory path)
+        return None
+    options, outputs, input_names = case.options, case.outputs, case.input_names
     start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
     n = round((stop - start) / step)
-    signals = {name: Verdict(name) for name in outputs}
-    envelopes = {key: Envelope(start, t_end) for key in
-                 [("ref", s) for s in outputs] + [("result", s) for s in outputs] + [("deviation", s) for s in outputs]
-                 + [("input", s) for s in input_names]}
-    zoom = {"at": None, "lines": None}
-    recent = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower, upper, deviation)
-    absent = [0, None]  # reference times without a result sample: count, the first
+    bar = streaming.progress or SampleProgress(n + 1)
+    state = _Comparer(case, settings.mode, bar)
 
-    def inputs():
-        for chunk in input_chunks:
+    def inputs(chunks):
+        for chunk in chunks:
             for s in input_names:
-                envelopes[("input", s)].add(chunk["time"], chunk[s])
+                state.envelopes[("input", s)].add(chunk["time"], chunk[s])
             yield chunk
 
-    results = runner.run_chunks(start, stop, step, inputs() if input_chunks is not None else None, input_names,
-                                start_values, outputs, options["RelTol"], steps_per_chunk=steps_per_chunk)
-    window = []  # result chunks not yet compared: [(first index, chunk)]
-    reached = 0  # result samples made
-    bar = progress or SampleProgress(n + 1)
-    writer = None
+    results = target.runner.run_chunks(Experiment(start, stop, step, options["RelTol"]),
+                                       Signals(inputs(case.input_chunks) if case.input_chunks is not None else None,
+                                               case.start_values, outputs),
+                                       input_names, streaming.steps_per_chunk)
     with contextlib.ExitStack() as stack:
         stack.callback(bar.close)
         stack.callback(results.close)  # given up or done: the run's chunks and pointers go now, not with the frame
-        out = stack.enter_context(open(result_file, "w", newline="\n")) if result_file else None
-
-        def result_until(k):
-            """The result window through sample k (or the end)."""
-            nonlocal reached, writer
-            while reached <= k:
-                chunk = next(results, None)
-                if chunk is None:
-                    return
-                window.append((reached, chunk))
-                reached += len(chunk)
-                for s in outputs:
-                    envelopes[("result", s)].add(chunk["time"], chunk[s])
-                if out is not None:
-                    writer = writer or TraceWriter(out, chunk.dtype.names)
-                    writer.write(chunk)
-                bar.update(reached)
-
+        if streaming.result_file:
+            state.out = stack.enter_context(open(streaming.result_file, "w", newline="\n"))
+        state.results = results
         try:
             held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-            for chunk in ref_chunks:
+            for chunk in case.ref_chunks:
                 if held is not None:
                     chunk = np.concatenate([held, chunk])
                 held = chunk[-1:]
-                _compare_rows(chunk[:-1], chunk["time"][-1], start, step, n, mode, outputs, signals, envelopes, window,
-                         result_until, absent, zoom, recent)
+                state.compare_rows(chunk[:-1], chunk["time"][-1])
             if held is not None:
-                _compare_rows(held, np.nan, start, step, n, mode, outputs, signals, envelopes, window, result_until,
-                         absent, zoom, recent)
-            result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
-            if reached != n + 1:
+                state.compare_rows(held, np.nan)
+            state.result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
+            if state.reached != n + 1:
                 raise FastLoopFailed("the run ended early")
         except (FastLoopFailed, NotPlain):
             return None
-
-    deviations = [signals[s].deviation for s in outputs]
-    outcome = CaseOutcome(name, **labels, streamed=True)
-    problem = ""
-    if absent[0]:
-        problem = f"the result has no sample at t={absent[1]!r} ({absent[0]} reference times without one)"
-    passed = not problem and all(d.passed for d in deviations)
-    outcome.status = Status.PASS if passed else Status.FAIL
-    outcome.deviations = [d for d in deviations if not d.passed]
-    outcome.messages = [problem] if problem else [d.describe() for d in deviations if not d.passed]
-    if more_messages is not None:
-        outcome.messages += more_messages(passed, outcome.deviations)
-    if plots == "all" or (plots == "failed" and not passed):
-        figure = Figure(title, [(s, *envelopes[("input", s)].line()) for s in input_names],
-                        [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
-                        [(s, *envelopes[("deviation", s)].line()) for s in outputs],
-                        (zoom["at"], zoom["lines"]) if zoom["lines"] else None)
-        outcome.png = draw(figure, mode, labels["fmu"])
-    outcome.seconds = time.perf_counter() - started
-    return outcome
+    return state.outcome(case, target.labels, settings)
 
 
-def _compare_rows(rows, next_time, start, step, n, mode, outputs, signals, envelopes, window, result_until, absent, zoom,
-             recent):
-    """Compares reference rows (next_time: the time of the row after the
-    last, NaN if none) with the result, as Pointwise.bands does on the
-    whole: comparison.aligned on the result samples around the rows' times."""
-    if not len(rows):
-        return
-    times = rows["time"]
-    for s in outputs:
-        envelopes[("ref", s)].add(times, rows[s])
-    # the communication points start + k * step from two before the first time to two after the last
-    first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2], 0, n)
-    first, last = int(first), int(last)
-    result_until(last)
-    while len(window) > 1 and window[1][0] <= first:
-        window.pop(0)  # chunks before the first sample needed
-    base = window[0][0]
-    result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
-    result = result[first - base:last - base + 1]
-    if not len(result):
-        raise FastLoopFailed("the run ended early")
-    index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
-    missing = np.flatnonzero(index == -1)
-    if len(missing):
-        if absent[1] is None:
-            absent[1] = float(times[missing[0]])
-        absent[0] += len(missing)
-    use = index >= 0
-    if not use.any():
-        return
-    picked = result[index[use]]
-    compared_times = times[use]
-    failing_now = []
-    for s in outputs:
-        expected = rows[s][use].astype(np.float64)
-        values = picked[s].astype(np.float64)
-        lower, upper, ok = mode.bounds(values, expected)
-        with np.errstate(invalid="ignore", over="ignore"):
-            deviation = values - expected
-        verdict = signals[s].deviation
-        before = verdict.failed
-        signals[s].add(Band(compared_times, values, lower, upper, ok, deviation))
-        envelopes[("deviation", s)].add(compared_times, deviation)
-        if zoom["lines"] is None and verdict.failed > before:
-            failing_now.append(verdict.time)
-        recent[s] = (compared_times, values, lower, upper, deviation)
-    if failing_now and zoom["lines"] is None:
-        at = min(failing_now)
-        zoom["at"], zoom["lines"] = at, []
-        for s in outputs:
-            t, v, lo, up, dev = recent[s]
-            k = int(np.searchsorted(t, at))
-            w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
-            zoom["lines"].append((s, t[w], v[w], lo[w], up[w], dev[w]))
+class _Comparer:
+    """A chunked case's comparison as it goes: the result's window, each
+    signal's verdict, the figure's envelopes and its zoom."""
+
+    def __init__(self, case: ChunkedCase, mode: Pointwise, bar: SampleProgress):
+        options, outputs = case.options, case.outputs
+        self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
+        self.n = round((options["StopTime"] - self.start) / self.step)
+        self.signals = {name: Verdict(name) for name in outputs}
+        self.envelopes = {key: Envelope(self.start, case.t_end) for key in
+                          [("ref", s) for s in outputs] + [("result", s) for s in outputs]
+                          + [("deviation", s) for s in outputs] + [("input", s) for s in case.input_names]}
+        self.zoom_at: float | None = None  # the first failing sample's time, the zoom's lines around it
+        self.zoom_lines: list | None = None
+        self.recent: dict[str, tuple] = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower,
+        # upper, deviation)
+        self.absent = 0  # reference times without a result sample: their count, the first's time
+        self.first_absent: float | None = None
+        self.window: list[tuple[int, np.ndarray]] = []  # result chunks not yet compared: (first index, chunk)
+        self.reached = 0  # result samples made
+        self.results: Iterator[np.ndarray] = iter(())  # the run's chunks
+        self.out: TextIO | None = None  # the result file
+        self.writer: TraceWriter | None = None
+        self.bar = bar
+
+    def result_until(self, k):
+        """The result window through sample k (or the end)."""
+        while self.reached <= k:
+            chunk = next(self.results, None)
+            if chunk is None:
+                return
+            self.window.append((self.reached, chunk))
+            self.reached += len(chunk)
+            for s in self.outputs:
+                self.envelopes[("result", s)].add(chunk["time"], chunk[s])
+            if self.out is not None:
+                self.writer = self.writer or TraceWriter(self.out, chunk.dtype.names)
+                self.writer.write(chunk)
+            self.bar.update(self.reached)
+
+    def compare_rows(self, rows, next_time):
+        """Compares reference rows (next_time: the time of the row after the
+        last, NaN if none) with the result, as Pointwise.bands does on the
+        whole: comparison.aligned on the result samples around the rows' times."""
+        if not len(rows):
+            return
+        start, step, n, window = self.start, self.step, self.n, self.window
+        times = rows["time"]
+        for s in self.outputs:
+            self.envelopes[("ref", s)].add(times, rows[s])
+        # the communication points start + k * step from two before the first time to two after the last
+        first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2],
+                              0, n)
+        first, last = int(first), int(last)
+        self.result_until(last)
+        while len(window) > 1 and window[1][0] <= first:
+            window.pop(0)  # chunks before the first sample needed
+        base = window[0][0]
+        result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
+        result = result[first - base:last - base + 1]
+        if not len(result):
+            raise FastLoopFailed("the run ended early")
+        index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
+        missing = np.flatnonzero(index == -1)
+        if len(missing):
+            if self.first_absent is None:
+                self.first_absent = float(times[missing[0]])
+            self.absent += len(missing)
+        use = index >= 0
+        if not use.any():
+            return
+        self._add(rows, result[index[use]], times[use], use)
+
+    def _add(self, rows, picked, compared_times, use):
+        """Each signal's band on the compared samples; the zoom at the first failing one."""
+        failing_now = []
+        for s in self.outputs:
+            expected = rows[s][use].astype(np.float64)
+            values = picked[s].astype(np.float64)
+            lower, upper, ok = self.mode.bounds(values, expected)
+            with np.errstate(invalid="ignore", over="ignore"):
+                deviation = values - expected
+            verdict = self.signals[s].deviation
+            before = verdict.failed
+            self.signals[s].add(Band(compared_times, values, lower, upper, ok, deviation))
+            self.envelopes[("deviation", s)].add(compared_times, deviation)
+            if self.zoom_lines is None and verdict.failed > before and verdict.time is not None:
+                failing_now.append(verdict.time)
+            self.recent[s] = (compared_times, values, lower, upper, deviation)
+        if failing_now and self.zoom_lines is None:
+            at = min(failing_now)
+            self.zoom_at, self.zoom_lines = at, []
+            for s in self.outputs:
+                t, v, lo, up, dev = self.recent[s]
+                k = int(np.searchsorted(t, at))
+                w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
+                self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w]))
+
+    def outcome(self, case: ChunkedCase, labels, settings):
+        """The case's CaseOutcome once every reference row was compared."""
+        outputs, envelopes = self.outputs, self.envelopes
+        deviations = [self.signals[s].deviation for s in outputs]
+        outcome = CaseOutcome(case.name, **labels, streamed=True)
+        problem = ""
+        if self.absent:
+            problem = f"the result has no sample at t={self.first_absent!r} ({self.absent} reference times without one)"
+        passed = not problem and all(d.passed for d in deviations)
+        outcome.status = Status.PASS if passed else Status.FAIL
+        outcome.deviations = [d for d in deviations if not d.passed]
+        outcome.messages = [problem] if problem else [d.describe() for d in deviations if not d.passed]
+        if case.more_messages is not None:
+            outcome.messages += case.more_messages(passed, outcome.deviations)
+        if settings.plots == "all" or (settings.plots == "failed" and not passed):
+            figure = Figure(case.title, [(s, *envelopes[("input", s)].line()) for s in case.input_names],
+                            [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
+                            [(s, *envelopes[("deviation", s)].line()) for s in outputs],
+                            (self.zoom_at, self.zoom_lines) if self.zoom_lines else None)
+            outcome.png = draw(figure, settings.mode, labels["fmu"])
+        outcome.seconds = time.perf_counter() - case.started
+        return outcome
 
 
-def simulate_long(fmu_path, input_path, out, start_values=None, start_time=None, stop_time=None, step_size=None,
-                  outputs=None, steps_per_chunk: int = STEPS_PER_CHUNK, chunk_bytes: int = CHUNK_BYTES,
-                  progress=None):
+def simulate_long(fmu_path, input_path, out, options: SimulationOptions, streaming: Streaming = Streaming()):
     """fmutrace run on a long input file, chunk by chunk: the result (as
     simulation.simulate gives it, the same bits) written to the text
     stream out as it is made; its samples, or None if this path cannot
@@ -264,8 +322,9 @@ def simulate_long(fmu_path, input_path, out, start_values=None, start_time=None,
             return None
         fmu = Fmu(fmu_path)
         first_in = next(trace_chunks(input_path, fmu.input_problem, chunk_bytes=1 << 16))
-        values = {name: fmu.start_value(name, value) for name, value in (start_values or {}).items()}
-        names = list(outputs) if outputs else fmu.outputs
+        values = {name: fmu.start_value(name, value) for name, value in (options.start_values or {}).items()}
+        names = list(options.outputs) if options.outputs else fmu.outputs
+        start_time, stop_time, step_size = options.start_time, options.stop_time, options.step_size
         if any(fmu.variable_problem(name) for name in names) or len(first_in) < 2:
             return None
         start = float(start_time) if start_time is not None else float(first_in["time"][0])
@@ -277,12 +336,12 @@ def simulate_long(fmu_path, input_path, out, start_values=None, start_time=None,
         return None
     runner = Runner(fmu.path.read_bytes())
     n = round((stop - start) / step)
-    bar = progress or SampleProgress(n + 1)
+    bar = streaming.progress or SampleProgress(n + 1)
     written, writer = 0, None
     try:
-        for chunk in runner.run_chunks(start, stop, step, trace_chunks(input_path, fmu.input_problem,
-                                                                       chunk_bytes=chunk_bytes),
-                                       first_in.dtype.names[1:], values, names, steps_per_chunk=steps_per_chunk):
+        inputs = trace_chunks(input_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+        for chunk in runner.run_chunks(Experiment(start, stop, step), Signals(inputs, values, names),
+                                       _signal_names(first_in), streaming.steps_per_chunk):
             if writer is None:
                 writer = TraceWriter(out, chunk.dtype.names)
             writer.write(chunk)

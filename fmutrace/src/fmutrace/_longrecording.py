@@ -8,9 +8,8 @@ import numpy as np
 
 from ._comparison import Pointwise
 from ._errors import InputError
-from ._longcase import stream_case
+from ._longcase import ChunkedCase, Streaming, stream_case
 from ._recorded import first_differs
-from ._runner import STEPS_PER_CHUNK
 from ._traces import LONG_CASE_BYTES, NotPlain
 from .recordings import stream, timebase
 from .recordings.align import off_cycle_note
@@ -25,12 +24,13 @@ def is_long_recording(path) -> bool:
         return False
 
 
-def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, result_file=None, progress=None,
-                       block_bytes=None, steps_per_chunk=None):
-    """The CaseOutcome of the one-file recording at path, streamed; None
-    if this path cannot take it (the in-memory path then reads it)."""
-    if not isinstance(mode, Pointwise):
+def run_long_recording(path, name, target, settings, streaming: Streaming = Streaming()):
+    """The CaseOutcome of the one-file recording at path on target (a
+    _worker.Target), read with settings.recording, streamed; None if this
+    path cannot take it (the in-memory path then reads it)."""
+    if not isinstance(settings.mode, Pointwise):
         return None
+    fmu, options, block_bytes = target.fmu, settings.recording, streaming.block_bytes
     try:
         table = stream.Table(path, fmu, options)
         recording = table.recording
@@ -45,7 +45,7 @@ def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, re
         return None
     drives, compares = matched.drives, matched.compares
     stop = max(cycles.last + shift, 1) * step
-    pending = {"inputs": [], "refs": []}
+    pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": []}
     row = 0  # the next block's first row, which is its cycle (stream.time_column_pass)
 
     def parse():
@@ -95,12 +95,11 @@ def run_long_recording(path, name, runner, fmu, labels, mode, plots, options, re
             return [description] + notes
         return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
 
-    title = f"{name} on {labels['fmu']}: {recording.format}"
-    return stream_case(name, labels, mode, plots, runner,
+    case = ChunkedCase(name, f"{name} on {target.labels['fmu']}: {recording.format}",
                        {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6}, start_values,
                        tuple(v for v, _ in drives), queue("inputs") if drives else None, queue("refs"),
-                       [v for v, _ in compares], stop, title, result_file, steps_per_chunk or STEPS_PER_CHUNK,
-                       progress, more_messages)
+                       [v for v, _ in compares], stop, more_messages)
+    return stream_case(case, target, settings, streaming)
 
 
 def _explain(table, deviations, channels, step, shift):

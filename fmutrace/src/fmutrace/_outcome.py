@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
 
+import numpy as np
+
 from ._comparison import Deviation, Mode
 from ._errors import ExitStatus
 
@@ -34,7 +36,7 @@ class CaseOutcome:
     messages: list = field(default_factory=list)
     deviations: list = field(default_factory=list)  # Deviation of the failing signals
     seconds: float = 0.0
-    result: object = None    # structured array
+    result: np.ndarray | None = None    # structured array
     png: bytes = b""
     result_path: str = ""    # a long case's result, in a file of its own (the report moves it in)
     csv: str = ""            # paths in the report folder
@@ -94,8 +96,8 @@ class CampaignResult:
     mode: Mode               # the comparison
     where: str = ""
     seconds: float = 0.0
-    report_dir: Path = None
-    _counts: dict = field(default=None, repr=False)  # by status, when known
+    report_dir: Path | None = None
+    _counts: dict | None = field(default=None, repr=False)  # by status, when known
 
     @property
     def passed(self) -> bool:

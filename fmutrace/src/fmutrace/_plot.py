@@ -164,7 +164,7 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         ax.legend(loc="best", fontsize=7)
     deviation_axis = axes.pop()
     many = max((len(r[0]) for _, _, r, _ in figure.signals), default=0) > COLUMNS
-    for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals):
+    for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals, strict=False):
         if band is not None and mode.fills_band:
             ax.fill_between(band[0], band[1], band[2], color="0.85", label=mode.name)
         ax.plot(ref_t, ref_v, **mode.reference_line, label=f"{name} reference")
@@ -179,7 +179,7 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         at, lines = figure.zoom
         zoom_axes = list(grid[has_inputs:, 1])
         zoom_deviation = zoom_axes.pop()
-        for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines):
+        for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines, strict=False):
             ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
             ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=name)
             ax.axvline(at, color="C3", linewidth=0.8)

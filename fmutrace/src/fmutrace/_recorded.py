@@ -18,9 +18,6 @@ from .recordings.matching import plan
 from .recordings.options import RecordingOptions
 from .recordings.timebase import UNIT_NAMES, normalise
 
-_UNITS = {"filetime": "FILETIME"}
-
-
 @dataclass
 class RecordedCase(Case):
     references: list = field(default_factory=list)  # structured arrays, one per time base of the compared channels
@@ -72,7 +69,7 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     if len(found) != 1:
         raise InputError(f"{path}: holds {len(found)} recordings: give them one by one (or their files)")
     recording = found[0]
-    normalise(recording, _UNITS.get(options.time_unit, options.time_unit), options.step_size, fmu.default_step)
+    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step)
     matched = plan(recording, fmu.variables, fmu.label, options.maps)
     aligned = align(recording, matched, options.timing, fmu.label)
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}

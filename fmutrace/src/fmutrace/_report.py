@@ -13,6 +13,15 @@ from ._traces import write_trace
 
 RESULTS_FORMAT = 1
 
+STYLE = ("<style>body{font-family:sans-serif;margin:1em 2em}"
+         "table{border-collapse:collapse;width:100%;table-layout:fixed}\n"
+         "td,th{border:1px solid #ccc;padding:.3em .6em;vertical-align:top;overflow-wrap:anywhere}"
+         "tr.pass td:nth-child(3){color:#176617}\n"
+         "tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){color:#b00;font-weight:bold}"
+         "img{max-width:100%;height:auto}</style>")
+COLUMNS = "<colgroup>" + "".join(f'<col style="width:{w}%">' for w in (16, 10, 28, 6, 40)) + "</colgroup>"
+
+
 
 def write_case_files(outcome: CaseOutcome, report_dir):
     """<fmu folder>/<case>_out.csv and .png; their paths into outcome."""
@@ -54,7 +63,7 @@ def write_junit(campaign: CampaignResult, path):
     totals first (one pass over the cases), then its cases (one pass per FMU)."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     counts = campaign.counts()
-    suites = {}  # fmu -> [tests, failures, errors, seconds]
+    suites: dict[str, list] = {}  # fmu -> [tests, failures, errors, seconds]
     for o in campaign.cases.light():
         totals = suites.setdefault(o.fmu, [0, 0, 0, 0.0])
         totals[0] += 1
@@ -98,12 +107,10 @@ def write_report(campaign: CampaignResult, report_dir):
                                  "| case | FMU | result | seconds | plot |", "|---|---|---|---|---|"]) + "\n")
         page.write(f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
-<style>body{{font-family:sans-serif;margin:1em 2em}}table{{border-collapse:collapse;width:100%;table-layout:fixed}}
-td,th{{border:1px solid #ccc;padding:.3em .6em;vertical-align:top;overflow-wrap:anywhere}}tr.pass td:nth-child(3){{color:#176617}}
-tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){{color:#b00;font-weight:bold}}img{{max-width:100%;height:auto}}</style>
+{STYLE}
 </head><body>
 <h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.mode.describe())}.</p>
-<table><colgroup><col style="width:16%"><col style="width:10%"><col style="width:28%"><col style="width:6%"><col style="width:40%"></colgroup>
+<table>{COLUMNS}
 <tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
 """)
         for o in campaign.cases.light():

@@ -39,6 +39,7 @@ import io
 import itertools
 import math
 from ctypes import c_void_p
+from typing import NamedTuple
 
 import cffi
 import numpy as np
@@ -46,7 +47,7 @@ from fmpy.simulation import apply_start_values, instantiate_fmu, settable_in_ini
     settable_in_instantiated
 
 from ._fmu import REAL_TYPES, unpacked
-from ._fmpy import held_to, run_fmpy
+from ._fmpy import Experiment, Signals, held_to, run_fmpy
 
 # per FMI type: the C type's dtype (fmpy's Input tables and getters) and the
 # recorded column's dtype (fmpy's Recorder)
@@ -177,11 +178,12 @@ class _InputRows:
     steps. Per FMI type the values of the rows that change, as fmpy
     converts them."""
 
-    def __init__(self, chunks, runner, start, stop, step):
-        self.chunks, self.runner, self.grid = chunks, runner, (start, stop, step)
-        self.table, self.offset, self.done = None, 0, False  # offset: the window's first row in the table
+    def __init__(self, chunks, runner, experiment: Experiment):
+        self.chunks, self.runner, self.experiment = chunks, runner, experiment
+        self.table: np.ndarray = np.empty(0)  # the window (offset: its first row in the table)
+        self.offset, self.done = 0, False
         self.last_row = None  # the row set at the last step
-        self.setters = None   # (FMI type, value references, count, dtype, names) per FMI type
+        self.setters: list | None = None   # (FMI type, value references, count, dtype, names) per FMI type
 
     def _read(self):
         chunk = next(self.chunks, None)
@@ -193,24 +195,24 @@ class _InputRows:
             self.setters = [(kind, _value_references(variables), len(variables), r.types[kind][0],
                              [v.name for v in variables])
                             for kind, variables in r._groups(chunk.dtype.names[1:]).items()]
-        self.table = chunk if self.table is None else np.concatenate([self.table, chunk])
-        problem = self.runner.event_problem(*self.grid, self.table)
+        self.table = np.concatenate([self.table, chunk]) if len(self.table) else chunk
+        problem = self.runner.event_problem(self.experiment, self.table)
         if problem:
             raise InputsNeedFmpy(problem)
 
     def reach(self, time):
         """Reads the table until its window reaches past time (each window's events checked as it is read)."""
-        while not self.done and (self.table is None or not (self.table["time"][-1] > time and
+        while not self.done and (not len(self.table) or not (self.table["time"][-1] > time and
                                                             not _close(time, self.table["time"][-1]))):
             self._read()
-        if self.table is None or not len(self.table):
+        if not len(self.table):
             raise FastLoopFailed("no input rows")
 
     def _setter(self, rows):
         """The calls that set the table's rows (global indices): per FMI type
         (function, value references, count, the rows' values)."""
         calls = []
-        for kind, vrs, count, dtype, names in self.setters:
+        for kind, vrs, count, dtype, names in self.setters or ():
             table = np.asarray(np.stack([self.table[name] for name in names]), dtype=dtype)  # fmpy's conversion
             values = np.ascontiguousarray(table[:, rows - self.offset].T)
             calls.append((self.runner._set[kind], vrs, count, values))
@@ -290,12 +292,22 @@ def _set_row(calls, row):
     return status
 
 
-def _steps_python(calls, do_step, component, times, sizes, set_at, setters, getters, flags):
+class _Instance(NamedTuple):
+    """What the step loop calls an instance through: its version's
+    _Fmi2Calls or _Fmi3Calls, its doStep, the instance pointer, and FMI 3's
+    step flags (None for FMI 2)."""
+    calls: type[_Fmi2Calls] | type[_Fmi3Calls]
+    do_step: object
+    component: object
+    flags: tuple | None
+
+
+def _steps_python(instance: _Instance, times, sizes, set_at, setters, getters):
     """Per step: the inputs where they change, doStep, one get per output
     type into the step's row; False as soon as a call fails (or an FMI 3
     step asks to terminate or returns early). getters: (function, value
-    references, count, a pointer to each step's row); calls: the FMU's
-    version's _Fmi2Calls or _Fmi3Calls."""
+    references, count, a pointer to each step's row)."""
+    calls, do_step, component, flags = instance
     set_calls = _setter_calls(calls, component, setters)
     get_calls = [(calls.values(component, function, vrs, count), rows) for function, vrs, count, rows in getters]
     step = calls.step(do_step, component, flags)
@@ -313,14 +325,16 @@ def _steps_python(calls, do_step, component, times, sizes, set_at, setters, gett
 def _call_table(calls):
     """fmutrace_calls of (function, value references, count, rows array, first row's pointer)."""
     table = FFI.new("fmutrace_calls[]", max(len(calls), 1))
-    for entry, (function, vrs, count, values, first) in zip(table, calls):
+    # (no calls get a table of one entry)
+    for entry, (function, vrs, count, values, first) in zip(table, calls, strict=False):
         entry.function, entry.vrs, entry.count = FFI.cast("void (*)(void)", function), vrs, count
         entry.rows, entry.row_bytes = first, values.strides[0]
     return table
 
 
-def _steps_c(calls, do_step, component, times, sizes, set_at, setters, getters):
+def _steps_c(instance: _Instance, times, sizes, set_at, setters, getters):
     """_steps_python's loop in C (_steps.c): the same calls in the same order."""
+    calls, do_step, component, _ = instance
     setter_table = _call_table([(f, vrs, n, values, FFI.cast("char *", values.ctypes.data))
                                 for f, vrs, n, values in setters])
     getter_table = _call_table(getters)
@@ -396,15 +410,16 @@ class Runner:
             return "Int64" if self.fmi3 else "Integer"
         return variable.type
 
-    def fast_path_problem(self, start, stop, step, inputs, outputs):
+    def fast_path_problem(self, experiment: Experiment, inputs, outputs):
         """Why the fast loop would not give fmpy's result for this trace
         (None if it would); see the module's docstring."""
         names = inputs.dtype.names[1:] if inputs is not None else ()
-        return self.static_problem(start, stop, step, names, outputs) or \
-            (self.event_problem(start, stop, step, inputs) if inputs is not None else None)
+        return self.static_problem(experiment, names, outputs) or \
+            (self.event_problem(experiment, inputs) if inputs is not None else None)
 
-    def static_problem(self, start, stop, step, input_names, outputs):
+    def static_problem(self, experiment: Experiment, input_names, outputs):
         """fast_path_problem's reasons that the names and the grid alone give."""
+        start, stop, step = experiment.start, experiment.stop, experiment.step
         n = round((stop - start) / step)
         if n < 1 or not math.isclose(start + n * step, stop):
             return "the stop time is not a whole number of steps from the start"
@@ -416,9 +431,10 @@ class Runner:
                 return f"{name} is a continuous input (fmpy interpolates it)"
         return None
 
-    def event_problem(self, start, stop, step, inputs):
+    def event_problem(self, experiment: Experiment, inputs):
         """fast_path_problem's reason that an input table (or a run of its
         consecutive rows) gives: an input event between communication points."""
+        start, stop, step = experiment.start, experiment.stop, experiment.step
         if self.variable_step:
             events = input_events(inputs)
             events = events[(events > start) & (events < stop) & ~_close(events, start) & ~_close(events, stop)]
@@ -428,15 +444,16 @@ class Runner:
                 return f"an input event at t={events[off][0]!r} between communication points"
         return None
 
-    def run(self, start, stop, step, inputs, start_values, outputs, relative_tolerance=None):
+    def run(self, experiment: Experiment, signals: Signals):
         """The trace's result, as fmpy.simulate_fmu(..., output_interval=step)
         returns it (a structured array). SimulationError if the FMU fails."""
-        inputs = held_to(inputs, stop)  # as run_fmpy gives them to fmpy
+        inputs = held_to(signals.inputs, experiment.stop)  # as run_fmpy gives them to fmpy
         names = inputs.dtype.names[1:] if inputs is not None else ()
-        if self.static_problem(start, stop, step, names, outputs) is None:
+        if self.static_problem(experiment, names, signals.outputs) is None:
             try:  # the input events are checked as the table is read, before the FMU is called
-                chunks = list(self._fast(start, stop, step, None if inputs is None else iter([inputs]), start_values,
-                                         outputs, relative_tolerance, STEPS_PER_CHUNK))
+                chunks = list(self._fast(experiment, Signals(None if inputs is None else iter([inputs]),
+                                                             signals.start_values, signals.outputs),
+                                         STEPS_PER_CHUNK))
                 self.fast_runs += 1
                 return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
             except InputsNeedFmpy:
@@ -444,25 +461,23 @@ class Runner:
             except FastLoopFailed:
                 self._drop_instance()  # a call failed: fmpy tells the story on an instance of its own
         self.fmpy_runs += 1
-        return run_fmpy(self.folder, self.md, start_time=start, stop_time=stop, step_size=step, inputs=inputs,
-                        start_values=start_values, outputs=outputs, relative_tolerance=relative_tolerance)
+        return run_fmpy(self.folder, self.md, experiment, Signals(inputs, signals.start_values, signals.outputs))
 
-    def run_chunks(self, start, stop, step, input_chunks, input_names, start_values, outputs,
-                   relative_tolerance=None, steps_per_chunk=STEPS_PER_CHUNK):
+    def run_chunks(self, experiment: Experiment, signals: Signals, input_names, steps_per_chunk=STEPS_PER_CHUNK):
         """The result of run() in consecutive structured arrays (the first
         holds the start time's row too), the instance kept from chunk to
         chunk: the same bits as run() gives (a test checks it), in memory
-        that does not grow with the length. input_chunks: consecutive
+        that does not grow with the length. signals.inputs: consecutive
         structured arrays of the input table (two rows at least in all),
-        or None. FastLoopFailed where run() would go through fmpy (before
-        the first chunk when the names or the grid say so)."""
-        problem = self.static_problem(start, stop, step, input_names, outputs)
+        or None; input_names: their columns. FastLoopFailed where run()
+        would go through fmpy (before the first chunk when the names or the
+        grid say so)."""
+        problem = self.static_problem(experiment, input_names, signals.outputs)
         if problem:
             raise FastLoopFailed(problem)
         self.fast_runs += 1
         try:
-            yield from self._fast(start, stop, step, input_chunks, start_values, outputs, relative_tolerance,
-                                  steps_per_chunk)
+            yield from self._fast(experiment, signals, steps_per_chunk)
         except FastLoopFailed:
             self._drop_instance()
             raise
@@ -495,16 +510,19 @@ class Runner:
 
     def _groups(self, names):
         """{kind: [variables]} of names, each list in model description order."""
-        groups = {}
-        for name in sorted(names, key=self.order.get):
+        groups: dict[str, list] = {}
+        for name in sorted(names, key=lambda name: self.order[name]):
             v = self.variables[name]
             groups.setdefault(self._kind(v), []).append(v)
         return groups
 
-    def _fast(self, start, stop, step, input_chunks, start_values, outputs, tolerance, steps_per_chunk):
+    def _fast(self, experiment: Experiment, signals: Signals, steps_per_chunk):
         """The fast loop's result chunk by chunk (see run_chunks);
         FastLoopFailed as soon as a call fails or the inputs need fmpy."""
-        inputs = _InputRows(input_chunks, self, start, stop, step) if input_chunks is not None else None
+        start, stop, step, tolerance = experiment.start, experiment.stop, experiment.step, \
+            experiment.relative_tolerance
+        start_values, outputs = signals.start_values, signals.outputs
+        inputs = _InputRows(signals.inputs, self, experiment) if signals.inputs is not None else None
         if inputs is not None:
             inputs.reach(start)  # the first window read (and its events checked) before the FMU is called
         with _quiet():
@@ -514,7 +532,8 @@ class Runner:
         component, calls = self._component, self.calls
 
         # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
-        getters, columns = [], [("time", np.float64)]
+        getters: list[tuple] = []
+        columns: list[tuple[str, type]] = [("time", np.float64)]
         groups = self._groups([name for name in outputs if name != "time"])
         for kind in self.types:
             if kind in groups:
@@ -565,15 +584,15 @@ class Runner:
                     set_at, setters = inputs.steps(times[:-1])
                 else:
                     set_at, setters = np.full(m, -1, dtype=np.int64), []
+                instance = _Instance(calls, self._do_step, component, self._step_flags)
                 if self.c_loop:
-                    done = _steps_c(calls, self._do_step, component, step_times, step_sizes, set_at, setters,
+                    done = _steps_c(instance, step_times, step_sizes, set_at, setters,
                                     [(function, vrs, count, values, pointers[1])
                                      for function, vrs, count, pointers, values, _, _ in getters])
                 else:
-                    done = _steps_python(calls, self._do_step, component, step_times, step_sizes, set_at, setters,
+                    done = _steps_python(instance, step_times, step_sizes, set_at, setters,
                                          [(function, vrs, count, pointers[1:m + 1])
-                                          for function, vrs, count, pointers, _, _, _ in getters],
-                                         self._step_flags)
+                                          for function, vrs, count, pointers, _, _, _ in getters])
                 if not done:
                     raise FastLoopFailed("a step failed")
             chunk = result(slice(1, m + 1), times[1:])

@@ -7,12 +7,14 @@ repeated time the row after the event), calls doStep(t, h) and records
 the outputs at t + h.
 """
 import math
+from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 
 import numpy as np
 
 from ._errors import InputError
+from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
 from ._runner import Runner
 from ._traces import read_trace
@@ -31,7 +33,18 @@ def every_nth(result, start_time, step_size, output_interval):
     return result[steps % n == 0]
 
 
-def simulate(fmu: str | PathLike | Fmu, input: str | PathLike | np.ndarray | None = None,
+@dataclass(frozen=True)
+class SimulationOptions:
+    """A simulation's settings, as simulate takes them (None: its default)."""
+    start_values: dict | None = None
+    start_time: float | None = None
+    stop_time: float | None = None
+    step_size: float | None = None
+    output_interval: float | None = None
+    outputs: list[str] | None = None
+
+
+def simulate(fmu: str | PathLike | Fmu, input: str | PathLike | np.ndarray | None = None, *,
              start_values: dict | None = None, start_time: float | None = None, stop_time: float | None = None,
              step_size: float | None = None, output_interval: float | None = None,
              outputs: list[str] | None = None) -> np.ndarray:
@@ -75,19 +88,19 @@ def simulate(fmu: str | PathLike | Fmu, input: str | PathLike | np.ndarray | Non
     def first(*candidates):
         return next((float(c) for c in candidates if c is not None), None)
 
-    has_input = inputs is not None and len(inputs)
-    start = first(start_time, inputs["time"][0] if has_input else None, fmu.default_start, 0.0)
-    stop = first(stop_time, inputs["time"][-1] if has_input else None, fmu.default_stop)
+    times = inputs["time"] if inputs is not None and len(inputs) else None
+    start = first(start_time, times[0] if times is not None else None, fmu.default_start, 0.0)
+    stop = first(stop_time, times[-1] if times is not None else None, fmu.default_stop)
     step = first(step_size, fmu.default_step)
     if step is None:
-        raise InputError(f"{fmu.label} gives no default step size: give one (--step-size)")
+        raise InputError(f"{fmu.label} gives no default step size: give step_size")
     if not step > 0:
         raise InputError(f"the step size must be greater than 0, not {step!r}")
     if stop is None or not stop > start:
         raise InputError(f"the stop time ({stop!r}) must be after the start time ({start!r})")
     runner = Runner(fmu.path.read_bytes())  # its own loop where it gives fmpy's result, else fmpy's
     try:
-        result = runner.run(start, stop, step, inputs, values, names)
+        result = runner.run(Experiment(start, stop, step), Signals(inputs, values, names))
     finally:
         runner.close()
     return every_nth(result, start, step, output_interval)

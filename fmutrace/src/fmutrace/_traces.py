@@ -24,7 +24,7 @@ import re
 import warnings
 from collections.abc import Callable, Iterator
 from os import PathLike
-from typing import TextIO
+from typing import NamedTuple, TextIO
 
 import numpy as np
 import pyarrow as pa
@@ -90,7 +90,9 @@ def split_cells(line, separator):
         if separator == " ":
             return line.split()
         return [cell.strip() for cell in line.split(separator)]
-    cells, current, quoted = [], [], False
+    cells: list[str] = []
+    current: list[str] = []
+    quoted = False
     for char in line:
         if char == '"':
             quoted = not quoted
@@ -151,7 +153,7 @@ def read_trace(path: str | PathLike, known: Callable[[str], str | None] | None =
     if len(time_columns) > 1:
         raise TraceError(path, header_line, time_columns[1] + 1, f"a second time column {names[time_columns[1]]!r}")
     time_index = time_columns[0]
-    seen = {}
+    seen: dict[str, int] = {}
     for i, name in enumerate(names):
         if not name:
             raise TraceError(path, header_line, i + 1, "a column without a name")
@@ -173,7 +175,7 @@ def read_trace(path: str | PathLike, known: Callable[[str], str | None] | None =
             for j, (name, _) in enumerate(dtype):
                 trace[name] = table[:, j]
             return trace
-    return _read_rows(path, lines, names, order, time_index, separator, dtype, header_line)
+    return _read_rows(path, lines, _Header(names, order, time_index, dtype, header_line), separator)
 
 
 def _plain_body(text, header_line, separator, columns):
@@ -199,8 +201,19 @@ def _plain_body(text, header_line, separator, columns):
     return table
 
 
-def _read_rows(path, lines, names, order, time_index, separator, dtype, header_line):
+class _Header(NamedTuple):
+    """A trace's header: its names, the order of the columns read (time
+    first), the time's column, the array's dtype, its line."""
+    names: list
+    order: list
+    time_index: int
+    dtype: list
+    line: int
+
+
+def _read_rows(path, lines, header: _Header, separator):
     """The general reader: every cell by itself, every problem placed."""
+    names, order, time_index, dtype, header_line = header
     decimal_comma = separator == ";"
     rows = []
     previous_time = -math.inf
@@ -270,7 +283,7 @@ def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None
         except pa.ArrowInvalid as error:
             raise NotPlain(str(error)) from None
         chunk = np.empty(table.num_rows, dtype=dtype)
-        for (field, _), name in zip(dtype, order):
+        for (field, _), name in zip(dtype, order, strict=True):
             chunk[field] = table.column(name).to_numpy()
         del table
         t = chunk["time"]
@@ -330,7 +343,7 @@ def write_trace(path: str | PathLike | TextIO, trace: np.ndarray) -> None:
     'time' first, names quoted, numbers that read back bit for bit,
     Booleans as 0/1. Formatted a block of rows at a time by pyarrow's
     writer (the shortest text that reads back as the same double)."""
-    if not hasattr(path, "write"):
+    if isinstance(path, (str, PathLike)):
         with open(path, "w", newline="\n") as out:
             return write_trace(out, trace)
     writer = TraceWriter(path, trace.dtype.names)

@@ -12,14 +12,15 @@ import sys
 
 from . import __version__
 from ._campaign import compare
+from ._executors import RunOptions
 from ._errors import ExitStatus, InputError, SimulationError
 from ._fmu import Fmu, is_fmu_file
 from ._longcase import simulate_long
+from ._simulation import SimulationOptions, simulate
 from ._outcome import Status
 from .recordings import is_recording
 from .recordings.align import TIMINGS
-from .recordings.options import TIME_UNITS
-from ._simulation import simulate
+from .recordings.options import TIME_UNITS, RecordingOptions
 from ._traces import write_trace
 from ._worker import PLOT_ALL_UP_TO, PLOTS
 
@@ -134,21 +135,22 @@ def parser():
 
 
 def run_command(args, out):
+    options = SimulationOptions(dict(args.set), args.start_time, args.stop_time, args.step_size,
+                                args.output_interval, args.output)
     if args.input and args.output_interval is None:  # a long input runs chunk by chunk, written as it goes
         with open(args.out, "w", newline="\n") if args.out else contextlib.nullcontext(out) as stream:
-            written = simulate_long(args.fmu, args.input, stream, dict(args.set), args.start_time, args.stop_time,
-                                    args.step_size, args.output)
+            written = simulate_long(args.fmu, args.input, stream, options)
         if written is not None:
             if args.out:
                 print(f"{written} samples of {len(args.output or Fmu(args.fmu).outputs)} signals written to "
                       f"{args.out}", file=out)
             return ExitStatus.SUCCESS
-    result = simulate(args.fmu, input=args.input, start_values=dict(args.set), start_time=args.start_time,
-                      stop_time=args.stop_time, step_size=args.step_size, output_interval=args.output_interval,
-                      outputs=args.output)
+    result = simulate(args.fmu, args.input, start_values=options.start_values, start_time=options.start_time,
+                      stop_time=options.stop_time, step_size=options.step_size,
+                      output_interval=options.output_interval, outputs=options.outputs)
     if args.out:
         write_trace(args.out, result)
-        print(f"{len(result)} samples of {len(result.dtype.names) - 1} signals written to {args.out}", file=out)
+        print(f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {args.out}", file=out)
     else:
         write_trace(out, result)
     return ExitStatus.SUCCESS
@@ -163,13 +165,16 @@ def compare_command(args, out):
         raise InputError("no case folder given: name the folders of cases after the FMUs")
     if args.resume and not args.report:
         raise InputError("--resume continues the campaign of a report folder: give it with --report")
-    result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
-                     tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
-                     scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
-                     case_timeout=args.case_timeout, cluster_timeout=args.cluster_timeout, resume=args.resume,
-                     step_size=args.step_size, maps=args.map, start_values=dict(args.set), time_unit=args.time_unit,
-                     timing=args.timing)
-    for o in result.failed(results=False) if not any(map(is_recording, cases)) else result.cases.light():
+    recordings = any(map(is_recording, cases))
+    run = RunOptions(jobs=args.jobs, scheduler=args.scheduler, shared_files=args.shared_files,
+                     case_timeout=args.case_timeout, cluster_timeout=args.cluster_timeout)
+    # the recordings group's flags read recordings; with case folders alone the command ignores them, as it did
+    recording = RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set) if recordings \
+        else RecordingOptions()
+    result = compare(fmus, cases, rel_tol=args.rel_tol, abs_tol=args.abs_tol, tube_time=args.tube_time,
+                     tube_value=args.tube_value, report=args.report, junit=args.junit, plots=args.plots,
+                     resume=args.resume, run=run, recording=recording)
+    for o in result.failed(results=False) if not recordings else result.cases.light():
         if o.status == Status.INVALID:
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
             continue

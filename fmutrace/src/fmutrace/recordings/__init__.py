@@ -77,7 +77,8 @@ def read_recording(paths):
     """A list of Recordings of the files and folders given: each file is
     one recording, except single-point histories (Niagara), which together
     make one (given as their files or as their folder)."""
-    recordings, points = [], []
+    recordings: list[Recording] = []
+    points: list[Recording] = []
     for path in _files([paths] if isinstance(paths, (str, os.PathLike)) else paths):
         recording = read_file(path)
         (points if recording.format == "Niagara history export" else recordings).append(recording)

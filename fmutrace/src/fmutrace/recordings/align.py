@@ -32,7 +32,7 @@ TIMINGS = ("cycle", "fmi")
 
 @dataclass
 class Aligned:
-    inputs: np.ndarray          # structured: time, then the driven variables (None if none)
+    inputs: np.ndarray | None   # structured: time, then the driven variables (None if none)
     references: list            # structured arrays: time, then compared variables sharing those instants
     start_time: float
     stop_time: float
@@ -45,7 +45,8 @@ def _cycles_of(channel, step, notes):
     index, off = cycles(channel.times, step)
     if len(off):
         i = int(off[0])
-        notes.append(off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step))
+        notes.append(off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]),
+                                    step))
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])
@@ -88,7 +89,7 @@ def align(recording, plan, timing="cycle", label="the FMU"):
         grid = np.unique(np.concatenate(indices))
         inputs = np.empty(len(grid), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in plan.drives])
         inputs["time"] = grid * step
-        for (variable, channel), index in zip(plan.drives, indices):
+        for (variable, channel), index in zip(plan.drives, indices, strict=True):
             where = np.searchsorted(index, grid, side="right") - 1
             inputs[variable] = channel.values[np.maximum(where, 0)]
             every = _interval(index)
@@ -96,7 +97,7 @@ def align(recording, plan, timing="cycle", label="the FMU"):
                 coarse.append((variable, every))
     references = []
     last = 0
-    groups = {}
+    groups: dict[bytes, tuple[np.ndarray, list]] = {}  # the cycles' bytes -> (cycles, [(variable, channel)])
     for variable, channel in plan.compares:
         index = _cycles_of(channel, step, notes)
         last = max(last, int(index[-1]) if len(index) else 0)

@@ -3,6 +3,7 @@ line, short rows padded with empty cells), and its columns as channels:
 an empty cell is no sample of that channel (recorders leave cells empty
 where a channel sampled less often)."""
 import operator
+from typing import NamedTuple
 
 import numpy as np
 
@@ -88,11 +89,19 @@ def check_increasing(text, stamps, lines, column, name):
                                                    f"{stamps[i]!r} after {stamps[i - 1]!r}")
 
 
-def channel_from(text, cells, lines, stamps, stamp_present, column, name, decimal_comma, symbol=""):
+class Rows(NamedTuple):
+    """A table's rows: each one's line number, time stamp, and whether its time cell holds something."""
+    lines: np.ndarray
+    stamps: np.ndarray
+    stamp_present: np.ndarray
+
+
+def channel_from(text, cells, table_rows: Rows, column, name, decimal_comma):
     """The channel of one value column: its samples are the rows where both
     its cell and its time cell hold something."""
+    lines, stamps, stamp_present = table_rows
     has = present(cells) & stamp_present
     rows = np.flatnonzero(has)
     values = texts.values(cells[rows], decimal_comma, text, lambda i: int(lines[rows[i]]), column, name)
     return Channel(name=name, stamps=stamps[rows], values=values, file=text.path, column=column,
-                   lines=lines[rows], symbol=symbol)
+                   lines=lines[rows])

@@ -89,7 +89,7 @@ def plan(recording, variables, label, maps=()):
                              f"{', '.join(c.name for c in recording.channels)})")
         taken[variable] = channel
     mapped = {id(c) for c in taken.values()}
-    folded = {}
+    folded: dict[str, list[str]] = {}
     for name in variables:
         folded.setdefault(name.lower(), []).append(name)
     result = Plan()

@@ -2,6 +2,8 @@
 its channel group, as recorded (nothing is resampled onto a common time
 base, so no value is invented). Master (time) channels are the stamps,
 in seconds; channels of text or byte arrays are listed as ignored."""
+from typing import Any, cast
+
 import numpy as np
 
 from .._errors import TraceError
@@ -15,19 +17,16 @@ def sniff(head):
 
 
 def read(path):
-    try:
-        from asammdf import MDF
-    except ImportError:  # pragma: no cover - pinned in requirements.txt
-        raise TraceError(path, 0, 0, "an MDF file: reading it needs the asammdf package") from None
+    from asammdf import MDF  # loaded on first use: it brings pandas, seconds of import for every other command
     try:
         mdf = MDF(str(path))
     except Exception as error:  # asammdf raises many kinds for a damaged file
         raise TraceError(path, 0, 0, f"not a readable MDF file ({error})") from None
     channels, notes = [], []
     try:
-        for group_index, group in enumerate(mdf.groups):
+        for group_index, group in enumerate(cast(list[Any], mdf.groups)):
             master = mdf.masters_db.get(group_index)
-            for channel_index, channel in enumerate(group.channels):
+            for channel_index in range(len(group.channels)):
                 if channel_index == master:
                     continue
                 signal = mdf.get(group=group_index, index=channel_index)

@@ -13,9 +13,9 @@ class Channel:
     values: np.ndarray          # float64
     file: str
     column: int = 0             # 1-based column of its values in a text file, 0 in MDF4
-    lines: np.ndarray = None    # line of each sample in a text file (int64), else None
+    lines: np.ndarray | None = None    # line of each sample in a text file (int64), else None
     symbol: str = ""            # a fuller name the recorder gives too (TwinCAT's SymbolName)
-    times: np.ndarray = None    # seconds from the recording's first sample (normalise())
+    times: np.ndarray | None = None    # seconds from the recording's first sample (normalise())
 
     def where(self, index):
         """'file, line L' of sample index (or the file and channel)."""
@@ -31,10 +31,10 @@ class Recording:
     channels: list
     time_unit: str              # "s", "ms", "us", "ns", "cycles", "FILETIME", "date", "OLE days"
     time_source: str            # why that unit: the header says so, or what was assumed
-    sample_time: float = None   # the recorder's sample interval in seconds, when the file declares it
+    sample_time: float | None = None   # the recorder's sample interval in seconds, when the file declares it
     encoding: str = ""
     notes: list = field(default_factory=list)
-    step_size: float = None     # set by normalise()
+    step_size: float | None = None     # set by normalise()
     step_source: str = ""
 
     @property

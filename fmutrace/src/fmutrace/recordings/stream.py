@@ -43,7 +43,6 @@ HEAD_BYTES = 1 << 20      # read as the in-memory path reads a whole file
 BLOCK_BYTES = 1 << 22     # of text per block of lines after the head
 MAX_INTERVALS = 1 << 16   # distinct intervals between stamps counted for the step (more: the in-memory path)
 _CODECS = {"UTF-8": "utf-8", "UTF-8 (with BOM)": "utf-8", "Windows-1252": "cp1252"}
-_UNITS = {"filetime": "FILETIME"}
 
 
 class Table:
@@ -75,8 +74,7 @@ class Table:
         rows = len(text.lines) - index - 1
         if any(c.stamps.dtype != np.float64 or len(c.values) != rows for c in recording.channels) or rows < 2:
             raise NotPlain("integer stamps, an empty cell or too few rows in the head")
-        time_unit = options.time_unit
-        timebase.normalise(recording, _UNITS.get(time_unit, time_unit), options.step_size, fmu.default_step)
+        timebase.normalise(recording, options.timebase_unit, options.step_size, fmu.default_step)
         self.recording = recording
         self.origin = float(recording.channels[0].stamps[0])
         self.factor = recording.step_size if recording.time_unit == "cycles" else \
@@ -201,7 +199,7 @@ class Cycles:
     rows: int
     last: int               # the last row's cycle
     off: int                # rows stamped more than OFF_CYCLE of a cycle off its end
-    first_off: tuple        # (line, seconds) of the first of them, or None
+    first_off: tuple | None  # (line, seconds) of the first of them, or None
 
 
 def time_column_pass(table, step, block_bytes=None):

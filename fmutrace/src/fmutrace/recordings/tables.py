@@ -97,8 +97,8 @@ def layout(text):
 def read(text):
     index, separator, names, time_columns, index_columns = layout(text)
     header_line = index + 1
-    preamble = [l for l in text.lines[:index] if l.strip()]
-    seen = {}
+    preamble = [line for line in text.lines[:index] if line.strip()]
+    seen: dict[str, int] = {}
     for i, name in enumerate(names):
         if not name:
             raise text.error(header_line, i + 1, "a column without a name")
@@ -112,7 +112,7 @@ def read(text):
         rows, lines = grids.body(text, index + 1, separator)
         if not rows:
             raise text.error(header_line, 0, "no samples: the table has a header line only")
-        for row, line in zip(rows, lines):
+        for row, line in zip(rows, lines, strict=True):
             if len(row) > len(names):
                 raise text.error(int(line), len(names) + 1, f"{len(row)} cells, the header has {len(names)} columns")
         table = grids.grid(rows, len(names))
@@ -143,7 +143,8 @@ def read(text):
             unit, source = timebase.unnamed_unit(stamps, time_name)
     grids.check_increasing(text, stamps, lines, time_column + 1, time_name)
     skip = {time_column} | set(index_columns)
-    channels = [grids.channel_from(text, table[:, j], lines, stamps, stamp_present, j + 1, names[j], decimal_comma)
+    rows = grids.Rows(lines, stamps, stamp_present)
+    channels = [grids.channel_from(text, table[:, j], rows, j + 1, names[j], decimal_comma)
                 for j in range(len(names)) if j not in skip]
     return Recording(paths=[text.path], format=_label(preamble, names, time_name, index_columns), channels=channels,
                      time_unit=unit, time_source=source, encoding=text.encoding)

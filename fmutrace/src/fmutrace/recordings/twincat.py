@@ -48,12 +48,14 @@ def sniff(text):
     return why if found is None else None
 
 
-def _realigned(text, line, key, cells, name_cells, key_columns, separator):
+def _realigned(text, line, key, cells, name_row, separator):
     """A property row with more cells than the Name row: Scope View writes
     a decimal comma in SampleTime[ms] even with ',' as the separator
     ('SampleTime[ms],0,2,SampleTime[ms],1'). Where a group of one channel
     got more cells than it has channels, they are one number; any other
-    misfit cannot be told apart and is an error at the row."""
+    misfit cannot be told apart and is an error at the row. name_row:
+    (the Name row's cells, the columns of its 'Name' keys)."""
+    name_cells, key_columns = name_row
     starts = [j for j, c in enumerate(cells) if c == key]
     if len(starts) != len(key_columns):
         raise text.error(line, 0, f"the row {key!r} has {len(starts)} groups, the Name row {len(key_columns)}")
@@ -88,7 +90,7 @@ def read(text):
     key_columns = [j for j, c in enumerate(name_cells) if c == "Name"]
     for key, (line, cells) in list(header.items()):
         if len(cells) != len(name_cells):
-            header[key] = (line, _realigned(text, line, key, cells, name_cells, key_columns, separator))
+            header[key] = (line, _realigned(text, line, key, cells, (name_cells, key_columns), separator))
     rows, lines = grids.body(text, index, separator if separator != " " else " ")
     if not rows:
         raise text.error(name_line, 0, "no samples: the export has its header only")
@@ -97,7 +99,7 @@ def read(text):
     decimal_comma = separator != ","
     channel_count = len(name_cells) - len(key_columns)
     no_time = max(len(r) for r in rows) <= channel_count and key_columns == [0]
-    groups = []  # (time column or None, [channel columns])
+    groups: list[tuple[int | None, list[int]]] = []  # (time column or None, [channel columns])
     for j in range(len(name_cells)):
         if j in key_columns and not no_time:
             groups.append((j, []))
@@ -133,8 +135,11 @@ def read(text):
             for j in columns:
                 k = rows_columns[columns.index(j)] if no_time else j
                 ms = texts.cell_value(prop("SampleTime[ms]", j))
-                channels.append(grids.channel_from(text, table[:, k], lines, row_stamps * ms, np.ones(len(rows), bool),
-                                                   k + 1, prop("Name", j), decimal_comma, prop("SymbolName", j)))
+                channel = grids.channel_from(text, table[:, k], grids.Rows(lines, row_stamps * ms,
+                                                                           np.ones(len(rows), bool)),
+                                             k + 1, prop("Name", j), decimal_comma)
+                channel.symbol = prop("SymbolName", j)
+                channels.append(channel)
             continue
         cells = table[:, time_column]
         stamp_present = grids.present(cells)
@@ -147,8 +152,10 @@ def read(text):
         stamps[rows_with] = stamps_present
         grids.check_increasing(text, stamps_present, lines[rows_with], time_column + 1, "time")
         for j in columns:
-            channels.append(grids.channel_from(text, table[:, j], lines, stamps, stamp_present, j + 1,
-                                               prop("Name", j), decimal_comma, prop("SymbolName", j)))
+            channel = grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, stamp_present), j + 1,
+                                         prop("Name", j), decimal_comma)
+            channel.symbol = prop("SymbolName", j)
+            channels.append(channel)
     unit = "FILETIME" if filetime else "ms"
     source = ("its stamps are FILETIME ('Full Timestamp')" if filetime
               else "Scope View writes milliseconds from the first point")

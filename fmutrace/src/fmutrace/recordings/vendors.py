@@ -36,7 +36,7 @@ from .tables import CYCLE_WORDS, bare_name
 
 # -- CODESYS 2.3 -----------------------------------------------------------------------
 def _codesys23_header(text):
-    lines = [l for l in text.lines[:3]]
+    lines = list(text.lines[:3])
     if len(lines) < 3 or len(text.lines) < 4:
         return None, "fewer than four lines (title, project, names, samples)"
     if not lines[1].strip().lower().endswith(".pro"):
@@ -58,7 +58,7 @@ def read_codesys23(text):
     rows, lines = grids.body(text, 3, " ")
     if not rows:
         raise text.error(3, 0, "no samples after the names")
-    for row, line in zip(rows, lines):
+    for row, line in zip(rows, lines, strict=True):
         if len(row) != len(names):
             raise text.error(int(line), min(len(row), len(names)) + 1,
                              f"{len(row)} values, the names line has {len(names)}")
@@ -67,7 +67,7 @@ def read_codesys23(text):
     grids.check_increasing(text, stamps, lines, 1, names[0])
     cycles = bare_name(names[0]) in CYCLE_WORDS
     everywhere = np.ones(len(rows), dtype=bool)
-    channels = [grids.channel_from(text, table[:, j], lines, stamps, everywhere, j + 1, names[j], True)
+    channels = [grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, everywhere), j + 1, names[j], True)
                 for j in range(1, len(names))]
     return Recording(paths=[text.path], format="CODESYS 2.3 trace (ASCII file)", channels=channels,
                      time_unit="cycles" if cycles else "ms",
@@ -177,7 +177,7 @@ def read_niagara(text):
     rows, lines = grids.body(text, index + 1, separator)
     if not rows:
         raise text.error(index + 1, 0, "no samples: the history has a header line only")
-    for row, line in zip(rows, lines):
+    for row, line in zip(rows, lines, strict=True):
         if len(row) < 4:
             raise text.error(int(line), len(row) + 1, f"{len(row)} cells: a row holds Timestamp, Trend Flags, "
                                                       "Status and Value")
@@ -205,7 +205,7 @@ def read_niagara(text):
 
 def merge(recordings):
     """One recording of several single-history files (Niagara)."""
-    names = {}
+    names: dict[str, int] = {}
     for recording in recordings:
         for channel in recording.channels:
             if channel.name in names:
