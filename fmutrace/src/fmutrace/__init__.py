@@ -7,6 +7,7 @@ with fmpy and report where they differ from references.
                                 run=fmutrace.RunOptions(jobs=4))
     assert campaign.passed, campaign.summary()
 """
+
 __version__ = "0.2.0"  # the package's version (pyproject.toml reads it from here)
 
 from ._campaign import compare
@@ -20,7 +21,30 @@ from ._simulation import simulate
 from ._traces import read_trace, write_trace
 from .recordings.options import RecordingOptions
 
-__all__ = ["CampaignResult", "Case", "CaseOutcome", "Comparison", "Deviation", "Exact", "ExitStatus", "Fmu",
-           "InputError", "Mode", "RecordingOptions", "RunOptions", "SimulationError", "Status", "Tolerance",
-           "TraceError", "Tube", "compare", "compare_traces", "comparison_mode", "find_cases", "load_case",
-           "read_trace", "simulate", "write_trace"]
+__all__ = [
+    "CampaignResult",
+    "Case",
+    "CaseOutcome",
+    "Comparison",
+    "Deviation",
+    "Exact",
+    "ExitStatus",
+    "Fmu",
+    "InputError",
+    "Mode",
+    "RecordingOptions",
+    "RunOptions",
+    "SimulationError",
+    "Status",
+    "Tolerance",
+    "TraceError",
+    "Tube",
+    "compare",
+    "compare_traces",
+    "comparison_mode",
+    "find_cases",
+    "load_case",
+    "read_trace",
+    "simulate",
+    "write_trace",
+]

@@ -5,6 +5,7 @@ The cases are indexed here (every FMU's cases, found under the folders
 given), run by an executor (executors.py), recorded as they finish (in
 memory, or in the report's journal) and reported at the end.
 """
+
 import time
 from array import array
 from bisect import bisect_right
@@ -30,11 +31,23 @@ from ._worker import PLOTS, CaseSettings, FmuFile, default_plots
 Paths = str | PathLike | Iterable[str | PathLike]  # one path, or several
 
 
-def compare(fmus: Paths, cases: Paths, *, mode: Mode | None = None, rel_tol: float | None = None,
-            abs_tol: float | None = None, tube_time: float | None = None, tube_value: float | None = None,
-            report: str | PathLike | None = None, junit: str | PathLike | None = None, plots: str | None = None,
-            resume: bool = False, progress: TextIO | None = None, run: RunOptions = RunOptions(),
-            recording: RecordingOptions = RecordingOptions()) -> CampaignResult:
+def compare(
+    fmus: Paths,
+    cases: Paths,
+    *,
+    mode: Mode | None = None,
+    rel_tol: float | None = None,
+    abs_tol: float | None = None,
+    tube_time: float | None = None,
+    tube_value: float | None = None,
+    report: str | PathLike | None = None,
+    junit: str | PathLike | None = None,
+    plots: str | None = None,
+    resume: bool = False,
+    progress: TextIO | None = None,
+    run: RunOptions = RunOptions(),
+    recording: RecordingOptions = RecordingOptions(),
+) -> CampaignResult:
     """Replay every case through every FMU and compare with its reference.
 
     fmus        an FMU path, or a list of them (FMI 2 or 3 co-simulation)
@@ -86,26 +99,36 @@ def compare(fmus: Paths, cases: Paths, *, mode: Mode | None = None, rel_tol: flo
         raise InputError("give at least one FMU and one case folder")
     has_recordings = any(is_recording(p) for p in case_paths)
     if recording != RecordingOptions() and not has_recordings:
-        raise InputError("recording options apply to recordings, and only case folders are given: a case folder "
-                         "carries its own settings (<Model>_ref.opt, <Model>_start.csv)")
+        raise InputError(
+            "recording options apply to recordings, and only case folders are given: a case folder "
+            "carries its own settings (<Model>_ref.opt, <Model>_start.csv)"
+        )
     loaded = [Fmu(path) for path in fmu_paths]
     cases_of = index_cases(loaded, case_paths)
     plots = (plots or default_plots(len(cases_of))) if report else "none"
     folders = _report_folders(loaded)
-    work = Work(fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
-                fmus={f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path),
-                                                    "fmu_folder": folders[f.path]}) for f in loaded},
-                settings=CaseSettings(mode, plots, recording, run.case_timeout))
+    work = Work(
+        fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
+        fmus={
+            f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]})
+            for f in loaded
+        },
+        settings=CaseSettings(mode, plots, recording, run.case_timeout),
+    )
     executor = executor_for(len(cases_of), run)
     key = campaign_key(work.fmu_bytes, mode, plots, recording.settings() if has_recordings else None)
     started = time.perf_counter()
     lock = ReportLock(report) if report else None
     try:  # the report folder stays locked until its last file is written
         outcomes, counts, where = _run(cases_of, work, executor, (report, key, resume), progress)
-        kept = JournaledOutcomes(report, Path(report) / JOURNAL, outcomes,
-                                 {str(f.path): folders[f.path] for f in loaded}) if report else KeptOutcomes(outcomes)
-        result = CampaignResult(kept, mode, where, time.perf_counter() - started, Path(report) if report else None,
-                                counts)
+        kept = (
+            JournaledOutcomes(report, Path(report) / JOURNAL, outcomes, {str(f.path): folders[f.path] for f in loaded})
+            if report
+            else KeptOutcomes(outcomes)
+        )
+        result = CampaignResult(
+            kept, mode, where, time.perf_counter() - started, Path(report) if report else None, counts
+        )
         if report:
             write_report(result, report)
         if junit:

@@ -11,6 +11,7 @@
 Every file is checked against the FMU before anything runs: a problem is
 an InputError naming the file, line and column.
 """
+
 import os
 from array import array
 from os import PathLike
@@ -31,13 +32,13 @@ FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
 
 @dataclass
 class Case:
-    name: str               # its folder, relative to the folder searched
+    name: str  # its folder, relative to the folder searched
     model: str
     folder: Path
-    options: dict           # StartTime, StopTime, StepSize, RelTol
-    start_values: dict      # name -> value of the variable's type
+    options: dict  # StartTime, StopTime, StepSize, RelTol
+    start_values: dict  # name -> value of the variable's type
     inputs: np.ndarray | None  # structured array, or None
-    reference: np.ndarray      # structured array
+    reference: np.ndarray  # structured array
     description: str = ""
 
     @property
@@ -68,15 +69,17 @@ def read_options(path, text, reference, fmu):
     options.setdefault("StopTime", float(reference["time"][-1]))
     if "StepSize" not in options:
         if fmu.default_step is None:
-            raise InputError(f"{path}: no StepSize: the file is missing or has none, and {fmu.label} gives no "
-                             "default step size")
+            raise InputError(
+                f"{path}: no StepSize: the file is missing or has none, and {fmu.label} gives no default step size"
+            )
         options["StepSize"] = fmu.default_step
     where = path if text is not None else f"{path} (defaults)"
     if not options["StepSize"] > 0:
         raise TraceError(where, 0, 0, f"StepSize {options['StepSize']!r} must be greater than 0")
     if not options["StopTime"] > options["StartTime"]:
-        raise TraceError(where, 0, 0, f"StopTime {options['StopTime']!r} must be after StartTime "
-                                      f"{options['StartTime']!r}")
+        raise TraceError(
+            where, 0, 0, f"StopTime {options['StopTime']!r} must be after StartTime {options['StartTime']!r}"
+        )
     return options
 
 
@@ -150,9 +153,9 @@ class CaseList(Sequence):
     that (a case folder given itself, a name prefixed) keep it as text."""
 
     def __init__(self, roots, names, root_of, folders):
-        self.roots = roots                           # the folders searched, as text
-        self.names, self.root_of = names, root_of    # per case: its name, the index of its root
-        self.folders = folders                       # case index -> folder, where it is not root/name
+        self.roots = roots  # the folders searched, as text
+        self.names, self.root_of = names, root_of  # per case: its name, the index of its root
+        self.folders = folders  # case index -> folder, where it is not root/name
 
     def __len__(self):
         return len(self.names)
@@ -199,8 +202,12 @@ def find_cases(paths: Sequence[str | PathLike], model: str) -> CaseList:
             names.append(name)
             root_of.append(len(roots) - 1)
     order = sorted(range(len(names)), key=names.__getitem__)
-    return CaseList(roots, [names[i] for i in order], array("H", (root_of[i] for i in order)),
-                    {new: folders[old] for new, old in enumerate(order) if old in folders})
+    return CaseList(
+        roots,
+        [names[i] for i in order],
+        array("H", (root_of[i] for i in order)),
+        {new: folders[old] for new, old in enumerate(order) if old in folders},
+    )
 
 
 def _walk(folder, relative, file_name, seen):

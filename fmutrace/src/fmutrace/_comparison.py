@@ -22,6 +22,7 @@ of steps); at a repeated time the reference's last row, the value from
 that instant on, is the one compared. A reference sample without a
 result sample at its time fails.
 """
+
 import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -36,11 +37,12 @@ TIME_MATCH = 1e-9  # seconds below |t| = 1 s, relative above
 @dataclass(frozen=True)
 class Band:
     """One signal's compared samples and the band each must lie in."""
+
     times: np.ndarray
-    values: np.ndarray     # the result's, as float64
+    values: np.ndarray  # the result's, as float64
     lower: np.ndarray
     upper: np.ndarray
-    ok: np.ndarray         # the sample passes
+    ok: np.ndarray  # the sample passes
     deviation: np.ndarray  # what the report plots under the signals
 
 
@@ -49,6 +51,7 @@ class Deviation:
     """A signal's verdict; for a failing signal where it first leaves the
     band (time, result, the band's bounds, by how much) and the largest
     excess."""
+
     name: str
     passed: bool
     compared: int = 0
@@ -70,19 +73,25 @@ class Deviation:
         if self.note:
             return f"{self.name}: {self.note}"
         band = f"{self.lower!r}" if self.lower == self.upper else f"[{self.lower!r}, {self.upper!r}]"
-        return (f"{self.name} leaves the band first at t={self.time!r}: {self.value!r}, expected {band}, "
-                f"off by {self.excess:.6g}; {self.failed} of {self.compared} samples outside, "
-                f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}")
+        return (
+            f"{self.name} leaves the band first at t={self.time!r}: {self.value!r}, expected {band}, "
+            f"off by {self.excess:.6g}; {self.failed} of {self.compared} samples outside, "
+            f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}"
+        )
 
     def to_json(self) -> dict:
         """The fields that have a value; NaN and infinities as "nan", "inf", "-inf" (JSON has none)."""
-        return {k: repr(v) if isinstance(v, float) and not math.isfinite(v) else v
-                for k, v in vars(self).items() if v is not None and v != ""}
+        return {
+            k: repr(v) if isinstance(v, float) and not math.isfinite(v) else v
+            for k, v in vars(self).items()
+            if v is not None and v != ""
+        }
 
     @classmethod
     def from_json(cls, entry: dict) -> "Deviation":
-        fields: dict[str, Any] = {k: float(v) if k in cls.NUMBERS and isinstance(v, str) else v
-                                  for k, v in entry.items()}
+        fields: dict[str, Any] = {
+            k: float(v) if k in cls.NUMBERS and isinstance(v, str) else v for k, v in entry.items()
+        }
         return cls(**fields)
 
 
@@ -106,10 +115,10 @@ class Mode:
     """How a result is judged against a reference (a frozen dataclass of
     its settings)."""
 
-    name: ClassVar[str]               # in results.json
-    fills_band: ClassVar[bool]        # the plot draws the band (else the reference is it)
-    reference_line: ClassVar[dict]    # how the plot draws the reference (matplotlib)
-    deviation_label: ClassVar[str]    # what the plot's last axis shows
+    name: ClassVar[str]  # in results.json
+    fills_band: ClassVar[bool]  # the plot draws the band (else the reference is it)
+    reference_line: ClassVar[dict]  # how the plot draws the reference (matplotlib)
+    deviation_label: ClassVar[str]  # what the plot's last axis shows
 
     def settings(self) -> dict:
         """The arguments of comparison_mode that make this mode."""
@@ -148,8 +157,10 @@ class Pointwise(Mode):
         absent = np.flatnonzero(index == -1)
         if not len(absent):
             return bands, ""
-        return bands, (f"the result has no sample at t={float(reference['time'][absent[0]])!r} "
-                       f"({len(absent)} reference times without one)")
+        return bands, (
+            f"the result has no sample at t={float(reference['time'][absent[0]])!r} "
+            f"({len(absent)} reference times without one)"
+        )
 
 
 @dataclass(frozen=True)
@@ -181,8 +192,9 @@ class Tolerance(Pointwise):
         with np.errstate(invalid="ignore"):
             allowed = self.abs_tol + self.rel_tol * np.abs(expected)
             lower, upper = expected - allowed, expected + allowed
-            ok = ((values >= lower) & (values <= upper)) | (np.isnan(values) & np.isnan(expected)) | \
-                (values == expected)  # an infinity equal to its reference (its band is NaN)
+            ok = (
+                ((values >= lower) & (values <= upper)) | (np.isnan(values) & np.isnan(expected)) | (values == expected)
+            )  # an infinity equal to its reference (its band is NaN)
         return lower, upper, ok
 
 
@@ -208,8 +220,9 @@ class Tube(Mode):
     def bands(self, result, reference, names):
         bands = {}
         for name in names:
-            lower, upper = tube_bounds(reference["time"], reference[name].astype(np.float64), result["time"],
-                                       self.time, self.value)
+            lower, upper = tube_bounds(
+                reference["time"], reference[name].astype(np.float64), result["time"], self.time, self.value
+            )
             inside = ~np.isnan(lower)  # the samples inside the reference's time range
             values, lower, upper = result[name].astype(np.float64)[inside], lower[inside], upper[inside]
             with np.errstate(invalid="ignore"):
@@ -230,8 +243,9 @@ def _check_widths(mode, **options):
 EXACT = Exact()
 
 
-def comparison_mode(rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float | None = None,
-                    tube_value: float | None = None) -> Mode:
+def comparison_mode(
+    rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float | None = None, tube_value: float | None = None
+) -> Mode:
     """The mode the command's options (and compare's arguments of the same
     names) choose: a tube, a tolerance, else exact. InputError if they do
     not make one."""
@@ -316,10 +330,13 @@ def tube_bounds(reference_time, reference_values, times, tube_time, tube_value):
         if not t_first <= t <= t_last:
             continue
         start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
-        inside = reference_values[np.searchsorted(reference_time, start, "left"):
-                                  np.searchsorted(reference_time, end, "right")]
-        edges = [_polyline_at(reference_time, reference_values, start),
-                 _polyline_at(reference_time, reference_values, end)]
+        inside = reference_values[
+            np.searchsorted(reference_time, start, "left") : np.searchsorted(reference_time, end, "right")
+        ]
+        edges = [
+            _polyline_at(reference_time, reference_values, start),
+            _polyline_at(reference_time, reference_values, end),
+        ]
         window = np.concatenate([inside, edges])
         if np.isnan(window).all():
             continue

@@ -1,12 +1,13 @@
 """What goes wrong, as exceptions that carry the command's exit status.
 The statuses are decided here, once; a campaign's is its worst case's
 (outcome.Status)."""
+
 from enum import IntEnum
 
 
 class ExitStatus(IntEnum):
-    SUCCESS = 0    # compare: every case passes
-    FAILURE = 1    # a result differs from its reference, or the FMU failed
+    SUCCESS = 0  # compare: every case passes
+    FAILURE = 1  # a result differs from its reference, or the FMU failed
     BAD_INPUT = 2  # usage, a file, an option: nothing a simulation can mend
 
 

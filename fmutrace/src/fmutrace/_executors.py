@@ -12,6 +12,7 @@ every worker) and returns the outcomes with their results and plots, so
 workers need the same Python packages (fmutrace itself is uploaded to
 them) but no shared file system; the report is written by the caller.
 """
+
 import atexit
 import contextlib
 import functools
@@ -33,10 +34,10 @@ from ._runner import Runner
 from ._worker import CaseSettings, FmuFile, Target, run_case, run_cases
 from .recordings import is_recording
 
-BATCH_CASES = 256              # cases per Dask task at most
-BATCH_TEXT_BYTES = 2_000_000   # of case files' text per task at most, when they are sent
-CLUSTER_ATTEMPTS = 2           # a local cluster whose start fails (a worker lost) is started again, once
-BATCH_ATTEMPTS = 3             # a batch lost with its worker is sent again, so many times in all
+BATCH_CASES = 256  # cases per Dask task at most
+BATCH_TEXT_BYTES = 2_000_000  # of case files' text per task at most, when they are sent
+CLUSTER_ATTEMPTS = 2  # a local cluster whose start fails (a worker lost) is started again, once
+BATCH_ATTEMPTS = 3  # a batch lost with its worker is sent again, so many times in all
 # Dask keeps its last messages for its developers (distributed.admin.low-level-log-length, 1000): a
 # message that sends a batch keeps the batch's cases, so a campaign's client (and a local cluster's
 # scheduler, in its process) would grow with the first 1000 batches. A few are enough here.
@@ -66,6 +67,7 @@ class RunOptions:
                      processes)
     cluster_timeout  seconds to wait for a cluster's results (None: no bound)
     """
+
     jobs: int | None = 1
     scheduler: str | None = None
     shared_files: bool = False
@@ -84,8 +86,9 @@ class RunOptions:
 @dataclass(frozen=True)
 class Work:
     """What every case of a campaign is run with."""
-    fmu_bytes: dict            # FMU path -> the file's bytes
-    fmus: dict                 # FMU path -> its FmuFile
+
+    fmu_bytes: dict  # FMU path -> the file's bytes
+    fmus: dict  # FMU path -> its FmuFile
     settings: CaseSettings
 
 
@@ -122,9 +125,13 @@ class ChildProcesses(Executor):
             by_fmu.setdefault(fmu, []).append((i, folder, name))
         for fmu, cases in by_fmu.items():
             arrived = iter(cases)
-            run_isolated([(str(folder), name, None) for _, folder, name in cases], work.fmu_bytes[fmu.path],
-                         work.fmus[fmu.path], work.settings,
-                         on_outcome=lambda outcome, arrived=arrived: finished(next(arrived)[0], outcome))
+            run_isolated(
+                [(str(folder), name, None) for _, folder, name in cases],
+                work.fmu_bytes[fmu.path],
+                work.fmus[fmu.path],
+                work.settings,
+                on_outcome=lambda outcome, arrived=arrived: finished(next(arrived)[0], outcome),
+            )
 
 
 def run_batch(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, isolate: bool):
@@ -144,8 +151,12 @@ class Dask(Executor):
     the files' texts. cluster_timeout bounds the wait for the cluster."""
 
     def __init__(self, jobs: int, options: RunOptions):
-        self.jobs, self.scheduler, self.shared_files, self.cluster_timeout = jobs, options.scheduler, \
-            options.shared_files, options.cluster_timeout
+        self.jobs, self.scheduler, self.shared_files, self.cluster_timeout = (
+            jobs,
+            options.scheduler,
+            options.shared_files,
+            options.cluster_timeout,
+        )
 
     def run(self, todo, work, finished):
         import dask
@@ -192,9 +203,14 @@ class Dask(Executor):
             with dask.config.set(LOCAL_CLUSTER):
                 # no dashboard, and the scheduler's HTTP server (health, metrics) on a free loopback port:
                 # dashboard_address=None alone still takes port 8787 (and warns where that is in use)
-                cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                                       silence_logs=logging.CRITICAL)
+                cluster = LocalCluster(
+                    n_workers=self.jobs,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                    silence_logs=logging.CRITICAL,
+                )
             return cluster, Client(cluster)
         except Exception:
             if cluster is not None:
@@ -218,8 +234,9 @@ class Dask(Executor):
         def submit(fmu, batch, isolated, attempt):
             self.submitted = True
             items = [(folder, name, texts) for _, folder, name, texts in batch]
-            future = client.submit(run_batch, items, shared[fmu.path], work.fmus[fmu.path], work.settings, isolated,
-                                   pure=False)
+            future = client.submit(
+                run_batch, items, shared[fmu.path], work.fmus[fmu.path], work.settings, isolated, pure=False
+            )
             submitted[future] = fmu, batch, isolated, attempt
             in_flight.add(future)
 
@@ -244,9 +261,15 @@ class Dask(Executor):
                     shared[fmu.path] = client.scatter(work.fmu_bytes[fmu.path], broadcast=True)
                     submit(fmu, batch, True, attempt + 1)  # isolated: a crashing case fails alone
                     continue
-                outcomes = [CaseOutcome(name, **work.fmus[fmu.path].labels, status=Status.ERROR,
-                                        messages=[f"lost with its Dask worker {attempt} times: {type(error).__name__}: "
-                                                  f"{error}"]) for _, _, name, _ in batch]
+                outcomes = [
+                    CaseOutcome(
+                        name,
+                        **work.fmus[fmu.path].labels,
+                        status=Status.ERROR,
+                        messages=[f"lost with its Dask worker {attempt} times: {type(error).__name__}: {error}"],
+                    )
+                    for _, _, name, _ in batch
+                ]
             for (i, _, _, _), outcome in zip(batch, outcomes, strict=True):
                 finished(i, outcome)
             del outcomes

@@ -1,6 +1,7 @@
 """fmpy's own co-simulation loop (fmpy.simulate_fmu), for the traces the
 Runner's fast loop cannot replay: its result as a structured array, a
 failure as a SimulationError that quotes what the FMU said."""
+
 import contextlib
 import io
 from dataclasses import dataclass
@@ -15,6 +16,7 @@ from ._errors import SimulationError
 class Experiment:
     """A simulation's time frame, as an FMU's DefaultExperiment gives it:
     from start to stop in communication steps of step."""
+
     start: float
     stop: float
     step: float
@@ -26,6 +28,7 @@ class Signals:
     """What a simulation is fed and records: inputs (a structured array,
     time first, or None; or consecutive such arrays where a run takes
     chunks), start values {name: value} and the outputs' names."""
+
     inputs: object
     start_values: dict
     outputs: list
@@ -41,8 +44,14 @@ def held_to(inputs, stop_time):
     return np.concatenate([inputs, last])
 
 
-def run_fmpy(fmu_location, model_description, experiment: Experiment, signals: Signals, fmi_type="CoSimulation",
-             debug_logging=False):
+def run_fmpy(
+    fmu_location,
+    model_description,
+    experiment: Experiment,
+    signals: Signals,
+    fmi_type="CoSimulation",
+    debug_logging=False,
+):
     """One simulation: the result as a structured array ('time' first). A
     failure is a SimulationError that quotes the FMU's warnings and errors:
     an FMI 3 FMU logs nothing unless logging is on, so a failed run that
@@ -71,8 +80,11 @@ def run_fmpy(fmu_location, model_description, experiment: Experiment, signals: S
                 # Model Exchange: no continuous states, so the solver only
                 # carries the time from event to event; a row per output
                 # point, as Co-Simulation records, not one per event too
-                **({"solver": "Euler", "step_size": step_size, "record_events": False}
-                   if fmi_type == "ModelExchange" else {}),
+                **(
+                    {"solver": "Euler", "step_size": step_size, "record_events": False}
+                    if fmi_type == "ModelExchange"
+                    else {}
+                ),
             )
     except Exception as error:  # fmpy raises FMICallException and plain Exceptions
         said = fmu_messages(printed.getvalue())

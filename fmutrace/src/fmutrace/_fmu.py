@@ -1,6 +1,7 @@
 """What fmutrace needs to know of an FMU: its variables (to check a trace's
 columns and start values before anything runs) and its default
 experiment; and the FMU unpacked once per process for fmpy."""
+
 import hashlib
 import math
 import os
@@ -16,9 +17,15 @@ from ._errors import InputError
 from ._traces import BOOLEAN_WORDS
 
 INTEGER_RANGES = {
-    "Integer": (-2**31, 2**31 - 1), "Int8": (-2**7, 2**7 - 1), "UInt8": (0, 2**8 - 1),
-    "Int16": (-2**15, 2**15 - 1), "UInt16": (0, 2**16 - 1), "Int32": (-2**31, 2**31 - 1),
-    "UInt32": (0, 2**32 - 1), "Int64": (-2**63, 2**63 - 1), "UInt64": (0, 2**64 - 1),
+    "Integer": (-(2**31), 2**31 - 1),
+    "Int8": (-(2**7), 2**7 - 1),
+    "UInt8": (0, 2**8 - 1),
+    "Int16": (-(2**15), 2**15 - 1),
+    "UInt16": (0, 2**16 - 1),
+    "Int32": (-(2**31), 2**31 - 1),
+    "UInt32": (0, 2**32 - 1),
+    "Int64": (-(2**63), 2**63 - 1),
+    "UInt64": (0, 2**64 - 1),
 }
 REAL_TYPES = ("Real", "Float32", "Float64")  # FMI 2 and FMI 3 floating-point types
 
@@ -60,8 +67,10 @@ class Fmu:
         if variable is None:
             return f"unknown column {name!r}: {self.label} has no variable of that name"
         if variable.causality != "input" and variable.variability != "tunable":
-            return (f"column {name!r} is a {variable.variability} {variable.causality} of {self.label}: "
-                    "only inputs and tunable parameters can change during a run")
+            return (
+                f"column {name!r} is a {variable.variability} {variable.causality} of {self.label}: "
+                "only inputs and tunable parameters can change during a run"
+            )
         return None
 
     def variable_problem(self, name):
@@ -76,10 +85,14 @@ class Fmu:
         variable = self.variables.get(name)
         if variable is None:
             raise InputError(f"{name!r} is not a variable of {self.label}")
-        if variable.causality not in ("parameter", "structuralParameter", "input") or \
-                variable.variability == "constant":
-            raise InputError(f"{name!r} is a {variable.variability} {variable.causality} of {self.label}: only "
-                             "parameters and inputs have start values to set")
+        if (
+            variable.causality not in ("parameter", "structuralParameter", "input")
+            or variable.variability == "constant"
+        ):
+            raise InputError(
+                f"{name!r} is a {variable.variability} {variable.causality} of {self.label}: only "
+                "parameters and inputs have start values to set"
+            )
         text = str(value).strip()
         kind = variable.type
         if kind == "Boolean":
@@ -106,8 +119,10 @@ class Fmu:
         if kind == "Enumeration":
             items = {int(item.value): item.name for item in variable.declaredType.items}
             if number not in items:
-                raise InputError(f"{name} is an enumeration {variable.declaredType.name}: {number} is not one of its "
-                                 f"values ({', '.join(f'{v} {n}' for v, n in sorted(items.items()))})")
+                raise InputError(
+                    f"{name} is an enumeration {variable.declaredType.name}: {number} is not one of its "
+                    f"values ({', '.join(f'{v} {n}' for v, n in sorted(items.items()))})"
+                )
         else:
             low, high = INTEGER_RANGES.get(kind, (-math.inf, math.inf))
             if not low <= number <= high:
@@ -119,8 +134,11 @@ class Fmu:
         declared = variable.declaredType
         low = _float(variable.min if variable.min is not None else declared and declared.min)
         high = _float(variable.max if variable.max is not None else declared and declared.max)
-        if (low is not None and number < low) or (high is not None and number > high) or \
-                (math.isnan(number) and (low is not None or high is not None)):
+        if (
+            (low is not None and number < low)
+            or (high is not None and number > high)
+            or (math.isnan(number) and (low is not None or high is not None))
+        ):
             bounds = f"[{'-inf' if low is None else f'{low:g}'}, {'inf' if high is None else f'{high:g}'}]"
             raise InputError(f"{variable.name} = {text} is outside its range {bounds}")
 

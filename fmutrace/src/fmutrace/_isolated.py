@@ -12,6 +12,7 @@ when it starts each case (an empty record): the timeout counts from there,
 so a child's start-up (imports, the FMU unpacked), slow on a loaded
 machine, is never charged to a case.
 """
+
 import os
 import pickle
 import queue
@@ -70,12 +71,17 @@ def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outc
     labels, case_timeout = fmu.labels, settings.case_timeout
     outcomes = []
     remaining = list(items)
-    environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))
+    environment = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(
+            [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
+        ),
+    )
     while remaining:
         said = tempfile.TemporaryFile()  # the child's last words, if it dies
-        child = subprocess.Popen([sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                 stderr=said, env=environment)
+        child = subprocess.Popen(
+            [sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=said, env=environment
+        )
         assert child.stdin is not None  # (a pipe: stdin=PIPE)
         child.stdin.write(pickle.dumps((remaining, fmu_bytes, fmu, settings)))
         child.stdin.close()
@@ -91,22 +97,29 @@ def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outc
             except queue.Empty:
                 child.kill()
                 child.wait()
-                why = f"stopped after the per-case timeout of {case_timeout:g} s" if running else \
-                    f"the simulation's process did not start the case within {START_SECONDS:g} s"
-                outcome = CaseOutcome(name, **labels, status=Status.ERROR, messages=[why],
-                                      seconds=time.monotonic() - started)
+                why = (
+                    f"stopped after the per-case timeout of {case_timeout:g} s"
+                    if running
+                    else f"the simulation's process did not start the case within {START_SECONDS:g} s"
+                )
+                outcome = CaseOutcome(
+                    name, **labels, status=Status.ERROR, messages=[why], seconds=time.monotonic() - started
+                )
             if outcome is None:  # the child died running this case
                 code = child.wait()
                 cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
-                outcome = CaseOutcome(name, **labels, status=Status.ERROR,
-                                        messages=[f"the simulation's process was {cause} while running this case"
-                                                  + _last_words(said)],
-                                        seconds=time.monotonic() - started)
+                outcome = CaseOutcome(
+                    name,
+                    **labels,
+                    status=Status.ERROR,
+                    messages=[f"the simulation's process was {cause} while running this case" + _last_words(said)],
+                    seconds=time.monotonic() - started,
+                )
             outcomes.append(outcome)
             if on_outcome:
                 on_outcome(outcome)
             if outcome.status == Status.ERROR and child.poll() is not None:
-                remaining = remaining[index + 1:]
+                remaining = remaining[index + 1 :]
                 break
         else:
             remaining = []
@@ -119,6 +132,7 @@ def main():
     out = os.fdopen(os.dup(1), "wb")
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes
+
     def started():
         out.write(HEADER.pack(0))
         out.flush()
@@ -129,4 +143,3 @@ def main():
         out.write(HEADER.pack(len(data)) + data)
         out.flush()
     return 0
-

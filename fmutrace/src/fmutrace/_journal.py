@@ -8,6 +8,7 @@ The first line describes the campaign (comparison, plots, the FMUs by
 content hash); a resumed campaign must be the same campaign. A line cut
 short by a kill is ignored (its case runs again).
 """
+
 import hashlib
 import json
 import os
@@ -62,8 +63,10 @@ class ReportLock:
             self.file.seek(1)
             holder = self.file.read().strip() or "another process"
             self.file.close()
-            raise InputError(f"{self.folder}: another campaign is writing this report folder ({holder}); wait for "
-                             "it to finish or choose another folder") from None
+            raise InputError(
+                f"{self.folder}: another campaign is writing this report folder ({holder}); wait for "
+                "it to finish or choose another folder"
+            ) from None
         self.file.seek(0)
         self.file.truncate()
         self.file.write(f" pid {os.getpid()}\n")
@@ -80,8 +83,12 @@ class ReportLock:
 def campaign_key(fmu_bytes: dict, mode: Mode, plots: str, recordings: dict | None = None) -> dict:
     """What makes a campaign the same campaign: its FMUs (by content), comparison, plots and how
     recordings are read."""
-    key = {"mode": mode.name, "tolerance": mode.settings(), "plots": plots,
-           "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values())}
+    key = {
+        "mode": mode.name,
+        "tolerance": mode.settings(),
+        "plots": plots,
+        "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values()),
+    }
     if recordings:
         key["recordings"] = recordings
     return key
@@ -103,8 +110,10 @@ class Journal:
             with open(self.path, "rb") as journal:
                 header = _parse(journal.readline())
                 if header is not None and header.get("campaign") != key:
-                    raise InputError(f"{self.path}: made by a campaign with other FMUs or options; resume it with "
-                                     "the same ones, or start afresh without --resume")
+                    raise InputError(
+                        f"{self.path}: made by a campaign with other FMUs or options; resume it with "
+                        "the same ones, or start afresh without --resume"
+                    )
                 offset = journal.tell()
                 for line in journal:
                     entry = _parse(line)

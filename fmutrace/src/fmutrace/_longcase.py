@@ -17,6 +17,7 @@ cannot replay, a failing FMU) goes to the in-memory path, which reads it
 or explains it: `run_long_case` returns None then, before anything is
 reported.
 """
+
 import contextlib
 import os
 import time
@@ -74,10 +75,11 @@ def _last_time(path):
 class Streaming:
     """How a long case streams: where its result goes, the size of its
     pieces (tests make them small), its progress bar."""
-    result_file: str | None = None          # the result written here as it is made (for the report), or None
+
+    result_file: str | None = None  # the result written here as it is made (for the report), or None
     steps_per_chunk: int = STEPS_PER_CHUNK  # steps run between two result chunks
-    chunk_bytes: int = CHUNK_BYTES          # CSV text per chunk of a case's files
-    block_bytes: int | None = None          # text per block of a recording's lines (None: recordings.stream's)
+    chunk_bytes: int = CHUNK_BYTES  # CSV text per chunk of a case's files
+    block_bytes: int | None = None  # text per block of a recording's lines (None: recordings.stream's)
     progress: SampleProgress | None = None  # (None: one on standard error)
 
 
@@ -85,15 +87,16 @@ class Streaming:
 class ChunkedCase:
     """A case given as chunks: input_chunks (None: no inputs) and
     ref_chunks are consecutive structured arrays, time first."""
+
     name: str
-    title: str                  # the figure's
-    options: dict               # StartTime, StopTime, StepSize, RelTol
+    title: str  # the figure's
+    options: dict  # StartTime, StopTime, StepSize, RelTol
     start_values: dict
     input_names: tuple
     input_chunks: Iterator | None
     ref_chunks: Iterator
     outputs: list
-    t_end: float                # the figure's last time
+    t_end: float  # the figure's last time
     # what the outcome's messages add after the comparison's: more_messages(passed, deviations)
     more_messages: Callable | None = None
     started: float = field(default_factory=time.perf_counter)
@@ -137,9 +140,18 @@ def run_long_case(folder, name, target, settings, streaming: Streaming = Streami
         yield from trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
 
     title = f"{name} on {labels['fmu']}" + (f": {description}" if description else "")
-    case = ChunkedCase(name, title, options, start_values, input_names, inputs() if input_names else None,
-                       trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes), outputs,
-                       max(stop, bounds["time"][1]), started=started)
+    case = ChunkedCase(
+        name,
+        title,
+        options,
+        start_values,
+        input_names,
+        inputs() if input_names else None,
+        trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes),
+        outputs,
+        max(stop, bounds["time"][1]),
+        started=started,
+    )
     return stream_case(case, target, settings, streaming)
 
 
@@ -162,10 +174,12 @@ def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Stre
                 state.envelopes[("input", s)].add(chunk["time"], chunk[s])
             yield chunk
 
-    results = target.runner.run_chunks(Experiment(start, stop, step, options["RelTol"]),
-                                       Signals(inputs(case.input_chunks) if case.input_chunks is not None else None,
-                                               case.start_values, outputs),
-                                       input_names, streaming.steps_per_chunk)
+    results = target.runner.run_chunks(
+        Experiment(start, stop, step, options["RelTol"]),
+        Signals(inputs(case.input_chunks) if case.input_chunks is not None else None, case.start_values, outputs),
+        input_names,
+        streaming.steps_per_chunk,
+    )
     with contextlib.ExitStack() as stack:
         stack.callback(bar.close)
         stack.callback(results.close)  # given up or done: the run's chunks and pointers go now, not with the frame
@@ -198,9 +212,13 @@ class _Comparer:
         self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
         self.n = round((options["StopTime"] - self.start) / self.step)
         self.signals = {name: Verdict(name) for name in outputs}
-        self.envelopes = {key: Envelope(self.start, case.t_end) for key in
-                          [("ref", s) for s in outputs] + [("result", s) for s in outputs]
-                          + [("deviation", s) for s in outputs] + [("input", s) for s in case.input_names]}
+        self.envelopes = {
+            key: Envelope(self.start, case.t_end)
+            for key in [("ref", s) for s in outputs]
+            + [("result", s) for s in outputs]
+            + [("deviation", s) for s in outputs]
+            + [("input", s) for s in case.input_names]
+        }
         self.zoom_at: float | None = None  # the first failing sample's time, the zoom's lines around it
         self.zoom_lines: list | None = None
         self.recent: dict[str, tuple] = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower,
@@ -240,15 +258,14 @@ class _Comparer:
         for s in self.outputs:
             self.envelopes[("ref", s)].add(times, rows[s])
         # the communication points start + k * step from two before the first time to two after the last
-        first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2],
-                              0, n)
+        first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2], 0, n)
         first, last = int(first), int(last)
         self.result_until(last)
         while len(window) > 1 and window[1][0] <= first:
             window.pop(0)  # chunks before the first sample needed
         base = window[0][0]
         result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
-        result = result[first - base:last - base + 1]
+        result = result[first - base : last - base + 1]
         if not len(result):
             raise FastLoopFailed("the run ended early")
         index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
@@ -302,10 +319,13 @@ class _Comparer:
         if case.more_messages is not None:
             outcome.messages += case.more_messages(passed, outcome.deviations)
         if settings.plots == "all" or (settings.plots == "failed" and not passed):
-            figure = Figure(case.title, [(s, *envelopes[("input", s)].line()) for s in case.input_names],
-                            [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
-                            [(s, *envelopes[("deviation", s)].line()) for s in outputs],
-                            (self.zoom_at, self.zoom_lines) if self.zoom_lines else None)
+            figure = Figure(
+                case.title,
+                [(s, *envelopes[("input", s)].line()) for s in case.input_names],
+                [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
+                [(s, *envelopes[("deviation", s)].line()) for s in outputs],
+                (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
+            )
             outcome.png = draw(figure, settings.mode, labels["fmu"])
         outcome.seconds = time.perf_counter() - case.started
         return outcome
@@ -340,8 +360,12 @@ def simulate_long(fmu_path, input_path, out, options: SimulationOptions, streami
     written, writer = 0, None
     try:
         inputs = trace_chunks(input_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
-        for chunk in runner.run_chunks(Experiment(start, stop, step), Signals(inputs, values, names),
-                                       _signal_names(first_in), streaming.steps_per_chunk):
+        for chunk in runner.run_chunks(
+            Experiment(start, stop, step),
+            Signals(inputs, values, names),
+            _signal_names(first_in),
+            streaming.steps_per_chunk,
+        ):
             if writer is None:
                 writer = TraceWriter(out, chunk.dtype.names)
             writer.write(chunk)

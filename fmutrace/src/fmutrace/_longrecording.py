@@ -2,6 +2,7 @@
 read block by block (recordings.stream reads it) through the long-case
 path (_longcase.stream_case), in memory that does not grow with its
 length; its notes and messages are the in-memory path's, word for word."""
+
 import os
 
 import numpy as np
@@ -85,20 +86,32 @@ def run_long_recording(path, name, target, settings, streaming: Streaming = Stre
         notes = []
         if cycles.off:
             line, time = cycles.first_off
-            notes = [off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
-                     for _, channel in drives + compares]
+            notes = [
+                off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
+                for _, channel in drives + compares
+            ]
         notes += matched.describe()
         unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
-        description = (f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
-                       f"step {step:g} s ({recording.step_source})")
+        description = (
+            f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
+            f"step {step:g} s ({recording.step_source})"
+        )
         if passed:
             return [description] + notes
         return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
 
-    case = ChunkedCase(name, f"{name} on {target.labels['fmu']}: {recording.format}",
-                       {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6}, start_values,
-                       tuple(v for v, _ in drives), queue("inputs") if drives else None, queue("refs"),
-                       [v for v, _ in compares], stop, more_messages)
+    case = ChunkedCase(
+        name,
+        f"{name} on {target.labels['fmu']}: {recording.format}",
+        {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6},
+        start_values,
+        tuple(v for v, _ in drives),
+        queue("inputs") if drives else None,
+        queue("refs"),
+        [v for v, _ in compares],
+        stop,
+        more_messages,
+    )
     return stream_case(case, target, settings, streaming)
 
 
@@ -124,6 +137,5 @@ def _explain(table, deviations, channels, step, shift):
     for deviation in deviations:
         if deviation.name in found:
             line, time, value = found[deviation.name]
-            messages.append(first_differs(deviation, wanted[deviation.name], f"{table.path}, line {line}", time,
-                                          value))
+            messages.append(first_differs(deviation, wanted[deviation.name], f"{table.path}, line {line}", time, value))
     return messages

@@ -7,6 +7,7 @@ A line of millions of samples is drawn decimated to what the figure can
 show: per pixel column the first and last sample and the smallest and
 largest value (Envelope), so the picture is the same and its cost does
 not grow with the length. A long case fills its envelopes chunk by chunk."""
+
 import importlib
 import io
 import threading
@@ -16,8 +17,8 @@ import numpy as np
 from ._comparison import Comparison, Mode
 
 WIDTH_INCHES, DPI = 8.0, 80
-COLUMNS = 600        # pixel columns of an axis (the figure is 640 pixels wide)
-ZOOM_SAMPLES = 40    # compared samples each side of the first deviation in the zoom
+COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
+ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
 
 
 class Envelope:
@@ -88,8 +89,14 @@ def case_figure(case, result, comparison: Comparison, label: str) -> Figure:
     inputs = []
     if case.inputs is not None:
         for name in case.inputs.dtype.names[1:]:
-            inputs.append((name, *decimated(np.append(case.inputs["time"], stop),
-                                            np.append(case.inputs[name], case.inputs[name][-1]))))
+            inputs.append(
+                (
+                    name,
+                    *decimated(
+                        np.append(case.inputs["time"], stop), np.append(case.inputs[name], case.inputs[name][-1])
+                    ),
+                )
+            )
     ref = case.reference
     signals, deviations = [], []
     for name in case.outputs:
@@ -100,8 +107,7 @@ def case_figure(case, result, comparison: Comparison, label: str) -> Figure:
             shown_band = (lower[0], lower[1], upper[1])
         elif band is not None:
             shown_band = (band.times, band.lower, band.upper)
-        signals.append((name, decimated(ref["time"], ref[name]), decimated(result["time"], result[name]),
-                        shown_band))
+        signals.append((name, decimated(ref["time"], ref[name]), decimated(result["time"], result[name]), shown_band))
         if band is not None:
             deviations.append((name, *decimated(band.times, band.deviation)))
     return Figure(title, inputs, signals, deviations, zoom_of(comparison))
@@ -119,8 +125,16 @@ def zoom_of(comparison: Comparison):
     for name, band in comparison.bands.items():
         k = int(np.searchsorted(band.times, first.time))
         window = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
-        lines.append((name, band.times[window], band.values[window], band.lower[window], band.upper[window],
-                      band.deviation[window]))
+        lines.append(
+            (
+                name,
+                band.times[window],
+                band.values[window],
+                band.lower[window],
+                band.upper[window],
+                band.deviation[window],
+            )
+        )
     return first.time, lines
 
 
@@ -168,8 +182,16 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         if band is not None and mode.fills_band:
             ax.fill_between(band[0], band[1], band[2], color="0.85", label=mode.name)
         ax.plot(ref_t, ref_v, **mode.reference_line, label=f"{name} reference")
-        ax.step(res_t, res_v, where="post", color="C1", linewidth=1.2, marker="" if many else ".", markersize=3,
-                label=f"{name} {label}")
+        ax.step(
+            res_t,
+            res_v,
+            where="post",
+            color="C1",
+            linewidth=1.2,
+            marker="" if many else ".",
+            markersize=3,
+            label=f"{name} {label}",
+        )
         ax.legend(loc="best", fontsize=7)
     for name, times, values in figure.deviations:
         deviation_axis.plot(times, values, drawstyle="steps-post", label=name)
@@ -219,8 +241,14 @@ def _layout(rows: int, columns: int, has_inputs: bool):
     if columns == 2 and has_inputs:
         grid[0, 1].set_axis_off()
     # fixed margins: tight_layout would cost more than the rest of the plot
-    fig.subplots_adjust(left=0.1 / (1 + 0.45 * (columns - 1)), right=0.98, top=1 - 0.45 / height,
-                        bottom=0.45 / height, hspace=0.12, wspace=0.18)
+    fig.subplots_adjust(
+        left=0.1 / (1 + 0.45 * (columns - 1)),
+        right=0.98,
+        top=1 - 0.45 / height,
+        bottom=0.45 / height,
+        hspace=0.12,
+        wspace=0.18,
+    )
     return fig, grid
 
 

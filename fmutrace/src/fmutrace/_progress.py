@@ -1,4 +1,5 @@
 """A campaign's progress bar on a terminal."""
+
 import sys
 import time
 
@@ -23,8 +24,9 @@ class Progress:
             return
         width = 30
         filled = width * done // max(1, self.total)
-        self.stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{self.total} cases, "
-                          f"{failed} failing, {elapsed:.0f} s ")
+        self.stream.write(
+            f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{self.total} cases, {failed} failing, {elapsed:.0f} s "
+        )
         self.stream.flush()
         self.shown = True
 

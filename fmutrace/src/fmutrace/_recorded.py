@@ -3,6 +3,7 @@ its steps (recordings.align), and compared signal by signal, each on its
 own samples; a failing comparison names the recording's file and line of
 its first deviation and, where the inputs were sampled coarser than the
 step, what that means."""
+
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,13 +19,14 @@ from .recordings.matching import plan
 from .recordings.options import RecordingOptions
 from .recordings.timebase import UNIT_NAMES, normalise
 
+
 @dataclass
 class RecordedCase(Case):
     references: list = field(default_factory=list)  # structured arrays, one per time base of the compared channels
-    channels: dict = field(default_factory=dict)    # compared variable -> its Channel
-    notes: list = field(default_factory=list)       # what was assumed, ignored or found
-    coarse: str = ""                                # why an exact comparison cannot hold
-    shift: int = 1                                  # steps from a row's time to its output's (timing)
+    channels: dict = field(default_factory=dict)  # compared variable -> its Channel
+    notes: list = field(default_factory=list)  # what was assumed, ignored or found
+    coarse: str = ""  # why an exact comparison cannot hold
+    shift: int = 1  # steps from a row's time to its output's (timing)
 
     def comparison(self, result, mode) -> Comparison:
         """Every compared signal on its own samples."""
@@ -49,8 +51,9 @@ class RecordedCase(Case):
             at = np.flatnonzero(np.rint(channel.times / step).astype(np.int64) == cycle)
             if len(at):
                 i = int(at[0])
-                messages.append(first_differs(deviation, cycle, channel.where(i), float(channel.times[i]),
-                                              float(channel.values[i])))
+                messages.append(
+                    first_differs(deviation, cycle, channel.where(i), float(channel.times[i]), float(channel.values[i]))
+                )
         if self.coarse:
             messages.append(self.coarse)
         return messages + self.notes
@@ -58,8 +61,10 @@ class RecordedCase(Case):
 
 def first_differs(deviation, cycle, where, time, recorded):
     """Where a failing signal's first deviation is in the recording."""
-    return (f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={time:.9g} s "
-            f"from its first sample): recorded {recorded!r}, the FMU gives {deviation.value!r}")
+    return (
+        f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={time:.9g} s "
+        f"from its first sample): recorded {recorded!r}, the FMU gives {deviation.value!r}"
+    )
 
 
 def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
@@ -75,16 +80,30 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     names = [v for reference in aligned.references for v in reference.dtype.names[1:]]
     unit = UNIT_NAMES.get(recording.time_unit, recording.time_unit)
-    description = (f"{recording.format}: {len(recording)} samples, time as {unit} ({recording.time_source}), "
-                   f"step {recording.step_size:g} s ({recording.step_source})")
-    return RecordedCase(name=name, model=fmu.model, folder=Path(recording.paths[0]),
-                        options={"StartTime": aligned.start_time, "StopTime": aligned.stop_time,
-                                 "StepSize": aligned.step_size, "RelTol": 1e-6},
-                        start_values=start_values, inputs=aligned.inputs, reference=_union(aligned.references, names),
-                        description=description, references=aligned.references,
-                        channels={v: c for v, c in matched.compares}, notes=aligned.notes + matched.describe(),
-                        coarse=aligned.coarse,
-                        shift=1 if options.timing == "cycle" else 0)
+    description = (
+        f"{recording.format}: {len(recording)} samples, time as {unit} ({recording.time_source}), "
+        f"step {recording.step_size:g} s ({recording.step_source})"
+    )
+    return RecordedCase(
+        name=name,
+        model=fmu.model,
+        folder=Path(recording.paths[0]),
+        options={
+            "StartTime": aligned.start_time,
+            "StopTime": aligned.stop_time,
+            "StepSize": aligned.step_size,
+            "RelTol": 1e-6,
+        },
+        start_values=start_values,
+        inputs=aligned.inputs,
+        reference=_union(aligned.references, names),
+        description=description,
+        references=aligned.references,
+        channels={v: c for v, c in matched.compares},
+        notes=aligned.notes + matched.describe(),
+        coarse=aligned.coarse,
+        shift=1 if options.timing == "cycle" else 0,
+    )
 
 
 def _union(references, names):

@@ -1,6 +1,7 @@
 """The report of a campaign: index.html (pass/fail table, one plot per
 case), summary.md, results.json and, when asked, JUnit XML; and each
 case's result as <case>_out.csv."""
+
 import html
 import json
 import os
@@ -13,14 +14,15 @@ from ._traces import write_trace
 
 RESULTS_FORMAT = 1
 
-STYLE = ("<style>body{font-family:sans-serif;margin:1em 2em}"
-         "table{border-collapse:collapse;width:100%;table-layout:fixed}\n"
-         "td,th{border:1px solid #ccc;padding:.3em .6em;vertical-align:top;overflow-wrap:anywhere}"
-         "tr.pass td:nth-child(3){color:#176617}\n"
-         "tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){color:#b00;font-weight:bold}"
-         "img{max-width:100%;height:auto}</style>")
+STYLE = (
+    "<style>body{font-family:sans-serif;margin:1em 2em}"
+    "table{border-collapse:collapse;width:100%;table-layout:fixed}\n"
+    "td,th{border:1px solid #ccc;padding:.3em .6em;vertical-align:top;overflow-wrap:anywhere}"
+    "tr.pass td:nth-child(3){color:#176617}\n"
+    "tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){color:#b00;font-weight:bold}"
+    "img{max-width:100%;height:auto}</style>"
+)
 COLUMNS = "<colgroup>" + "".join(f'<col style="width:{w}%">' for w in (16, 10, 28, 6, 40)) + "</colgroup>"
-
 
 
 def write_case_files(outcome: CaseOutcome, report_dir):
@@ -72,11 +74,15 @@ def write_junit(campaign: CampaignResult, path):
         totals[3] += o.seconds
     with open(path, "w") as out:
         out.write("<?xml version='1.0' encoding='utf-8'?>\n")
-        out.write(f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts[Status.FAIL]}" '
-                  f'errors="{counts[Status.ERROR] + counts[Status.INVALID]}" time="{campaign.seconds:.3f}">\n')
+        out.write(
+            f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts[Status.FAIL]}" '
+            f'errors="{counts[Status.ERROR] + counts[Status.INVALID]}" time="{campaign.seconds:.3f}">\n'
+        )
         for fmu, (tests, failures, errors, seconds) in suites.items():
-            out.write(f'  <testsuite name={quoteattr(fmu)} tests="{tests}" failures="{failures}" errors="{errors}" '
-                      f'time="{seconds:.3f}">\n')
+            out.write(
+                f'  <testsuite name={quoteattr(fmu)} tests="{tests}" failures="{failures}" errors="{errors}" '
+                f'time="{seconds:.3f}">\n'
+            )
             for o in campaign.cases.light():
                 if o.fmu != fmu:
                     continue
@@ -86,8 +92,10 @@ def write_junit(campaign: CampaignResult, path):
                     continue
                 kind = "failure" if o.status == Status.FAIL else "error"
                 message = o.messages[0] if o.messages else o.status
-                out.write(f"{case}>\n      <{kind} message={quoteattr(message)}>{escape(chr(10).join(o.messages))}"
-                          f"</{kind}>\n    </testcase>\n")
+                out.write(
+                    f"{case}>\n      <{kind} message={quoteattr(message)}>{escape(chr(10).join(o.messages))}"
+                    f"</{kind}>\n    </testcase>\n"
+                )
             out.write("  </testsuite>\n")
         out.write("</testsuites>\n")
 
@@ -103,8 +111,21 @@ def write_report(campaign: CampaignResult, report_dir):
     report_dir.mkdir(parents=True, exist_ok=True)
     headline = campaign.headline()
     with open(report_dir / "summary.md", "w") as summary, open(report_dir / "index.html", "w") as page:
-        summary.write("\n".join(["# fmutrace", "", headline, "", f"Comparison: {campaign.mode.describe()}.", "",
-                                 "| case | FMU | result | seconds | plot |", "|---|---|---|---|---|"]) + "\n")
+        summary.write(
+            "\n".join(
+                [
+                    "# fmutrace",
+                    "",
+                    headline,
+                    "",
+                    f"Comparison: {campaign.mode.describe()}.",
+                    "",
+                    "| case | FMU | result | seconds | plot |",
+                    "|---|---|---|---|---|",
+                ]
+            )
+            + "\n"
+        )
         page.write(f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
 {STYLE}
@@ -115,12 +136,20 @@ def write_report(campaign: CampaignResult, report_dir):
 """)
         for o in campaign.cases.light():
             verdict = _verdict(o)
-            summary.write(f"| {o.case} | {o.fmu} | {verdict.replace('|', '/')} | {o.seconds:.2f} | "
-                          + (f"[png]({o.plot})" if o.plot else "") + " |\n")
-            image = f'<a href="{html.escape(o.plot)}"><img src="{html.escape(o.plot)}" loading="lazy"></a>' \
-                if o.plot else ""
+            summary.write(
+                f"| {o.case} | {o.fmu} | {verdict.replace('|', '/')} | {o.seconds:.2f} | "
+                + (f"[png]({o.plot})" if o.plot else "")
+                + " |\n"
+            )
+            image = (
+                f'<a href="{html.escape(o.plot)}"><img src="{html.escape(o.plot)}" loading="lazy"></a>'
+                if o.plot
+                else ""
+            )
             csv = f'<br><a href="{html.escape(o.csv)}">result CSV</a>' if o.csv else ""
-            page.write(f'<tr class="{o.status}"><td>{html.escape(o.case)}</td><td>{html.escape(o.fmu)}</td>'
-                       f'<td>{html.escape(verdict)}{csv}</td><td>{o.seconds:.2f}</td><td>{image}</td></tr>\n')
+            page.write(
+                f'<tr class="{o.status}"><td>{html.escape(o.case)}</td><td>{html.escape(o.fmu)}</td>'
+                f"<td>{html.escape(verdict)}{csv}</td><td>{o.seconds:.2f}</td><td>{image}</td></tr>\n"
+            )
         page.write("</table></body></html>\n")
     write_results_json(campaign, report_dir / "results.json")

@@ -33,6 +33,7 @@ section 4.2.1: inputs are set, not consumed), so the FMU sees the same
 values; the tests check the results against fmpy's on every reference
 scenario and on random traces.
 """
+
 import contextlib
 import importlib.util
 import io
@@ -43,8 +44,12 @@ from typing import NamedTuple
 
 import cffi
 import numpy as np
-from fmpy.simulation import apply_start_values, instantiate_fmu, settable_in_initialization_mode, \
-    settable_in_instantiated
+from fmpy.simulation import (
+    apply_start_values,
+    instantiate_fmu,
+    settable_in_initialization_mode,
+    settable_in_instantiated,
+)
 
 from ._fmu import REAL_TYPES, unpacked
 from ._fmpy import Experiment, Signals, held_to, run_fmpy
@@ -52,10 +57,22 @@ from ._fmpy import Experiment, Signals, held_to, run_fmpy
 # per FMI type: the C type's dtype (fmpy's Input tables and getters) and the
 # recorded column's dtype (fmpy's Recorder)
 FMI2_TYPES = {"Real": (np.float64, np.float64), "Integer": (np.int32, np.int32), "Boolean": (np.int32, np.bool_)}
-FMI3_TYPES = {t: (d, d) for t, d in (("Float32", np.float32), ("Float64", np.float64), ("Int8", np.int8),
-                                     ("UInt8", np.uint8), ("Int16", np.int16), ("UInt16", np.uint16),
-                                     ("Int32", np.int32), ("UInt32", np.uint32), ("Int64", np.int64),
-                                     ("UInt64", np.uint64), ("Boolean", np.bool_))}
+FMI3_TYPES = {
+    t: (d, d)
+    for t, d in (
+        ("Float32", np.float32),
+        ("Float64", np.float64),
+        ("Int8", np.int8),
+        ("UInt8", np.uint8),
+        ("Int16", np.int16),
+        ("UInt16", np.uint16),
+        ("Int32", np.int32),
+        ("UInt32", np.uint32),
+        ("Int64", np.int64),
+        ("UInt64", np.uint64),
+        ("Boolean", np.bool_),
+    )
+}
 
 
 def discrete_rows(t, times, after_event):
@@ -98,18 +115,29 @@ def input_events(inputs):
 # The hot loop calls the library through cffi: a call costs about half what
 # a ctypes call does. The values are passed as byte pointers into NumPy arrays.
 FFI = cffi.FFI()
-FFI.cdef("\n".join(
-    [f"int fmi2{verb}{kind}(void *, const unsigned int *, size_t, char *);"
-     for kind in FMI2_TYPES for verb in ("Set", "Get")]
-    + [f"int fmi3{verb}{kind}(void *, const unsigned int *, size_t, char *, size_t);"
-       for kind in FMI3_TYPES for verb in ("Set", "Get")]
-    + ["int fmi2DoStep(void *, double, double, int);",
-       "int fmi3DoStep(void *, double, double, bool, bool *, bool *, bool *, double *);",
-       # _steps.c: a chunk of steps in C, the same calls as _steps_python
-       "typedef struct { void (*function)(void); const unsigned int *vrs; size_t count; char *rows;"
-       " ptrdiff_t row_bytes; } fmutrace_calls;",
-       "size_t fmutrace_steps(int, void (*)(void), void *, const double *, const double *, size_t, const long long *,"
-       " const fmutrace_calls *, size_t, const fmutrace_calls *, size_t);"]))
+FFI.cdef(
+    "\n".join(
+        [
+            f"int fmi2{verb}{kind}(void *, const unsigned int *, size_t, char *);"
+            for kind in FMI2_TYPES
+            for verb in ("Set", "Get")
+        ]
+        + [
+            f"int fmi3{verb}{kind}(void *, const unsigned int *, size_t, char *, size_t);"
+            for kind in FMI3_TYPES
+            for verb in ("Set", "Get")
+        ]
+        + [
+            "int fmi2DoStep(void *, double, double, int);",
+            "int fmi3DoStep(void *, double, double, bool, bool *, bool *, bool *, double *);",
+            # _steps.c: a chunk of steps in C, the same calls as _steps_python
+            "typedef struct { void (*function)(void); const unsigned int *vrs; size_t count; char *rows;"
+            " ptrdiff_t row_bytes; } fmutrace_calls;",
+            "size_t fmutrace_steps(int, void (*)(void), void *, const double *, const double *, size_t,"
+            " const long long *, const fmutrace_calls *, size_t, const fmutrace_calls *, size_t);",
+        ]
+    )
+)
 
 
 def _load_c_steps():
@@ -183,7 +211,7 @@ class _InputRows:
         self.table: np.ndarray = np.empty(0)  # the window (offset: its first row in the table)
         self.offset, self.done = 0, False
         self.last_row = None  # the row set at the last step
-        self.setters: list | None = None   # (FMI type, value references, count, dtype, names) per FMI type
+        self.setters: list | None = None  # (FMI type, value references, count, dtype, names) per FMI type
 
     def _read(self):
         chunk = next(self.chunks, None)
@@ -192,9 +220,10 @@ class _InputRows:
             return
         if self.setters is None:
             r = self.runner
-            self.setters = [(kind, _value_references(variables), len(variables), r.types[kind][0],
-                             [v.name for v in variables])
-                            for kind, variables in r._groups(chunk.dtype.names[1:]).items()]
+            self.setters = [
+                (kind, _value_references(variables), len(variables), r.types[kind][0], [v.name for v in variables])
+                for kind, variables in r._groups(chunk.dtype.names[1:]).items()
+            ]
         self.table = np.concatenate([self.table, chunk]) if len(self.table) else chunk
         problem = self.runner.event_problem(self.experiment, self.table)
         if problem:
@@ -202,8 +231,9 @@ class _InputRows:
 
     def reach(self, time):
         """Reads the table until its window reaches past time (each window's events checked as it is read)."""
-        while not self.done and (not len(self.table) or not (self.table["time"][-1] > time and
-                                                            not _close(time, self.table["time"][-1]))):
+        while not self.done and (
+            not len(self.table) or not (self.table["time"][-1] > time and not _close(time, self.table["time"][-1]))
+        ):
             self._read()
         if not len(self.table):
             raise FastLoopFailed("no input rows")
@@ -245,6 +275,7 @@ class _InputRows:
 
 class _Fmi2Calls:
     """How the step loop calls an FMI 2 FMU (a Runner picks its version's once)."""
+
     fmi_version = 2  # fmutrace_steps' first argument: its loop for this version
 
     @staticmethod
@@ -262,6 +293,7 @@ class _Fmi3Calls:
     """How the step loop calls an FMI 3 FMU: Set and Get take the number
     of values too (count: scalars); a step that asks to terminate or
     returns early counts as an Error (the loop stops after its getters)."""
+
     fmi_version = 3
 
     @staticmethod
@@ -275,13 +307,16 @@ class _Fmi3Calls:
         def step(t, h):
             status = do_step(component, t, h, True, event, terminate, early, last)
             return 3 if terminate[0] or early[0] else status
+
         return step
 
 
 def _setter_calls(calls, component, setters):
     """(call, a pointer to each row) of every setter (function, value references, count, rows)."""
-    return [(calls.values(component, function, vrs, count), _row_pointers(values))
-            for function, vrs, count, values in setters]
+    return [
+        (calls.values(component, function, vrs, count), _row_pointers(values))
+        for function, vrs, count, values in setters
+    ]
 
 
 def _set_row(calls, row):
@@ -296,6 +331,7 @@ class _Instance(NamedTuple):
     """What the step loop calls an instance through: its version's
     _Fmi2Calls or _Fmi3Calls, its doStep, the instance pointer, and FMI 3's
     step flags (None for FMI 2)."""
+
     calls: type[_Fmi2Calls] | type[_Fmi3Calls]
     do_step: object
     component: object
@@ -335,16 +371,26 @@ def _call_table(calls):
 def _steps_c(instance: _Instance, times, sizes, set_at, setters, getters):
     """_steps_python's loop in C (_steps.c): the same calls in the same order."""
     calls, do_step, component, _ = instance
-    setter_table = _call_table([(f, vrs, n, values, FFI.cast("char *", values.ctypes.data))
-                                for f, vrs, n, values in setters])
+    setter_table = _call_table(
+        [(f, vrs, n, values, FFI.cast("char *", values.ctypes.data)) for f, vrs, n, values in setters]
+    )
     getter_table = _call_table(getters)
     times = np.ascontiguousarray(times, dtype=np.float64)
     sizes = np.ascontiguousarray(sizes, dtype=np.float64)
     set_at = np.ascontiguousarray(set_at, dtype=np.int64)
-    done = C_STEPS(calls.fmi_version, FFI.cast("void (*)(void)", do_step), component,
-                   FFI.cast("double *", times.ctypes.data), FFI.cast("double *", sizes.ctypes.data), len(times),
-                   FFI.cast("long long *", set_at.ctypes.data), setter_table, len(setters), getter_table,
-                   len(getters))
+    done = C_STEPS(
+        calls.fmi_version,
+        FFI.cast("void (*)(void)", do_step),
+        component,
+        FFI.cast("double *", times.ctypes.data),
+        FFI.cast("double *", sizes.ctypes.data),
+        len(times),
+        FFI.cast("long long *", set_at.ctypes.data),
+        setter_table,
+        len(setters),
+        getter_table,
+        len(getters),
+    )
     return done == len(times)
 
 
@@ -362,7 +408,7 @@ class Runner:
         self.fmu = self._lib = None
         self.fast_runs = self.fmpy_runs = 0
         self.c_loop = C_STEPS is not None  # the steps in C (_steps.c), else in Python: the same calls
-        self._grids = {}    # (start, step, n) -> the communication points and step sizes as C doubles
+        self._grids = {}  # (start, step, n) -> the communication points and step sizes as C doubles
         self._buffers = {}  # (kind, count, n) -> output array kept from trace to trace, and its rows as C pointers
 
     # ---- the instance ----------------------------------------------------
@@ -414,8 +460,9 @@ class Runner:
         """Why the fast loop would not give fmpy's result for this trace
         (None if it would); see the module's docstring."""
         names = inputs.dtype.names[1:] if inputs is not None else ()
-        return self.static_problem(experiment, names, outputs) or \
-            (self.event_problem(experiment, inputs) if inputs is not None else None)
+        return self.static_problem(experiment, names, outputs) or (
+            self.event_problem(experiment, inputs) if inputs is not None else None
+        )
 
     def static_problem(self, experiment: Experiment, input_names, outputs):
         """fast_path_problem's reasons that the names and the grid alone give."""
@@ -451,9 +498,13 @@ class Runner:
         names = inputs.dtype.names[1:] if inputs is not None else ()
         if self.static_problem(experiment, names, signals.outputs) is None:
             try:  # the input events are checked as the table is read, before the FMU is called
-                chunks = list(self._fast(experiment, Signals(None if inputs is None else iter([inputs]),
-                                                             signals.start_values, signals.outputs),
-                                         STEPS_PER_CHUNK))
+                chunks = list(
+                    self._fast(
+                        experiment,
+                        Signals(None if inputs is None else iter([inputs]), signals.start_values, signals.outputs),
+                        STEPS_PER_CHUNK,
+                    )
+                )
                 self.fast_runs += 1
                 return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
             except InputsNeedFmpy:
@@ -519,8 +570,7 @@ class Runner:
     def _fast(self, experiment: Experiment, signals: Signals, steps_per_chunk):
         """The fast loop's result chunk by chunk (see run_chunks);
         FastLoopFailed as soon as a call fails or the inputs need fmpy."""
-        start, stop, step, tolerance = experiment.start, experiment.stop, experiment.step, \
-            experiment.relative_tolerance
+        start, stop, step, tolerance = experiment.start, experiment.stop, experiment.step, experiment.relative_tolerance
         start_values, outputs = signals.start_values, signals.outputs
         inputs = _InputRows(signals.inputs, self, experiment) if signals.inputs is not None else None
         if inputs is not None:
@@ -539,8 +589,9 @@ class Runner:
             if kind in groups:
                 variables = groups[kind]
                 values, pointers = self._buffer(kind, len(variables), size)
-                getters.append((self._get[kind], _value_references(variables), len(variables), pointers, values,
-                                variables, kind))
+                getters.append(
+                    (self._get[kind], _value_references(variables), len(variables), pointers, values, variables, kind)
+                )
                 columns += [(v.name, self.types[kind][1]) for v in variables]
 
         def result(rows, times):
@@ -586,13 +637,29 @@ class Runner:
                     set_at, setters = np.full(m, -1, dtype=np.int64), []
                 instance = _Instance(calls, self._do_step, component, self._step_flags)
                 if self.c_loop:
-                    done = _steps_c(instance, step_times, step_sizes, set_at, setters,
-                                    [(function, vrs, count, values, pointers[1])
-                                     for function, vrs, count, pointers, values, _, _ in getters])
+                    done = _steps_c(
+                        instance,
+                        step_times,
+                        step_sizes,
+                        set_at,
+                        setters,
+                        [
+                            (function, vrs, count, values, pointers[1])
+                            for function, vrs, count, pointers, values, _, _ in getters
+                        ],
+                    )
                 else:
-                    done = _steps_python(instance, step_times, step_sizes, set_at, setters,
-                                         [(function, vrs, count, pointers[1:m + 1])
-                                          for function, vrs, count, pointers, _, _, _ in getters])
+                    done = _steps_python(
+                        instance,
+                        step_times,
+                        step_sizes,
+                        set_at,
+                        setters,
+                        [
+                            (function, vrs, count, pointers[1 : m + 1])
+                            for function, vrs, count, pointers, _, _, _ in getters
+                        ],
+                    )
                 if not done:
                     raise FastLoopFailed("a step failed")
             chunk = result(slice(1, m + 1), times[1:])

@@ -6,6 +6,7 @@ time on for discrete inputs, continuous ones are interpolated; at a
 repeated time the row after the event), calls doStep(t, h) and records
 the outputs at t + h.
 """
+
 import math
 from dataclasses import dataclass
 from os import PathLike
@@ -27,8 +28,9 @@ def every_nth(result, start_time, step_size, output_interval):
     ratio = output_interval / step_size
     n = round(ratio)
     if n < 1 or not math.isclose(ratio, n, rel_tol=1e-9):
-        raise InputError(f"the output interval {output_interval:g} s must be a whole multiple of the step size "
-                         f"{step_size:g} s")
+        raise InputError(
+            f"the output interval {output_interval:g} s must be a whole multiple of the step size {step_size:g} s"
+        )
     steps = np.rint((result["time"] - start_time) / step_size).astype(np.int64)
     return result[steps % n == 0]
 
@@ -36,6 +38,7 @@ def every_nth(result, start_time, step_size, output_interval):
 @dataclass(frozen=True)
 class SimulationOptions:
     """A simulation's settings, as simulate takes them (None: its default)."""
+
     start_values: dict | None = None
     start_time: float | None = None
     stop_time: float | None = None
@@ -44,10 +47,17 @@ class SimulationOptions:
     outputs: list[str] | None = None
 
 
-def simulate(fmu: str | PathLike | Fmu, input: str | PathLike | np.ndarray | None = None, *,
-             start_values: dict | None = None, start_time: float | None = None, stop_time: float | None = None,
-             step_size: float | None = None, output_interval: float | None = None,
-             outputs: list[str] | None = None) -> np.ndarray:
+def simulate(
+    fmu: str | PathLike | Fmu,
+    input: str | PathLike | np.ndarray | None = None,
+    *,
+    start_values: dict | None = None,
+    start_time: float | None = None,
+    stop_time: float | None = None,
+    step_size: float | None = None,
+    output_interval: float | None = None,
+    outputs: list[str] | None = None,
+) -> np.ndarray:
     """Simulate an FMI 2 or FMI 3 co-simulation FMU on input signals.
 
     fmu              path of the .fmu file

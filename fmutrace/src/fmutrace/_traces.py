@@ -18,6 +18,7 @@ sample. Accepted, without options:
 Anything else raises a TraceError, which names the file, the line and
 the column.
 """
+
 import io
 import math
 import re
@@ -56,7 +57,7 @@ def data_lines(text):
     number, position, end = 0, 0, len(text)
     while position < end:
         cut = _LINE_BREAK.search(text, position)
-        line, position = (text[position:cut.start()], cut.end()) if cut else (text[position:], end)
+        line, position = (text[position : cut.start()], cut.end()) if cut else (text[position:], end)
         number += 1
         if line.strip() and not line.lstrip().startswith("#"):
             yield number, line
@@ -129,8 +130,9 @@ def parse_number(text, decimal_comma=False):
         return None
 
 
-def read_trace(path: str | PathLike, known: Callable[[str], str | None] | None = None,
-               text: str | None = None) -> np.ndarray:
+def read_trace(
+    path: str | PathLike, known: Callable[[str], str | None] | None = None, text: str | None = None
+) -> np.ndarray:
     """The trace in path (or its text, given) as a structured array with
     'time' first.
 
@@ -148,8 +150,13 @@ def read_trace(path: str | PathLike, known: Callable[[str], str | None] | None =
     names = split_cells(header, separator)
     time_columns = [i for i, n in enumerate(names) if n in TIME_NAMES]
     if not time_columns:
-        raise TraceError(path, header_line, 1, f"no time column: one of the columns must be named "
-                                               f"{', '.join(TIME_NAMES[:-1])} or {TIME_NAMES[-1]} (found {names[0]!r})")
+        raise TraceError(
+            path,
+            header_line,
+            1,
+            f"no time column: one of the columns must be named "
+            f"{', '.join(TIME_NAMES[:-1])} or {TIME_NAMES[-1]} (found {names[0]!r})",
+        )
     if len(time_columns) > 1:
         raise TraceError(path, header_line, time_columns[1] + 1, f"a second time column {names[time_columns[1]]!r}")
     time_index = time_columns[0]
@@ -184,8 +191,11 @@ def _plain_body(text, header_line, separator, columns):
     read by NumPy's C parser; None for any other body, which the general
     reader then reads or explains. Both read a number with a correctly
     rounded conversion, so they give the same bits (a test checks it)."""
-    if separator != "," or any(c in text for c in UNUSUAL_LINE_BREAKS) or \
-            ("\r" in text and "\r" in text.replace("\r\n", "")):
+    if (
+        separator != ","
+        or any(c in text for c in UNUSUAL_LINE_BREAKS)
+        or ("\r" in text and "\r" in text.replace("\r\n", ""))
+    ):
         return None  # splitlines() would count the lines otherwise
     body = text.split("\n", header_line)[-1]
     if '"' in body or "#" in body:
@@ -204,6 +214,7 @@ def _plain_body(text, header_line, separator, columns):
 class _Header(NamedTuple):
     """A trace's header: its names, the order of the columns read (time
     first), the time's column, the array's dtype, its line."""
+
     names: list
     order: list
     time_index: int
@@ -220,20 +231,31 @@ def _read_rows(path, lines, header: _Header, separator):
     for number, line in lines:
         cells = split_cells(line, separator)
         if len(cells) != len(names):
-            raise TraceError(path, number, min(len(cells), len(names)) + 1,
-                             f"{len(cells)} cells, the header has {len(names)} columns")
+            raise TraceError(
+                path,
+                number,
+                min(len(cells), len(names)) + 1,
+                f"{len(cells)} cells, the header has {len(names)} columns",
+            )
         row = []
         for i in order:
             value = parse_number(cells[i], decimal_comma)
             if value is None:
-                raise TraceError(path, number, i + 1, f"{cells[i]!r} in column {names[i]!r} is not a number"
-                                 if cells[i] else f"an empty cell in column {names[i]!r}")
+                raise TraceError(
+                    path,
+                    number,
+                    i + 1,
+                    f"{cells[i]!r} in column {names[i]!r} is not a number"
+                    if cells[i]
+                    else f"an empty cell in column {names[i]!r}",
+                )
             row.append(value)
         if not math.isfinite(row[0]):
             raise TraceError(path, number, time_index + 1, f"time {cells[time_index]!r} is not a finite number")
         if row[0] < previous_time:
-            raise TraceError(path, number, time_index + 1,
-                             f"time goes backwards: {cells[time_index]} after {previous_time!r}")
+            raise TraceError(
+                path, number, time_index + 1, f"time goes backwards: {cells[time_index]} after {previous_time!r}"
+            )
         previous_time = row[0]
         rows.append(tuple(row))
     if not rows:
@@ -245,8 +267,9 @@ CHUNK_BYTES = 1 << 22  # of CSV text per chunk of trace_chunks
 LONG_CASE_BYTES = 32 << 20  # a case or recording whose file is larger runs chunk by chunk
 
 
-def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None = None,
-                 chunk_bytes: int = CHUNK_BYTES) -> Iterator[np.ndarray]:
+def trace_chunks(
+    path: str | PathLike, known: Callable[[str], str | None] | None = None, chunk_bytes: int = CHUNK_BYTES
+) -> Iterator[np.ndarray]:
     """The trace in path as consecutive structured arrays ('time' first) of
     about chunk_bytes of text each, read by pyarrow's CSV reader: memory
     stays flat in the file's length. For the plain dialect (',' separated
@@ -263,13 +286,18 @@ def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None
         raise NotPlain("not the plain dialect")
     names = split_cells(header, ",")
     times = [i for i, n in enumerate(names) if n in TIME_NAMES]
-    if len(times) != 1 or len(set(names)) != len(names) or not all(names) or \
-            (known is not None and any(known(n) for i, n in enumerate(names) if i != times[0])):
+    if (
+        len(times) != 1
+        or len(set(names)) != len(names)
+        or not all(names)
+        or (known is not None and any(known(n) for i, n in enumerate(names) if i != times[0]))
+    ):
         raise NotPlain("the header needs read_trace's explanation")
     order = [names[times[0]]] + [n for i, n in enumerate(names) if i != times[0]]
     dtype = [("time", np.float64)] + [(n, np.float64) for n in order[1:]]
-    convert = pcsv.ConvertOptions(column_types={n: pa.float64() for n in names}, null_values=[],
-                                  strings_can_be_null=False)
+    convert = pcsv.ConvertOptions(
+        column_types={n: pa.float64() for n in names}, null_values=[], strings_can_be_null=False
+    )
     parse = pcsv.ParseOptions(delimiter=",", quote_char=False)
     previous = -math.inf
     rows = 0
@@ -277,9 +305,12 @@ def trace_chunks(path: str | PathLike, known: Callable[[str], str | None] | None
     # memory that grows with the file (measured: 80 MB at 360,000 rows, 240 MB at 17,280,000)
     for block in _line_blocks(path, chunk_bytes):
         try:
-            table = pcsv.read_csv(io.BytesIO(block), read_options=pcsv.ReadOptions(column_names=names,
-                                                                                     use_threads=True),
-                                  parse_options=parse, convert_options=convert)
+            table = pcsv.read_csv(
+                io.BytesIO(block),
+                read_options=pcsv.ReadOptions(column_names=names, use_threads=True),
+                parse_options=parse,
+                convert_options=convert,
+            )
         except pa.ArrowInvalid as error:
             raise NotPlain(str(error)) from None
         chunk = np.empty(table.num_rows, dtype=dtype)
@@ -360,7 +391,7 @@ class TraceWriter:
 
     def write(self, trace: np.ndarray):
         for begin in range(0, len(trace), WRITE_ROWS):
-            block = trace[begin:begin + WRITE_ROWS]
+            block = trace[begin : begin + WRITE_ROWS]
             table = pa.table({name: np.asarray(block[name], dtype=np.float64) for name in self.names})
             data = io.BytesIO()
             pcsv.write_csv(table, data, write_options=pcsv.WriteOptions(include_header=False, quoting_style="none"))

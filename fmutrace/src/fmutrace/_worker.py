@@ -1,6 +1,7 @@
 """One case on one FMU, where the work happens (this process, a child
 process or a Dask worker): read and checked, simulated, compared, plotted
 if asked."""
+
 import hashlib
 import os
 import tempfile
@@ -22,7 +23,7 @@ from .recordings.options import RecordingOptions
 from ._runner import Runner
 
 PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV
-PLOT_ALL_UP_TO = 500               # the default: all for campaigns up to so many cases, else the failed ones
+PLOT_ALL_UP_TO = 500  # the default: all for campaigns up to so many cases, else the failed ones
 
 
 def default_plots(cases: int) -> str:
@@ -32,15 +33,17 @@ def default_plots(cases: int) -> str:
 @dataclass(frozen=True)
 class CaseSettings:
     """What every case of a campaign is run, compared and reported with."""
+
     mode: Mode
-    plots: str = "none"                   # which cases get a plot and a result CSV: PLOTS
+    plots: str = "none"  # which cases get a plot and a result CSV: PLOTS
     recording: RecordingOptions = field(default_factory=RecordingOptions)  # how recordings are read
-    case_timeout: float | None = None     # seconds a case may run in a child process (None: no bound)
+    case_timeout: float | None = None  # seconds a case may run in a child process (None: no bound)
 
 
 @dataclass(frozen=True)
 class FmuFile:
     """An FMU as a campaign names it where its cases run (its bytes travel beside it)."""
+
     path: str
     labels: dict  # the CaseOutcome fields that name the FMU
 
@@ -48,6 +51,7 @@ class FmuFile:
 @dataclass(frozen=True)
 class Target:
     """The FMU a case runs on in this process: its Runner (one instance, reused), its Fmu and labels."""
+
     runner: Runner
     fmu: Fmu
     labels: dict
@@ -63,8 +67,11 @@ def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> Cas
     if streamed:
         result_file = _result_file() if plots != "none" else None
         streaming = Streaming(result_file=result_file)
-        long = run_long_recording(folder, name, target, settings, streaming) if recorded else \
-            run_long_case(folder, name, target, settings, streaming)
+        long = (
+            run_long_recording(folder, name, target, settings, streaming)
+            if recorded
+            else run_long_case(folder, name, target, settings, streaming)
+        )
         if result_file and (long is None or not long.png):  # a result file only with the case's plot
             os.unlink(result_file)
         elif long is not None:
@@ -84,8 +91,10 @@ def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> Cas
         return outcome
     try:
         o = case.options
-        result = runner.run(Experiment(o["StartTime"], o["StopTime"], o["StepSize"], o["RelTol"]),
-                            Signals(case.inputs, case.start_values, case.outputs))
+        result = runner.run(
+            Experiment(o["StartTime"], o["StopTime"], o["StepSize"], o["RelTol"]),
+            Signals(case.inputs, case.start_values, case.outputs),
+        )
         comparison = case.comparison(result, mode)
         outcome.status = Status.PASS if comparison.passed else Status.FAIL
     except SimulationError as error:

@@ -13,6 +13,7 @@ fits reads the file):
 
 A file none of them fits is a TraceError that says, for each, why not.
 """
+
 import os
 from pathlib import Path
 
@@ -31,8 +32,19 @@ TEXT_FORMATS = (
 )
 FORMAT_NAMES = ("ASAM MDF4",) + tuple(name for name, _, _ in TEXT_FORMATS)
 
-__all__ = ["Channel", "FORMAT_NAMES", "OFF_CYCLE", "Plan", "Recording", "is_recording", "last_component",
-           "normalise", "plan", "read_file", "read_recording"]
+__all__ = [
+    "Channel",
+    "FORMAT_NAMES",
+    "OFF_CYCLE",
+    "Plan",
+    "Recording",
+    "is_recording",
+    "last_component",
+    "normalise",
+    "plan",
+    "read_file",
+    "read_recording",
+]
 
 
 def read_file(path):
@@ -61,8 +73,11 @@ def _files(paths):
     for path in paths:
         path = os.fspath(path)
         if os.path.isdir(path):
-            inside = sorted(os.path.join(path, n) for n in os.listdir(path)
-                            if not n.startswith(".") and os.path.isfile(os.path.join(path, n)))
+            inside = sorted(
+                os.path.join(path, n)
+                for n in os.listdir(path)
+                if not n.startswith(".") and os.path.isfile(os.path.join(path, n))
+            )
             if not inside:
                 raise InputError(f"{path}: an empty folder")
             files.extend(inside)

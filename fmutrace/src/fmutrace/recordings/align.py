@@ -20,6 +20,7 @@ image does); before a channel's first sample its first value holds.
 Channels sampled on other instants keep their own time bases: no value
 is invented for a reference.
 """
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,36 +33,41 @@ TIMINGS = ("cycle", "fmi")
 
 @dataclass
 class Aligned:
-    inputs: np.ndarray | None   # structured: time, then the driven variables (None if none)
-    references: list            # structured arrays: time, then compared variables sharing those instants
+    inputs: np.ndarray | None  # structured: time, then the driven variables (None if none)
+    references: list  # structured arrays: time, then compared variables sharing those instants
     start_time: float
     stop_time: float
     step_size: float
-    notes: list = field(default_factory=list)    # what was assumed, skipped or found
-    coarse: str = ""            # why an exact comparison cannot hold (inputs sampled coarser than the step)
+    notes: list = field(default_factory=list)  # what was assumed, skipped or found
+    coarse: str = ""  # why an exact comparison cannot hold (inputs sampled coarser than the step)
 
 
 def _cycles_of(channel, step, notes):
     index, off = cycles(channel.times, step)
     if len(off):
         i = int(off[0])
-        notes.append(off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]),
-                                    step))
+        notes.append(
+            off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step)
+        )
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])
-        raise InputError(f"{channel.where(i + 1)}: samples of {channel.name} at t={float(channel.times[i]):.9g} s and "
-                         f"t={float(channel.times[i + 1]):.9g} s fall on the same cycle of {step:g} s: the step is "
-                         "coarser than the recording (give the recorder's cycle with --step-size)")
+        raise InputError(
+            f"{channel.where(i + 1)}: samples of {channel.name} at t={float(channel.times[i]):.9g} s and "
+            f"t={float(channel.times[i + 1]):.9g} s fall on the same cycle of {step:g} s: the step is "
+            "coarser than the recording (give the recorder's cycle with --step-size)"
+        )
     return index
 
 
 def off_cycle_note(name, off, samples, where, time, step):
     """What a channel with off time stamps gets: how many of its samples,
     the first (where: its file and line, time: seconds)."""
-    return (f"{name}: {off} of its {samples} time stamps are more than {OFF_CYCLE:g} of a cycle "
-            f"({OFF_CYCLE * step:g} s) off a cycle end, matched to the nearest one; the first at {where}: "
-            f"t={time:.9g} s, {time / step:.3f} cycles: is the step size the recorder's cycle?")
+    return (
+        f"{name}: {off} of its {samples} time stamps are more than {OFF_CYCLE:g} of a cycle "
+        f"({OFF_CYCLE * step:g} s) off a cycle end, matched to the nearest one; the first at {where}: "
+        f"t={time:.9g} s, {time / step:.3f} cycles: is the step size the recorder's cycle?"
+    )
 
 
 def _interval(index):
@@ -76,8 +82,10 @@ def align(recording, plan, timing="cycle", label="the FMU"):
     if timing not in TIMINGS:
         raise InputError(f"timing must be one of {', '.join(TIMINGS)}, not {timing!r}")
     if not plan.compares:
-        raise InputError(f"{recording.label}: no channel is an output of {label}: nothing to compare (channels: "
-                         f"{', '.join(c.name for c in recording.channels)}; map one with --map VARIABLE=CHANNEL)")
+        raise InputError(
+            f"{recording.label}: no channel is an output of {label}: nothing to compare (channels: "
+            f"{', '.join(c.name for c in recording.channels)}; map one with --map VARIABLE=CHANNEL)"
+        )
     step = recording.step_size
     notes = list(recording.notes)
     shift = 1 if timing == "cycle" else 0
@@ -111,8 +119,7 @@ def align(recording, plan, timing="cycle", label="the FMU"):
     if inputs is not None:
         last = max(last, int(np.rint(inputs["time"][-1] / step)))
     stop = max(last + shift, 1) * step
-    aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step,
-                      notes=notes)
+    aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step, notes=notes)
     if coarse:
         aligned.coarse = _coarse_note(coarse, plan, step)
     return aligned
@@ -133,9 +140,11 @@ def _coarse_note(coarse, plan, step):
             rate = float(np.max(moves[ok] / gaps[ok]))
             spans.append((variable, rate * (every - 1)))
     tolerance = max((s for _, s in spans), default=0.0)
-    return (f"the recording's inputs were sampled coarser than the step ({names}; step {step:g} s): between two "
-            "samples the FMU holds the last recorded value while the controller saw values the recording does not "
-            f"hold, so its output may lead or lag the recorded one by up to {every - 1} cycles and an exact "
-            f"comparison cannot hold. A meaningful comparison allows that lag: --tube-time {lag:.6g} --tube-value 0, "
-            f"or --abs-tol {tolerance:.6g} (the largest change of "
-            f"{', '.join(v for v, _ in spans) or 'the outputs'} over {every - 1} cycles, as recorded)")
+    return (
+        f"the recording's inputs were sampled coarser than the step ({names}; step {step:g} s): between two "
+        "samples the FMU holds the last recorded value while the controller saw values the recording does not "
+        f"hold, so its output may lead or lag the recorded one by up to {every - 1} cycles and an exact "
+        f"comparison cannot hold. A meaningful comparison allows that lag: --tube-time {lag:.6g} --tube-value 0, "
+        f"or --abs-tol {tolerance:.6g} (the largest change of "
+        f"{', '.join(v for v, _ in spans) or 'the outputs'} over {every - 1} cycles, as recorded)"
+    )

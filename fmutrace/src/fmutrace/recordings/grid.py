@@ -2,6 +2,7 @@
 line, short rows padded with empty cells), and its columns as channels:
 an empty cell is no sample of that channel (recorders leave cells empty
 where a channel sampled less often)."""
+
 import operator
 from typing import NamedTuple
 
@@ -85,12 +86,14 @@ def check_increasing(text, stamps, lines, column, name):
         back = np.flatnonzero(stamps[1:] < stamps[:-1])
         if len(back):
             i = int(back[0]) + 1
-            raise text.error(int(lines[i]), column, f"time goes backwards in column {name!r}: "
-                                                   f"{stamps[i]!r} after {stamps[i - 1]!r}")
+            raise text.error(
+                int(lines[i]), column, f"time goes backwards in column {name!r}: {stamps[i]!r} after {stamps[i - 1]!r}"
+            )
 
 
 class Rows(NamedTuple):
     """A table's rows: each one's line number, time stamp, and whether its time cell holds something."""
+
     lines: np.ndarray
     stamps: np.ndarray
     stamp_present: np.ndarray
@@ -103,5 +106,4 @@ def channel_from(text, cells, table_rows: Rows, column, name, decimal_comma):
     has = present(cells) & stamp_present
     rows = np.flatnonzero(has)
     values = texts.values(cells[rows], decimal_comma, text, lambda i: int(lines[rows[i]]), column, name)
-    return Channel(name=name, stamps=stamps[rows], values=values, file=text.path, column=column,
-                   lines=lines[rows])
+    return Channel(name=name, stamps=stamps[rows], values=values, file=text.path, column=column, lines=lines[rows])

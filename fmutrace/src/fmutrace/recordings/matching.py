@@ -7,6 +7,7 @@ name in another case too, when that is the only such variable). --map
 VARIABLE=CHANNEL says it where the names differ. A channel of an input
 or a tunable parameter drives the FMU, one of an output is compared, any
 other is listed as ignored with the reason."""
+
 from dataclasses import dataclass, field
 
 from .._errors import InputError
@@ -33,9 +34,9 @@ def last_component(name):
 
 @dataclass
 class Plan:
-    drives: list = field(default_factory=list)    # (variable name, Channel): inputs and tunable parameters
+    drives: list = field(default_factory=list)  # (variable name, Channel): inputs and tunable parameters
     compares: list = field(default_factory=list)  # (variable name, Channel): outputs
-    ignored: list = field(default_factory=list)   # (Channel, why)
+    ignored: list = field(default_factory=list)  # (Channel, why)
 
     def describe(self):
         lines = []
@@ -85,8 +86,10 @@ def plan(recording, variables, label, maps=()):
             raise InputError(f"--map {variable}={wanted}: {label} has no variable {variable!r}")
         channel = _find_channel(recording, wanted)
         if channel is None:
-            raise InputError(f"--map {variable}={wanted}: {recording.label} has no channel {wanted!r} (its channels: "
-                             f"{', '.join(c.name for c in recording.channels)})")
+            raise InputError(
+                f"--map {variable}={wanted}: {recording.label} has no channel {wanted!r} (its channels: "
+                f"{', '.join(c.name for c in recording.channels)})"
+            )
         taken[variable] = channel
     mapped = {id(c) for c in taken.values()}
     folded: dict[str, list[str]] = {}
@@ -100,8 +103,9 @@ def plan(recording, variables, label, maps=()):
             result.ignored.append((channel, "no samples"))
             continue
         variable = None
-        for candidate in dict.fromkeys((last_component(channel.symbol) if channel.symbol else None,
-                                        last_component(channel.name))):
+        for candidate in dict.fromkeys(
+            (last_component(channel.symbol) if channel.symbol else None, last_component(channel.name))
+        ):
             if candidate is None:
                 continue
             if candidate in variables:
@@ -111,16 +115,19 @@ def plan(recording, variables, label, maps=()):
             if variable:
                 break
         if variable is None:
-            result.ignored.append((channel, f"no variable of {label} is named "
-                                            f"{last_component(channel.symbol or channel.name)!r}"))
+            result.ignored.append(
+                (channel, f"no variable of {label} is named {last_component(channel.symbol or channel.name)!r}")
+            )
             continue
         if variable in taken:
             other = taken[variable]
             if any(v == variable for v, _ in maps):
                 result.ignored.append((channel, f"{variable} is mapped to {other.name!r}"))
                 continue
-            raise InputError(f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
-                             f"{_column(channel)} both mean {variable}: say which with --map {variable}=CHANNEL")
+            raise InputError(
+                f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
+                f"{_column(channel)} both mean {variable}: say which with --map {variable}=CHANNEL"
+            )
         taken[variable] = channel
     for variable, channel in taken.items():
         role, why = _role(variables[variable])

@@ -2,6 +2,7 @@
 its channel group, as recorded (nothing is resampled onto a common time
 base, so no value is invented). Master (time) channels are the stamps,
 in seconds; channels of text or byte arrays are listed as ignored."""
+
 from typing import Any, cast
 
 import numpy as np
@@ -18,6 +19,7 @@ def sniff(head):
 
 def read(path):
     from asammdf import MDF  # loaded on first use: it brings pandas, seconds of import for every other command
+
     try:
         mdf = MDF(str(path))
     except Exception as error:  # asammdf raises many kinds for a damaged file
@@ -34,9 +36,21 @@ def read(path):
                 if samples.dtype.kind not in "biuf" or samples.ndim != 1:
                     notes.append(f"channel {signal.name!r} (group {group_index}) holds {samples.dtype} values: ignored")
                     continue
-                channels.append(Channel(name=signal.name, stamps=np.asarray(signal.timestamps, dtype=np.float64),
-                                        values=samples.astype(np.float64), file=str(path)))
+                channels.append(
+                    Channel(
+                        name=signal.name,
+                        stamps=np.asarray(signal.timestamps, dtype=np.float64),
+                        values=samples.astype(np.float64),
+                        file=str(path),
+                    )
+                )
     finally:
         mdf.close()
-    return Recording(paths=[str(path)], format="ASAM MDF4", channels=channels, time_unit="s",
-                     time_source="MDF's time channels are in seconds", notes=notes)
+    return Recording(
+        paths=[str(path)],
+        format="ASAM MDF4",
+        channels=channels,
+        time_unit="s",
+        time_source="MDF's time channels are in seconds",
+        notes=notes,
+    )

@@ -1,6 +1,7 @@
 """The normalised recording every reader produces: channels, each with its
 own time stamps and values as NumPy arrays (columnar: a reader that reads
 in chunks can append to them), and how its time is to be read."""
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -8,14 +9,14 @@ import numpy as np
 
 @dataclass
 class Channel:
-    name: str                   # as the recorder wrote it, e.g. "DB_Ramp".value
-    stamps: np.ndarray          # as recorded: float64, int64 (FILETIME ticks) or datetime64[ns]
-    values: np.ndarray          # float64
+    name: str  # as the recorder wrote it, e.g. "DB_Ramp".value
+    stamps: np.ndarray  # as recorded: float64, int64 (FILETIME ticks) or datetime64[ns]
+    values: np.ndarray  # float64
     file: str
-    column: int = 0             # 1-based column of its values in a text file, 0 in MDF4
-    lines: np.ndarray | None = None    # line of each sample in a text file (int64), else None
-    symbol: str = ""            # a fuller name the recorder gives too (TwinCAT's SymbolName)
-    times: np.ndarray | None = None    # seconds from the recording's first sample (normalise())
+    column: int = 0  # 1-based column of its values in a text file, 0 in MDF4
+    lines: np.ndarray | None = None  # line of each sample in a text file (int64), else None
+    symbol: str = ""  # a fuller name the recorder gives too (TwinCAT's SymbolName)
+    times: np.ndarray | None = None  # seconds from the recording's first sample (normalise())
 
     def where(self, index):
         """'file, line L' of sample index (or the file and channel)."""
@@ -26,15 +27,15 @@ class Channel:
 
 @dataclass
 class Recording:
-    paths: list                 # the files it was read from
-    format: str                 # the recorder's export, as users call it
+    paths: list  # the files it was read from
+    format: str  # the recorder's export, as users call it
     channels: list
-    time_unit: str              # "s", "ms", "us", "ns", "cycles", "FILETIME", "date", "OLE days"
-    time_source: str            # why that unit: the header says so, or what was assumed
-    sample_time: float | None = None   # the recorder's sample interval in seconds, when the file declares it
+    time_unit: str  # "s", "ms", "us", "ns", "cycles", "FILETIME", "date", "OLE days"
+    time_source: str  # why that unit: the header says so, or what was assumed
+    sample_time: float | None = None  # the recorder's sample interval in seconds, when the file declares it
     encoding: str = ""
     notes: list = field(default_factory=list)
-    step_size: float | None = None     # set by normalise()
+    step_size: float | None = None  # set by normalise()
     step_source: str = ""
 
     @property

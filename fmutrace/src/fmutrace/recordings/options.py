@@ -1,4 +1,5 @@
 """How the recordings of a campaign are read: one RecordingOptions for all."""
+
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
@@ -31,6 +32,7 @@ class RecordingOptions:
                   FMU's variable
     start_values  {name: value} (or pairs): start values of the FMU
     """
+
     step_size: float | None = None
     time_unit: str | None = None
     timing: str = "cycle"
@@ -53,5 +55,10 @@ class RecordingOptions:
         return "FILETIME" if self.time_unit == "filetime" else self.time_unit
 
     def settings(self) -> dict:
-        return {"step_size": self.step_size, "time_unit": self.time_unit, "timing": self.timing,
-                "maps": [list(m) for m in self.maps], "start_values": [list(s) for s in self.start_values]}
+        return {
+            "step_size": self.step_size,
+            "time_unit": self.time_unit,
+            "timing": self.timing,
+            "maps": [list(m) for m in self.maps],
+            "start_values": [list(s) for s in self.start_values],
+        }

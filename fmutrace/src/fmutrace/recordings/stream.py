@@ -25,6 +25,7 @@ in-memory path reads the file (or explains it): what the head or the time
 column shows before the FMU runs, a bad cell of another column when its
 block is read, after the FMU ran the cycles before it.
 """
+
 import io
 from dataclasses import dataclass
 
@@ -39,9 +40,9 @@ from . import grid as grids
 from . import text as texts
 from . import timebase
 
-HEAD_BYTES = 1 << 20      # read as the in-memory path reads a whole file
-BLOCK_BYTES = 1 << 22     # of text per block of lines after the head
-MAX_INTERVALS = 1 << 16   # distinct intervals between stamps counted for the step (more: the in-memory path)
+HEAD_BYTES = 1 << 20  # read as the in-memory path reads a whole file
+BLOCK_BYTES = 1 << 22  # of text per block of lines after the head
+MAX_INTERVALS = 1 << 16  # distinct intervals between stamps counted for the step (more: the in-memory path)
 _CODECS = {"UTF-8": "utf-8", "UTF-8 (with BOM)": "utf-8", "Windows-1252": "cp1252"}
 
 
@@ -56,7 +57,7 @@ class Table:
         if mdf.sniff(head[:64]) is None:
             raise NotPlain("MDF4")
         if not at_end:
-            head = head[:head.rfind(b"\n") + 1]
+            head = head[: head.rfind(b"\n") + 1]
         decoded, self.encoding = texts.decode(self.path, head)
         if self.encoding not in _CODECS or _unusual_breaks(decoded):
             raise NotPlain("an encoding or line breaks the blocks cannot follow")
@@ -77,10 +78,12 @@ class Table:
         timebase.normalise(recording, options.timebase_unit, options.step_size, fmu.default_step)
         self.recording = recording
         self.origin = float(recording.channels[0].stamps[0])
-        self.factor = recording.step_size if recording.time_unit == "cycles" else \
-            timebase.TIME_FACTORS[recording.time_unit]
-        self.step_given = recording.time_unit == "cycles" or recording.step_source != \
-            "the finest interval between its time stamps"
+        self.factor = (
+            recording.step_size if recording.time_unit == "cycles" else timebase.TIME_FACTORS[recording.time_unit]
+        )
+        self.step_given = (
+            recording.time_unit == "cycles" or recording.step_source != "the finest interval between its time stamps"
+        )
         # the body starts after the header's line (index: 0-based), counted in bytes of the head
         start = 0
         for _ in range(index + 1):
@@ -137,10 +140,14 @@ class Table:
                 io.BytesIO(block),
                 read_options=pcsv.ReadOptions(column_names=names, use_threads=True),
                 parse_options=pcsv.ParseOptions(delimiter=self.separator, quote_char=False, ignore_empty_lines=False),
-                convert_options=pcsv.ConvertOptions(include_columns=[names[j] for j in read],
-                                                    column_types={names[j]: pa.float64() for j in read},
-                                                    null_values=[], strings_can_be_null=False,
-                                                    decimal_point="," if self.decimal_comma else "."))
+                convert_options=pcsv.ConvertOptions(
+                    include_columns=[names[j] for j in read],
+                    column_types={names[j]: pa.float64() for j in read},
+                    null_values=[],
+                    strings_can_be_null=False,
+                    decimal_point="," if self.decimal_comma else ".",
+                ),
+            )
         except pa.ArrowInvalid:
             return None
         columns = {j: table.column(names[j]).to_numpy() for j in read}
@@ -169,8 +176,9 @@ class Table:
         try:
             if not grids.present(cells).all():
                 raise NotPlain("an empty cell")
-            stamps = grids.numeric_stamps(text, cells[:, self.time_column], line_numbers, self.time_column + 1,
-                                          self.time_name, self.decimal_comma)
+            stamps = grids.numeric_stamps(
+                text, cells[:, self.time_column], line_numbers, self.time_column + 1, self.time_name, self.decimal_comma
+            )
         except TraceError:
             raise NotPlain("a time cell the in-memory path explains") from None
         if stamps.dtype != np.float64:
@@ -183,8 +191,14 @@ class Table:
         if isinstance(cells, dict):
             return cells[j]
         try:
-            return texts.values(cells[:, j], self.decimal_comma, texts.Text(self.path, "", self.encoding),
-                                lambda i: int(line_numbers[i]), j + 1, name)
+            return texts.values(
+                cells[:, j],
+                self.decimal_comma,
+                texts.Text(self.path, "", self.encoding),
+                lambda i: int(line_numbers[i]),
+                j + 1,
+                name,
+            )
         except TraceError:
             raise NotPlain("a cell the in-memory path explains") from None
 
@@ -196,9 +210,10 @@ def _unusual_breaks(text):
 @dataclass
 class Cycles:
     """What the pre-pass over a streamed recording's time column found."""
+
     rows: int
-    last: int               # the last row's cycle
-    off: int                # rows stamped more than OFF_CYCLE of a cycle off its end
+    last: int  # the last row's cycle
+    off: int  # rows stamped more than OFF_CYCLE of a cycle off its end
     first_off: tuple | None  # (line, seconds) of the first of them, or None
 
 

@@ -10,6 +10,7 @@ unit in its name: 'Time [ms]', 'Zeit (ms)', 'time_us'; or date strings),
 an optional sample index (Index, Sample, Nr, No, #; with no time column
 the index counts cycles) and the channels. No public sample of TIA
 Portal's export is known, so it is read by these general rules."""
+
 import numpy as np
 
 from .._traces import split_cells
@@ -18,10 +19,41 @@ from . import text as texts
 from . import timebase
 from .model import Recording
 
-TIME_WORDS = ("time", "t", "zeit", "timestamp", "zeitstempel", "time stamp", "datetime", "date/time",
-              "datum/zeit", "relative time", "rel. time", "reltime")
-INDEX_WORDS = ("index", "sample", "sample index", "samples", "nr", "nr.", "no", "no.", "#", "id", "messpunkt",
-               "point", "cycle", "cycles", "zyklus", "sample no.", "sample number", "zeile", "row")
+TIME_WORDS = (
+    "time",
+    "t",
+    "zeit",
+    "timestamp",
+    "zeitstempel",
+    "time stamp",
+    "datetime",
+    "date/time",
+    "datum/zeit",
+    "relative time",
+    "rel. time",
+    "reltime",
+)
+INDEX_WORDS = (
+    "index",
+    "sample",
+    "sample index",
+    "samples",
+    "nr",
+    "nr.",
+    "no",
+    "no.",
+    "#",
+    "id",
+    "messpunkt",
+    "point",
+    "cycle",
+    "cycles",
+    "zyklus",
+    "sample no.",
+    "sample number",
+    "zeile",
+    "row",
+)
 CYCLE_WORDS = ("cycle", "cycles", "zyklus")
 HEADER_SCAN = 200  # lines searched for the header
 
@@ -31,10 +63,10 @@ def bare_name(name):
     name = texts.unquote(name).strip().strip('"').lower()
     for opener in ("[", "("):
         if opener in name:
-            name = name[:name.index(opener)]
+            name = name[: name.index(opener)]
     for suffix in ("_ms", "_us", "_s", "_ns", "/ms", "/s", "/us"):
         if name.endswith(suffix):
-            name = name[:-len(suffix)]
+            name = name[: -len(suffix)]
     return name.strip()
 
 
@@ -74,8 +106,14 @@ def find_header(text):
                 return i, separator, names
     if not candidates:
         return None, None, "no line of column names"
-    return None, None, ("no header line with a time column (time, t, Zeit, Timestamp, 'Time [ms]') or a sample "
-                        "index followed by a line of values")
+    return (
+        None,
+        None,
+        (
+            "no header line with a time column (time, t, Zeit, Timestamp, 'Time [ms]') or a sample "
+            "index followed by a line of values"
+        ),
+    )
 
 
 def sniff(text):
@@ -119,8 +157,11 @@ def read(text):
     decimal_comma = separator != ","
     time_column = time_columns[0] if time_columns else (index_columns[0] if index_columns else None)
     if time_column is None:
-        raise text.error(header_line, 1, f"no time column: one of the columns must be the time or a sample index "
-                                         f"(found {names[0]!r})")
+        raise text.error(
+            header_line,
+            1,
+            f"no time column: one of the columns must be the time or a sample index (found {names[0]!r})",
+        )
     time_name = names[time_column]
     cells = table[:, time_column]
     stamp_present = grids.present(cells)
@@ -144,10 +185,19 @@ def read(text):
     grids.check_increasing(text, stamps, lines, time_column + 1, time_name)
     skip = {time_column} | set(index_columns)
     rows = grids.Rows(lines, stamps, stamp_present)
-    channels = [grids.channel_from(text, table[:, j], rows, j + 1, names[j], decimal_comma)
-                for j in range(len(names)) if j not in skip]
-    return Recording(paths=[text.path], format=_label(preamble, names, time_name, index_columns), channels=channels,
-                     time_unit=unit, time_source=source, encoding=text.encoding)
+    channels = [
+        grids.channel_from(text, table[:, j], rows, j + 1, names[j], decimal_comma)
+        for j in range(len(names))
+        if j not in skip
+    ]
+    return Recording(
+        paths=[text.path],
+        format=_label(preamble, names, time_name, index_columns),
+        channels=channels,
+        time_unit=unit,
+        time_source=source,
+        encoding=text.encoding,
+    )
 
 
 def _label(preamble, names, time_name, index_columns):

@@ -14,6 +14,7 @@ BOOL#TRUE, WORD#16#00FF). A column is converted at once with NumPy; only
 when that fails are its cells looked at one by one, to name the first
 bad one.
 """
+
 import re
 
 import numpy as np
@@ -65,7 +66,7 @@ def _strict(path, data, codec, label):
     try:
         return data.decode(codec), label
     except UnicodeDecodeError as error:
-        line = data[:error.start].count(b"\n" if "16" not in codec else "\n".encode(codec)) + 1
+        line = data[: error.start].count(b"\n" if "16" not in codec else "\n".encode(codec)) + 1
         raise TraceError(path, line, 0, f"not {label} text ({error.reason} at byte {error.start})") from None
 
 
@@ -144,10 +145,16 @@ def numbers(cells, decimal_comma, where):
 def values(cells, decimal_comma, text, line_of, column, name):
     """numbers() with the usual message: "'x' in column 'name' is not a
     value" at the cell's line and column."""
+
     def where(i):
         def make(shown):
-            message = (f"{shown} in column {name!r} is not a number, TRUE/FALSE or an IEC literal (16#...)"
-                       if shown != "''" else f"an empty cell in column {name!r}")
+            message = (
+                f"{shown} in column {name!r} is not a number, TRUE/FALSE or an IEC literal (16#...)"
+                if shown != "''"
+                else f"an empty cell in column {name!r}"
+            )
             return text.error(line_of(i), column, message)
+
         return make
+
     return numbers(cells, decimal_comma, where)

@@ -12,6 +12,7 @@ A stamp belongs to the nearest cycle end; one further than OFF_CYCLE of a
 cycle from it is reported (recorders' clocks and printed decimals are
 not exact, a stamp that far off means another clock or another step).
 """
+
 import re
 from datetime import datetime, timedelta, timezone
 
@@ -20,16 +21,35 @@ import numpy as np
 from .._errors import InputError, TraceError
 from .model import TIME_FACTORS
 
-OFF_CYCLE = 0.1          # a stamp more than this fraction of a cycle from a cycle end is reported
-MAX_STEPS = 200_000_000    # more steps than this (23 days of 10 ms cycles) is a misread unit
-MAX_SPARSE = 100           # and so are samples this many steps apart on average (unless --time-unit says so)
-MAX_SPAN = 366 * 86400.0   # and so is a recording over a year long
-SNAP = 1e-3                # an interval between stamps this close to a shorter decimal is that decimal
-UNIT_WORDS = {"s": "s", "sec": "s", "seconds": "s", "ms": "ms", "msec": "ms", "us": "us", "µs": "us",
-              "μs": "us", "usec": "us", "ns": "ns", "cycle": "cycles", "cycles": "cycles"}
-UNIT_NAMES = {"s": "seconds", "ms": "milliseconds", "us": "microseconds", "ns": "nanoseconds",
-              "cycles": "cycle counts", "FILETIME": "FILETIME (100 ns ticks since 1601)",
-              "OLE days": "OLE days (days since 30 Dec 1899, times 1e6)", "date": "dates and times"}
+OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
+MAX_STEPS = 200_000_000  # more steps than this (23 days of 10 ms cycles) is a misread unit
+MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless --time-unit says so)
+MAX_SPAN = 366 * 86400.0  # and so is a recording over a year long
+SNAP = 1e-3  # an interval between stamps this close to a shorter decimal is that decimal
+UNIT_WORDS = {
+    "s": "s",
+    "sec": "s",
+    "seconds": "s",
+    "ms": "ms",
+    "msec": "ms",
+    "us": "us",
+    "µs": "us",
+    "μs": "us",
+    "usec": "us",
+    "ns": "ns",
+    "cycle": "cycles",
+    "cycles": "cycles",
+}
+UNIT_NAMES = {
+    "s": "seconds",
+    "ms": "milliseconds",
+    "us": "microseconds",
+    "ns": "nanoseconds",
+    "cycles": "cycle counts",
+    "FILETIME": "FILETIME (100 ns ticks since 1601)",
+    "OLE days": "OLE days (days since 30 Dec 1899, times 1e6)",
+    "date": "dates and times",
+}
 _UNIT_IN_NAME = re.compile(r"(?:[\[(]\s*([^\])]+?)\s*[\])]|[_/ ](ms|us|µs|ns|s)\s*$)", re.IGNORECASE)
 
 
@@ -60,20 +80,27 @@ def unnamed_unit(stamps, name):
 
 
 # -- date strings ---------------------------------------------------------------
-_MONTHS = {m: i + 1 for i, m in enumerate(("jan", "feb", "mar", "apr", "may", "jun", "jul", "aug", "sep", "oct",
-                                          "nov", "dec"))}
+_MONTHS = {
+    m: i + 1 for i, m in enumerate(("jan", "feb", "mar", "apr", "may", "jun", "jul", "aug", "sep", "oct", "nov", "dec"))
+}
 _MONTHS.update({"mär": 3, "mrz": 3, "mai": 5, "okt": 10, "dez": 12})
 _DATE_FORMS = [
     # 2026-11-20T14:03:11.125+01:00, 2026-11-20 14:03:11,125
-    re.compile(r"^(?P<Y>\d{4})-(?P<m>\d{1,2})-(?P<d>\d{1,2})[T ](?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
-               r"(?:[.,](?P<f>\d+))?\s*(?P<z>Z|[+-]\d{2}:?\d{2})?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"),
+    re.compile(
+        r"^(?P<Y>\d{4})-(?P<m>\d{1,2})-(?P<d>\d{1,2})[T ](?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+        r"(?:[.,](?P<f>\d+))?\s*(?P<z>Z|[+-]\d{2}:?\d{2})?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"
+    ),
     # 24.03.2014 10:42:55.123 (WinCC), 20/11/2026 14:03:11
-    re.compile(r"^(?P<d>\d{1,2})[./](?P<m>\d{1,2})[./](?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
-               r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"),
+    re.compile(
+        r"^(?P<d>\d{1,2})[./](?P<m>\d{1,2})[./](?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+        r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"
+    ),
     # 22-Sep-26 09:00:01.250 AM UTC (Niagara)
-    re.compile(r"^(?P<d>\d{1,2})-(?P<b>[A-Za-zä]{3})-(?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
-               r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<z>[+-]\d{2}:?\d{2}))?"
-               r"(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"),
+    re.compile(
+        r"^(?P<d>\d{1,2})-(?P<b>[A-Za-zä]{3})-(?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+        r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<z>[+-]\d{2}:?\d{2}))?"
+        r"(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"
+    ),
 ]
 
 
@@ -113,8 +140,7 @@ def parse_date(text):
         moment -= sign * timedelta(hours=int(digits[:2]), minutes=int(digits[2:]))
     fraction = g.get("f") or ""
     nanoseconds = int((fraction + "000000000")[:9]) if fraction else 0
-    return (int((moment - datetime(1970, 1, 1, tzinfo=timezone.utc)).total_seconds()) * 1_000_000_000
-            + nanoseconds)
+    return int((moment - datetime(1970, 1, 1, tzinfo=timezone.utc)).total_seconds()) * 1_000_000_000 + nanoseconds
 
 
 def dates(cells, text, line_of, column, name):
@@ -124,8 +150,12 @@ def dates(cells, text, line_of, column, name):
     for i, cell in enumerate(cells):
         value = parse_date(cell)
         if value is None:
-            raise text.error(line_of(i), column, f"{cell.strip()!r} in column {name!r} is not a date and time "
-                                                 "(e.g. 2026-11-20 14:03:11.125 or 20.11.2026 14:03:11.125)")
+            raise text.error(
+                line_of(i),
+                column,
+                f"{cell.strip()!r} in column {name!r} is not a date and time "
+                "(e.g. 2026-11-20 14:03:11.125 or 20.11.2026 14:03:11.125)",
+            )
         out[i] = value
     return out
 
@@ -141,8 +171,10 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
     naming the unit it assumed."""
     if time_unit:
         if recording.time_unit in ("date", "OLE days") and time_unit != recording.time_unit:
-            raise InputError(f"{recording.label}: its time stamps are {UNIT_NAMES[recording.time_unit]}: "
-                             f"--time-unit {time_unit} does not apply")
+            raise InputError(
+                f"{recording.label}: its time stamps are {UNIT_NAMES[recording.time_unit]}: "
+                f"--time-unit {time_unit} does not apply"
+            )
         recording.time_unit, recording.time_source = time_unit, "--time-unit"
     unit = recording.time_unit
     channels = [c for c in recording.channels if len(c.stamps)]
@@ -153,18 +185,25 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
         if not step:
             raise InputError(f"{recording.label}: its time is a cycle count: give the cycle time with --step-size")
         recording.step_size = step
-        recording.step_source = ("--step-size" if step_size else "the recording's sample time"
-                                 if recording.sample_time else "the FMU's default step size")
+        recording.step_source = (
+            "--step-size"
+            if step_size
+            else "the recording's sample time"
+            if recording.sample_time
+            else "the FMU's default step size"
+        )
     origin = min(c.stamps[0] for c in channels)
     factor = recording.step_size if unit == "cycles" else 1e-9 if unit == "date" else TIME_FACTORS[unit]
     for channel in recording.channels:
         channel.times = _minus(channel.stamps, origin) * factor
     span = max(float(c.times[-1]) for c in channels)
-    assumed = (f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit])
+    assumed = f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit]
     if too_long(span):
-        raise InputError(f"{recording.label}: with its time read as {assumed}, the recording would span "
-                         f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give --time-unit "
-                         "(s, ms, us, ns, cycles, filetime)")
+        raise InputError(
+            f"{recording.label}: with its time read as {assumed}, the recording would span "
+            f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give --time-unit "
+            "(s, ms, us, ns, cycles, filetime)"
+        )
     if unit != "cycles":
         if step_size:
             recording.step_size, recording.step_source = step_size, "--step-size"
@@ -174,8 +213,7 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
             step = finest_interval(channels)
             if step is None:
                 if not default_step:
-                    raise InputError(f"{recording.label}: one sample per channel tells no cycle time: give "
-                                     "--step-size")
+                    raise InputError(f"{recording.label}: one sample per channel tells no cycle time: give --step-size")
                 step, source = default_step, "the FMU's default step size"
             else:
                 source = "the finest interval between its time stamps"
@@ -183,10 +221,12 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
     steps = span / recording.step_size
     samples = max(len(c.times) for c in channels)
     if too_many_steps(steps, samples, recording.time_source):
-        raise InputError(f"{recording.label}: with its time read as {assumed} and a step of "
-                         f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
-                         f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit "
-                         "(s, ms, us, ns, cycles, filetime)")
+        raise InputError(
+            f"{recording.label}: with its time read as {assumed} and a step of "
+            f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
+            f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit "
+            "(s, ms, us, ns, cycles, filetime)"
+        )
     return recording
 
 

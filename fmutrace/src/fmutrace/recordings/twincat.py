@@ -18,6 +18,7 @@ Times are milliseconds from the export's first point or, with 'Full
 Timestamp', FILETIME. A group that sampled less often ends earlier:
 its cells are blank (or the row is shorter). An 'EOF' line may close the
 file."""
+
 import numpy as np
 
 from .._traces import split_cells
@@ -25,8 +26,18 @@ from . import grid as grids
 from . import text as texts
 from .model import Recording
 
-KEYS = ("SampleTime[ms]", "SampleTime", "SymbolName", "Data-Type", "SymbolComment", "VariableSize", "NetID",
-        "IndexGroup", "SymbolBased", "Unit")
+KEYS = (
+    "SampleTime[ms]",
+    "SampleTime",
+    "SymbolName",
+    "Data-Type",
+    "SymbolComment",
+    "VariableSize",
+    "NetID",
+    "IndexGroup",
+    "SymbolBased",
+    "Unit",
+)
 TITLE_SCAN = 40
 
 
@@ -64,13 +75,22 @@ def _realigned(text, line, key, cells, name_row, separator):
     for g, start in enumerate(starts):
         slots = bounds[g + 1] - bounds[g] - 1
         end = starts[g + 1] if g + 1 < len(starts) else len(cells)
-        values = cells[start + 1:end]
+        values = cells[start + 1 : end]
         if len(values) != slots:
             if slots != 1 or not all(v.strip().lstrip("-").isdigit() for v in values):
-                why = "a name with blanks, blanks separating" if separator == " " else \
-                    "a decimal comma, ',' separating" if separator == "," else "a separator inside a name"
-                raise text.error(line, start + 1, f"the row {key!r} has {len(values)} cells for {slots} channels "
-                                                  f"({why}?): export with another separator")
+                why = (
+                    "a name with blanks, blanks separating"
+                    if separator == " "
+                    else "a decimal comma, ',' separating"
+                    if separator == ","
+                    else "a separator inside a name"
+                )
+                raise text.error(
+                    line,
+                    start + 1,
+                    f"the row {key!r} has {len(values)} cells for {slots} channels "
+                    f"({why}?): export with another separator",
+                )
             values = [",".join(values)]
         fixed += [key] + values
     return fixed
@@ -119,8 +139,11 @@ def read(text):
             if literal:
                 value = texts.cell_value(literal)
                 if value is None or not value > 0:
-                    raise text.error(header.get("SampleTime[ms]", (0,))[0], j + 1,
-                                     f"SampleTime[ms] {literal!r} is not a positive number")
+                    raise text.error(
+                        header.get("SampleTime[ms]", (0,))[0],
+                        j + 1,
+                        f"SampleTime[ms] {literal!r} is not a positive number",
+                    )
                 sample_times.append(value)
     if no_time:
         rows_columns = [j - 1 for j in range(len(name_cells)) if j not in key_columns]
@@ -135,30 +158,50 @@ def read(text):
             for j in columns:
                 k = rows_columns[columns.index(j)] if no_time else j
                 ms = texts.cell_value(prop("SampleTime[ms]", j))
-                channel = grids.channel_from(text, table[:, k], grids.Rows(lines, row_stamps * ms,
-                                                                           np.ones(len(rows), bool)),
-                                             k + 1, prop("Name", j), decimal_comma)
+                channel = grids.channel_from(
+                    text,
+                    table[:, k],
+                    grids.Rows(lines, row_stamps * ms, np.ones(len(rows), bool)),
+                    k + 1,
+                    prop("Name", j),
+                    decimal_comma,
+                )
                 channel.symbol = prop("SymbolName", j)
                 channels.append(channel)
             continue
         cells = table[:, time_column]
         stamp_present = grids.present(cells)
         rows_with = np.flatnonzero(stamp_present)
-        stamps_present = grids.numeric_stamps(text, cells[rows_with], lines[rows_with], time_column + 1,
-                                              f"time of {prop('Name', columns[0]) if columns else 'a group'}",
-                                              decimal_comma)
+        stamps_present = grids.numeric_stamps(
+            text,
+            cells[rows_with],
+            lines[rows_with],
+            time_column + 1,
+            f"time of {prop('Name', columns[0]) if columns else 'a group'}",
+            decimal_comma,
+        )
         filetime = filetime or stamps_present.dtype.kind == "i"
         stamps = np.zeros(len(rows), dtype=stamps_present.dtype)
         stamps[rows_with] = stamps_present
         grids.check_increasing(text, stamps_present, lines[rows_with], time_column + 1, "time")
         for j in columns:
-            channel = grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, stamp_present), j + 1,
-                                         prop("Name", j), decimal_comma)
+            channel = grids.channel_from(
+                text, table[:, j], grids.Rows(lines, stamps, stamp_present), j + 1, prop("Name", j), decimal_comma
+            )
             channel.symbol = prop("SymbolName", j)
             channels.append(channel)
     unit = "FILETIME" if filetime else "ms"
-    source = ("its stamps are FILETIME ('Full Timestamp')" if filetime
-              else "Scope View writes milliseconds from the first point")
-    return Recording(paths=[text.path], format="Beckhoff TwinCAT Scope View CSV export", channels=channels,
-                     time_unit=unit, time_source=source, encoding=text.encoding,
-                     sample_time=min(sample_times) * 1e-3 if sample_times else None)
+    source = (
+        "its stamps are FILETIME ('Full Timestamp')"
+        if filetime
+        else "Scope View writes milliseconds from the first point"
+    )
+    return Recording(
+        paths=[text.path],
+        format="Beckhoff TwinCAT Scope View CSV export",
+        channels=channels,
+        time_unit=unit,
+        time_source=source,
+        encoding=text.encoding,
+        sample_time=min(sample_times) * 1e-3 if sample_times else None,
+    )

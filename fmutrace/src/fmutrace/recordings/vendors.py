@@ -22,6 +22,7 @@ its unit: 'Value (°C)'). A sample whose status is not ok ({null},
 point's name is the file's name, unless a line before the table names
 the history ('History: /Station/delayedValue', 'HistoryId,...'): then its
 last component."""
+
 import os
 
 import numpy as np
@@ -60,20 +61,26 @@ def read_codesys23(text):
         raise text.error(3, 0, "no samples after the names")
     for row, line in zip(rows, lines, strict=True):
         if len(row) != len(names):
-            raise text.error(int(line), min(len(row), len(names)) + 1,
-                             f"{len(row)} values, the names line has {len(names)}")
+            raise text.error(
+                int(line), min(len(row), len(names)) + 1, f"{len(row)} values, the names line has {len(names)}"
+            )
     table = grids.grid(rows, len(names))
     stamps = grids.numeric_stamps(text, table[:, 0], lines, 1, names[0], True)
     grids.check_increasing(text, stamps, lines, 1, names[0])
     cycles = bare_name(names[0]) in CYCLE_WORDS
     everywhere = np.ones(len(rows), dtype=bool)
-    channels = [grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, everywhere), j + 1, names[j], True)
-                for j in range(1, len(names))]
-    return Recording(paths=[text.path], format="CODESYS 2.3 trace (ASCII file)", channels=channels,
-                     time_unit="cycles" if cycles else "ms",
-                     time_source=f"its first column is {names[0]!r}" + ("" if cycles else
-                                                                         ": CODESYS 2.3 writes ms since the start"),
-                     encoding=text.encoding)
+    channels = [
+        grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, everywhere), j + 1, names[j], True)
+        for j in range(1, len(names))
+    ]
+    return Recording(
+        paths=[text.path],
+        format="CODESYS 2.3 trace (ASCII file)",
+        channels=channels,
+        time_unit="cycles" if cycles else "ms",
+        time_source=f"its first column is {names[0]!r}" + ("" if cycles else ": CODESYS 2.3 writes ms since the start"),
+        encoding=text.encoding,
+    )
 
 
 # -- WinCC ---------------------------------------------------------------------------
@@ -133,12 +140,33 @@ def read_wincc(text):
         rows_of = np.flatnonzero(keep & (tags == tag))
         tag_stamps = stamps[rows_of]
         grids.check_increasing(text, tag_stamps, lines[rows_of], j + 1, f"time of {tag}")
-        values = texts.values(table[rows_of, value_column], decimal_comma, text,
-                              lambda i, rows_of=rows_of: int(lines[rows_of[i]]), value_column + 1, "VarValue")
-        channels.append(Channel(name=tag, stamps=tag_stamps, values=values, file=text.path, column=value_column + 1,
-                                lines=lines[rows_of]))
-    return Recording(paths=[text.path], format="WinCC data log CSV", channels=channels, time_unit=unit,
-                     time_source=source, encoding=text.encoding, notes=notes)
+        values = texts.values(
+            table[rows_of, value_column],
+            decimal_comma,
+            text,
+            lambda i, rows_of=rows_of: int(lines[rows_of[i]]),
+            value_column + 1,
+            "VarValue",
+        )
+        channels.append(
+            Channel(
+                name=tag,
+                stamps=tag_stamps,
+                values=values,
+                file=text.path,
+                column=value_column + 1,
+                lines=lines[rows_of],
+            )
+        )
+    return Recording(
+        paths=[text.path],
+        format="WinCC data log CSV",
+        channels=channels,
+        time_unit=unit,
+        time_source=source,
+        encoding=text.encoding,
+        notes=notes,
+    )
 
 
 # -- Niagara -------------------------------------------------------------------------
@@ -179,8 +207,9 @@ def read_niagara(text):
         raise text.error(index + 1, 0, "no samples: the history has a header line only")
     for row, line in zip(rows, lines, strict=True):
         if len(row) < 4:
-            raise text.error(int(line), len(row) + 1, f"{len(row)} cells: a row holds Timestamp, Trend Flags, "
-                                                      "Status and Value")
+            raise text.error(
+                int(line), len(row) + 1, f"{len(row)} cells: a row holds Timestamp, Trend Flags, Status and Value"
+            )
     # the Status cell may hold separators itself ({fault,stale}): the value is the last cell
     table = grids.grid([[r[0], " ".join(r[2:-1]), r[-1]] for r in rows], 3)
     status = np.char.lower(np.char.strip(table[:, 1]))
@@ -190,17 +219,28 @@ def read_niagara(text):
     notes = []
     if not good.all():
         first = int(np.flatnonzero(~good)[0])
-        notes.append(f"{name}: {int((~good).sum())} samples whose status is not ok or that hold no value skipped "
-                     f"(the first at {text.path}, line {int(lines[first])}: {table[first, 1] or table[first, 2]!r})")
+        notes.append(
+            f"{name}: {int((~good).sum())} samples whose status is not ok or that hold no value skipped "
+            f"(the first at {text.path}, line {int(lines[first])}: {table[first, 1] or table[first, 2]!r})"
+        )
     rows_of = np.flatnonzero(good)
     stamps = timebase.dates(table[rows_of, 0], text, lambda i: int(lines[rows_of[i]]), 1, "Timestamp")
     grids.check_increasing(text, stamps, lines[rows_of], 1, "Timestamp")
-    values = texts.values(value_cells[rows_of], separator != ",", text, lambda i: int(lines[rows_of[i]]),
-                          len(rows[0]), "Value")
-    channel = Channel(name=name, stamps=stamps, values=values, file=text.path, column=len(rows[0]),
-                      lines=lines[rows_of])
-    return Recording(paths=[text.path], format="Niagara history export", channels=[channel], time_unit="date",
-                     time_source="Niagara's Timestamp", encoding=text.encoding, notes=notes)
+    values = texts.values(
+        value_cells[rows_of], separator != ",", text, lambda i: int(lines[rows_of[i]]), len(rows[0]), "Value"
+    )
+    channel = Channel(
+        name=name, stamps=stamps, values=values, file=text.path, column=len(rows[0]), lines=lines[rows_of]
+    )
+    return Recording(
+        paths=[text.path],
+        format="Niagara history export",
+        channels=[channel],
+        time_unit="date",
+        time_source="Niagara's Timestamp",
+        encoding=text.encoding,
+        notes=notes,
+    )
 
 
 def merge(recordings):
@@ -209,11 +249,17 @@ def merge(recordings):
     for recording in recordings:
         for channel in recording.channels:
             if channel.name in names:
-                raise texts.TraceError(channel.file, 0, 0, f"the point {channel.name!r} again (also in "
-                                                           f"{names[channel.name]})")
+                raise texts.TraceError(
+                    channel.file, 0, 0, f"the point {channel.name!r} again (also in {names[channel.name]})"
+                )
             names[channel.name] = channel.file
     first = recordings[0]
-    return Recording(paths=[p for r in recordings for p in r.paths], format=first.format,
-                     channels=[c for r in recordings for c in r.channels], time_unit=first.time_unit,
-                     time_source=first.time_source, encoding=first.encoding,
-                     notes=[n for r in recordings for n in r.notes])
+    return Recording(
+        paths=[p for r in recordings for p in r.paths],
+        format=first.format,
+        channels=[c for r in recordings for c in r.channels],
+        time_unit=first.time_unit,
+        time_source=first.time_source,
+        encoding=first.encoding,
+        notes=[n for r in recordings for n in r.notes],
+    )
