@@ -37,7 +37,7 @@ from ._outcome import CaseOutcome, Status
 from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK, FastLoopFailed, Runner
-from ._simulation import SimulationOptions
+from ._simulation import SimulationOptions, resolved
 from ._traces import CHUNK_BYTES, LONG_CASE_BYTES, NotPlain, TraceWriter, read_text, trace_chunks
 
 
@@ -342,27 +342,21 @@ def simulate_long(fmu_path, input_path, out, options: SimulationOptions, streami
             return None
         fmu = Fmu(fmu_path)
         first_in = next(trace_chunks(input_path, fmu.input_problem, chunk_bytes=1 << 16))
-        values = {name: fmu.start_value(name, value) for name, value in (options.start_values or {}).items()}
-        names = list(options.outputs) if options.outputs else fmu.outputs
-        start_time, stop_time, step_size = options.start_time, options.stop_time, options.step_size
-        if any(fmu.variable_problem(name) for name in names) or len(first_in) < 2:
+        if len(first_in) < 2:
             return None
-        start = float(start_time) if start_time is not None else float(first_in["time"][0])
-        stop = float(stop_time) if stop_time is not None else _last_time(input_path)
-        step = float(step_size) if step_size is not None else fmu.default_step
-        if step is None or not step > 0 or not stop > start:
-            return None
+        span = (first_in["time"][0], _last_time(input_path))
+        experiment, signals = resolved(fmu, options, span)  # the defaults as simulate resolves them
     except (InputError, NotPlain, OSError, ValueError, StopIteration):
-        return None
+        return None  # simulate explains
     runner = Runner(fmu.path.read_bytes())
-    n = round((stop - start) / step)
-    bar = streaming.progress or SampleProgress(n + 1)
+    start, step = experiment.start, experiment.step
+    bar = streaming.progress or SampleProgress(round((experiment.stop - start) / step) + 1)
     written, writer = 0, None
     try:
         inputs = trace_chunks(input_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
         for chunk in runner.run_chunks(
-            Experiment(start, stop, step),
-            Signals(inputs, values, names),
+            experiment,
+            Signals(inputs, signals.start_values, signals.outputs),
             _signal_names(first_in),
             streaming.steps_per_chunk,
         ):

@@ -88,8 +88,25 @@ def simulate(
                 raise InputError(problem)
     else:
         inputs = None
-    values = {name: fmu.start_value(name, value) for name, value in (start_values or {}).items()}
-    names = list(outputs) if outputs else fmu.outputs
+    options = SimulationOptions(start_values, start_time, stop_time, step_size, output_interval, outputs)
+    times = inputs["time"] if inputs is not None and len(inputs) else None
+    experiment, signals = resolved(fmu, options, (times[0], times[-1]) if times is not None else None)
+    runner = Runner(fmu.path.read_bytes())  # its own loop where it gives fmpy's result, else fmpy's
+    try:
+        result = runner.run(experiment, Signals(inputs, signals.start_values, signals.outputs))
+    finally:
+        runner.close()
+    return every_nth(result, experiment.start, experiment.step, output_interval)
+
+
+def resolved(fmu: Fmu, options: SimulationOptions, input_span: tuple | None) -> tuple[Experiment, Signals]:
+    """A simulation's experiment and signals (its inputs left None) with
+    every default resolved, for simulate and `fmutrace run` alike: the
+    times given, else the input's first and last time (input_span), else
+    the FMU's default experiment (else a start at 0); the FMU's default
+    step; its outputs. InputError for what cannot be run."""
+    values = {name: fmu.start_value(name, value) for name, value in (options.start_values or {}).items()}
+    names = list(options.outputs) if options.outputs else fmu.outputs
     for name in names:
         problem = fmu.variable_problem(name)
         if problem:
@@ -98,19 +115,14 @@ def simulate(
     def first(*candidates):
         return next((float(c) for c in candidates if c is not None), None)
 
-    times = inputs["time"] if inputs is not None and len(inputs) else None
-    start = first(start_time, times[0] if times is not None else None, fmu.default_start, 0.0)
-    stop = first(stop_time, times[-1] if times is not None else None, fmu.default_stop)
-    step = first(step_size, fmu.default_step)
+    first_time, last_time = input_span if input_span is not None else (None, None)
+    start = first(options.start_time, first_time, fmu.default_start, 0.0)
+    stop = first(options.stop_time, last_time, fmu.default_stop)
+    step = first(options.step_size, fmu.default_step)
     if step is None:
         raise InputError(f"{fmu.label} gives no default step size: give step_size")
     if not step > 0:
         raise InputError(f"the step size must be greater than 0, not {step!r}")
     if stop is None or not stop > start:
         raise InputError(f"the stop time ({stop!r}) must be after the start time ({start!r})")
-    runner = Runner(fmu.path.read_bytes())  # its own loop where it gives fmpy's result, else fmpy's
-    try:
-        result = runner.run(Experiment(start, stop, step), Signals(inputs, values, names))
-    finally:
-        runner.close()
-    return every_nth(result, start, step, output_interval)
+    return Experiment(start, stop, step), Signals(None, values, names)

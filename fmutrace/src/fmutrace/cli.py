@@ -216,16 +216,7 @@ def run_command(args, out):
                     file=out,
                 )
             return ExitStatus.SUCCESS
-    result = simulate(
-        args.fmu,
-        args.input,
-        start_values=options.start_values,
-        start_time=options.start_time,
-        stop_time=options.stop_time,
-        step_size=options.step_size,
-        output_interval=options.output_interval,
-        outputs=options.outputs,
-    )
+    result = simulate(args.fmu, args.input, **vars(options))
     if args.out:
         write_trace(args.out, result)
         print(f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {args.out}", file=out)
