@@ -199,3 +199,35 @@ print(open(lock.path).read().strip())
 lock.release()
 print(msvcrt.locked)""").splitlines()
     assert said[0].startswith("pid ") and said[1] == "[(2, 1), (0, 1)]"
+
+
+PARAMETERS_AT_MOST = 6  # an internal function's; more settings travel as one object (RunOptions, CaseSettings, ...)
+
+
+def functions():
+    """(module, function name, its ast.arguments) of every function of the package."""
+    for name, path in module_names().items():
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                yield name, node.name, node.args
+
+
+def test_no_internal_function_takes_more_than_six_parameters():
+    import fmutrace
+
+    many = [f"{module}.{function}" for module, function, args in functions()
+            if len([a for a in args.posonlyargs + args.args + args.kwonlyargs if a.arg not in ("self", "cls")])
+            > PARAMETERS_AT_MOST and function not in fmutrace.__all__]
+    assert not many, many
+
+
+@pytest.mark.parametrize("entry", ["compare", "simulate"])
+def test_the_entry_points_take_their_settings_by_keyword(entry):
+    """compare(fmus, cases, *, ...) and simulate(fmu, input, *, ...)."""
+    import inspect
+
+    import fmutrace
+
+    parameters = list(inspect.signature(getattr(fmutrace, entry)).parameters.values())
+    assert [p.kind for p in parameters[:2]] == [inspect.Parameter.POSITIONAL_OR_KEYWORD] * 2
+    assert all(p.kind == inspect.Parameter.KEYWORD_ONLY for p in parameters[2:]) and len(parameters) > 2
