@@ -218,18 +218,21 @@ class Tube(Mode):
         return f"tube of {self.time:g} s and {self.value:g}"
 
     def bands(self, result, reference, names):
-        bands = {}
-        for name in names:
-            lower, upper = tube_bounds(
-                reference["time"], reference[name].astype(np.float64), result["time"], self.time, self.value
-            )
-            inside = ~np.isnan(lower)  # the samples inside the reference's time range
-            values, lower, upper = result[name].astype(np.float64)[inside], lower[inside], upper[inside]
-            with np.errstate(invalid="ignore"):
-                ok = (values >= lower) & (values <= upper)
-                outside = np.where(values > upper, values - upper, np.where(values < lower, values - lower, 0.0))
-            bands[name] = Band(result["time"][inside], values, lower, upper, ok, outside)
-        return bands, ""
+        return {name: self.band(result, reference, name) for name in names}, ""
+
+    def band(self, result, reference, name, span=None):
+        """The Band of the result's samples of signal name in the tube
+        around the reference; span: the whole reference's (first, last)
+        time where reference is a window of it (None: its own)."""
+        lower, upper = tube_bounds(
+            reference["time"], reference[name].astype(np.float64), result["time"], (self.time, self.value), span
+        )
+        inside = ~np.isnan(lower)  # the samples inside the reference's time range
+        values, lower, upper = result[name].astype(np.float64)[inside], lower[inside], upper[inside]
+        with np.errstate(invalid="ignore"):
+            ok = (values >= lower) & (values <= upper)
+            outside = np.where(values > upper, values - upper, np.where(values < lower, values - lower, 0.0))
+        return Band(result["time"][inside], values, lower, upper, ok, outside)
 
 
 def _check_widths(mode, **options):
@@ -320,12 +323,17 @@ def _polyline_at(times, values, at):
     return float(values[k] + (values[k + 1] - values[k]) * (at - t0) / (t1 - t0))
 
 
-def tube_bounds(reference_time, reference_values, times, tube_time, tube_value):
+def tube_bounds(reference_time, reference_values, times, widths, span=None):
     """The tube's lower and upper bound at each of times (NaN outside the
-    reference's time range: there the reference says nothing)."""
+    reference's time range: there the reference says nothing); widths:
+    (time, value). span: the whole reference's (first, last) time where
+    reference_time is a window of it that holds every sample within the
+    tube's time of each of times and one more on either side (None: its
+    own)."""
+    tube_time, tube_value = widths
     lower = np.full(len(times), np.nan)
     upper = np.full(len(times), np.nan)
-    t_first, t_last = reference_time[0], reference_time[-1]
+    t_first, t_last = span if span is not None else (reference_time[0], reference_time[-1])
     for i, t in enumerate(times):
         if not t_first <= t <= t_last:
             continue

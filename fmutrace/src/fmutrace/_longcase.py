@@ -11,11 +11,13 @@ with comparison.compare_traces), bit for bit, from the comparison
 module's own rules (its samples matched by comparison.aligned, the
 verdict accumulated by comparison.Verdict): every signal's counts, its
 first deviation and its largest, and a reference time the result lacks
-(a test runs both on the same cases). A case this path cannot take (a
-tube, a file that is not the plain CSV dialect, an input the fast loop
-cannot replay, a failing FMU) goes to the in-memory path, which reads it
-or explains it: `run_long_case` returns None then, before anything is
-reported.
+(a test runs both on the same cases). A tube compares each result sample
+with the reference around it: the reference is kept from the row before
+that window to a row after it (Tube.band on that window gives the whole
+reference's bounds). A case this path cannot take (a file that is not
+the plain CSV dialect, an input the fast loop cannot replay, a failing
+FMU) goes to the in-memory path, which reads it or explains it:
+`run_long_case` returns None then, before anything is reported.
 """
 
 import contextlib
@@ -29,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ._cases import read_options, read_start_values
-from ._comparison import Band, Pointwise, Verdict, aligned
+from ._comparison import Band, Mode, Pointwise, Tube, Verdict, aligned
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
@@ -106,8 +108,6 @@ def run_long_case(folder, name, target, settings, streaming: Streaming = Streami
     """The CaseOutcome of the case in folder on target (a _worker.Target),
     chunk by chunk; None if this path cannot take it (the in-memory path
     then runs it)."""
-    if not isinstance(settings.mode, Pointwise):  # (a tube looks around each sample: the in-memory path)
-        return None
     started = time.perf_counter()
     folder = Path(folder)
     fmu, labels = target.fmu, target.labels
@@ -160,8 +160,6 @@ def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Stre
     _worker.Target); None if this path cannot take it (a chunk raises
     NotPlain, the fast loop cannot replay it), before anything is
     reported."""
-    if not isinstance(settings.mode, Pointwise):  # (a tube looks around each sample: the in-memory path)
-        return None
     options, outputs, input_names = case.options, case.outputs, case.input_names
     start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
     n = round((stop - start) / step)
@@ -187,14 +185,19 @@ def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Stre
             state.out = stack.enter_context(open(streaming.result_file, "w", newline="\n"))
         state.results = results
         try:
-            held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-            for chunk in case.ref_chunks:
+            if isinstance(settings.mode, Tube):
+                for chunk in case.ref_chunks:
+                    state.tube_rows(chunk)
+                state.tube_rows(None)
+            else:
+                held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
+                for chunk in case.ref_chunks:
+                    if held is not None:
+                        chunk = np.concatenate([held, chunk])
+                    held = chunk[-1:]
+                    state.compare_rows(chunk[:-1], chunk["time"][-1])
                 if held is not None:
-                    chunk = np.concatenate([held, chunk])
-                held = chunk[-1:]
-                state.compare_rows(chunk[:-1], chunk["time"][-1])
-            if held is not None:
-                state.compare_rows(held, np.nan)
+                    state.compare_rows(held, np.nan)
             state.result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
             if state.reached != n + 1:
                 raise FastLoopFailed("the run ended early")
@@ -207,7 +210,7 @@ class _Comparer:
     """A chunked case's comparison as it goes: the result's window, each
     signal's verdict, the figure's envelopes and its zoom."""
 
-    def __init__(self, case: ChunkedCase, mode: Pointwise, bar: SampleProgress):
+    def __init__(self, case: ChunkedCase, mode: Mode, bar: SampleProgress):
         options, outputs = case.options, case.outputs
         self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
         self.n = round((options["StopTime"] - self.start) / self.step)
@@ -231,6 +234,9 @@ class _Comparer:
         self.out: TextIO | None = None  # the result file
         self.writer: TraceWriter | None = None
         self.bar = bar
+        self.reference: np.ndarray | None = None  # a tube's: the reference rows its next samples look around
+        self.t_first: float | None = None  # the reference's first time
+        self.compared = 0  # a tube's: the result samples compared
 
     def result_until(self, k):
         """The result window through sample k (or the end)."""
@@ -277,28 +283,78 @@ class _Comparer:
         use = index >= 0
         if not use.any():
             return
-        self._add(rows, result[index[use]], times[use], use)
-
-    def _add(self, rows, picked, compared_times, use):
-        """Each signal's band on the compared samples; the zoom at the first failing one."""
-        failing_now = []
+        assert isinstance(self.mode, Pointwise)  # (stream_case gives a tube's rows to tube_rows)
+        picked, compared_times, bands = result[index[use]], times[use], {}
         for s in self.outputs:
             expected = rows[s][use].astype(np.float64)
             values = picked[s].astype(np.float64)
             lower, upper, ok = self.mode.bounds(values, expected)
             with np.errstate(invalid="ignore", over="ignore"):
-                deviation = values - expected
+                bands[s] = Band(compared_times, values, lower, upper, ok, values - expected)
+        self._add(bands)
+
+    def tube_rows(self, rows):
+        """A tube's comparison as Tube.bands makes it on the whole: adds
+        reference rows (None: there are no more) and compares the result
+        samples whose look-around window they cover, each against the
+        reference from its time - the tube's time to its time + the tube's
+        time (the window: from the row before that on, to a row after it)."""
+        mode = self.mode
+        assert isinstance(mode, Tube)
+        if rows is not None and len(rows):
+            for s in self.outputs:
+                self.envelopes[("ref", s)].add(rows["time"], rows[s])
+            self.t_first = float(rows["time"][0]) if self.t_first is None else self.t_first
+            self.reference = rows if self.reference is None else np.concatenate([self.reference, rows])
+        if self.reference is None or self.t_first is None:
+            return
+        reference = self.reference
+        last = float(reference["time"][-1])
+        # the samples whose window ends before the last row (or all of them once the reference is whole)
+        covered = np.inf if rows is None else last - mode.time
+        while True:
+            if self.compared >= self.reached:
+                before = self.reached
+                self.result_until(self.reached)
+                if self.reached == before:
+                    return  # the run has no more samples
+            window = self.window
+            while len(window) > 1 and window[1][0] <= self.compared:
+                window.pop(0)  # chunks compared already
+            base = window[0][0]
+            result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
+            result = result[self.compared - base :]
+            take = int(np.searchsorted(result["time"], covered, side="left"))
+            if take:
+                span = (self.t_first, last if rows is None else np.inf)
+                self._add({s: mode.band(result[:take], reference, s, span) for s in self.outputs})
+                self.compared += take
+            if take < len(result):
+                break
+        # the rows the next sample's window needs: from the one before its time - the tube's time on
+        keep = int(np.searchsorted(reference["time"], float(result["time"][take]) - mode.time, side="left")) - 1
+        self.reference = reference[max(keep, 0) :]
+
+    def _add(self, bands):
+        """Each signal's band on the compared samples; the zoom at the first failing one."""
+        failing_now = []
+        for s in self.outputs:
+            band = bands[s]
+            if not len(band.times):
+                continue
             verdict = self.signals[s].deviation
             before = verdict.failed
-            self.signals[s].add(Band(compared_times, values, lower, upper, ok, deviation))
-            self.envelopes[("deviation", s)].add(compared_times, deviation)
+            self.signals[s].add(band)
+            self.envelopes[("deviation", s)].add(band.times, band.deviation)
             if self.zoom_lines is None and verdict.failed > before and verdict.time is not None:
                 failing_now.append(verdict.time)
-            self.recent[s] = (compared_times, values, lower, upper, deviation)
+            self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation)
         if failing_now and self.zoom_lines is None:
             at = min(failing_now)
             self.zoom_at, self.zoom_lines = at, []
             for s in self.outputs:
+                if s not in self.recent:
+                    continue
                 t, v, lo, up, dev = self.recent[s]
                 k = int(np.searchsorted(t, at))
                 w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
