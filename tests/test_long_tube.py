@@ -79,3 +79,44 @@ def test_varied_references_in_a_tube_chunked_as_in_memory(how, mode, tmp_path):
     # range; the ramp reaches 10 at t = 6, the last sample, there made 3: every window around t = 6 tops at
     # 9 (t = 5.5) + 0.25 at the most
     assert whole.passed == (how != "off")
+
+
+SAMPLES = SCENARIO_ROOT.parent / "recordings"
+TABLES = [("codesys_v3_ratelimiter.csv", "RateLimiter"), ("plain_ratelimiter.tsv", "RateLimiter"),
+          ("tia_portal_siemens.csv", "LGF_LimRateOfChangeCI")]
+
+
+@pytest.mark.parametrize("mode", TUBES, ids=["narrow", "few-steps", "wide"])
+@pytest.mark.parametrize("name, model", TABLES + [("perturbed", "LGF_LimRateOfChangeCI")],
+                         ids=[t[0] for t in TABLES] + ["perturbed"])
+def test_table_exports_in_a_tube_streamed_as_in_memory(name, model, mode, monkeypatch, tmp_path):
+    """A one-file recording streamed in blocks of a few lines (its head 400
+    bytes), in a tube: the outcome run_case gives reading it whole; the
+    TIA Portal export with an output 0.25 off in one row fails the
+    narrow tube, and names the row."""
+    from fmutrace import _worker as worker
+    from fmutrace._longrecording import run_long_recording
+    from fmutrace.recordings import stream
+    from fmutrace.recordings.options import RecordingOptions
+
+    path = SAMPLES / name
+    if name == "perturbed":
+        lines = (SAMPLES / "tia_portal_siemens.csv").read_text(encoding="cp1252").splitlines()
+        assert ";0,5;" in lines[16]
+        lines[16] = lines[16].replace(";0,5;", ";0,75;")
+        path = tmp_path / "tia_portal_siemens.csv"
+        path.write_text("\r\n".join(lines) + "\r\n", encoding="cp1252")
+    fmu_file = fmu_path(BUILD_DIR, model, 3)
+    runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
+    target = Target(runner, fmu, {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"})
+    settings = CaseSettings(mode, "none", RecordingOptions())
+    monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
+    whole = run_case(str(path), path.name, None, target, settings)
+    monkeypatch.setattr(stream, "HEAD_BYTES", 400)
+    for block in (40, 120, 1 << 20):
+        streamed = run_long_recording(str(path), path.name, target, settings,
+                                      Streaming(block_bytes=block, steps_per_chunk=3))
+        assert streamed is not None and streamed.streamed
+        same(whole, streamed)
+    if name == "perturbed" and mode == TUBES[0]:
+        assert not whole.passed and any("line 17" in m for m in whole.messages), whole.messages

@@ -7,7 +7,6 @@ import os
 
 import numpy as np
 
-from ._comparison import Pointwise
 from ._errors import InputError
 from ._longcase import ChunkedCase, Streaming, stream_case
 from ._recorded import first_differs
@@ -29,8 +28,6 @@ def run_long_recording(path, name, target, settings, streaming: Streaming = Stre
     """The CaseOutcome of the one-file recording at path on target (a
     _worker.Target), read with settings.recording, streamed; None if this
     path cannot take it (the in-memory path then reads it)."""
-    if not isinstance(settings.mode, Pointwise):
-        return None
     fmu, options, block_bytes = target.fmu, settings.recording, streaming.block_bytes
     try:
         table = stream.Table(path, fmu, options)
