@@ -320,7 +320,8 @@ def _polyline_at(times, values, at):
     t0, t1 = times[k], times[k + 1]
     if t1 == t0:
         return float(values[k + 1])
-    return float(values[k] + (values[k + 1] - values[k]) * (at - t0) / (t1 - t0))
+    with np.errstate(invalid="ignore"):  # a NaN sample gives NaN, which the window's nanmin and nanmax leave out
+        return float(values[k] + (values[k + 1] - values[k]) * (at - t0) / (t1 - t0))
 
 
 def tube_bounds(reference_time, reference_values, times, widths, span=None):
