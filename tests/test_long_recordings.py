@@ -1,4 +1,4 @@
-"""A long one-file recording streamed in blocks (fmutrace.recordings.stream)
+"""A long one-file recording streamed in blocks (fmutrace.recordings._stream)
 gives the in-memory path's outcome (worker.run_case reading the whole
 file), bit for bit: status, messages (notes, the recorded sample at a
 first deviation, with its line) and every failing signal's deviation.
@@ -16,8 +16,8 @@ from fmutrace import _worker as worker
 from fmutrace._fmu import Fmu
 from fmutrace._longcase import LONG_CASE_BYTES
 from fmutrace._longrecording import is_long_recording, run_long_recording
-from fmutrace.recordings import stream, timebase
-from fmutrace.recordings.options import RecordingOptions
+from fmutrace.recordings import _stream as stream, _timebase as timebase
+from fmutrace.recordings._options import RecordingOptions
 from fmutrace._runner import Runner
 from fmutrace._longcase import Streaming
 from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu

@@ -96,8 +96,8 @@ def test_table_exports_in_a_tube_streamed_as_in_memory(name, model, mode, monkey
     narrow tube, and names the row."""
     from fmutrace import _worker as worker
     from fmutrace._longrecording import run_long_recording
-    from fmutrace.recordings import stream
-    from fmutrace.recordings.options import RecordingOptions
+    from fmutrace.recordings import _stream as stream
+    from fmutrace.recordings._options import RecordingOptions
 
     path = SAMPLES / name
     if name == "perturbed":

@@ -19,7 +19,7 @@ from ._fmu import Fmu
 from ._outcome import CampaignResult, CaseOutcome, Status
 from ._simulation import simulate
 from ._traces import read_trace, write_trace
-from .recordings.options import RecordingOptions
+from .recordings._options import RecordingOptions
 
 __all__ = [
     "CampaignResult",

@@ -24,7 +24,7 @@ from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_
 from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
 from .recordings import is_recording, recording_paths
-from .recordings.options import RecordingOptions
+from .recordings._options import RecordingOptions
 from ._report import write_case_files, write_junit, write_report
 from ._worker import PLOTS, CaseSettings, FmuFile, default_plots
 

@@ -81,7 +81,7 @@ class Streaming:
     result_file: str | None = None  # the result written here as it is made (for the report), or None
     steps_per_chunk: int = STEPS_PER_CHUNK  # steps run between two result chunks
     chunk_bytes: int = CHUNK_BYTES  # CSV text per chunk of a case's files
-    block_bytes: int | None = None  # text per block of a recording's lines (None: recordings.stream's)
+    block_bytes: int | None = None  # text per block of a recording's lines (None: recordings._stream's)
     progress: SampleProgress | None = None  # (None: one on standard error)
 
 

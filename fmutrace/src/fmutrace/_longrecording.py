@@ -1,5 +1,5 @@
 """A long one-file recording (a table export) run and compared as it is
-read block by block (recordings.stream reads it) through the long-case
+read block by block (recordings._stream reads it) through the long-case
 path (_longcase.stream_case), in memory that does not grow with its
 length; its notes and messages are the in-memory path's, word for word."""
 
@@ -11,9 +11,9 @@ from ._errors import InputError
 from ._longcase import ChunkedCase, Streaming, stream_case
 from ._recorded import first_differs
 from ._traces import LONG_CASE_BYTES, NotPlain
-from .recordings import stream, timebase
-from .recordings.align import off_cycle_note
-from .recordings.matching import plan
+from .recordings import _stream as stream, _timebase as timebase
+from .recordings._align import off_cycle_note
+from .recordings._matching import plan
 
 
 def is_long_recording(path) -> bool:

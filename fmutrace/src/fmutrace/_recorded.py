@@ -1,5 +1,5 @@
 """A recording as a case of a campaign: read, matched to the FMU, laid on
-its steps (recordings.align), and compared signal by signal, each on its
+its steps (recordings._align), and compared signal by signal, each on its
 own samples; a failing comparison names the recording's file and line of
 its first deviation and, where the inputs were sampled coarser than the
 step, what that means."""
@@ -14,10 +14,10 @@ from ._cases import Case
 from ._comparison import Comparison, compare_traces
 from ._errors import InputError
 from .recordings import read_recording
-from .recordings.align import align
-from .recordings.matching import plan
-from .recordings.options import RecordingOptions
-from .recordings.timebase import UNIT_NAMES, normalise
+from .recordings._align import align
+from .recordings._matching import plan
+from .recordings._options import RecordingOptions
+from .recordings._timebase import UNIT_NAMES, normalise
 
 
 @dataclass

@@ -118,7 +118,7 @@ def parse_number(text, decimal_comma=False):
     """A cell's value as a float: a number (with a decimal comma if
     decimal_comma, where the cell has no point), or a Boolean word; None
     if it is neither. The one rule for numbers (recordings add IEC
-    literals to it: recordings.text.cell_value)."""
+    literals to it: recordings._text.cell_value)."""
     word = text.strip().lower()
     if word in BOOLEAN_WORDS:
         return BOOLEAN_WORDS[word]

@@ -19,7 +19,7 @@ from ._outcome import CaseOutcome, Status
 from ._plot import load_plotting, plot_case
 from ._recorded import RecordedCase, recorded_case
 from .recordings import is_recording
-from .recordings.options import RecordingOptions
+from .recordings._options import RecordingOptions
 from ._runner import Runner
 
 PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV

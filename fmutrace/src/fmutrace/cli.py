@@ -20,8 +20,8 @@ from ._longcase import simulate_long
 from ._simulation import SimulationOptions, simulate
 from ._outcome import Status
 from .recordings import is_recording
-from .recordings.align import TIMINGS
-from .recordings.options import TIME_UNITS, RecordingOptions
+from .recordings._align import TIMINGS
+from .recordings._options import TIME_UNITS, RecordingOptions
 from ._traces import write_trace
 from ._worker import PLOT_ALL_UP_TO, PLOTS
 

@@ -1,5 +1,5 @@
 """Recordings as controllers' recorders export them, read into one
-normalised, columnar Recording (recordings.model) whatever the recorder.
+normalised, columnar Recording (recordings._model) whatever the recorder.
 
 The format is recognised from the content, in this order (the first that
 fits reads the file):
@@ -18,10 +18,10 @@ import os
 from pathlib import Path
 
 from .._errors import InputError, TraceError
-from . import mdf, tables, text as texts, twincat, vendors
-from .matching import Plan, last_component, plan
-from .model import Channel, Recording
-from .timebase import OFF_CYCLE, normalise
+from . import _mdf as mdf, _tables as tables, _text as texts, _twincat as twincat, _vendors as vendors
+from ._matching import Plan, last_component, plan
+from ._model import Channel, Recording
+from ._timebase import OFF_CYCLE, normalise
 
 TEXT_FORMATS = (
     ("Beckhoff TwinCAT Scope View CSV", twincat.sniff, twincat.read),

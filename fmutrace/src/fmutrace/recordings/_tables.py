@@ -14,10 +14,10 @@ Portal's export is known, so it is read by these general rules."""
 import numpy as np
 
 from .._traces import split_cells
-from . import grid as grids
-from . import text as texts
-from . import timebase
-from .model import Recording
+from . import _grid as grids
+from . import _text as texts
+from . import _timebase as timebase
+from ._model import Recording
 
 TIME_WORDS = (
     "time",

@@ -35,10 +35,10 @@ import pyarrow.csv as pcsv
 
 from .._errors import TraceError
 from .._traces import UNUSUAL_LINE_BREAKS, NotPlain
-from . import TEXT_FORMATS, mdf, tables
-from . import grid as grids
-from . import text as texts
-from . import timebase
+from . import TEXT_FORMATS, _mdf as mdf, _tables as tables
+from . import _grid as grids
+from . import _text as texts
+from . import _timebase as timebase
 
 HEAD_BYTES = 1 << 20  # read as the in-memory path reads a whole file
 BLOCK_BYTES = 1 << 22  # of text per block of lines after the head

@@ -4,7 +4,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from .._errors import InputError
-from .align import TIMINGS
+from ._align import TIMINGS
 
 TIME_UNITS = ("s", "ms", "us", "ns", "cycles", "filetime")
 
@@ -51,7 +51,7 @@ class RecordingOptions:
 
     @property
     def timebase_unit(self) -> str | None:
-        """time_unit as recordings.timebase names it."""
+        """time_unit as recordings._timebase names it."""
         return "FILETIME" if self.time_unit == "filetime" else self.time_unit
 
     def settings(self) -> dict:

@@ -22,9 +22,9 @@ file."""
 import numpy as np
 
 from .._traces import split_cells
-from . import grid as grids
-from . import text as texts
-from .model import Recording
+from . import _grid as grids
+from . import _text as texts
+from ._model import Recording
 
 KEYS = (
     "SampleTime[ms]",

@@ -9,8 +9,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .._traces import split_cells
-from . import text as texts
-from .model import Channel
+from . import _text as texts
+from ._model import Channel
 
 
 def grid(rows, width=None):

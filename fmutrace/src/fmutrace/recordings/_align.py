@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._errors import InputError
-from .timebase import OFF_CYCLE, cycles
+from ._timebase import OFF_CYCLE, cycles
 
 TIMINGS = ("cycle", "fmi")
 

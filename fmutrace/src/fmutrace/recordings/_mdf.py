@@ -8,7 +8,7 @@ from typing import Any, cast
 import numpy as np
 
 from .._errors import TraceError
-from .model import Channel, Recording
+from ._model import Channel, Recording
 
 MAGIC = b"MDF     "
 

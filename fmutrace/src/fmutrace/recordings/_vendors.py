@@ -28,11 +28,11 @@ import os
 import numpy as np
 
 from .._traces import split_cells
-from . import grid as grids
-from . import text as texts
-from . import timebase
-from .model import Channel, Recording
-from .tables import CYCLE_WORDS, bare_name
+from . import _grid as grids
+from . import _text as texts
+from . import _timebase as timebase
+from ._model import Channel, Recording
+from ._tables import CYCLE_WORDS, bare_name
 
 
 # -- CODESYS 2.3 -----------------------------------------------------------------------

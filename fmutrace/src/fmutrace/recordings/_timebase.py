@@ -19,7 +19,7 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 
 from .._errors import InputError, TraceError
-from .model import TIME_FACTORS
+from ._model import TIME_FACTORS
 
 OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
 MAX_STEPS = 200_000_000  # more steps than this (23 days of 10 ms cycles) is a misread unit
