@@ -54,8 +54,9 @@ def case_inputs(seed, steps):
 
 def write_case(args):
     """One case folder with its reference from fmutrace's runner."""
-    from fmutrace.runner import Runner
-    from fmutrace.traces import write_trace
+    from fmutrace._fmpy import Experiment, Signals
+    from fmutrace._runner import Runner
+    from fmutrace._traces import write_trace
 
     folder, seed, steps, fmu = args
     inputs, start = case_inputs(seed, steps)
@@ -65,7 +66,7 @@ def write_case(args):
     stop = round(steps * STEP, 10)
     (folder / f"{MODEL}_ref.opt").write_text(f"StartTime,0\nStopTime,{stop!r}\nStepSize,{STEP!r}\nRelTol,1e-6\n")
     runner = write_case.runners.get(fmu) or write_case.runners.setdefault(fmu, Runner(Path(fmu).read_bytes()))
-    result = runner.run(0.0, stop, STEP, inputs, start, ["y", "status"])
+    result = runner.run(Experiment(0.0, stop, STEP), Signals(inputs, start, ["y", "status"]))
     write_trace(folder / f"{MODEL}_ref.csv", result)
 
 
@@ -172,9 +173,7 @@ def worker_peaks(fmu, folders_root, jobs, report):
             folders_root,
             report=report,
             plots="failed",
-            scheduler=cluster.scheduler_address,
-            shared_files=True,
-            cluster_timeout=3600,
+            run=fmutrace.RunOptions(scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=3600),
         )
         if not campaign.passed:
             raise SystemExit(campaign.summary()[:3000])

@@ -34,7 +34,7 @@ def child(fmu, cases, report, jobs):
     import dask
     from dask.distributed import Client, LocalCluster
     import fmutrace
-    from fmutrace.executors import LOCAL_CLUSTER, SHORT_LOGS
+    from fmutrace._executors import LOCAL_CLUSTER, SHORT_LOGS
 
     started = time.perf_counter()
     with (
@@ -47,9 +47,7 @@ def child(fmu, cases, report, jobs):
             cases,
             report=report,
             plots="failed",
-            scheduler=cluster.scheduler_address,
-            shared_files=True,
-            cluster_timeout=7200,
+            run=fmutrace.RunOptions(scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=7200),
         )
         workers = sorted(client.run(peak_megabytes).values())
         counts = campaign.counts()

@@ -130,7 +130,7 @@ def measured(command, timeout=None):
 
 def read_floor(paths):
     """Child: read the files with fmutrace's reader (chunks of columns, nothing else); prints the rows."""
-    from fmutrace.traces import trace_chunks
+    from fmutrace._traces import trace_chunks
 
     rows = 0
     for path in paths:
@@ -182,9 +182,9 @@ def main():
     fmu = build / "fmi3" / f"{MODEL}.fmu"
     root = build / "benchmarks" / "long"
     cli = [sys.executable, "-m", "fmutrace"]
-    from fmutrace.longcase import is_long
-    from fmutrace.recordings.stream import is_long_recording
-    from fmutrace.runner import C_STEPS
+    from fmutrace._longcase import is_long
+    from fmutrace._longrecording import is_long_recording
+    from fmutrace._runner import C_STEPS
 
     print(
         f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "

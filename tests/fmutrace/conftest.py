@@ -11,7 +11,7 @@ def clusters_only_where_marked(request, monkeypatch):
     lane stays free of clusters as tests are added."""
     if request.node.get_closest_marker("cluster"):
         return
-    from fmutrace import executors
+    from fmutrace import _executors as executors
 
     def refuse(self, *args, **kwargs):
         raise AssertionError(f"{request.node.nodeid} runs a campaign on Dask: mark it @pytest.mark.cluster")

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import fmutrace
-from fmutrace.executors import package_zip
+from fmutrace._executors import package_zip
 from support.fmu_driver import BUILD_DIR, REPO
 from support.reports import without_timings
 from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
@@ -22,10 +22,14 @@ from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
 def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_path):
     fmus = [fmu_path(BUILD_DIR, model, version) for model in ("RateLimiter", "Ramp") for version in FMI_VERSIONS]
     cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
-    distributed = fmutrace.compare(fmus, cases, report=tmp_path / "distributed", scheduler=cluster, cluster_timeout=600)
+    distributed = fmutrace.compare(
+        fmus, cases, report=tmp_path / "distributed", run=fmutrace.RunOptions(scheduler=cluster, cluster_timeout=600)
+    )
     assert distributed.where == f"Dask, 2 workers at {cluster}"
-    shared = fmutrace.compare(fmus, cases, scheduler=cluster, shared_files=True, cluster_timeout=600)
-    serial = fmutrace.compare(fmus, cases, report=tmp_path / "serial", jobs=1)
+    shared = fmutrace.compare(
+        fmus, cases, run=fmutrace.RunOptions(scheduler=cluster, shared_files=True, cluster_timeout=600)
+    )
+    serial = fmutrace.compare(fmus, cases, report=tmp_path / "serial", run=fmutrace.RunOptions(jobs=1))
     assert [(o.case, o.status) for o in shared.cases] == [(o.case, o.status) for o in serial.cases]
     assert serial.where == "1 process"
     assert len(serial.cases) == 2 * len(discover(["RateLimiter", "Ramp"]))

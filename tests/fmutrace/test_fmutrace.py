@@ -532,7 +532,7 @@ def test_progress_bar_only_on_a_terminal():
             return True
 
     for stream, expected in ((Terminal(), True), (io.StringIO(), False)):
-        bar = fmutrace.progress.Progress(10, stream)
+        bar = fmutrace._progress.Progress(10, stream)
         bar.started -= 10  # a campaign that has run for ten seconds
         bar.update(4, 1)
         bar.close()

@@ -142,11 +142,11 @@ def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp
 def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 6)
     report = tmp_path / "report"
-    assert fmutrace.compare(PASS_THROUGH, cases, report=report, jobs=1).passed
+    assert fmutrace.compare(PASS_THROUGH, cases, report=report, run=fmutrace.RunOptions(jobs=1)).passed
     journal = report / "results.jsonl"
     lines = journal.read_bytes().splitlines(keepends=True)
     journal.write_bytes(b"".join(lines[:4]) + lines[4][:25])  # three cases whole, the fourth cut by a kill
-    campaign = fmutrace.compare(PASS_THROUGH, cases, report=report, jobs=1, resume=True)
+    campaign = fmutrace.compare(PASS_THROUGH, cases, report=report, run=fmutrace.RunOptions(jobs=1), resume=True)
     assert campaign.passed and campaign.where == "1 process (3 cases from the journal)"
     assert [o.case for o in campaign.cases] == [f"case_{k:02d}" for k in range(6)]
     keys = journal_keys(report)
@@ -161,8 +161,10 @@ def test_a_journaled_campaign_gives_its_outcomes_and_results_back(tmp_path):
     results from their CSV files: the outcomes of a campaign kept in memory,
     and the results worked by hand (y(t + 0.1) = u(t))."""
     cases = step_cases(tmp_path / "cases", "PassThrough", [3, 4])
-    in_memory = fmutrace.compare(PASS_THROUGH, cases, jobs=1)
-    journaled = fmutrace.compare(PASS_THROUGH, cases, jobs=1, plots="all", report=tmp_path / "report")
+    in_memory = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=1))
+    journaled = fmutrace.compare(
+        PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=1), plots="all", report=tmp_path / "report"
+    )
     assert len(journaled.cases) == len(in_memory.cases) == 2
     for k, kept, read in zip((3, 4), in_memory.cases, journaled.cases, strict=True):
         assert (read.case, read.fmu, read.status, read.messages) == (kept.case, kept.fmu, kept.status, kept.messages)
@@ -177,7 +179,7 @@ def test_the_failed_cases_of_a_journaled_campaign_with_or_without_their_results(
     each result back from its CSV file."""
     cases = step_cases(tmp_path / "cases", "PassThrough", [3, 4, 5])
     (cases / "case_04" / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,4\n0.4,9\n")
-    campaign = fmutrace.compare(PASS_THROUGH, cases, jobs=1, report=tmp_path / "report")
+    campaign = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=1), report=tmp_path / "report")
     whole, light = campaign.failed(), campaign.failed(results=False)
     assert [o.case for o in whole] == [o.case for o in light] == ["case_04"]
     assert whole[0].messages == light[0].messages and whole[0].status == light[0].status == "fail"
@@ -225,7 +227,9 @@ def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
     campaign = threading.Thread(
         target=lambda: result.setdefault(
             "campaign",
-            fmutrace.compare(fmus, cases, report=report, scheduler=cluster, cluster_timeout=600, plots="all"),
+            fmutrace.compare(
+                fmus, cases, report=report, run=fmutrace.RunOptions(scheduler=cluster, cluster_timeout=600), plots="all"
+            ),
         )
     )
     campaign.start()
@@ -242,7 +246,7 @@ def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
     total = 2 * len(discover(["RateLimiter", "Ramp"]))
     keys = journal_keys(report)
     assert len(killed.cases) == total and len(keys) == total and len(set(keys)) == total
-    fmutrace.compare(fmus, cases, report=tmp_path / "serial", jobs=1, plots="all")
+    fmutrace.compare(fmus, cases, report=tmp_path / "serial", run=fmutrace.RunOptions(jobs=1), plots="all")
     assert comparable(report) == comparable(tmp_path / "serial")
     for page in ("index.html", "summary.md"):
         assert without_timings((report / page).read_text()) == without_timings((tmp_path / "serial" / page).read_text())
@@ -323,7 +327,7 @@ def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path
     starts = _FailingStarts(dask.distributed.LocalCluster, failures)
     monkeypatch.setattr(dask.distributed, "LocalCluster", starts)
     cases = pass_through_cases(tmp_path / "cases", 24)
-    result = fmutrace.compare(PASS_THROUGH, cases, jobs=2, report=tmp_path / "report")
+    result = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=2), report=tmp_path / "report")
     assert result.passed and len(result.cases) == 24, result.summary()
     assert starts.starts == min(failures + 1, 2)
     assert ("Dask, 2 workers" in result.where) == (failures == 1), result.where
@@ -332,8 +336,8 @@ def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path
 
 # evaluated in each worker: where its fmutrace comes from, and each Runner's loop and fast runs
 WORKER_LOOPS = (
-    "(__import__('fmutrace.runner').runner.__file__, "
-    "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace.worker').worker._fmus.values()])"
+    "(__import__('fmutrace._runner')._runner.__file__, "
+    "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace._worker')._worker._fmus.values()])"
 )
 
 
@@ -344,7 +348,7 @@ def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeyp
     its Python sources (where the C loop cannot be imported). Its
     scheduler starts no dashboard and leaves port 8787 alone (held here
     while it runs): no warning that the port is in use."""
-    from fmutrace import executors
+    from fmutrace import _executors as executors
 
     reports = {}
     run = executors.Dask._run
@@ -360,7 +364,7 @@ def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeyp
         with contextlib.suppress(OSError):  # (taken already: just as well)
             dashboard_port.bind(("127.0.0.1", 8787))
             dashboard_port.listen()
-        result = fmutrace.compare(PASS_THROUGH, cases, jobs=2, plots="none")
+        result = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=2), plots="none")
     assert not [str(w.message) for w in recwarn if "8787" in str(w.message)]
     assert result.passed and len(result.cases) == 40 and "Dask, 2 workers" in result.where, result.summary()
     assert len(reports) == 2, reports

@@ -21,12 +21,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fmutrace import read_trace, write_trace
-from fmutrace import runner as runner_module
-from fmutrace.runner import FastLoopFailed, Runner, discrete_rows
-from fmutrace.simulation import run_fmpy
-from fmutrace import traces as trace_module
-from fmutrace.simulation import held_to
-from fmutrace.traces import NotPlain, trace_chunks
+from fmutrace import _runner as runner_module
+from fmutrace._runner import FastLoopFailed, Runner, discrete_rows
+from fmutrace._fmpy import Experiment, Signals, run_fmpy
+from fmutrace import _traces as trace_module
+from fmutrace._fmpy import held_to
+from fmutrace._traces import NotPlain, trace_chunks
 from fmpy.simulation import Input
 from support.fmu_driver import BUILD_DIR, MODELS, REPO
 from support.scenarios import discover, fmu_path
@@ -47,18 +47,9 @@ def same_bits(a, b):
 
 
 def both(model, version, start, stop, step, inputs, start_values, outputs, tolerance=None):
-    fast = runner(model, version).run(start, stop, step, inputs, start_values, outputs, tolerance)
-    plain = run_fmpy(
-        str(fmu_path(BUILD_DIR, model, version)),
-        None,
-        start_time=start,
-        stop_time=stop,
-        step_size=step,
-        inputs=inputs,
-        start_values=start_values,
-        outputs=outputs,
-        relative_tolerance=tolerance,
-    )
+    experiment, signals = Experiment(start, stop, step, tolerance), Signals(inputs, start_values, outputs)
+    fast = runner(model, version).run(experiment, signals)
+    plain = run_fmpy(str(fmu_path(BUILD_DIR, model, version)), None, experiment, signals)
     return fast, plain
 
 
@@ -87,16 +78,16 @@ def test_every_reference_scenario_bit_for_bit(version):
 def test_the_runner_says_why_a_trace_takes_fmpys_loop():
     r = runner("RateLimiter", 3)
     off_grid = np.array([(0.0, 1.0), (0.25, 2.0)], dtype=[("time", float), ("u", float)])
-    assert "between communication points" in r.fast_path_problem(0.0, 1.0, 0.1, off_grid, ["y"])
-    assert "whole number of steps" in r.fast_path_problem(0.0, 1.05, 0.1, None, ["y"])
-    assert r.fast_path_problem(0.0, 1.0, 0.1, off_grid[:1], ["y"]) is None
+    assert "between communication points" in r.fast_path_problem(Experiment(0.0, 1.0, 0.1), off_grid, ["y"])
+    assert "whole number of steps" in r.fast_path_problem(Experiment(0.0, 1.05, 0.1), None, ["y"])
+    assert r.fast_path_problem(Experiment(0.0, 1.0, 0.1), off_grid[:1], ["y"]) is None
 
 
 def test_a_trace_whose_inputs_need_fmpy_leaves_the_instance_to_the_next_trace():
     r = runner("RateLimiter", 2)
     on_grid = np.array([(0.0, 0.0), (0.2, 5.0)], dtype=[("time", float), ("u", float)])
     off_grid = np.array([(0.0, 1.0), (0.25, 2.0)], dtype=[("time", float), ("u", float)])
-    r.run(0.0, 1.0, 0.1, on_grid, {}, ["y"])
+    r.run(Experiment(0.0, 1.0, 0.1), Signals(on_grid, {}, ["y"]))
     instance, fast, fmpy = r.fmu, r.fast_runs, r.fmpy_runs
     fast_off, plain_off = both("RateLimiter", 2, 0.0, 1.0, 0.1, off_grid, {"rateUpPar": 3.0}, ["y"])
     assert same_bits(fast_off, plain_off)
@@ -174,7 +165,7 @@ def test_an_instance_that_failed_is_replaced_and_the_next_trace_is_right():
     good = np.array([(0.0, 0.0), (0.2, 5.0)], dtype=[("time", float), ("u", float)])
     r = runner("RateLimiter", 3)
     with pytest.raises(Exception, match="zeroRate = 7 is outside its range"):
-        r.run(0.0, 1.0, 0.1, bad, {}, ["y"])
+        r.run(Experiment(0.0, 1.0, 0.1), Signals(bad, {}, ["y"]))
     fast, plain = both("RateLimiter", 3, 0.0, 1.0, 0.1, good, {"rateUpPar": 3.0}, ["y", "status"])
     assert same_bits(fast, plain)
 
@@ -197,7 +188,9 @@ def both_loops(model, version, *args):
     loop); one ran it if and only if the other did."""
     c, python = runner(model, version), python_loop_runner(model, version)
     before = c.fast_runs, python.fast_runs
-    c_result, python_result = c.run(*args), python.run(*args)
+    start, stop, step, inputs, start_values, outputs, *tolerance = args
+    experiment, signals = Experiment(start, stop, step, *tolerance), Signals(inputs, start_values, outputs)
+    c_result, python_result = c.run(experiment, signals), python.run(experiment, signals)
     c_fast, python_fast = c.fast_runs > before[0], python.fast_runs > before[1]
     assert c_fast == python_fast and c.c_loop and not python.c_loop
     return c_result, python_result, c_fast
@@ -262,7 +255,7 @@ def test_both_step_loops_stop_at_a_failing_call_as_fmpy_does():
     for r in (runner("RateLimiter", 2), python_loop_runner("RateLimiter", 2)):
         through_fmpy = r.fmpy_runs
         with pytest.raises(Exception, match="zeroRate = 7 is outside its range"):
-            r.run(0.0, 1.0, 0.1, bad, {}, ["y"])
+            r.run(Experiment(0.0, 1.0, 0.1), Signals(bad, {}, ["y"]))
         assert r.fmpy_runs == through_fmpy + 1  # the fast loop stopped and left the story to fmpy
 
 
@@ -274,7 +267,10 @@ def chunked(model, version, start, stop, step, inputs, start_values, outputs, st
     try:
         chunks = list(
             runner(model, version).run_chunks(
-                start, stop, step, pieces, names, start_values, outputs, tolerance, steps_per_chunk=steps
+                Experiment(start, stop, step, tolerance),
+                Signals(pieces, start_values, outputs),
+                names,
+                steps_per_chunk=steps,
             )
         )
     except FastLoopFailed:
@@ -290,7 +286,7 @@ def test_chunked_runs_equal_whole_runs_on_every_reference_scenario(version, step
     for s in SCENARIOS:
         o = s.options
         args = (s.model, version, o["StartTime"], o["StopTime"], o["StepSize"], s.inputs, s.start_values, s.outputs)
-        whole = runner(s.model, version).run(*args[2:], o["RelTol"])
+        whole = runner(s.model, version).run(Experiment(*args[2:5], o["RelTol"]), Signals(*args[5:]))
         parts = chunked(*args, steps, rows, o["RelTol"])
         if parts is not None:
             assert same_bits(parts, whole), s.name
@@ -305,7 +301,7 @@ def test_chunked_runs_equal_whole_runs_on_random_traces(trace, version, steps, r
     r = runner(model, version)
     parts = chunked(model, version, start, stop, step, inputs, start_values, outputs, steps, rows)
     through_fmpy = r.fmpy_runs
-    whole = r.run(start, stop, step, inputs, start_values, outputs)
+    whole = r.run(Experiment(start, stop, step), Signals(inputs, start_values, outputs))
     if parts is None:  # refused: the whole run needs fmpy's loop too
         assert r.fmpy_runs == through_fmpy + 1
     else:

@@ -1,4 +1,4 @@
-"""A report's figure drawn on a reused layout (fmutrace.plot keeps one
+"""A report's figure drawn on a reused layout (fmutrace._plot keeps one
 figure per layout in a process and only clears and refills it) is the
 picture a freshly built figure gives, pixel for pixel: cases of each
 layout drawn one after the other in the same process, a layout reused by
@@ -11,8 +11,8 @@ import pytest
 from matplotlib.image import imread
 
 from fmutrace import Exact, Tolerance
-from fmutrace import plot
-from fmutrace.comparison import comparison_mode
+from fmutrace import _plot as plot
+from fmutrace._comparison import comparison_mode
 
 TUBE = comparison_mode(tube_time=0.02, tube_value=0.01)
 

@@ -143,7 +143,9 @@ def test_from_python_with_cases_beside(tmp_path):
     )
     assert campaign.passed, campaign.summary()
     assert len(campaign.cases) > 1
-    failing = fmutrace.compare(SIEMENS[3], SAMPLES / "wincc_siemens.csv", maps={"value": "DB_Ramp_value"})
+    failing = fmutrace.compare(
+        SIEMENS[3], SAMPLES / "wincc_siemens.csv", recording=fmutrace.RecordingOptions(maps={"value": "DB_Ramp_value"})
+    )
     assert failing.exit_code == 2 and "no channel is an output" in failing.summary()
 
 

@@ -1,4 +1,4 @@
-"""A long case run chunk by chunk (fmutrace.longcase) gives the in-memory
+"""A long case run chunk by chunk (fmutrace._longcase) gives the in-memory
 path's outcome (worker.run_case), bit for bit: status, messages and every
 failing signal's deviation, on every reference scenario (in chunks of a
 few steps and a few rows, so every boundary case occurs) and on
@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance, read_trace, write_trace
-from fmutrace.longcase import run_long_case, simulate_long
-from fmutrace.progress import SampleProgress
-from fmutrace.simulation import simulate
-from fmutrace.worker import run_case, worker_fmu
+from fmutrace._longcase import Streaming, run_long_case, simulate_long
+from fmutrace._progress import SampleProgress
+from fmutrace._simulation import SimulationOptions, simulate
+from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
 from support.scenarios import SCENARIO_ROOT, fmu_path
 from support.fmu_driver import BUILD_DIR
 
@@ -30,9 +30,13 @@ def outcomes(folder, version, mode, steps, chunk_bytes):
     path = fmu_path(BUILD_DIR, folder.parent.name, version)
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
-    whole = run_case(folder, folder.name, None, runner, fmu, labels, mode, "none")
+    whole = run_case(folder, folder.name, None, Target(runner, fmu, labels), CaseSettings(mode, "none"))
     long = run_long_case(
-        folder, folder.name, runner, fmu, labels, mode, "none", steps_per_chunk=steps, chunk_bytes=chunk_bytes
+        folder,
+        folder.name,
+        Target(runner, fmu, labels),
+        CaseSettings(mode, "none"),
+        Streaming(steps_per_chunk=steps, chunk_bytes=chunk_bytes),
     )
     return whole, long
 
@@ -94,16 +98,20 @@ def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
     out = tmp_path / "out.csv"
     long = run_long_case(
-        folder, "ulp", runner, fmu, labels, Exact(), "failed", result_file=out, steps_per_chunk=2, chunk_bytes=16
+        folder,
+        "ulp",
+        Target(runner, fmu, labels),
+        CaseSettings(Exact(), "failed"),
+        Streaming(result_file=out, steps_per_chunk=2, chunk_bytes=16),
     )
     assert not long.passed and long.png.startswith(b"\x89PNG")
-    whole = run_case(folder, "ulp", None, runner, fmu, labels, Exact(), "failed")
+    whole = run_case(folder, "ulp", None, Target(runner, fmu, labels), CaseSettings(Exact(), "failed"))
     write_trace(tmp_path / "whole.csv", whole.result)
     assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
 
 
 def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
-    import fmutrace.longcase as longcase
+    import fmutrace._longcase as longcase
 
     monkeypatch.setattr(longcase, "LONG_CASE_BYTES", 0)
     scenario = SCENARIO_ROOT / "RateLimiter" / "asymmetric"
@@ -111,9 +119,15 @@ def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
     start = {"rateUpPar": "2.0", "rateDownPar": "0.5"}
     with open(tmp_path / "long.csv", "w") as out:
         written = simulate_long(
-            path, scenario / "RateLimiter_in.csv", out, start, 0.0, 8.0, 0.5, None, steps_per_chunk=3, chunk_bytes=8
+            path,
+            scenario / "RateLimiter_in.csv",
+            out,
+            SimulationOptions(start, 0.0, 8.0, 0.5),
+            Streaming(steps_per_chunk=3, chunk_bytes=8),
         )
-    whole = simulate(path, scenario / "RateLimiter_in.csv", start, 0.0, 8.0, 0.5)
+    whole = simulate(
+        path, scenario / "RateLimiter_in.csv", start_values=start, start_time=0.0, stop_time=8.0, step_size=0.5
+    )
     write_trace(tmp_path / "whole.csv", whole)
     assert written == len(whole)
     assert (tmp_path / "long.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
@@ -147,7 +161,7 @@ def test_a_long_case_shows_its_progress_on_a_terminal_only(terminal, monkeypatch
 
 @pytest.mark.parametrize("width", [10, 5000, 100_000])
 def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
-    from fmutrace.longcase import _last_time
+    from fmutrace._longcase import _last_time
 
     names = ["time"] + [f"s{i}" for i in range(width // 10)]
     lines = [
@@ -162,7 +176,7 @@ def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
 
 @pytest.mark.parametrize("parts", [1, 2, 7])
 def test_a_verdict_given_in_chunks_is_the_verdict_on_the_whole(parts):
-    from fmutrace.comparison import Band, Verdict, _verdict
+    from fmutrace._comparison import Band, Verdict, _verdict
 
     rng = np.random.default_rng(parts)
     times = np.arange(50) * 0.1

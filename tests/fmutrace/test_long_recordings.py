@@ -1,4 +1,4 @@
-"""A long one-file recording streamed in blocks (fmutrace.recordings.stream)
+"""A long one-file recording streamed in blocks (fmutrace.recordings._stream)
 gives the in-memory path's outcome (worker.run_case reading the whole
 file), bit for bit: status, messages (notes, the recorded sample at a
 first deviation, with its line) and every failing signal's deviation.
@@ -13,13 +13,15 @@ import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance
-from fmutrace import worker
-from fmutrace.fmu import Fmu
-from fmutrace.longcase import LONG_CASE_BYTES
-from fmutrace.recordings import stream, timebase
-from fmutrace.recordings.case import RecordingOptions
-from fmutrace.runner import Runner
-from fmutrace.worker import run_case, worker_fmu
+from fmutrace import _worker as worker
+from fmutrace._fmu import Fmu
+from fmutrace._longcase import LONG_CASE_BYTES
+from fmutrace._longrecording import is_long_recording, run_long_recording
+from fmutrace.recordings import _stream as stream, _timebase as timebase
+from fmutrace.recordings._options import RecordingOptions
+from fmutrace._runner import Runner
+from fmutrace._longcase import Streaming
+from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
 
@@ -35,10 +37,14 @@ def outcomes(path, model, mode=None, options=None, head=400, block=120, version=
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
     monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
-    whole = run_case(str(path), path.name, None, runner, fmu, labels, mode, "none", options)
+    whole = run_case(str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(mode, "none", options))
     monkeypatch.setattr(stream, "HEAD_BYTES", head)
-    streamed = stream.run_long_recording(
-        str(path), path.name, runner, fmu, labels, mode, "none", options, block_bytes=block, steps_per_chunk=3
+    streamed = run_long_recording(
+        str(path),
+        path.name,
+        Target(runner, fmu, labels),
+        CaseSettings(mode, "none", options),
+        Streaming(block_bytes=block, steps_per_chunk=3),
     )
     return whole, streamed
 
@@ -158,7 +164,9 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
     monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
-    whole = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
+    whole = run_case(
+        str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none", RecordingOptions())
+    )
     runs = []
     run_chunks = runner.run_chunks
 
@@ -169,7 +177,9 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
     monkeypatch.setattr(runner, "run_chunks", kept_run_chunks)
     monkeypatch.setattr(worker, "is_long_recording", lambda path: True)
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
-    first = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
+    first = run_case(
+        str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none", RecordingOptions())
+    )
     assert len(runs) == 1 and runs[0].gi_frame is None  # started, given up on, closed
     assert (first.status, first.messages, first.streamed) == (whole.status, whole.messages, False)
     assert [d.to_json() for d in first.deviations] == [d.to_json() for d in whole.deviations]
@@ -202,17 +212,12 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
         fmu = Fmu(str(fmu_file), runner.md)
         labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
         written = tmp_path / "result.csv"
-        streamed = stream.run_long_recording(
+        streamed = run_long_recording(
             str(path),
             path.name,
-            runner,
-            fmu,
-            labels,
-            Exact(),
-            "all",
-            RecordingOptions(),
-            result_file=str(written),
-            block_bytes=120,
+            Target(runner, fmu, labels),
+            CaseSettings(Exact(), "all", RecordingOptions()),
+            Streaming(result_file=str(written), block_bytes=120),
         )
         return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not written.exists()
 
@@ -226,7 +231,9 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
     runner = Runner(fmu_file.read_bytes())
     fmu = Fmu(str(fmu_file), runner.md)
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
-    outcome = run_case(str(path), path.name, None, runner, fmu, labels, Exact(), "none", RecordingOptions())
+    outcome = run_case(
+        str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none", RecordingOptions())
+    )
     assert (outcome.status, outcome.streamed, runner.fmu, runner.fast_runs) == ("invalid", False, None, 0)
     assert outcome.messages == [
         f"{path}, line 17, column 2: '12x' in column 'Time [ms]' is not a number, TRUE/FALSE or an IEC literal (16#...)"
@@ -253,5 +260,5 @@ def test_intervals_median_is_numpys():
 
 
 def test_a_recording_is_streamed_from_the_size_of_a_long_case(tmp_path):
-    assert not stream.is_long_recording(SAMPLES / "plain_ratelimiter.tsv")
+    assert not is_long_recording(SAMPLES / "plain_ratelimiter.tsv")
     assert LONG_CASE_BYTES == 32 << 20

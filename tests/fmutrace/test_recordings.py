@@ -15,10 +15,10 @@ import pytest
 
 from fmutrace import InputError, TraceError
 from fmutrace.recordings import FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file, read_recording
-from fmutrace.recordings.align import align
-from fmutrace.recordings.text import decode, numbers
-from fmutrace.traces import split_cells as split
-from fmutrace.recordings.timebase import parse_date, unit_in_name
+from fmutrace.recordings._align import align
+from fmutrace.recordings._text import decode, numbers
+from fmutrace._traces import split_cells as split
+from fmutrace.recordings._timebase import parse_date, unit_in_name
 from support.oracle import oracle_for
 
 SAMPLES = Path(__file__).parents[1] / "recordings"
@@ -442,7 +442,7 @@ def test_codesys23_with_a_time_column_in_milliseconds(tmp_path):
     ],
 )
 def test_the_one_split_of_a_plain_body_equals_the_line_by_line_reading(tmp_path, body):
-    from fmutrace.recordings import grid, text as texts
+    from fmutrace.recordings import _grid as grid, _text as texts
 
     separator = ";" if ";" in body else "\t"
     path = tmp_path / "t.csv"
@@ -455,7 +455,7 @@ def test_the_one_split_of_a_plain_body_equals_the_line_by_line_reading(tmp_path,
 
 @pytest.mark.parametrize("body", ['0;"1";2\n', "0;1;2\n\n1;2;3\n", "0;1\n", "0;1;2;3\n"])
 def test_bodies_the_one_split_cannot_read_go_line_by_line(tmp_path, body):
-    from fmutrace.recordings import grid, text as texts
+    from fmutrace.recordings import _grid as grid, _text as texts
 
     path = tmp_path / "t.csv"
     path.write_text("time;a;b\n" + body)

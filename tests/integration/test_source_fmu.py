@@ -148,8 +148,14 @@ def test_the_description_lists_the_one_unit(version, tmp_path):
         unit = (folder / "sources" / files[0]).read_text()
         assert "#define RL_UNIT\n" in unit
         included = [line.split('"')[1] for line in unit.splitlines() if line.startswith("#include")]
-        assert included == ["rate_limiter.c", f"{model}.c", "fmu_core.c", "fmu_model_exchange.c", "fmu_state.c",
-                f"fmi{version}_glue.c"]
+        assert included == [
+            "rate_limiter.c",
+            f"{model}.c",
+            "fmu_core.c",
+            "fmu_model_exchange.c",
+            "fmu_state.c",
+            f"fmi{version}_glue.c",
+        ]
         assert sorted(p.name for p in (folder / "sources").glob("*.c")) == sorted(included + files)
 
 

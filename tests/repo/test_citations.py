@@ -85,7 +85,7 @@ def test_the_outside_check_reads_every_kind_of_file_shipped():
         "docs/rules.md",
         "fmu_src/fmu_core.c",
         "modelDescription/Ramp.toml",
-        "fmutrace/src/fmutrace/runner.py",
+        "fmutrace/src/fmutrace/_runner.py",
         "tests/scenarios/Ramp/real_slow_ramp/README.md",
         "tests/support/oracle.py",
         "benchmarks/fmu_bench.c",

@@ -138,8 +138,14 @@ def test_sources_are_shipped(model, version):
     md = read_model_description(str(fmu_file(model, version)))
     files = md.buildConfigurations[0].sourceFileSets[0].sourceFiles
     assert files == [f"{model}_fmi{version}.c"]  # the FMU's one unit, which includes the rest (test_source_fmu.py)
-    included = ["rate_limiter.c", f"{model}.c", "fmu_core.c", "fmu_model_exchange.c", "fmu_state.c",
-                f"fmi{version}_glue.c"]
+    included = [
+        "rate_limiter.c",
+        f"{model}.c",
+        "fmu_core.c",
+        "fmu_model_exchange.c",
+        "fmu_state.c",
+        f"fmi{version}_glue.c",
+    ]
     assert all(f"sources/{f}" in names for f in files + included)
     assert f"sources/{model}_variables.h" in names
     if version == 3:

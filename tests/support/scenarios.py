@@ -6,7 +6,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from fmutrace import Exact, Fmu, compare_traces, load_case
-from fmutrace.simulation import run_fmpy
+from fmutrace._fmpy import Experiment, Signals, run_fmpy
 
 from support.fmu_driver import BUILD_DIR
 
@@ -41,14 +41,9 @@ def simulate(scenario, fmu, fmi_type="CoSimulation", **start_values):
     return run_fmpy(
         str(fmu),
         None,
-        start_time=o["StartTime"],
-        stop_time=o["StopTime"],
-        step_size=o["StepSize"],
-        inputs=scenario.inputs,
-        start_values={**dict(scenario.start_values), **start_values},
-        outputs=scenario.outputs,
-        relative_tolerance=o["RelTol"],
-        fmi_type=fmi_type,
+        Experiment(o["StartTime"], o["StopTime"], o["StepSize"], o["RelTol"]),
+        Signals(scenario.inputs, {**dict(scenario.start_values), **start_values}, scenario.outputs),
+        fmi_type,
     )
 
 
