@@ -22,50 +22,50 @@
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
-#define ERR  MODE_ERROR
+#define ERR MODE_ERROR
 #define EVENT MODE_EVENT
 #define CONT MODE_CONTINUOUS
 #define NO_MODE 0
 
 #define ANY (INST | INIT | STEP | EVENT | CONT | TERM | ERR)
-#define MODES_fmi2SetDebugLogging               ANY
-#define MODES_fmi2SetupExperiment               (INST)
-#define MODES_fmi2EnterInitializationMode       (INST)
-#define MODES_fmi2ExitInitializationMode        (INIT)
-#define MODES_fmi2Terminate                     (STEP | EVENT | CONT)
-#define MODES_fmi2Reset                         ANY
-#define MODES_fmi2GetReal                       (INIT | STEP | EVENT | CONT | TERM | ERR)
-#define MODES_fmi2GetInteger                    MODES_fmi2GetReal
-#define MODES_fmi2GetBoolean                    MODES_fmi2GetReal
-#define MODES_fmi2GetString                     MODES_fmi2GetReal
-#define MODES_fmi2SetReal                       (INST | INIT | STEP | EVENT | CONT)
-#define MODES_fmi2SetInteger                    MODES_fmi2SetReal
-#define MODES_fmi2SetBoolean                    MODES_fmi2SetReal
-#define MODES_fmi2SetString                     MODES_fmi2SetReal
-#define MODES_fmi2GetFMUstate                   ANY
-#define MODES_fmi2SetFMUstate                   MODES_fmi2GetFMUstate
-#define MODES_fmi2FreeFMUstate                  MODES_fmi2GetFMUstate
-#define MODES_fmi2SerializedFMUstateSize        MODES_fmi2GetFMUstate
-#define MODES_fmi2SerializeFMUstate             MODES_fmi2GetFMUstate
-#define MODES_fmi2DeSerializeFMUstate           MODES_fmi2GetFMUstate
+#define MODES_fmi2SetDebugLogging ANY
+#define MODES_fmi2SetupExperiment (INST)
+#define MODES_fmi2EnterInitializationMode (INST)
+#define MODES_fmi2ExitInitializationMode (INIT)
+#define MODES_fmi2Terminate (STEP | EVENT | CONT)
+#define MODES_fmi2Reset ANY
+#define MODES_fmi2GetReal (INIT | STEP | EVENT | CONT | TERM | ERR)
+#define MODES_fmi2GetInteger MODES_fmi2GetReal
+#define MODES_fmi2GetBoolean MODES_fmi2GetReal
+#define MODES_fmi2GetString MODES_fmi2GetReal
+#define MODES_fmi2SetReal (INST | INIT | STEP | EVENT | CONT)
+#define MODES_fmi2SetInteger MODES_fmi2SetReal
+#define MODES_fmi2SetBoolean MODES_fmi2SetReal
+#define MODES_fmi2SetString MODES_fmi2SetReal
+#define MODES_fmi2GetFMUstate ANY
+#define MODES_fmi2SetFMUstate MODES_fmi2GetFMUstate
+#define MODES_fmi2FreeFMUstate MODES_fmi2GetFMUstate
+#define MODES_fmi2SerializedFMUstateSize MODES_fmi2GetFMUstate
+#define MODES_fmi2SerializeFMUstate MODES_fmi2GetFMUstate
+#define MODES_fmi2DeSerializeFMUstate MODES_fmi2GetFMUstate
 /* Co-Simulation */
-#define MODES_fmi2DoStep                        (STEP)
-#define MODES_fmi2CancelStep                    NO_MODE
-#define MODES_fmi2GetStatus                     (STEP | TERM)
-#define MODES_fmi2GetRealStatus                 MODES_fmi2GetStatus
-#define MODES_fmi2GetIntegerStatus              MODES_fmi2GetStatus
-#define MODES_fmi2GetBooleanStatus              MODES_fmi2GetStatus
-#define MODES_fmi2GetStringStatus               MODES_fmi2GetStatus
+#define MODES_fmi2DoStep (STEP)
+#define MODES_fmi2CancelStep NO_MODE
+#define MODES_fmi2GetStatus (STEP | TERM)
+#define MODES_fmi2GetRealStatus MODES_fmi2GetStatus
+#define MODES_fmi2GetIntegerStatus MODES_fmi2GetStatus
+#define MODES_fmi2GetBooleanStatus MODES_fmi2GetStatus
+#define MODES_fmi2GetStringStatus MODES_fmi2GetStatus
 /* Model Exchange */
-#define MODES_fmi2EnterEventMode                (EVENT | CONT)
-#define MODES_fmi2NewDiscreteStates             (EVENT)
-#define MODES_fmi2EnterContinuousTimeMode       (EVENT)
-#define MODES_fmi2CompletedIntegratorStep       (CONT)
-#define MODES_fmi2SetTime                       (EVENT | CONT) /* Event Mode: a pure discrete-time FMU's next instant */
-#define MODES_fmi2SetContinuousStates           (CONT)
-#define MODES_fmi2GetEventIndicators            (INIT | EVENT | CONT | TERM | ERR)
-#define MODES_fmi2GetContinuousStates           MODES_fmi2GetEventIndicators
-#define MODES_fmi2GetDerivatives                MODES_fmi2GetEventIndicators
+#define MODES_fmi2EnterEventMode (EVENT | CONT)
+#define MODES_fmi2NewDiscreteStates (EVENT)
+#define MODES_fmi2EnterContinuousTimeMode (EVENT)
+#define MODES_fmi2CompletedIntegratorStep (CONT)
+#define MODES_fmi2SetTime (EVENT | CONT) /* Event Mode: a pure discrete-time FMU's next instant */
+#define MODES_fmi2SetContinuousStates (CONT)
+#define MODES_fmi2GetEventIndicators (INIT | EVENT | CONT | TERM | ERR)
+#define MODES_fmi2GetContinuousStates MODES_fmi2GetEventIndicators
+#define MODES_fmi2GetDerivatives MODES_fmi2GetEventIndicators
 #define MODES_fmi2GetNominalsOfContinuousStates (INST | EVENT | CONT | TERM | ERR)
 
 typedef struct {
@@ -81,25 +81,25 @@ typedef struct {
 /* The start of every entry point; name is its full name (fmi2DoStep), the modes it may
  * be called in MODES_<name>. The _AS forms are for macros (fmi_entries.h). */
 #define BEGIN(name) BEGIN_AS(#name, MODES_##name)
-#define BEGIN_AS(function, modes)                                             \
-    FmuInstance *I = (FmuInstance *)instance;                                 \
-    static const char FN[] = function;                                        \
-    if (!I) return fmi2Error;                                                 \
+#define BEGIN_AS(function, modes) \
+    FmuInstance *I = (FmuInstance *)instance; \
+    static const char FN[] = function; \
+    if (!I) return fmi2Error; \
     if (!(I->core.mode & (modes))) return (fmi2Status)fmu_mode_error(I, FN)
 
 /* a function of one interface: an instance of the other is refused */
-#define BEGIN_ONLY_AS(function, modes, fmuType)                               \
-    BEGIN_AS(function, modes);                                                \
+#define BEGIN_ONLY_AS(function, modes, fmuType) \
+    BEGIN_AS(function, modes); \
     if (I->modelExchange != ((fmuType) == fmi2ModelExchange)) return (fmi2Status)other_interface(I, FN)
 
 /* a Model Exchange function (fmi_entries.h) */
 #define BEGIN_ME(name) BEGIN_ME_AS(#name, MODES_##name)
 #define BEGIN_ME_AS(function, modes) BEGIN_ONLY_AS(function, modes, fmi2ModelExchange)
 
-#define CHECK(expression)                                                     \
-    do {                                                                      \
-        const FmuStatus status_ = (expression);                               \
-        if (status_ > FMU_WARNING) return (fmi2Status)status_;                \
+#define CHECK(expression) \
+    do { \
+        const FmuStatus status_ = (expression); \
+        if (status_ > FMU_WARNING) return (fmi2Status)status_; \
     } while (0)
 
 FMU_COLD static FmuStatus other_interface(FmuInstance *I, const char *function) {
@@ -122,8 +122,12 @@ static void release_state(FmuInstance *instance, void *memory) {
     ((Fmi2Instance *)instance)->functions.freeMemory(memory);
 }
 
-const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
-const char *fmi2GetVersion(void) { return fmi2Version; }
+const char *fmi2GetTypesPlatform(void) {
+    return fmi2TypesPlatform;
+}
+const char *fmi2GetVersion(void) {
+    return fmi2Version;
+}
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
@@ -177,7 +181,8 @@ void fmi2FreeInstance(fmi2Component instance) {
     release(g);
 }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component instance, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
+fmi2Status fmi2SetDebugLogging(fmi2Component instance, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[]) {
     BEGIN(fmi2SetDebugLogging);
     return (fmi2Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, ALWAYS_LOGGED);
 }
@@ -207,31 +212,31 @@ LIFECYCLE_ENTRIES(fmi2, fmi2Component, fmi2ExitInitializationMode, fmi2Terminate
 
 /* One value is the common call: straight-line code without a frame; any
  * other count goes through the loops (all checked before any is set). */
-#define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI, FROM_FMI)                \
-    FMU_NOINLINE static fmi2Status GET##_array(FmuInstance *I, const char *FN, \
-        const fmi2ValueReference vr[], size_t nvr, TYPE value[]) {            \
-        CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
+#define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI, FROM_FMI) \
+    FMU_NOINLINE static fmi2Status GET##_array(FmuInstance *I, const char *FN, const fmi2ValueReference vr[], \
+                                               size_t nvr, TYPE value[]) { \
+        CHECK(fmu_check_array(I, FN, nvr, vr, value)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) value[i] = TO_FMI(fmu_get(I, vr[i])); \
-        return fmi2OK;                                                        \
-    }                                                                         \
-    FMU_NOINLINE static fmi2Status SET##_array(FmuInstance *I, const char *FN, \
-        const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) {      \
-        CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
+        return fmi2OK; \
+    } \
+    FMU_NOINLINE static fmi2Status SET##_array(FmuInstance *I, const char *FN, const fmi2ValueReference vr[], \
+                                               size_t nvr, const TYPE value[]) { \
+        CHECK(fmu_check_array(I, FN, nvr, vr, value)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], FROM_FMI(value[i]))); \
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], FROM_FMI(value[i])); \
-        return fmi2OK;                                                        \
-    }                                                                         \
+        return fmi2OK; \
+    } \
     fmi2Status GET(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
-        BEGIN_AS(#GET, MODES_##GET);                                          \
-        double v_;                                                            \
+        BEGIN_AS(#GET, MODES_##GET); \
+        double v_; \
         if (nvr != 1 || !vr || !value) return GET##_array(I, FN, vr, nvr, value); \
-        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi2Error;     \
-        value[0] = TO_FMI(v_);                                                \
-        return fmi2OK;                                                        \
-    }                                                                         \
+        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi2Error; \
+        value[0] = TO_FMI(v_); \
+        return fmi2OK; \
+    } \
     fmi2Status SET(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
-        BEGIN_AS(#SET, MODES_##SET);                                          \
+        BEGIN_AS(#SET, MODES_##SET); \
         if (nvr != 1 || !vr || !value) return SET##_array(I, FN, vr, nvr, value); \
         return fmu_set_one(I, FN, TYPE_MASK, vr[0], FROM_FMI(value[0])) ? fmi2OK : fmi2Error; \
     }
@@ -279,13 +284,13 @@ fmi2Status fmi2CancelStep(fmi2Component instance) {
  * is the FMU's time, fmi2Terminated (Boolean) is false. One body: kind
  * is the status kind the getter answers, NO_KIND for none. */
 #define NO_KIND (-1)
-#define STATUS_GETTER(NAME, TYPE, KIND, VALUE)                                \
+#define STATUS_GETTER(NAME, TYPE, KIND, VALUE) \
     fmi2Status NAME(fmi2Component instance, const fmi2StatusKind s, TYPE *value) { \
-        BEGIN_ONLY_AS(#NAME, MODES_##NAME, fmi2CoSimulation);                 \
-        if ((KIND) == NO_KIND || (int)s != (KIND)) return fmi2Discard;        \
+        BEGIN_ONLY_AS(#NAME, MODES_##NAME, fmi2CoSimulation); \
+        if ((KIND) == NO_KIND || (int)s != (KIND)) return fmi2Discard; \
         if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL"); \
-        *value = VALUE;                                                       \
-        return fmi2OK;                                                        \
+        *value = VALUE; \
+        return fmi2OK; \
     }
 
 STATUS_GETTER(fmi2GetStatus, fmi2Status, NO_KIND, fmi2OK)
@@ -323,21 +328,32 @@ static fmi2Status unsupported(fmi2Component instance, const char *function, cons
 
 #define NO_DERIVATIVES "this FMU provides no derivatives (see the model description)"
 
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component instance, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
-                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component instance, const fmi2ValueReference vUnknown_ref[],
+                                        size_t nUnknown, const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown; (void)dvUnknown;
+    (void)vUnknown_ref;
+    (void)nUnknown;
+    (void)vKnown_ref;
+    (void)nKnown;
+    (void)dvKnown;
+    (void)dvUnknown;
     return unsupported(instance, "fmi2GetDirectionalDerivative", NO_DERIVATIVES);
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-    (void)vr; (void)nvr; (void)order; (void)value;
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
     return unsupported(instance, "fmi2SetRealInputDerivatives", NO_DERIVATIVES);
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
-    (void)vr; (void)nvr; (void)order; (void)value;
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
     return unsupported(instance, "fmi2GetRealOutputDerivatives", NO_DERIVATIVES);
 }

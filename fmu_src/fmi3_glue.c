@@ -31,60 +31,60 @@
 /* the super state Initialized */
 #define INITIALIZED (STEP | EVENT | CONT | TERM)
 
-#define MODES_fmi3SetDebugLogging               SETTABLE
-#define MODES_fmi3EnterInitializationMode       (INST)
-#define MODES_fmi3ExitInitializationMode        (INIT)
-#define MODES_fmi3Terminate                     (STEP | EVENT | CONT)
-#define MODES_fmi3Reset                         SETTABLE
-#define MODES_Get                               (INIT | STEP | EVENT | CONT | TERM)
-#define MODES_Set                               (INST | INIT | STEP | EVENT | CONT)
-#define MODES_fmi3GetFMUState                   SETTABLE
-#define MODES_fmi3SetFMUState                   SETTABLE
-#define MODES_fmi3FreeFMUState                  SETTABLE
-#define MODES_fmi3SerializedFMUStateSize        SETTABLE
-#define MODES_fmi3SerializeFMUState             SETTABLE
-#define MODES_fmi3DeserializeFMUState           SETTABLE
-#define MODES_fmi3DoStep                        (STEP)
+#define MODES_fmi3SetDebugLogging SETTABLE
+#define MODES_fmi3EnterInitializationMode (INST)
+#define MODES_fmi3ExitInitializationMode (INIT)
+#define MODES_fmi3Terminate (STEP | EVENT | CONT)
+#define MODES_fmi3Reset SETTABLE
+#define MODES_Get (INIT | STEP | EVENT | CONT | TERM)
+#define MODES_Set (INST | INIT | STEP | EVENT | CONT)
+#define MODES_fmi3GetFMUState SETTABLE
+#define MODES_fmi3SetFMUState SETTABLE
+#define MODES_fmi3FreeFMUState SETTABLE
+#define MODES_fmi3SerializedFMUStateSize SETTABLE
+#define MODES_fmi3SerializeFMUState SETTABLE
+#define MODES_fmi3DeserializeFMUState SETTABLE
+#define MODES_fmi3DoStep (STEP)
 /* Model Exchange */
-#define MODES_fmi3EnterEventMode                (CONT)
-#define MODES_fmi3UpdateDiscreteStates          (EVENT)
-#define MODES_fmi3EnterContinuousTimeMode       (EVENT)
-#define MODES_fmi3CompletedIntegratorStep       (CONT)
-#define MODES_fmi3SetTime                       (CONT)
-#define MODES_fmi3SetContinuousStates           (CONT)
+#define MODES_fmi3EnterEventMode (CONT)
+#define MODES_fmi3UpdateDiscreteStates (EVENT)
+#define MODES_fmi3EnterContinuousTimeMode (EVENT)
+#define MODES_fmi3CompletedIntegratorStep (CONT)
+#define MODES_fmi3SetTime (CONT)
+#define MODES_fmi3SetContinuousStates (CONT)
 #define MODES_fmi3GetContinuousStateDerivatives (INIT | EVENT | CONT | TERM)
-#define MODES_fmi3GetEventIndicators            MODES_fmi3GetContinuousStateDerivatives
-#define MODES_fmi3GetContinuousStates           MODES_fmi3GetContinuousStateDerivatives
+#define MODES_fmi3GetEventIndicators MODES_fmi3GetContinuousStateDerivatives
+#define MODES_fmi3GetContinuousStates MODES_fmi3GetContinuousStateDerivatives
 #define MODES_fmi3GetNominalsOfContinuousStates (INIT | INITIALIZED)
-#define MODES_fmi3GetNumberOfEventIndicators    (INST | EVENT | CONT)
-#define MODES_fmi3GetNumberOfContinuousStates   MODES_fmi3GetNumberOfEventIndicators
+#define MODES_fmi3GetNumberOfEventIndicators (INST | EVENT | CONT)
+#define MODES_fmi3GetNumberOfContinuousStates MODES_fmi3GetNumberOfEventIndicators
 /* every fmi3Get<Type> and fmi3Set<Type> */
-#define MODES_fmi3GetFloat32                    MODES_Get
-#define MODES_fmi3SetFloat32                    MODES_Set
-#define MODES_fmi3GetFloat64                    MODES_Get
-#define MODES_fmi3SetFloat64                    MODES_Set
-#define MODES_fmi3GetInt8                       MODES_Get
-#define MODES_fmi3SetInt8                       MODES_Set
-#define MODES_fmi3GetUInt8                      MODES_Get
-#define MODES_fmi3SetUInt8                      MODES_Set
-#define MODES_fmi3GetInt16                      MODES_Get
-#define MODES_fmi3SetInt16                      MODES_Set
-#define MODES_fmi3GetUInt16                     MODES_Get
-#define MODES_fmi3SetUInt16                     MODES_Set
-#define MODES_fmi3GetInt32                      MODES_Get
-#define MODES_fmi3SetInt32                      MODES_Set
-#define MODES_fmi3GetUInt32                     MODES_Get
-#define MODES_fmi3SetUInt32                     MODES_Set
-#define MODES_fmi3GetInt64                      MODES_Get
-#define MODES_fmi3SetInt64                      MODES_Set
-#define MODES_fmi3GetUInt64                     MODES_Get
-#define MODES_fmi3SetUInt64                     MODES_Set
-#define MODES_fmi3GetBoolean                    MODES_Get
-#define MODES_fmi3SetBoolean                    MODES_Set
-#define MODES_fmi3GetString                     MODES_Get
-#define MODES_fmi3SetString                     MODES_Set
-#define MODES_fmi3GetBinary                     MODES_Get
-#define MODES_fmi3SetBinary                     MODES_Set
+#define MODES_fmi3GetFloat32 MODES_Get
+#define MODES_fmi3SetFloat32 MODES_Set
+#define MODES_fmi3GetFloat64 MODES_Get
+#define MODES_fmi3SetFloat64 MODES_Set
+#define MODES_fmi3GetInt8 MODES_Get
+#define MODES_fmi3SetInt8 MODES_Set
+#define MODES_fmi3GetUInt8 MODES_Get
+#define MODES_fmi3SetUInt8 MODES_Set
+#define MODES_fmi3GetInt16 MODES_Get
+#define MODES_fmi3SetInt16 MODES_Set
+#define MODES_fmi3GetUInt16 MODES_Get
+#define MODES_fmi3SetUInt16 MODES_Set
+#define MODES_fmi3GetInt32 MODES_Get
+#define MODES_fmi3SetInt32 MODES_Set
+#define MODES_fmi3GetUInt32 MODES_Get
+#define MODES_fmi3SetUInt32 MODES_Set
+#define MODES_fmi3GetInt64 MODES_Get
+#define MODES_fmi3SetInt64 MODES_Set
+#define MODES_fmi3GetUInt64 MODES_Get
+#define MODES_fmi3SetUInt64 MODES_Set
+#define MODES_fmi3GetBoolean MODES_Get
+#define MODES_fmi3SetBoolean MODES_Set
+#define MODES_fmi3GetString MODES_Get
+#define MODES_fmi3SetString MODES_Set
+#define MODES_fmi3GetBinary MODES_Get
+#define MODES_fmi3SetBinary MODES_Set
 
 typedef struct {
     FmuInstance base; /* first: an fmi3Instance is an FmuInstance */
@@ -94,22 +94,22 @@ typedef struct {
 /* The start of every entry point; name is its full name (fmi3DoStep), the modes it may
  * be called in MODES_<name>. The _AS forms are for macros (fmi_entries.h). */
 #define BEGIN(name) BEGIN_AS(#name, MODES_##name)
-#define BEGIN_AS(function, modes)                                             \
-    FmuInstance *I = (FmuInstance *)instance;                                 \
-    static const char FN[] = function;                                        \
-    if (!I) return fmi3Error;                                                 \
+#define BEGIN_AS(function, modes) \
+    FmuInstance *I = (FmuInstance *)instance; \
+    static const char FN[] = function; \
+    if (!I) return fmi3Error; \
     if (!(I->core.mode & (modes))) return (fmi3Status)fmu_mode_error(I, FN)
 
 /* a Model Exchange function: a Co-Simulation instance is refused */
 #define BEGIN_ME(name) BEGIN_ME_AS(#name, MODES_##name)
-#define BEGIN_ME_AS(function, modes)                                          \
-    BEGIN_AS(function, modes);                                                \
+#define BEGIN_ME_AS(function, modes) \
+    BEGIN_AS(function, modes); \
     if (!I->modelExchange) return (fmi3Status)fmu_error(I, FN, "%s", NO_EVENT_MODE)
 
-#define CHECK(expression)                                                     \
-    do {                                                                      \
-        const FmuStatus status_ = (expression);                               \
-        if (status_ > FMU_WARNING) return (fmi3Status)status_;                \
+#define CHECK(expression) \
+    do { \
+        const FmuStatus status_ = (expression); \
+        if (status_ > FMU_WARNING) return (fmi3Status)status_; \
     } while (0)
 
 #define NO_EVENT_MODE "a Model Exchange function, and this instance was instantiated for Co-Simulation"
@@ -131,7 +131,9 @@ static void release_state(FmuInstance *instance, void *memory) {
     free(memory);
 }
 
-const char *fmi3GetVersion(void) { return fmi3Version; }
+const char *fmi3GetVersion(void) {
+    return fmi3Version;
+}
 
 /* A new instance; NULL, said why, on the first problem: those of every
  * instance, then the interface's own (interfaceRefusal, if not NULL). */
@@ -167,13 +169,16 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
                                          const fmi3ValueReference requiredIntermediateVariables[],
                                          size_t nRequiredIntermediateVariables,
-                                         fmi3InstanceEnvironment instanceEnvironment,
-                                         fmi3LogMessageCallback logMessage,
+                                         fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage,
                                          fmi3IntermediateUpdateCallback intermediateUpdate) {
-    (void)resourcePath; (void)visible; (void)earlyReturnAllowed;
-    (void)requiredIntermediateVariables; (void)intermediateUpdate;
-    const char *reason = eventModeUsed ? NO_CS_EVENT_MODE
-                       : nRequiredIntermediateVariables > 0 ? "this FMU provides no intermediate update" : NULL;
+    (void)resourcePath;
+    (void)visible;
+    (void)earlyReturnAllowed;
+    (void)requiredIntermediateVariables;
+    (void)intermediateUpdate;
+    const char *reason = eventModeUsed                        ? NO_CS_EVENT_MODE
+                         : nRequiredIntermediateVariables > 0 ? "this FMU provides no intermediate update"
+                                                              : NULL;
     return instantiate(reason, false, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
 }
 
@@ -181,7 +186,8 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage) {
-    (void)resourcePath; (void)visible;
+    (void)resourcePath;
+    (void)visible;
     return instantiate(NULL, true, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
 }
 
@@ -189,7 +195,8 @@ void fmi3FreeInstance(fmi3Instance instance) {
     free(instance);
 }
 
-fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories, const fmi3String categories[]) {
+fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
+                               const fmi3String categories[]) {
     BEGIN(fmi3SetDebugLogging);
     return (fmi3Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, 0);
 }
@@ -218,32 +225,32 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
 
 /* One value is the common call: straight-line code without a frame; any
  * other count goes through the loops (all checked before any is set). */
-#define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI)                          \
-    FMU_NOINLINE static fmi3Status GET##_array(FmuInstance *I, const char *FN, \
-        const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
-        CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
+#define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI) \
+    FMU_NOINLINE static fmi3Status GET##_array(FmuInstance *I, const char *FN, const fmi3ValueReference vr[], \
+                                               size_t nvr, TYPE values[], size_t nValues) { \
+        CHECK(check_arrays(I, FN, vr, nvr, values, nValues)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) values[i] = TO_FMI(fmu_get(I, vr[i])); \
-        return fmi3OK;                                                        \
-    }                                                                         \
-    FMU_NOINLINE static fmi3Status SET##_array(FmuInstance *I, const char *FN, \
-        const fmi3ValueReference vr[], size_t nvr, const TYPE values[], size_t nValues) { \
-        CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
+        return fmi3OK; \
+    } \
+    FMU_NOINLINE static fmi3Status SET##_array(FmuInstance *I, const char *FN, const fmi3ValueReference vr[], \
+                                               size_t nvr, const TYPE values[], size_t nValues) { \
+        CHECK(check_arrays(I, FN, vr, nvr, values, nValues)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], (double)values[i])); \
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], (double)values[i]); \
-        return fmi3OK;                                                        \
-    }                                                                         \
+        return fmi3OK; \
+    } \
     fmi3Status GET(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
-        BEGIN_AS(#GET, MODES_##GET);                                          \
-        double v_;                                                            \
+        BEGIN_AS(#GET, MODES_##GET); \
+        double v_; \
         if (nvr != 1 || nValues != 1 || !vr || !values) return GET##_array(I, FN, vr, nvr, values, nValues); \
-        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi3Error;     \
-        values[0] = TO_FMI(v_);                                               \
-        return fmi3OK;                                                        \
-    }                                                                         \
+        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi3Error; \
+        values[0] = TO_FMI(v_); \
+        return fmi3OK; \
+    } \
     fmi3Status SET(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const TYPE values[], \
-                   size_t nValues) {                                          \
-        BEGIN_AS(#SET, MODES_##SET);                                          \
+                   size_t nValues) { \
+        BEGIN_AS(#SET, MODES_##SET); \
         if (nvr != 1 || nValues != 1 || !vr || !values) return SET##_array(I, FN, vr, nvr, values, nValues); \
         return fmu_set_one(I, FN, TYPE_MASK, vr[0], (double)values[0]) ? fmi3OK : fmi3Error; \
     }
@@ -266,24 +273,24 @@ ACCESSORS(fmi3GetUInt16, fmi3SetUInt16, fmi3UInt16, NO_TYPE, (fmi3UInt16)AS_INT)
 ACCESSORS(fmi3GetUInt32, fmi3SetUInt32, fmi3UInt32, NO_TYPE, (fmi3UInt32)AS_INT)
 ACCESSORS(fmi3GetUInt64, fmi3SetUInt64, fmi3UInt64, NO_TYPE, (fmi3UInt64)AS_INT)
 
-fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         fmi3String values[], size_t nValues) {
+fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
+                         size_t nValues) {
     BEGIN(fmi3GetString);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NO_TYPE, vr[i]));
     return fmi3OK;
 }
 
-fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         const fmi3String values[], size_t nValues) {
+fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
+                         size_t nValues) {
     BEGIN(fmi3SetString);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NO_TYPE, vr[i], 0.0));
     return fmi3OK;
 }
 
-fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         size_t valueSizes[], fmi3Binary values[], size_t nValues) {
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t valueSizes[],
+                         fmi3Binary values[], size_t nValues) {
     BEGIN(fmi3GetBinary);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
@@ -291,8 +298,8 @@ fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], s
     return fmi3OK;
 }
 
-fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         const size_t valueSizes[], const fmi3Binary values[], size_t nValues) {
+fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const size_t valueSizes[],
+                         const fmi3Binary values[], size_t nValues) {
     BEGIN(fmi3SetBinary);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
@@ -349,12 +356,12 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
     return fmi3OK;
 }
 
-#define NUMBER_OF_NONE(NAME)                                                  \
-    fmi3Status NAME(fmi3Instance instance, size_t *n) {                       \
-        BEGIN_ME_AS(#NAME, MODES_##NAME);                                     \
-        if (!n) return (fmi3Status)fmu_error(I, FN, "the pointer is NULL");   \
-        *n = 0;                                                               \
-        return fmi3OK;                                                        \
+#define NUMBER_OF_NONE(NAME) \
+    fmi3Status NAME(fmi3Instance instance, size_t *n) { \
+        BEGIN_ME_AS(#NAME, MODES_##NAME); \
+        if (!n) return (fmi3Status)fmu_error(I, FN, "the pointer is NULL"); \
+        *n = 0; \
+        return fmi3OK; \
     }
 
 NUMBER_OF_NONE(fmi3GetNumberOfEventIndicators)
@@ -374,52 +381,78 @@ static fmi3Status unsupported(fmi3Instance instance, const char *function, const
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
                                                fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                                fmi3InstanceEnvironment instanceEnvironment,
-                                               fmi3LogMessageCallback logMessage,
-                                               fmi3ClockUpdateCallback clockUpdate,
+                                               fmi3LogMessageCallback logMessage, fmi3ClockUpdateCallback clockUpdate,
                                                fmi3LockPreemptionCallback lockPreemption,
                                                fmi3UnlockPreemptionCallback unlockPreemption) {
-    (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible;
-    (void)clockUpdate; (void)lockPreemption; (void)unlockPreemption;
+    (void)instanceName;
+    (void)instantiationToken;
+    (void)resourcePath;
+    (void)visible;
+    (void)clockUpdate;
+    (void)lockPreemption;
+    (void)unlockPreemption;
     if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_SCHEDULED);
     return NULL;
 }
 
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
-    (void)vr; (void)nvr; (void)values;
+    (void)vr;
+    (void)nvr;
+    (void)values;
     return unsupported(instance, "fmi3GetClock", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
-    (void)vr; (void)nvr; (void)values;
+    (void)vr;
+    (void)nvr;
+    (void)values;
     return unsupported(instance, "fmi3SetClock", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t *n) {
-    (void)vr; (void)n;
+    (void)vr;
+    (void)n;
     return unsupported(instance, "fmi3GetNumberOfVariableDependencies", NO_DERIVATIVES);
 }
 
-fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent, size_t elementIndicesOfDependent[],
-                                       fmi3ValueReference independents[], size_t elementIndicesOfIndependents[],
-                                       fmi3DependencyKind dependencyKinds[], size_t nDependencies) {
-    (void)dependent; (void)elementIndicesOfDependent; (void)independents;
-    (void)elementIndicesOfIndependents; (void)dependencyKinds; (void)nDependencies;
+fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent,
+                                       size_t elementIndicesOfDependent[], fmi3ValueReference independents[],
+                                       size_t elementIndicesOfIndependents[], fmi3DependencyKind dependencyKinds[],
+                                       size_t nDependencies) {
+    (void)dependent;
+    (void)elementIndicesOfDependent;
+    (void)independents;
+    (void)elementIndicesOfIndependents;
+    (void)dependencyKinds;
+    (void)nDependencies;
     return unsupported(instance, "fmi3GetVariableDependencies", NO_DERIVATIVES);
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
-    (void)sensitivity; (void)nSensitivity;
+    (void)unknowns;
+    (void)nUnknowns;
+    (void)knowns;
+    (void)nKnowns;
+    (void)seed;
+    (void)nSeed;
+    (void)sensitivity;
+    (void)nSensitivity;
     return unsupported(instance, "fmi3GetDirectionalDerivative", NO_DERIVATIVES);
 }
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                     const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                     size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
-    (void)sensitivity; (void)nSensitivity;
+    (void)unknowns;
+    (void)nUnknowns;
+    (void)knowns;
+    (void)nKnowns;
+    (void)seed;
+    (void)nSeed;
+    (void)sensitivity;
+    (void)nSensitivity;
     return unsupported(instance, "fmi3GetAdjointDerivative", NO_DERIVATIVES);
 }
 
@@ -433,46 +466,71 @@ fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                   fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
-    (void)vr; (void)nvr; (void)intervals; (void)qualifiers;
+    (void)vr;
+    (void)nvr;
+    (void)intervals;
+    (void)qualifiers;
     return unsupported(instance, "fmi3GetIntervalDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                   fmi3UInt64 counters[], fmi3UInt64 resolutions[], fmi3IntervalQualifier qualifiers[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions; (void)qualifiers;
+                                   fmi3UInt64 counters[], fmi3UInt64 resolutions[],
+                                   fmi3IntervalQualifier qualifiers[]) {
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
+    (void)qualifiers;
     return unsupported(instance, "fmi3GetIntervalFraction", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 shifts[]) {
-    (void)vr; (void)nvr; (void)shifts;
+    (void)vr;
+    (void)nvr;
+    (void)shifts;
     return unsupported(instance, "fmi3GetShiftDecimal", NO_CLOCKS);
 }
 
-fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                fmi3UInt64 counters[], fmi3UInt64 resolutions[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 counters[],
+                                fmi3UInt64 resolutions[]) {
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
     return unsupported(instance, "fmi3GetShiftFraction", NO_CLOCKS);
 }
 
-fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 intervals[]) {
-    (void)vr; (void)nvr; (void)intervals;
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                  const fmi3Float64 intervals[]) {
+    (void)vr;
+    (void)nvr;
+    (void)intervals;
     return unsupported(instance, "fmi3SetIntervalDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                    const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
     return unsupported(instance, "fmi3SetIntervalFraction", NO_CLOCKS);
 }
 
-fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 shifts[]) {
-    (void)vr; (void)nvr; (void)shifts;
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                               const fmi3Float64 shifts[]) {
+    (void)vr;
+    (void)nvr;
+    (void)shifts;
     return unsupported(instance, "fmi3SetShiftDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                 const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
     return unsupported(instance, "fmi3SetShiftFraction", NO_CLOCKS);
 }
 
@@ -486,11 +544,17 @@ fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                     const fmi3Int32 orders[], fmi3Float64 values[], size_t nValues) {
-    (void)vr; (void)nvr; (void)orders; (void)values; (void)nValues;
+    (void)vr;
+    (void)nvr;
+    (void)orders;
+    (void)values;
+    (void)nValues;
     return unsupported(instance, "fmi3GetOutputDerivatives", NO_DERIVATIVES);
 }
 
-fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
-    (void)clockReference; (void)activationTime;
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
+                                      fmi3Float64 activationTime) {
+    (void)clockReference;
+    (void)activationTime;
     return unsupported(instance, "fmi3ActivateModelPartition", NO_SCHEDULED);
 }

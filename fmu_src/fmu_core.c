@@ -91,8 +91,8 @@ void fmu_log(FmuInstance *instance, FmuStatus status, const char *fmt, ...) {
     va_end(args);
 }
 
-FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, bool loggingOn,
-                                size_t nCategories, const char *const categories[], int alwaysOn) {
+FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, bool loggingOn, size_t nCategories,
+                                const char *const categories[], int alwaysOn) {
     int enabled = 0;
     if (nCategories > 0 && !categories) {
         return fmu_error(instance, function, "the category array is NULL");
@@ -103,7 +103,8 @@ FmuStatus fmu_set_debug_logging(FmuInstance *instance, const char *function, boo
             if (categories[i] && strcmp(categories[i], log_category_names[k]) == 0) bit = 1 << k;
         }
         if (!bit) {
-            return fmu_error(instance, function, "unknown log category \"%s\"", categories[i] ? categories[i] : "(null)");
+            return fmu_error(instance, function, "unknown log category \"%s\"",
+                             categories[i] ? categories[i] : "(null)");
         }
         enabled |= bit;
     }
@@ -141,8 +142,8 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
     }
     const FmuVariable *v = &model->variables[vr];
     if (!(TYPE_BIT(v->type) & typeMask)) {
-        return fmu_error(instance, function, "%s (value reference %u) is %s variable, which %s cannot access",
-                         v->name, vr, type_name(v->type), function);
+        return fmu_error(instance, function, "%s (value reference %u) is %s variable, which %s cannot access", v->name,
+                         vr, type_name(v->type), function);
     }
     /* a get is refused only for the two reasons above (fmu_readable): a set from here */
     if (v->causality == FMU_OUTPUT || v->causality == FMU_INDEPENDENT) {
@@ -160,7 +161,8 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
 static void publish(FmuInstance *instance, bool block) {
     instance->core.values[0] = instance->core.time; /* the independent variable */
     if (block) {
-        instance->model->publish(&instance->core.block, &instance->prepared, instance->modelMode, instance->core.values);
+        instance->model->publish(&instance->core.block, &instance->prepared, instance->modelMode,
+                                 instance->core.values);
     }
     instance->outputsStale = FMU_FRESH;
 }
@@ -258,10 +260,11 @@ void fmu_log_status(FmuInstance *instance) {
     if (rl_status_is_error(p->status)) {
         const FmuVariable *cause = &instance->model->variables[p->statusSource];
         const bool noCycleInME = instance->modelExchange && p->status == RL_STATUS_NO_CYCLE;
-        fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds%s",
-                (unsigned)p->status, rl_status_text(p->status), cause->name, instance->core.values[p->statusSource],
+        fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds%s", (unsigned)p->status,
+                rl_status_text(p->status), cause->name, instance->core.values[p->statusSource],
                 noCycleInME ? ". Model Exchange runs the block at the ends of its cycles: set cycleTime to the PLC "
-                              "cycle (the interval of the cyclic interrupt OB or task)" : "");
+                              "cycle (the interval of the cyclic interrupt OB or task)"
+                            : "");
     } else {
         fmu_log(instance, FMU_OK, "status 16#%04X: %s", (unsigned)p->status, rl_status_text(p->status));
     }
@@ -294,8 +297,8 @@ FmuStatus fmu_run_cycles(FmuInstance *instance, const char *function, double end
     const double last = cycles_ended_by(core, cycle, end);
     const double pending = last - (double)core->cycles;
     if (!islessequal(pending, FMU_MAX_CYCLES_PER_STEP)) {
-        return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step",
-                         h, pending, cycle, FMU_MAX_CYCLES_PER_STEP);
+        return fmu_error(instance, function, "a step of %g s would run %g cycles of %g s; at most %g per step", h,
+                         pending, cycle, FMU_MAX_CYCLES_PER_STEP);
     }
     *ran = pending >= 1;
     if (*ran) {
@@ -317,7 +320,8 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
         return fmu_error(instance, function, "communicationStepSize must be finite and > 0, not %g", h);
     }
     if (!fmu_time_matches(t, core->time)) {
-        return fmu_error(instance, function, "currentCommunicationPoint %.17g is not the FMU's time %.17g", t, core->time);
+        return fmu_error(instance, function, "currentCommunicationPoint %.17g is not the FMU's time %.17g", t,
+                         core->time);
     }
     const double end = rl_sum(t, h);
     if (isinf(end)) {
@@ -353,7 +357,8 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
      * magnitude for any t: nothing overflows.) */
     if (instance->cycleTime == 0 && instance->prepared.plain && rl_steady_value(core->block.y) &&
         core->block.decided == RL_DECIDED_RAMP && core->block.periodBefore == h &&
-        islessequal(h, 8.452712498170644e+270 /* 2^900 */) && islessequal(fabs(core->time), 2.4948003869184e+291 /* 2^968 */)) {
+        islessequal(h, 8.452712498170644e+270 /* 2^900 */) &&
+        islessequal(fabs(core->time), 2.4948003869184e+291 /* 2^968 */)) {
         rl_hold_period(&core->block, h);
         const bool real = instance->prepared.config.real;
         instance->fastPeriodReal = real ? h : NAN;

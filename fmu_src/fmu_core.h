@@ -23,13 +23,13 @@ typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } FmuStatu
  * modes it is allowed in. Step Mode is Co-Simulation's, Event Mode and
  * Continuous-Time Mode are Model Exchange's; the others are shared. */
 typedef enum {
-    MODE_INSTANTIATED   = 1 << 0,
+    MODE_INSTANTIATED = 1 << 0,
     MODE_INITIALIZATION = 1 << 1,
-    MODE_STEP           = 1 << 2,
-    MODE_TERMINATED     = 1 << 3,
-    MODE_ERROR          = 1 << 4,
-    MODE_EVENT          = 1 << 5,
-    MODE_CONTINUOUS     = 1 << 6
+    MODE_STEP = 1 << 2,
+    MODE_TERMINATED = 1 << 3,
+    MODE_ERROR = 1 << 4,
+    MODE_EVENT = 1 << 5,
+    MODE_CONTINUOUS = 1 << 6
 } FmuMode;
 
 /* A step that would run more cycles than this is refused (no endless loop
@@ -49,13 +49,13 @@ typedef struct {
     RlState block;
     double startTime;
     double time;
-    uint64_t cycles;        /* cycles run since the start (cycleTime > 0) */
+    uint64_t cycles; /* cycles run since the start (cycleTime > 0) */
     /* Model Exchange: the values as the last event instant left them, which
      * the next cycle runs with (latch), and that instant's time */
     double latched[FMU_MAX_VARIABLES];
     double eventTime;
-    int mode;               /* FmuMode */
-    int reportedStatus;     /* status word last reported in the log */
+    int mode;           /* FmuMode */
+    int reportedStatus; /* status word last reported in the log */
 } FmuCore;
 
 typedef struct FmuInstance FmuInstance;
@@ -67,10 +67,10 @@ struct FmuInstance {
      * from the values at the next step (configure), prepared before a
      * cycle runs (prepareDue) */
     RlPrepared prepared;
-    int modelMode;          /* the model's own, from the same configure */
-    bool configDirty;       /* a parameter or input other than u changed */
+    int modelMode;              /* the model's own, from the same configure */
+    bool configDirty;           /* a parameter or input other than u changed */
     unsigned char outputsStale; /* FMU_STALE_*: what changed since the outputs were published */
-    bool prepareDue;        /* the configuration changed: prepare before the next cycle */
+    bool prepareDue;            /* the configuration changed: prepare before the next cycle */
     /* Step size of the common step (fmu_step_fast), one per arithmetic of
      * the prepared block, so that the step's compare of h also picks the
      * arithmetic: set (the one of the block's arithmetic, the other NaN) by
@@ -79,7 +79,7 @@ struct FmuInstance {
      * changes (fmu_disarm); and its time tolerance, set there too (see
      * there why it never exceeds the general one). */
     double fastPeriodReal, fastPeriodLreal, fastTolerance;
-    double cycleTime;       /* sub-cycle length, 0 = one cycle per step */
+    double cycleTime; /* sub-cycle length, 0 = one cycle per step */
     /* model->inputVr and outputVr, one load nearer. Every model's u is an
      * unranged, non-fixed Real input and its y a Real output (checked
      * against each model's TOML by test_model_description.py), so the
@@ -87,10 +87,10 @@ struct FmuInstance {
     unsigned inputVr, outputVr;
     const ModelDefinition *model;
     FmuLogFunction *logFunction;
-    int logCategories;      /* enabled categories */
-    int errorMode;          /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
-    bool modelExchange;     /* instantiated for Model Exchange, not Co-Simulation */
-    void *environment;      /* the importer's instance environment */
+    int logCategories;  /* enabled categories */
+    int errorMode;      /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
+    bool modelExchange; /* instantiated for Model Exchange, not Co-Simulation */
+    void *environment;  /* the importer's instance environment */
     /* memory for FMU states, as the importer provides it (FMI 2) or not */
     void *(*allocate)(FmuInstance *instance, size_t size);
     void (*release)(FmuInstance *instance, void *memory);

@@ -12,8 +12,8 @@ RL_LINKAGE void fmu_enter_event_mode(FmuInstance *instance);
 /* The event update: the cycles that ended by the FMU's time, with the
  * latched values. *nextEventTime: the next cycle end; none (0, and
  * *nextEventTimeDefined false) without a valid cycle. */
-RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function,
-                                                bool *nextEventTimeDefined, double *nextEventTime);
+RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function, bool *nextEventTimeDefined,
+                                                double *nextEventTime);
 /* Continuous-Time Mode entered: the instant is left. */
 RL_LINKAGE void fmu_enter_continuous_time_mode(FmuInstance *instance);
 /* The instant is left (Continuous-Time Mode entered, or the time set anew

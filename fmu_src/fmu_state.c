@@ -84,12 +84,12 @@ static double get_f64(const unsigned char **p) {
 }
 
 static size_t payload_size(const ModelDefinition *model) {
-    return 4 + 8 * (size_t)model->count      /* values */
-         + 8 + 8 + 8 + 1 + 8 + 8 + 8         /* block */
-         + 8 + 8 + 8                         /* startTime, time, cycles */
-         + 8 + 8 + 8                         /* block: the cycle before the last */
-         + 8 * (size_t)model->count + 8      /* latched values, eventTime */
-         + 4 + 4;                            /* mode, status */
+    return 4 + 8 * (size_t)model->count   /* values */
+           + 8 + 8 + 8 + 1 + 8 + 8 + 8    /* block */
+           + 8 + 8 + 8                    /* startTime, time, cycles */
+           + 8 + 8 + 8                    /* block: the cycle before the last */
+           + 8 * (size_t)model->count + 8 /* latched values, eventTime */
+           + 4 + 4;                       /* mode, status */
 }
 
 static size_t serialized_size(const FmuInstance *instance) {
@@ -141,10 +141,8 @@ static bool fmu_mode_possible(const FmuInstance *instance, int mode) {
  * unranged Real), as fmu_check_set would accept it. */
 static bool value_possible(const FmuVariable *v, double value) {
     switch (v->type) {
-    case FMU_REAL:
-        return fmu_in_range(v, value);
-    case FMU_BOOLEAN:
-        return value == 0.0 || value == 1.0;
+    case FMU_REAL: return fmu_in_range(v, value);
+    case FMU_BOOLEAN: return value == 0.0 || value == 1.0;
     default: /* Integer, Enumeration: an int32 in range */
         return value == floor(value) && isgreaterequal(value, -2147483648.0) && islessequal(value, 2147483647.0) &&
                isgreaterequal(value, v->min) && islessequal(value, v->max);
@@ -174,7 +172,8 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
                          model->identifier, model->token);
     }
     if (size != expected || get_u32(&p) != payload_size(model)) {
-        return fmu_error(instance, function, "serialized state has %zu bytes; expected %zu (truncated or padded)", size, expected);
+        return fmu_error(instance, function, "serialized state has %zu bytes; expected %zu (truncated or padded)", size,
+                         expected);
     }
     const unsigned char *trailer = in + size - SERIAL_TRAILER;
     if (crc32(in, size - SERIAL_TRAILER) != get_u32(&trailer)) {
@@ -220,7 +219,8 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     }
     /* runningTime is a sum of whole cycles: no NaN, infinity or negative */
     if (!isfinite(s.startTime) || !isfinite(s.time) || !isfinite(s.eventTime) || s.cycles > MAX_EXACT_CYCLES ||
-        s.block.runCycles > MAX_EXACT_CYCLES || !(isgreaterequal(s.block.runPeriod, 0) && islessequal(s.block.runPeriod, DBL_MAX)) ||
+        s.block.runCycles > MAX_EXACT_CYCLES ||
+        !(isgreaterequal(s.block.runPeriod, 0) && islessequal(s.block.runPeriod, DBL_MAX)) ||
         !(isgreaterequal(s.block.runBase, 0) && islessequal(s.block.runBase, DBL_MAX)) ||
         !(isgreaterequal(s.block.periodLast, 0) && islessequal(s.block.periodLast, DBL_MAX)) ||
         !(isgreaterequal(s.block.periodBefore, 0) && islessequal(s.block.periodBefore, DBL_MAX))) {
@@ -229,8 +229,9 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     /* Event Mode is an instant: entering it, SetTime in it and the end of
      * initialisation make the time that of the event (fmu_set_time relies on it) */
     if (s.mode == MODE_EVENT && s.time != s.eventTime) {
-        return fmu_error(instance, function, "serialized state is in Event Mode at time %.17g, not at its event's %.17g",
-                         s.time, s.eventTime);
+        return fmu_error(instance, function,
+                         "serialized state is in Event Mode at time %.17g, not at its event's %.17g", s.time,
+                         s.eventTime);
     }
     *out = s;
     return FMU_OK;
