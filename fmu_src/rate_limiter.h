@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 /* Compiler hints, portable: GCC and clang read them, any other compiler
  * (MSVC compiling the source FMU) gets nothing; FMU_PORTABLE forces that
@@ -154,17 +155,19 @@ typedef struct {
  * that it does not drift. */
 typedef struct {
     double y;
+    double yPrevious; /* y before the last cycle */
+    double yBefore;   /* y before the cycle before (d2ydt2) */
     double uPrevious;
-    double yPrevious;      /* y before the last cycle */
     unsigned char decided; /* RL_DECIDED_*: what decided the last cycle */
     uint64_t runCycles;
     double runPeriod;
     double runBase;
-    /* the cycle before the last (d2ydt2, and the acceleration limit's
-     * velocity): y before it, and the lengths of both cycles */
-    double yBefore;
+    /* the lengths of the last cycle and the one before (d2ydt2, and the
+     * acceleration limit's velocity after a change of step size) */
     double periodLast, periodBefore;
 } RlState;
+/* rl_shift_outputs: y, yPrevious and yBefore adjacent, in this order */
+typedef char rl_outputs_adjacent[offsetof(RlState, yBefore) == offsetof(RlState, y) + 2 * sizeof(double) ? 1 : -1];
 
 /* An error status: the block holds its output (rule 5). */
 static inline bool rl_status_is_error(int status) {
@@ -208,6 +211,21 @@ static inline void rl_shift(RlState *s, double period) {
     s->yBefore = s->yPrevious;
     s->periodBefore = s->periodLast;
     s->periodLast = period;
+}
+
+/* y, yPrevious and yBefore move one back (yPrevious = y, yBefore =
+ * yPrevious) as one copy of two adjacent doubles: the common step's whole
+ * cost of keeping the cycle before the last. y is then set. */
+static inline void rl_shift_outputs(RlState *s) {
+    memmove((char *)s + offsetof(RlState, yPrevious), (char *)s + offsetof(RlState, y), 2 * sizeof(double));
+}
+
+/* The end of a cycle rule 6 decided: y after yp (ypHeld). */
+static inline void rl_ramped(RlState *s, double period, double ypHeld, double y) {
+    s->decided = RL_DECIDED_RAMP;
+    rl_shift(s, period);
+    s->yPrevious = ypHeld;
+    s->y = y;
 }
 
 /* runningTime counts in cycles of period from now on. rl_ramp does this

@@ -243,7 +243,7 @@ static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_
 
 /* The step of the last cycle, as the acceleration limit's velocity at this
  * cycle's length: 0 after a cycle that did not ramp or jumped. */
-static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
+static inline RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
     if (s->decided != RL_DECIDED_RAMP || (p->durationLimited && rl_running_time(s) >= p->durationReached) ||
         !isfinite(s->y) || !isfinite(s->yPrevious)) {
         return 0;
@@ -255,18 +255,11 @@ static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_previous_step)(const RlSt
     return RL_NAME(rl_product)(step, RL_NAME(rl_quotient)(RL_ENTER(p->period), RL_ENTER(s->periodLast)));
 }
 
-/* Rule 6: ramp towards uc at the limits picked by the output's sign, or
- * jump to uc once the duration has run out. u has entered the block's
- * arithmetic (rl_input). */
-static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, double u) {
-    const double ypHeld = s->y;
-    const RL_NUM yp = (RL_NUM)ypHeld;
-    const bool negative = isless(yp, 0);
-    const RL_NUM target = (RL_NUM)rl_target(u, p);
-    const RL_NUM previous = p->accelLimited ? RL_NAME(rl_previous_step)(s, p) : 0;
-    RL_NUM y = yp;
-    /* a u equal to uPrevious (a zero of the other sign included: nothing
-     * tells them apart) is not stored, so that a held u costs no store */
+/* Rule 6's bookkeeping of runningTime: it restarts for a new u and counts
+ * the cycle while y is not at the target. A u equal to uPrevious (a zero
+ * of the other sign included: nothing tells them apart) is not stored, so
+ * that a held u costs no store. */
+static inline void RL_NAME(rl_count_running)(RlState *s, const RlPrepared *p, double u, RL_NUM y, RL_NUM target) {
     if (u != s->uPrevious) {
         s->runCycles = 0;
         s->runBase = 0.0;
@@ -276,18 +269,41 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
         if (p->period != s->runPeriod) rl_period_changed(s, p->period);
         s->runCycles++;
     }
+}
+
+/* Rule 6 with the acceleration limit: out of line, so that the ramp
+ * without it stays as small as it was. */
+static FMU_NOINLINE FMU_MAYBE_UNUSED void RL_NAME(rl_accel_cycle)(RlState *s, const RlPrepared *p, double u) {
+    const double ypHeld = s->y;
+    const RL_NUM yp = (RL_NUM)ypHeld;
+    const RL_NUM target = (RL_NUM)rl_target(u, p);
+    const RL_NUM previous = RL_NAME(rl_previous_step)(s, p); /* before this cycle counts */
+    RL_NAME(rl_count_running)(s, p, u, yp, target);
+    const bool jump = p->durationLimited && rl_running_time(s) >= p->durationReached;
+    rl_ramped(s, p->period, ypHeld, (double)(jump ? target : RL_NAME(rl_accel_step)(yp, target, previous, p)));
+}
+
+/* Rule 6: ramp towards uc at the limits picked by the output's sign, or
+ * jump to uc once the duration has run out. u has entered the block's
+ * arithmetic (rl_input). */
+static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, double u) {
+    if (p->accelLimited) {
+        RL_NAME(rl_accel_cycle)(s, p, u);
+        return;
+    }
+    const double ypHeld = s->y;
+    const RL_NUM yp = (RL_NUM)ypHeld;
+    const bool negative = isless(yp, 0);
+    const RL_NUM target = (RL_NUM)rl_target(u, p);
+    RL_NUM y = yp;
+    RL_NAME(rl_count_running)(s, p, u, yp, target);
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) { /* both finite */
         y = target;
-    } else if (p->accelLimited) {
-        y = RL_NAME(rl_accel_step)(y, target, previous, p);
     } else {
         y = RL_NAME(rl_step_towards)(y, target, negative ? (RL_NUM)p->maxUpNeg : RL_MAX_UP(p),
                                      negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p), false);
     }
-    s->decided = RL_DECIDED_RAMP;
-    rl_shift(s, p->period);
-    s->yPrevious = ypHeld;
-    s->y = (double)y;
+    rl_ramped(s, p->period, ypHeld, (double)y);
 }
 
 /* The common step's cycle: false (nothing done) if u is not a steady value
@@ -319,9 +335,8 @@ static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, doub
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) {
         y = u;
     }
+    rl_shift_outputs(s); /* both cycles of p->period (fmu_step_fast) */
     s->y = y;
-    s->yBefore = s->yPrevious; /* both cycles of p->period (fmu_step_fast) */
-    s->yPrevious = yp;
     return true;
 }
 
