@@ -296,7 +296,7 @@ static double remaining_time(const RlState *s, const RlPrepared *p, double y, do
 #define RL_PLAN_CYCLES 67108864.0 /* 2^26 */
 static double planned_time(const RlState *s, const RlPrepared *p, double uc) {
     RlState ahead = *s;
-    ahead.decided = s->decided == RL_DECIDED_HOLD ? RL_DECIDED_OTHER : s->decided; /* hold stops the output */
+    if (s->decided == RL_DECIDED_HOLD) ahead.decided = RL_DECIDED_OTHER; /* hold stops the output */
     double cycles = 0;
     while (ahead.y != uc && cycles < RL_PLAN_CYCLES) {
         const double before = ahead.y;
