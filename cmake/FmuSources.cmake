@@ -13,7 +13,7 @@
 #   FMU_HEADERS: the headers they include (the source FMU carries them)
 #   FMU_INCLUDE_DIRS: where the unit finds them in the source tree
 set(FMU_HEADERS fmu_src/rate_limiter.h fmu_src/rate_limiter_rules.h fmu_src/model.h fmu_src/fmu_core.h
-                fmu_src/fmu_model_exchange.h fmu_src/fmu_state.h fmu_src/fmi_entries.h
+                fmu_src/fmu_model_exchange.h fmu_src/fmu_state.h fmu_src/fmi_entries.h fmu_src/fmi3_unsupported.h
                 fmu_src/models/siemens.h fmu_src/models/unified.h)
 set(FMU_INCLUDE_DIRS fmu_src fmu_src/models)
 

@@ -59,6 +59,7 @@ FILES = (
     "fmu_model_exchange.c",
     "fmu_state.c",
     "fmi_entries.h",
+    "fmi3_unsupported.h",
     "fmi2_glue.c",
     "fmi3_glue.c",
 )
