@@ -22,7 +22,8 @@ def trace(ys, values, T=1.0, y0=0.0, per_cycle=None, outputs=None, settle=False,
         dydt = real(real(y - yp) / real(T))
         ramps = not (all_values[k].get("hold") or all_values[k].get("bypass"))
         d2 = real(real(dydt - dydt_before) / real(T)) if ramps else 0.0
-        uc = min(max(all_values[k]["u"], all_values[k].get("yMinPar", -math.inf)), all_values[k].get("yMaxPar", math.inf))
+        here = all_values[k]
+        uc = min(max(here["u"], here.get("yMinPar", -math.inf)), here.get("yMaxPar", math.inf))
         later = next((j for j in range(k + 1, len(ys)) if ys[j] == uc and all_values[j] == all_values[k]), None)
         remaining = 0.0 if y == uc else (later - k) * T if later is not None else math.inf
         out = {"y": y, "dydt": dydt, "d2ydt2": d2, "remainingTime": remaining, "runningTime": 0.0, "status": 0}

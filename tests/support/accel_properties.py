@@ -183,7 +183,8 @@ def resolve(values, arithmetic, T):
     else:
         status = 0
     return Settings(real(values["u"]), up, down, up_neg, down_neg, period, int(values.get("zeroRate", 1)), y_max,
-                    y_min, bool(values.get("bypass", False)), real(or_par("bypassValue")), bool(values.get("hold", False)),
+                    y_min, bool(values.get("bypass", False)), real(or_par("bypassValue")),
+                    bool(values.get("hold", False)),
                     duration, accel, decel, status, real(T))
 
 

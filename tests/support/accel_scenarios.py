@@ -14,7 +14,7 @@ import math
 import sys
 from dataclasses import asdict, dataclass, field
 
-from support.accel_properties import LREAL, REAL, Cycle, Segment, check
+from support.accel_properties import REAL, Cycle, Segment, check
 from support.fmu_driver import Instance
 from support.oracle import start_values
 
