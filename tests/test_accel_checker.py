@@ -2,10 +2,13 @@
 on hand-made traces: each breaks one property and must be flagged for it,
 and clean ones (worked by hand from SPEC section 11) must pass. No FMU."""
 import math
+import random
 
 import pytest
 
+from support.accel_model import ModelBlock
 from support.accel_properties import LREAL, REAL, Cycle, Segment, check, f32
+from support.accel_scenarios import RandomChooser, run_random, violations
 
 BASE = {"rateUpPar": 100.0, "rateDownPar": 100.0, "ratePeriod": 1.0, "accelMax": 1.0, "decelMax": 0.0}
 
@@ -251,3 +254,32 @@ def test_interface_d2ydt2_after_a_hold():
     per_cycle = [{}, {"hold": True}, {}]
     assert "interface" in props(trace([1.0, 1.0, 2.0], dict(BASE, u=10.0), per_cycle=per_cycle,
                                       outputs={2: {"d2ydt2": -1.0}}))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_second_order_limiter_that_keeps_the_properties_passes_random_scenarios(seed):
+    """support/accel_model.py (a plain time-optimal limiter, exact, that brakes a few ulp harder to absorb the
+    rounding of its outputs) through the random scenarios the FMU gets: no violation, so that one found in the
+    FMU is the FMU's and not the checker's."""
+    scenario, segments = run_random(RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60),
+                                    block=ModelBlock)
+    assert sum(len(s.cycles) for s in segments) > 20
+    assert violations(scenario, segments) == [], scenario.dumps()
+
+
+class FirstOrder(ModelBlock):
+    """The block of section 3 and 6: the acceleration parameters not passed on."""
+
+    def start(self, t0, values):
+        return super().start(t0, {k: v for k, v in values.items() if k not in ("accelMax", "decelMax")})
+
+    def cycle(self, T, changes):
+        return super().cycle(T, {k: v for k, v in changes.items() if k not in ("accelMax", "decelMax")})
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_block_without_the_acceleration_limit_fails_the_same_scenarios(seed):
+    """The control of the test above: the first-order block jumps to its velocity limit from rest."""
+    scenario, segments = run_random(RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60),
+                                    block=FirstOrder)
+    assert "2" in {v.prop for v in violations(scenario, segments)}

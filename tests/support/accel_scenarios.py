@@ -138,9 +138,11 @@ def settable(model, values):
 class Run:
     """A scenario as it runs: the values in effect, the segments for the checker."""
 
-    def __init__(self, scenario, model_exchange=False):
+    def __init__(self, scenario, model_exchange=False, block=None):
         self.sc = scenario
-        self.block = Block(scenario.model, scenario.version, model_exchange)
+        self.block = (block or Block)(scenario.model, scenario.version, model_exchange)
+        # a Python block (support/accel_model.py) takes every value; an FMU those its model has
+        self.settable = settable if block is None else (lambda model, values: dict(values))
         self.segments = []
         self.t = 0.0
         self.n = 0            # cycles since the segment's start
@@ -153,7 +155,7 @@ class Run:
         self.values["cycleTime"] = self.sc.cycle_time
         self.values["arithmetic"] = self.sc.arithmetic
         t0 = self.t
-        init_values = settable(self.sc.model, dict(start, cycleTime=self.sc.cycle_time,
+        init_values = self.settable(self.sc.model, dict(start, cycleTime=self.sc.cycle_time,
                                                    arithmetic=self.sc.arithmetic))
         out = self.block.start(t0, init_values)
         self.segments.append(Segment(dict(self.values), t0, out))
@@ -165,7 +167,7 @@ class Run:
         if "_reinit" in changes:
             self.block.reset()
             return self.begin(changes["_reinit"])
-        changes = settable(self.sc.model, changes)
+        changes = self.settable(self.sc.model, changes)
         self.values.update(changes)
         out = self.block.cycle(self.sc.T, changes)
         self.n += 1
@@ -260,8 +262,8 @@ class Generator:
         return {name: value}
 
     def braking(self, speed):
-        b = self.a
-        return speed * speed / (2 * b) + speed
+        """About the way braking needs from speed (per cycle)."""
+        return speed * (speed / (2 * self.a)) + speed
 
     def changes(self, k, y, v, values):
         """What changes before cycle k, given the last output y, its step v and the values in effect."""
@@ -321,7 +323,9 @@ class Generator:
             return {"_reinit": self.reinit_values()}
         elif event == "period":
             out["zeroRate"] = c.pick([1, 2])
-        return out
+        # a value past the largest double is no scenario (a limit of +inf, a target of +inf by overflow)
+        return {n: x for n, x in out.items() if not (isinstance(x, float) and math.isinf(x) and event != "nonfinite"
+                                                     and n not in ("rateUpPar", "rateDownPar", "rateUp", "rateDown"))}
 
     def reinit_values(self):
         return self.settings()
@@ -336,13 +340,13 @@ class Generator:
 
 
 def run_random(chooser, model, version, arithmetic, model_exchange=False, cycles=(40, 200), accel_zero=False,
-               settle_cap=20000):
+               settle_cap=20000, block=None):
     """Draw and run one scenario in Co-Simulation (with the FMU's cycleTime for a later Model Exchange replay):
     (scenario, segments). The last stretch is held until the output has settled on its target for 3 cycles, or
     settle_cap cycles."""
     gen = Generator(chooser, model, version, arithmetic, model_exchange, cycles, accel_zero)
     sc = gen.scenario
-    run = Run(sc)
+    run = Run(sc, block=block)
     try:
         run.begin(sc.start)
         for k in range(1, gen.length + 1):
