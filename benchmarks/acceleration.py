@@ -23,7 +23,7 @@ description, go here through
 each input from rest at 0 for 2 s (the loopback: 0.5 s of the sine, then
 0.5 s with the input = the block's own previous output). Counted per input,
 with the property checker of the tests (tests/support/accel_properties.py,
-the allowance of SPEC section 11): velocity and acceleration limit
+the allowance of the acceleration limit in docs/rules.md): velocity and acceleration limit
 violations, position limit violations, avoidable overshoots (the output
 passes a target it could have stopped before: a target not moved inside the
 braking distance), the largest overshoot past the target, the time to the

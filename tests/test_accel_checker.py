@@ -1,6 +1,6 @@
 """The property checker of the acceleration limit (support/accel_properties.py)
 on hand-made traces: each breaks one property and must be flagged for it,
-and clean ones (worked by hand from SPEC section 11) must pass. No FMU."""
+and clean ones (worked by hand from the properties) must pass. No FMU."""
 import math
 import random
 

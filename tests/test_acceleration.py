@@ -1,4 +1,4 @@
-"""The acceleration limit (SPEC section 11) through the FMU binaries.
+"""The acceleration limit (docs/rules.md) through the FMU binaries.
 
 - Properties: random scenarios (support/accel_scenarios.py: cycles, rates
   with the Neg rates, zeroRate and ratePeriod 0 or not, accelMax and
@@ -113,7 +113,7 @@ def run_against_oracle(scenario):
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(data=st.data())
 def test_accel_max_zero_is_the_block_without_the_acceleration_limit(model, version, arithmetic, data):
-    """accelMax = 0 (decelMax 0 or not: it brakes only where accelMax limits): the oracle of rules.md, which
+    """accelMax = 0 (decelMax 0 or not: it brakes only where accelMax limits): the oracle (rules.md) which
     has no acceleration limit, bit for bit after every cycle, every output it has."""
     scenario, _ = run_random(HypothesisChooser(data), model, version, arithmetic, cycles=CI_CYCLES,
                              accel_zero=True, settle_cap=50)
@@ -131,7 +131,7 @@ BAD = [-1.0, -1e300, math.nan, math.inf, -math.inf]
 @pytest.mark.parametrize("model", MODELS)
 @pytest.mark.parametrize("name", ["accelMax", "decelMax"])
 def test_a_bad_acceleration_is_status_8205_naming_it_and_holds(model, version, arithmetic, name):
-    """SPEC section 11: accelMax or decelMax negative or not finite is 16#8205 with its value reference;
+    """accelMax or decelMax negative or not finite is 16#8205 with its value reference;
     as every error status, the output holds (rule 5). Set at the start, and set mid-ramp (both tunable):
     the next cycle reports it and holds; a good value again and the ramp goes on."""
     for bad in BAD:
@@ -181,7 +181,7 @@ def test_8205_comes_after_8204_and_before_8601(model, version):
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
 def test_a_negative_acceleration_that_rounds_to_minus_zero_in_real_is_no_error(model, version):
-    """SPEC section 8: in REAL the status checks judge the binary32 values; -1e-50 is -0 there, not negative
+    """rules.md, Arithmetic: in REAL the status words judge the binary32 values; -1e-50 is -0 there, not negative
     (and an acceleration of 0: no limit, the ramp of section 3: 10 per cycle at once)."""
     fmu = Instance(model, version, logging=False)
     try:

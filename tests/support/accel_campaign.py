@@ -1,6 +1,6 @@
 """N random scenarios of the acceleration limit per arithmetic through the
-FMU binaries, every cycle checked against the properties of SPEC section 11
-(support/accel_properties.py). From tests/, after the build:
+FMU binaries, every cycle checked against the properties of the acceleration limit
+(docs/rules.md; support/accel_properties.py). From tests/, after the build:
 
     python -m support.accel_campaign --scenarios 10000 --arithmetic lreal
     python -m support.accel_campaign --scenarios 10000 --arithmetic real --seed 7

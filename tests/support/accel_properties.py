@@ -1,4 +1,4 @@
-"""The properties of the acceleration limit (SPEC section 11), checked on a
+"""The properties of the acceleration limit (docs/rules.md), checked on a
 run's cycles, whatever algorithm produced them.
 
 A run is a list of segments (an initialisation and the cycles after it,
@@ -146,7 +146,7 @@ class Settings:
 
 
 def resolve(values, arithmetic, T):
-    """rules.md, rule 0 and the status table (with 16#8205), in the arithmetic."""
+    """Rule 0 and the status words (rules.md) with 16#8205, in the arithmetic."""
     real = f32 if arithmetic == REAL else float
 
     def or_par(name):
