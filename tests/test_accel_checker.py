@@ -283,3 +283,11 @@ def test_the_block_without_the_acceleration_limit_fails_the_same_scenarios(seed)
     scenario, segments = run_random(RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60),
                                     block=FirstOrder)
     assert "2" in {v.prop for v in violations(scenario, segments)}
+
+
+def test_1_braking_to_a_lowered_limit_ends_when_the_limit_is_raised_again():
+    """Speed 4, rateUp lowered to 1: braking 3; the rate raised to 10 again: accelerating to 4 is allowed."""
+    values = dict(BASE, u=100.0, rateUpPar=4.0, rateDownPar=4.0)
+    per_cycle = [{}] * 4 + [{"rateUpPar": 1.0}] + [{"rateUpPar": 10.0}] * 2
+    ys = [1.0, 3.0, 6.0, 10.0, 13.0, 17.0, 22.0]
+    assert check([trace(ys, values, per_cycle=per_cycle)], LREAL, 1.0) == []

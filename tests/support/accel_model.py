@@ -10,12 +10,14 @@ while it can still stop at the target: the largest speed w per cycle within
 [|v| - b, |v| + a] and the velocity limit with w + B(w) <= E (E the distance
 to uc, B(w) the way braking at b needs from w); moving away from uc it
 brakes (and, once it can stop within the cycle, turns towards uc with what
-is left of a). LREAL only.
+is left of a). Exact arithmetic, the output rounded once to the block's
+arithmetic (LREAL or REAL).
 """
 import collections
 import math
 from fractions import Fraction
 
+from support.accel_properties import ulp
 from support.oracle import RateLimiterOracle, finite
 
 
@@ -48,7 +50,7 @@ class AccelModel(RateLimiterOracle):
         self.last = self.evaluate_outputs()
 
     def accel(self):
-        accel, decel = self.values.get("accelMax", 0.0), self.values.get("decelMax", 0.0)
+        accel, decel = self.real(self.values.get("accelMax", 0.0)), self.real(self.values.get("decelMax", 0.0))
         return accel, decel if decel > 0 else accel
 
     def evaluate_status(self):
@@ -70,12 +72,15 @@ class AccelModel(RateLimiterOracle):
         period = self.rate_period()
         if limit == 0:
             return Fraction(0)
+        T = self.real(T)
         return Fraction(rate.value) * Fraction(T) / Fraction(period) if period > 0 else Fraction(rate.value)
 
     def step(self, yp, v, uc, T):
         """The next output from yp after a step v (exact arithmetic, the output rounded once)."""
         accel, decel = self.accel()
-        a, b = Fraction(accel) * Fraction(T) ** 2, Fraction(decel) * Fraction(T) ** 2
+        Th = Fraction(self.real(T))
+        a, b = Fraction(accel) * Th ** 2, Fraction(decel) * Th ** 2
+        out = self.round
         Y, U = Fraction(yp), Fraction(uc)
         d = 1 if U > Y else -1 if U < Y else 0
         s, E = abs(v), abs(U - Y)
@@ -83,7 +88,7 @@ class AccelModel(RateLimiterOracle):
             return yp
         if d == 0 or d * v < 0:       # at uc while moving, or moving away from it: brake
             if s > b:
-                return float(Y + (s - b) * (1 if v > 0 else -1))
+                return out(Y + (s - b) * (1 if v > 0 else -1))
             if d == 0:
                 return yp
             limit = self.limit(d > 0, yp, T)
@@ -96,13 +101,20 @@ class AccelModel(RateLimiterOracle):
         if low + stopping(low, b) > E:
             # short of the braking curve by the rounding of the outputs: brake up to 4 ulp harder (within the
             # allowance) to keep to it; else it cannot stop before uc: pass it
-            slack = 4 * Fraction(math.ulp(max(abs(yp), abs(uc))))
+            slack = 4 * ulp(max(abs(yp), abs(uc)), self.values["arithmetic"])
             harder = max(Fraction(0), low - slack)
             if harder + stopping(harder, b) > E:
-                return float(Y + d * low)
+                return out(Y + d * low)
             low = harder
         w = fastest(E, low, high, b)
-        return uc if w >= E else float(Y + d * w)
+        return uc if w >= E else out(Y + d * w)
+
+    def round(self, x):
+        """An exact value as the arithmetic holds the output (REAL: binary32, overflow to an infinity)."""
+        try:
+            return self.real(float(x))
+        except OverflowError:
+            return math.copysign(math.inf, x)
 
     def cycle(self, T, elapsed):
         yp = self.y
@@ -129,7 +141,8 @@ class AccelModel(RateLimiterOracle):
             return out
         dydt = out["dydt"]
         ramped_before = getattr(self, "ramped_before", False)
-        out["d2ydt2"] = (dydt - self.dydt_before) / self.T if self.ramped and ramped_before else 0.0
+        real = self.real
+        out["d2ydt2"] = real(real(dydt - self.dydt_before) / real(self.T)) if self.ramped and ramped_before else 0.0
         self.dydt_before = dydt
         accel, _ = self.accel()
         uc = self.target(self.u_prev)

@@ -274,7 +274,7 @@ class Checker:
 
     def interface(self, index, seg, settings, ramping, decided):
         """dydt = (y - yp) / T in the arithmetic; d2ydt2 = (dydt - dydt_previous) / T after two ramping cycles
-        (binary32 or binary64 of the binary32 values in REAL: the contract does not say which), 0 after a cycle
+        (in REAL binary32, or binary64 with T rounded or not: the contract does not say which), 0 after a cycle
         that did not ramp, finite always."""
         real, cycles = self.real, seg.cycles
         for k, (c, s) in enumerate(zip(cycles, settings), start=1):
@@ -299,6 +299,8 @@ class Checker:
                     expected = {real(real(dydt - dydt_prev) / s.T), (dydt - dydt_prev) / s.T}
                 else:
                     expected = {0.0}
+                if finite(dydt) and finite(dydt_prev):  # or binary64 with the binary64 T
+                    expected.add((dydt - dydt_prev) / self.T)
                 if d2 not in expected:
                     self.flag("interface", index, k, f"d2ydt2 = {d2!r}, (dydt - dydt_previous) / T = "
                               f"({dydt!r} - {dydt_prev!r}) / T = {sorted(expected)!r}")
@@ -324,8 +326,9 @@ class Checker:
                 if limit is not None and changed and not self.holds(abs(p), limit, *mags):
                     braking_to = (p > 0, limit)
             if braking_to is not None:
-                rising, limit = braking_to
-                if (step > 0) != rising or step == 0 or self.holds(abs(step), limit, *mags):
+                rising = braking_to[0]
+                limit = s.limit(rising, yp)  # the limit of this cycle: raised again, it ends the braking
+                if limit is None or (step > 0) != rising or step == 0 or self.holds(abs(step), limit, *mags):
                     braking_to = None
                 elif not self.holds(abs(step), max(limit, abs(p) - s.b()), *mags):
                     self.flag("1", index, k, f"speed {float(abs(p))!r} -> {float(abs(step))!r} per cycle above the "
