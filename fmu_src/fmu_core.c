@@ -9,7 +9,7 @@
 static const char *const log_category_names[3] = { "logStatusError", "logStatusWarning", "logEvents" };
 
 #define SERIAL_MAGIC "RLFS"
-#define SERIAL_VERSION 3u
+#define SERIAL_VERSION 3u /* with the payload's size, checked too: the cycle before the last added 24 bytes */
 /* magic, version, model hash, payload size; CRC-32 after the payload */
 #define SERIAL_HEADER 16u
 #define SERIAL_TRAILER 4u
@@ -377,7 +377,7 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
      * reach 2^969, and below 2^970, t - time is at most DBL_MAX in
      * magnitude for any t: nothing overflows.) */
     if (instance->cycleTime == 0 && instance->prepared.plain && rl_steady_value(core->block.y) &&
-        core->block.decided == RL_DECIDED_RAMP &&
+        core->block.decided == RL_DECIDED_RAMP && core->block.periodBefore == h &&
         islessequal(h, 8.452712498170644e+270 /* 2^900 */) && islessequal(fabs(core->time), 2.4948003869184e+291 /* 2^968 */)) {
         rl_hold_period(&core->block, h);
         const bool real = instance->prepared.config.real;
@@ -565,6 +565,7 @@ static size_t payload_size(const ModelDefinition *model) {
     return 4 + 8 * (size_t)model->count      /* values */
          + 8 + 8 + 8 + 1 + 8 + 8 + 8         /* block */
          + 8 + 8 + 8                         /* startTime, time, cycles */
+         + 8 + 8 + 8                         /* block: the cycle before the last */
          + 8 * (size_t)model->count + 8      /* latched values, eventTime */
          + 4 + 4;                            /* mode, status */
 }
@@ -593,6 +594,9 @@ static void serialize(const FmuInstance *instance, const FmuCore *s, unsigned ch
     p = put_f64(p, s->startTime);
     p = put_f64(p, s->time);
     p = put_u64(p, s->cycles);
+    p = put_f64(p, s->block.yBefore);
+    p = put_f64(p, s->block.periodLast);
+    p = put_f64(p, s->block.periodBefore);
     for (unsigned i = 0; i < model->count; i++) p = put_f64(p, s->latched[i]);
     p = put_f64(p, s->eventTime);
     p = put_u32(p, (uint32_t)s->mode);
@@ -670,6 +674,9 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     s.startTime = get_f64(&p);
     s.time = get_f64(&p);
     s.cycles = get_u64(&p);
+    s.block.yBefore = get_f64(&p);
+    s.block.periodLast = get_f64(&p);
+    s.block.periodBefore = get_f64(&p);
     for (unsigned i = 0; i < model->count; i++) s.latched[i] = get_f64(&p);
     s.eventTime = get_f64(&p);
     s.mode = (int)get_u32(&p);
@@ -692,7 +699,9 @@ static FmuStatus deserialize(FmuInstance *instance, const char *function, const 
     /* runningTime is a sum of whole cycles: no NaN, infinity or negative */
     if (!isfinite(s.startTime) || !isfinite(s.time) || !isfinite(s.eventTime) || s.cycles > MAX_EXACT_CYCLES ||
         s.block.runCycles > MAX_EXACT_CYCLES || !(isgreaterequal(s.block.runPeriod, 0) && islessequal(s.block.runPeriod, DBL_MAX)) ||
-        !(isgreaterequal(s.block.runBase, 0) && islessequal(s.block.runBase, DBL_MAX))) {
+        !(isgreaterequal(s.block.runBase, 0) && islessequal(s.block.runBase, DBL_MAX)) ||
+        !(isgreaterequal(s.block.periodLast, 0) && islessequal(s.block.periodLast, DBL_MAX)) ||
+        !(isgreaterequal(s.block.periodBefore, 0) && islessequal(s.block.periodBefore, DBL_MAX))) {
         return fmu_error(instance, function, "serialized state has an impossible time or cycle count");
     }
     /* Event Mode is an instant: entering it, SetTime in it and the end of

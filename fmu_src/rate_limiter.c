@@ -21,6 +21,7 @@ void rl_without_section6(RlConfig *c) {
     c->yMax = c->yMin = rl_value(NAN, 0);
     c->hold = false;
     c->limitInitialOutput = false;
+    c->accelMax = c->decelMax = rl_value(0.0, 0);
 }
 
 int rl_status(const RlConfig *c, int *source) {
@@ -42,6 +43,10 @@ int rl_status(const RlConfig *c, int *source) {
         status = RL_STATUS_DURATION; culprit = &c->duration;
     } else if (isgreater(rl_low_limit(c->yMin.value), rl_high_limit(c->yMax.value))) {
         status = RL_STATUS_LIMITS; culprit = &c->yMin;
+    } else if (!(isgreaterequal(c->accelMax.value, 0) && isfinite(c->accelMax.value))) {
+        status = RL_STATUS_ACCELERATION; culprit = &c->accelMax;
+    } else if (!(isgreaterequal(c->decelMax.value, 0) && isfinite(c->decelMax.value))) {
+        status = RL_STATUS_ACCELERATION; culprit = &c->decelMax;
     } else if (c->cycleRefused || !isgreaterequal(c->cycleTime.value, 0) || !isfinite(c->cycleTime.value)) {
         status = RL_STATUS_NO_CYCLE; culprit = &c->cycleTime;
     }
@@ -56,6 +61,15 @@ static double cycle_limit(double rate, const RlConfig *c, double period) {
     }
     return c->real ? rl_per_cycle_real(rate, period, c->ratePeriod.value)
                    : rl_per_cycle_lreal(rate, period, c->ratePeriod.value);
+}
+
+/* x * T * T, left to right, in the arithmetic */
+static double cycle_square(double x, const RlConfig *c, double period) {
+    if (c->real) {
+        const float t = rl_binary32(period);
+        return (double)rl_product_real(rl_product_real((float)x, t), t);
+    }
+    return rl_product(rl_product(x, period), period);
 }
 
 static double binary32(double x) {
@@ -81,6 +95,8 @@ static RlConfig entered(const RlConfig *c) {
         r.ratePeriod = binary32_value(c->ratePeriod);
         r.bypassValue = binary32(c->bypassValue);
         r.initValue = binary32(c->initValue);
+        r.accelMax = binary32_value(c->accelMax);
+        r.decelMax = binary32_value(c->decelMax);
     }
     return r;
 }
@@ -108,7 +124,12 @@ void rl_prepare(RlPrepared *p, const RlConfig *config, double period) {
      * makes rule 6 ramp otherwise (output limits, other limits below 0)
      * must clear it here; so must a per-cycle limit too large for the
      * unchecked sums of the steady paths (RL_STEADY_BELOW). */
-    p->plain = !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && !rl_status_is_error(p->status) && !c->hold &&
+    /* the acceleration limit's steps per cycle, accelMax * T * T */
+    p->accelLimited = isgreater(c->accelMax.value, 0) && !rl_status_is_error(p->status);
+    const double decelMax = isgreater(c->decelMax.value, 0) ? c->decelMax.value : c->accelMax.value;
+    p->accelStep = p->accelLimited ? cycle_square(c->accelMax.value, c, period) : 0.0;
+    p->decelStep = p->accelLimited ? cycle_square(decelMax, c, period) : 0.0;
+    p->plain = !p->accelLimited && !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && !rl_status_is_error(p->status) && !c->hold &&
                p->yLow == -INFINITY && p->yHigh == INFINITY && p->maxUpNeg == p->maxUp &&
                p->maxDownNeg == p->maxDown && rl_steady_limit(p->maxUp) && rl_steady_limit(p->maxDown);
     p->durationLimited = isgreater(c->duration.value, 0);
@@ -131,6 +152,8 @@ void rl_init(RlState *s, const RlPrepared *p, double u) {
     }
     s->y = y;
     s->yPrevious = y;
+    s->yBefore = y;
+    s->periodLast = s->periodBefore = 0.0;
     s->decided = RL_DECIDED_NOTHING;
     s->uPrevious = u;
     s->runCycles = 0;
@@ -159,6 +182,7 @@ void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
     } else if (c->hold) {
         /* rule 5b: y and runningTime as they are */
         s->decided = RL_DECIDED_HOLD;
+        rl_shift(s, p->period);
         s->yPrevious = s->y;
         s->uPrevious = u;
         return;
@@ -167,6 +191,7 @@ void rl_cycle_rules(RlState *s, const RlPrepared *p, double u, double elapsed) {
         return;
     }
     s->decided = RL_DECIDED_OTHER;
+    rl_shift(s, p->period);
     s->yPrevious = s->y;
     s->y = y;
     s->uPrevious = u;
@@ -206,6 +231,7 @@ const char *rl_status_text(int status) {
     case RL_STATUS_RATE_PERIOD: return "ratePeriod is negative or not finite";
     case RL_STATUS_DURATION: return "duration is negative, or NaN after falling back to its parameter";
     case RL_STATUS_LIMITS: return "yMin is above yMax";
+    case RL_STATUS_ACCELERATION: return "accelMax or decelMax is negative or not finite";
     case RL_STATUS_NO_CYCLE: return "no valid cycle configured";
     default: return "unknown status";
     }
@@ -250,6 +276,25 @@ static double remaining_time(const RlState *s, const RlPrepared *p, double y, do
     return total;
 }
 
+/* With the acceleration limit the time to uc is the block's own plan: its
+ * cycles run ahead on a copy at constant inputs, counted (rules.md). A
+ * plan that does not arrive within RL_PLAN_CYCLES, or stalls (a step that
+ * does not move the output from rest), gives +inf. */
+#define RL_PLAN_CYCLES 67108864.0 /* 2^26 */
+static double planned_time(const RlState *s, const RlPrepared *p, double uc) {
+    RlState ahead = *s;
+    ahead.decided = s->decided == RL_DECIDED_HOLD ? RL_DECIDED_OTHER : s->decided; /* hold stops the output */
+    double cycles = 0;
+    while (ahead.y != uc && cycles < RL_PLAN_CYCLES) {
+        const double before = ahead.y;
+        const bool atRest = ahead.decided != RL_DECIDED_RAMP || ahead.y == ahead.yPrevious;
+        rl_ramp(&ahead, p, s->uPrevious);
+        cycles += 1;
+        if (atRest && ahead.y == before) return INFINITY;
+    }
+    return ahead.y == uc ? rl_product(cycles, p->period) : INFINITY;
+}
+
 void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
     const double y = s->y, yp = s->yPrevious;
     const double uc = rl_target(s->uPrevious, p);
@@ -259,13 +304,23 @@ void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
     const bool real = p->config.real;
     const double maxUp = negative ? p->maxUpNeg : p->maxUp, maxDown = negative ? p->maxDownNeg : p->maxDown;
     o->rampActive = ramped && y != uc;
-    o->limitingUp = ramped && !jumped && (real ? rl_cut_up_real(yp, maxUp, uc) : rl_cut_up_lreal(yp, maxUp, uc));
-    o->limitingDown = ramped && !jumped &&
-                      (real ? rl_cut_down_real(yp, maxDown, uc) : rl_cut_down_lreal(yp, maxDown, uc));
+    if (p->accelLimited) {
+        /* the step is at the velocity limit, short of uc */
+        o->limitingUp = ramped && !jumped && isless(y, uc) &&
+                        (real ? rl_at_limit_real(yp, maxUp, y) : rl_at_limit_lreal(yp, maxUp, y));
+        o->limitingDown = ramped && !jumped && isgreater(y, uc) &&
+                          (real ? rl_at_limit_real(yp, -maxDown, y) : rl_at_limit_lreal(yp, -maxDown, y));
+    } else {
+        o->limitingUp = ramped && !jumped && (real ? rl_cut_up_real(yp, maxUp, uc) : rl_cut_up_lreal(yp, maxUp, uc));
+        o->limitingDown = ramped && !jumped &&
+                          (real ? rl_cut_down_real(yp, maxDown, uc) : rl_cut_down_lreal(yp, maxDown, uc));
+    }
     o->highLimit = isfinite(y) && isgreaterequal(y, p->yHigh);
     o->lowLimit = isfinite(y) && islessequal(y, p->yLow);
     o->dydt = s->decided != RL_DECIDED_NOTHING && isfinite(y) && isfinite(yp)
                   ? (real ? rl_dydt_real(y, yp, p->period) : rl_dydt_lreal(y, yp, p->period)) : 0.0;
-    o->remainingTime = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc)
-                           ? remaining_time(s, p, y, uc) : 0.0;
+    const bool remains = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc);
+    o->remainingTime = !remains ? 0.0 : p->accelLimited ? planned_time(s, p, uc) : remaining_time(s, p, y, uc);
+    o->d2ydt2 = !ramped || !isfinite(o->dydt) ? 0.0
+                : real ? rl_d2ydt2_real(o->dydt, s, p->period) : rl_d2ydt2_lreal(o->dydt, s, p->period);
 }

@@ -6,6 +6,7 @@
 #include <float.h>
 #include <math.h>
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 /* Compiler hints, portable: GCC and clang read them, any other compiler
@@ -57,6 +58,7 @@ enum {
     RL_STATUS_RATE_PERIOD       = 0x8202,
     RL_STATUS_DURATION          = 0x8203,
     RL_STATUS_LIMITS            = 0x8204,
+    RL_STATUS_ACCELERATION      = 0x8205,
     RL_STATUS_NO_CYCLE          = 0x8601
 };
 
@@ -96,6 +98,8 @@ typedef struct {
     RlValue rateUpNeg, rateDownNeg; /* the same while the output is < 0 */
     RlValue yMax, yMin;        /* output limits; NaN: none */
     bool hold;                 /* rule 5b: freeze the output */
+    RlValue accelMax, decelMax; /* units/s^2; accelMax 0: no acceleration
+                                  limit; decelMax 0: braking at accelMax */
     RlValue ratePeriod;        /* s; 0 = change per cycle */
     RlValue duration;          /* s; 0 = never jump */
     RlValue cycleTime;         /* s; only validated here */
@@ -135,6 +139,12 @@ typedef struct {
                                   same limits whatever the output's sign
                                   (rl_prepare says when) */
     bool durationLimited;      /* duration > 0 */
+    /* rules.md, Acceleration limit: accelMax > 0 and no error; then the
+     * largest change of the step per cycle while it grows (accelStep =
+     * accelMax * T * T) and while it shrinks (decelStep), in the
+     * arithmetic's values */
+    bool accelLimited;
+    double accelStep, decelStep;
 } RlPrepared;
 
 /* The block's memory between cycles. runningTime is counted in whole cycles
@@ -148,6 +158,10 @@ typedef struct {
     uint64_t runCycles;
     double runPeriod;
     double runBase;
+    /* the cycle before the last (d2ydt2, and the acceleration limit's
+     * velocity): y before it, and the lengths of both cycles */
+    double yBefore;
+    double periodLast, periodBefore;
 } RlState;
 
 /* An error status: the block holds its output (rule 5). */
@@ -184,6 +198,14 @@ static inline void rl_period_changed(RlState *s, double period) {
     s->runBase += (double)s->runCycles * s->runPeriod;
     s->runCycles = 0;
     s->runPeriod = period;
+}
+
+/* A cycle of length period sets y: y before the last cycle and the
+ * lengths of the last two cycles move one back. */
+static inline void rl_shift(RlState *s, double period) {
+    s->yBefore = s->yPrevious;
+    s->periodBefore = s->periodLast;
+    s->periodLast = period;
 }
 
 /* runningTime counts in cycles of period from now on. rl_ramp does this
@@ -264,6 +286,12 @@ static inline double rl_sum(double a, double b) {
     return isgreaterequal(fabs(half), 8.98846567431158e307 /* 2^1023 */) ? copysign(INFINITY, half) : a + b;
 }
 
+/* x rounded to the arithmetic of a value of that size: binary32 for a
+ * float, as it is for a double */
+static inline double rl_binary32_or_not(double x, size_t size) {
+    return size == sizeof(float) ? (double)rl_binary32(x) : x;
+}
+
 /* The same in binary32: a float operation done in binary64 and rounded to
  * binary32 once gives the binary32 result (53 >= 2 * 24 + 2 bits). */
 static inline float rl_sum_real(float a, float b) {
@@ -281,6 +309,37 @@ static inline float rl_quotient_real(float a, float b) {
 #define rl_sum_lreal rl_sum
 #define rl_product_lreal rl_product
 #define rl_quotient_lreal rl_quotient
+
+/* Error-free transformations (binary64, round to nearest, no fused
+ * operations but fma's own): a + b = sum + error and a * b = product +
+ * error exactly, for results that neither overflow nor underflow. They let
+ * the acceleration limit decide feasibility exactly (rules.md). */
+static inline double rl_two_sum(double a, double b, double *error) {
+    const double sum = a + b, bb = sum - a;
+    *error = (a - (sum - bb)) + (b - bb);
+    return sum;
+}
+
+static inline double rl_two_product(double a, double b, double *error) {
+    const double product = a * b;
+    *error = fma(a, b, -product);
+    return product;
+}
+
+/* Whether braking at b per cycle from a step s stops within the distance
+ * e, exactly: s + sum over j >= 1 of max(0, s - j * b) <= e, for s, b > 0
+ * and e >= 0 finite and below 2^1000, with n = floor(s / b) < 2^26 terms,
+ * so that n * (n + 1) / 2 is exact: (n + 1) * s - b * n * (n + 1) / 2 - e,
+ * its sign taken from the exact terms. */
+static inline bool rl_stops_within(double s, double b, double e) {
+    double n = floor(s / b);
+    if (fma(n, b, -s) > 0) n -= 1;        /* n * b <= s < (n + 1) * b */
+    else if (fma(n + 1, b, -s) <= 0) n += 1;
+    double pe, qe, e1, e2;
+    const double p = rl_two_product(n + 1, s, &pe), q = rl_two_product(b, n * (n + 1) / 2, &qe);
+    const double s1 = rl_two_sum(p, -q, &e1), s2 = rl_two_sum(s1, -e, &e2);
+    return s2 + (((e1 + e2) + pe) - qe) <= 0;
+}
 
 /* The steady paths (the FMUs' common step, rl_run's held cycles, both
  * plain: rl_prepare) add and subtract unchecked: u, y and the per-cycle
@@ -306,12 +365,20 @@ static inline bool rl_steady_limit(double limit) {
 #define RL_ENTER(x) (x)
 #define RL_MAX_UP(p) ((p)->maxUp)
 #define RL_MAX_DOWN(p) ((p)->maxDown)
+#define RL_NUM_MAX DBL_MAX
+#define RL_MANT_DIG DBL_MANT_DIG
+#define RL_MIN_EXP DBL_MIN_EXP
+#define RL_NEXT_TOWARDS(x, y) nextafter(x, y)
 #include "rate_limiter_rules.h"
 #define RL_NUM float
 #define RL_SUFFIX _real
 #define RL_ENTER(x) rl_binary32(x)
 #define RL_MAX_UP(p) ((p)->maxUpReal)
 #define RL_MAX_DOWN(p) ((p)->maxDownReal)
+#define RL_NUM_MAX FLT_MAX
+#define RL_MANT_DIG FLT_MANT_DIG
+#define RL_MIN_EXP FLT_MIN_EXP
+#define RL_NEXT_TOWARDS(x, y) nextafterf(x, y)
 #include "rate_limiter_rules.h"
 
 /* A value as it enters the block's arithmetic: u, every cycle. */
@@ -374,6 +441,7 @@ typedef struct {
     bool highLimit, lowLimit;  /* y finite and at or beyond yMax / yMin */
     double dydt;               /* (y - yp) / T; 0 if either is not finite */
     double remainingTime;      /* s the ramp still needs to reach uc */
+    double d2ydt2;             /* (dydt - dydt of the cycle before) / T */
 } RlOutputs;
 
 RL_LINKAGE void rl_outputs(const RlState *state, const RlPrepared *prepared, RlOutputs *outputs);

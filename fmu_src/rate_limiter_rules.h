@@ -57,6 +57,200 @@ static inline double RL_NAME(rl_step_down)(double y, RL_NUM target, double maxDo
     return (double)(limited > target ? limited : target);
 }
 
+/* ---- The acceleration limit (rules.md, Acceleration limit) ----------------
+ * Distances and steps per cycle, in the arithmetic; b > 0 is the largest
+ * decrease of the step per cycle (decelStep), a the largest increase. */
+
+/* The unit roundoff of the arithmetic and one unit in the last place of x
+ * (finite): the allowances of the rules' rounding. */
+#define RL_ROUNDOFF ((RL_NUM)ldexp(1.0, -RL_MANT_DIG))
+static inline RL_NUM RL_NAME(rl_ulp)(RL_NUM x) {
+    int e = RL_MIN_EXP;
+    if (x != 0) (void)frexp((double)x, &e);
+    return (RL_NUM)ldexp(1.0, (e > RL_MIN_EXP ? e : RL_MIN_EXP) - RL_MANT_DIG);
+}
+
+static inline RL_NUM RL_NAME(rl_min)(RL_NUM x, RL_NUM y) {
+    return isless(y, x) ? y : x;
+}
+
+/* Beyond this many cycles of braking the counts below are not whole
+ * numbers in the arithmetic: the continuous form stands in. */
+#define RL_BRAKING_COUNTED ((RL_NUM)ldexp(1.0, RL_MANT_DIG / 2))
+
+/* b * n * (n + 1) / 2, the distance of n braking steps after b, 2b, ...: quiet */
+static inline RL_NUM RL_NAME(rl_triangle)(RL_NUM b, RL_NUM n) {
+    return RL_NAME(rl_product)(RL_NAME(rl_product)(b, n), n + 1) / 2;
+}
+
+/* The distance braking needs from a step s >= 0: the steps s - j*b,
+ * j = 1, 2, ..., while positive; n = floor(s / b) of them:
+ * n * (s - b * (n + 1) / 2). */
+static inline RL_NUM RL_NAME(rl_braking_distance)(RL_NUM s, RL_NUM b) {
+    if (!isgreater(s, b)) return 0;
+    if (isinf(s)) return s;
+    const RL_NUM n = (RL_NUM)floor((double)RL_NAME(rl_quotient)(s, b));
+    return RL_NAME(rl_product)(n, RL_NAME(rl_sum)(s, -(RL_NAME(rl_product)(b, n + 1) / 2)));
+}
+
+/* The largest step s after which braking stops within the distance e >= 0
+ * (finite): s + rl_braking_distance(s, b) = e. With n braking steps after
+ * it, b * n * (n + 1) / 2 <= e < b * (n + 1) * (n + 2) / 2, and
+ * s = e / (n + 1) + b / 2 * n. */
+static inline RL_NUM RL_NAME(rl_stoppable_step)(RL_NUM e, RL_NUM b) {
+    if (isinf(b)) return e;
+    const RL_NUM q = RL_NAME(rl_quotient)(e, b);
+    if (!isless(q, RL_BRAKING_COUNTED * RL_BRAKING_COUNTED)) {
+        /* s * s / (2 * b) = e, less b for the cycles' head start */
+        const RL_NUM root = RL_NAME(rl_product)((RL_NUM)sqrt(2.0 * (double)b), (RL_NUM)sqrt((double)e));
+        const RL_NUM s = RL_NAME(rl_sum)(root, -b);
+        return isgreater(s, 0) ? s : 0;
+    }
+    RL_NUM n = (RL_NUM)floor((sqrt(8 * (double)q + 1) - 1) / 2);
+    if (isgreater(RL_NAME(rl_triangle)(b, n), e)) {
+        n = n - 1;
+    } else if (islessequal(RL_NAME(rl_triangle)(b, n + 1), e)) {
+        n = n + 1;
+    }
+    return RL_NAME(rl_sum)(e / (n + 1), RL_NAME(rl_product)(b / 2, n));
+}
+
+/* The largest step s from a position z >= 0 before a zone boundary after
+ * which braking brings the step down to v (the new zone's velocity limit)
+ * before the boundary: the K steps above v (K = ceil((s - v) / b)) all
+ * start before it, (K - 1) * s - b * (K - 1) * (K - 2) / 2 <= z. */
+static inline RL_NUM RL_NAME(rl_zone_reach)(RL_NUM k, RL_NUM v, RL_NUM b) {
+    /* how far K steps above v take the output: (K - 1) * v + b * K * (K - 1) / 2 */
+    return RL_NAME(rl_sum)(RL_NAME(rl_product)(k - 1, v), RL_NAME(rl_triangle)(b, k - 1));
+}
+
+static inline RL_NUM RL_NAME(rl_zone_step)(RL_NUM z, RL_NUM v, RL_NUM b) {
+    if (isinf(b) || isinf(v)) return (RL_NUM)INFINITY;
+    const RL_NUM q = RL_NAME(rl_quotient)(z, b), w = RL_NAME(rl_quotient)(v, b);
+    if (!isless(q, RL_BRAKING_COUNTED * RL_BRAKING_COUNTED) || !isless(w, RL_BRAKING_COUNTED)) {
+        /* s * s = v * v + 2 * b * z, less b; in binary64, quiet */
+        const double s2 = rl_sum(rl_product((double)v, (double)v), rl_product(2.0 * (double)b, (double)z));
+        const RL_NUM s = RL_NAME(rl_sum)((RL_NUM)rl_binary32_or_not(sqrt(s2), sizeof(RL_NUM)), -b);
+        return isgreater(s, v) ? s : v;
+    }
+    /* the largest K >= 1 with (K - 1) * w + K * (K - 1) / 2 <= q */
+    RL_NUM k = (RL_NUM)floor(((1 - 2 * (double)w) + sqrt((2 * (double)w - 1) * (2 * (double)w - 1) +
+                                                          8 * ((double)w + (double)q))) / 2);
+    if (k < 1) k = 1;
+    if (k > 1 && isgreater(RL_NAME(rl_zone_reach)(k, v, b), z)) {
+        k = k - 1;
+    } else if (islessequal(RL_NAME(rl_zone_reach)(k + 1, v, b), z)) {
+        k = k + 1;
+    }
+    if (k <= 1) return RL_NAME(rl_sum)(v, b);
+    return RL_NAME(rl_min)(RL_NAME(rl_sum)(v, RL_NAME(rl_product)(k, b)),
+                           RL_NAME(rl_sum)(z / (k - 1), RL_NAME(rl_product)(b / 2, k - 2)));
+}
+
+/* rl_stops_within in the arithmetic: exact where its bounds hold, else
+ * the sum itself, rounded */
+static inline bool RL_NAME(rl_stops_within)(RL_NUM s, RL_NUM b, RL_NUM e) {
+    if (!isgreater(s, b)) return islessequal(s, e);
+    if (isinf(b)) return islessequal(s, e);
+    const double big = 1e300; /* below 2^1000 */
+    if (isless((double)s, big) && isless((double)e, big) && isgreater((double)b, 1e-290) &&
+        isless((double)RL_NAME(rl_quotient)(s, b), 67108864.0 /* 2^26 */)) {
+        return rl_stops_within((double)s, (double)b, (double)e);
+    }
+    return islessequal(RL_NAME(rl_sum)(s, RL_NAME(rl_braking_distance)(s, b)), e);
+}
+
+/* y + delta in the arithmetic, but never past the exact sum: rounded
+ * towards y where rounding to nearest went beyond it (a position or a step
+ * further than planned would not stop in time). */
+static inline RL_NUM RL_NAME(rl_advance)(RL_NUM y, RL_NUM delta) {
+    if (!(isless(fabs((double)y), 1e300) && isless(fabs((double)delta), 1e300))) {
+        return RL_NAME(rl_sum)(y, delta);
+    }
+    double error;
+    const double exact = rl_two_sum((double)y, (double)delta, &error); /* + error */
+    const RL_NUM next = (RL_NUM)rl_binary32_or_not(exact, sizeof(RL_NUM)); /* y + delta, rounded once */
+    const double beyond = ((double)next - exact) - error;
+    if (isgreater(delta, 0) ? isgreater(beyond, 0) : isless(beyond, 0)) {
+        return RL_NEXT_TOWARDS(next, y);
+    }
+    return next;
+}
+
+/* One cycle of rule 6 with the acceleration limit: the output y (finite)
+ * moves towards the target uc (finite); previous is the last cycle's step
+ * scaled to this cycle's length (0 from rest). The step is the largest the
+ * bounds allow after which braking still stops at uc and slows to the
+ * velocity limit of the zone beyond 0 before reaching it; it lands on uc
+ * itself when within the rounding of it, and is otherwise rounded towards
+ * y, so that rounding never takes the output further than planned. */
+static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous, const RlPrepared *p) {
+    const RL_NUM a = (RL_NUM)p->accelStep, b = (RL_NUM)p->decelStep;
+    const RL_NUM e = RL_NAME(rl_sum)(uc, -y);
+    /* towards the target; at the target, the way the output moves */
+    const bool up = isgreater(e, 0) || (e == 0 && isgreater(previous, 0));
+    RL_NUM distance = up ? e : -e;
+    if (isinf(distance)) distance = RL_NUM_MAX; /* the way is longer than the largest value */
+    const RL_NUM moving = up ? previous : -previous;
+    const bool negative = isless(y, 0);
+    const RL_NUM limit = (RL_NUM)(up ? (negative ? p->maxUpNeg : p->maxUp) : (negative ? p->maxDownNeg : p->maxDown));
+    RL_NUM step;
+    if (isless(moving, 0) && isgreater(-moving, b)) {
+        step = RL_NAME(rl_sum)(moving, b); /* still moving away: brake */
+    } else {
+        /* the fastest the bounds allow: accelerate, or turn within the cycle */
+        RL_NUM fastest = !isless(moving, 0) ? RL_NAME(rl_sum)(moving, a)
+                         : isinf(b)        ? a
+                                           : RL_NAME(rl_product)(a, RL_NAME(rl_quotient)(RL_NAME(rl_sum)(b, moving), b));
+        fastest = RL_NAME(rl_min)(fastest, limit);
+        /* a slower zone ahead, before the target: slow down in time */
+        const bool zoneAhead = up ? negative && !isless(uc, 0) : !negative && isless(uc, 0);
+        if (zoneAhead) {
+            const RL_NUM zoneLimit = (RL_NUM)(up ? p->maxUp : p->maxDownNeg);
+            RL_NUM z = negative ? -y : y;
+            z = RL_NAME(rl_sum)(z, -(RL_NAME(rl_product)(z, 8 * RL_ROUNDOFF) + (up ? 2 * RL_NAME(rl_ulp)(z) : 0)));
+            if (isless(zoneLimit, fastest)) {
+                fastest = isless(z, 0) ? zoneLimit : RL_NAME(rl_min)(fastest, RL_NAME(rl_zone_step)(z, zoneLimit, b));
+            }
+        }
+        /* the target: stop at or before it, decided exactly */
+        if (!RL_NAME(rl_stops_within)(fastest, b, distance)) {
+            RL_NUM stoppable = RL_NAME(rl_stoppable_step)(distance, b);
+            for (int i = 0; i < 8 && isgreater(stoppable, 0) && !RL_NAME(rl_stops_within)(stoppable, b, distance); i++) {
+                stoppable = RL_NEXT_TOWARDS(stoppable, 0); /* the step's rounding, taken back */
+            }
+            fastest = RL_NAME(rl_min)(fastest, stoppable);
+        }
+        /* braking harder than b is not allowed: a target too close is passed */
+        if (isgreater(moving, b)) {
+            const RL_NUM braked = RL_NAME(rl_advance)(moving, -b);
+            step = isless(fastest, braked) ? braked : fastest;
+        } else {
+            step = fastest;
+        }
+    }
+    const RL_NUM scale = isgreater(fabs((double)uc), fabs((double)y)) ? uc : y;
+    const RL_NUM arrival = 4 * RL_NAME(rl_ulp)(scale);
+    if (islessequal(fabs((double)RL_NAME(rl_sum)(step, -distance)), (double)arrival)) {
+        return uc;
+    }
+    return RL_NAME(rl_advance)(y, up ? step : -step);
+}
+
+/* The step of the last cycle, as the acceleration limit's velocity at this
+ * cycle's length: 0 after a cycle that did not ramp or jumped. */
+static inline RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
+    if (s->decided != RL_DECIDED_RAMP || (p->durationLimited && rl_running_time(s) >= p->durationReached) ||
+        !isfinite(s->y) || !isfinite(s->yPrevious)) {
+        return 0;
+    }
+    const RL_NUM step = RL_NAME(rl_sum)((RL_NUM)s->y, -(RL_NUM)s->yPrevious);
+    if (s->periodLast == p->period || !isgreater(s->periodLast, 0)) {
+        return step;
+    }
+    return RL_NAME(rl_product)(step, RL_NAME(rl_quotient)(RL_ENTER(p->period), RL_ENTER(s->periodLast)));
+}
+
 /* Rule 6: ramp towards uc at the limits picked by the output's sign, or
  * jump to uc once the duration has run out. u has entered the block's
  * arithmetic (rl_input). */
@@ -65,6 +259,7 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
     const RL_NUM yp = (RL_NUM)ypHeld;
     const bool negative = isless(yp, 0);
     const RL_NUM target = (RL_NUM)rl_target(u, p);
+    const RL_NUM previous = p->accelLimited ? RL_NAME(rl_previous_step)(s, p) : 0;
     RL_NUM y = yp;
     /* a u equal to uPrevious (a zero of the other sign included: nothing
      * tells them apart) is not stored, so that a held u costs no store */
@@ -79,11 +274,14 @@ static inline void RL_NAME(rl_ramp_cycle)(RlState *s, const RlPrepared *p, doubl
     }
     if (p->durationLimited && rl_running_time(s) >= p->durationReached) { /* both finite */
         y = target;
+    } else if (p->accelLimited) {
+        y = RL_NAME(rl_accel_step)(y, target, previous, p);
     } else {
         y = RL_NAME(rl_step_towards)(y, target, negative ? (RL_NUM)p->maxUpNeg : RL_MAX_UP(p),
                                      negative ? (RL_NUM)p->maxDownNeg : RL_MAX_DOWN(p), false);
     }
     s->decided = RL_DECIDED_RAMP;
+    rl_shift(s, p->period);
     s->yPrevious = ypHeld;
     s->y = (double)y;
 }
@@ -118,6 +316,7 @@ static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, doub
         y = u;
     }
     s->y = y;
+    s->yBefore = s->yPrevious; /* both cycles of p->period (fmu_step_fast) */
     s->yPrevious = yp;
     return true;
 }
@@ -126,11 +325,12 @@ static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, doub
  * without its resets; once y reaches u nothing changes any more. */
 static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, double uHeld, uint64_t first, uint64_t last) {
     const RL_NUM u = (RL_NUM)uHeld, maxUp = RL_MAX_UP(p), maxDown = RL_MAX_DOWN(p);
-    RL_NUM y = (RL_NUM)s->y, yp = (RL_NUM)s->yPrevious;
+    RL_NUM y = (RL_NUM)s->y, yp = (RL_NUM)s->yPrevious, ypp = (RL_NUM)s->yBefore;
     uint64_t cycles = s->runCycles;
     uint64_t n = first + 1;
     for (; n <= last && y != u; n++) {
         cycles++;
+        ypp = yp;
         yp = y;
         if (p->durationLimited && s->runBase + (double)cycles * s->runPeriod >= p->durationReached) {
             y = u;
@@ -138,11 +338,14 @@ static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, doubl
             y = RL_NAME(rl_step_towards)(y, u, maxUp, maxDown, true);
         }
     }
-    if (n <= last) {
-        yp = y; /* cycles that found y at u */
+    if (n <= last) { /* cycles that found y at u */
+        ypp = n < last ? y : yp;
+        yp = y;
     }
     s->y = (double)y;
     s->yPrevious = (double)yp;
+    s->yBefore = (double)ypp;
+    s->periodBefore = s->periodLast; /* the first cycle's, p->period */
     s->runCycles = cycles;
 }
 
@@ -150,6 +353,22 @@ static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, doubl
  * step's limit cut it (yp + maxUp < uc, yp - maxDown > uc). */
 static inline double RL_NAME(rl_dydt)(double y, double yp, double period) {
     return (double)RL_NAME(rl_quotient)(RL_NAME(rl_sum)((RL_NUM)y, -(RL_NUM)yp), RL_ENTER(period));
+}
+
+/* d2ydt2 = (dydt - dydt of the cycle before) / T; that dydt is
+ * (yPrevious - yBefore) / periodBefore, 0 where it did not move. */
+static inline double RL_NAME(rl_d2ydt2)(double dydt, const RlState *s, double period) {
+    const RL_NUM moved = RL_NAME(rl_sum)((RL_NUM)s->yPrevious, -(RL_NUM)s->yBefore);
+    const RL_NUM before = moved == 0 ? 0 : RL_NAME(rl_quotient)(moved, RL_ENTER(s->periodBefore));
+    if (!isfinite(before)) return 0.0;
+    const RL_NUM change = RL_NAME(rl_sum)((RL_NUM)dydt, -before);
+    return isfinite(change) ? (double)RL_NAME(rl_quotient)(change, RL_ENTER(period)) : 0.0;
+}
+
+/* the step from yp reached the (signed) limit: yp + limit is at or past y */
+static inline bool RL_NAME(rl_at_limit)(double yp, double limit, double y) {
+    const RL_NUM reached = RL_NAME(rl_sum)((RL_NUM)yp, (RL_NUM)limit);
+    return isless(limit, 0) ? isgreaterequal(reached, (RL_NUM)y) : islessequal(reached, (RL_NUM)y);
 }
 
 static inline bool RL_NAME(rl_cut_up)(double yp, double maxUp, double uc) {
@@ -168,3 +387,9 @@ static inline bool RL_NAME(rl_cut_down)(double yp, double maxDown, double uc) {
 #undef RL_ENTER
 #undef RL_MAX_UP
 #undef RL_MAX_DOWN
+#undef RL_NUM_MAX
+#undef RL_MANT_DIG
+#undef RL_MIN_EXP
+#undef RL_NEXT_TOWARDS
+#undef RL_ROUNDOFF
+#undef RL_BRAKING_COUNTED

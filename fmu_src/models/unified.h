@@ -8,8 +8,9 @@
 
 /* The value references of those variables in the model. */
 typedef struct {
-    unsigned hold, ratePeriod, cycleTime, bypass, zeroRate, initMode, initValue, initDelay, arithmetic;
-    unsigned y, rampActive, runningTime, dydt, limitingUp, limitingDown, highLimit, lowLimit, remainingTime;
+    unsigned hold, ratePeriod, cycleTime, bypass, zeroRate, initMode, initValue, initDelay, arithmetic, accelMax,
+        decelMax;
+    unsigned y, rampActive, runningTime, dydt, limitingUp, limitingDown, highLimit, lowLimit, remainingTime, d2ydt2;
 } UnifiedVariables;
 
 static inline RlValue unified_value(const double *v, unsigned vr) {
@@ -30,6 +31,8 @@ static inline void unified_configure(const UnifiedVariables *vr, const double *v
     c->passNonFinite = true;
     c->limitInitialOutput = true;
     c->real = (int)v[vr->arithmetic] == RL_ARITHMETIC_REAL;
+    c->accelMax = unified_value(v, vr->accelMax);
+    c->decelMax = unified_value(v, vr->decelMax);
 }
 
 static inline void unified_publish(const UnifiedVariables *vr, const RlState *block, const RlPrepared *prepared,
@@ -45,13 +48,14 @@ static inline void unified_publish(const UnifiedVariables *vr, const RlState *bl
     v[vr->highLimit] = o.highLimit;
     v[vr->lowLimit] = o.lowLimit;
     v[vr->remainingTime] = o.remainingTime;
+    v[vr->d2ydt2] = o.d2ydt2;
 }
 
 /* The table of a unified block's variables, from its generated header */
 #define UNIFIED_VARIABLES                                                                                         \
     { VR_hold, VR_ratePeriod, VR_cycleTime, VR_bypass, VR_zeroRate, VR_initMode, VR_initValue, VR_initDelay,       \
-      VR_arithmetic, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp, VR_limitingDown, VR_highLimit, \
-      VR_lowLimit, VR_remainingTime }
+      VR_arithmetic, VR_accelMax, VR_decelMax, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp,       \
+      VR_limitingDown, VR_highLimit, VR_lowLimit, VR_remainingTime, VR_d2ydt2 }
 
 /* The mapping of a unified block and its fmuModel (u in, y out):
  * resolve(v, c) sets rateUp, rateDown, yMax, yMin, duration and bypassValue
