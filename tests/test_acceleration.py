@@ -20,7 +20,7 @@ More scenarios than CI runs: `python -m support.accel_campaign` (from tests/).
 import math
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from support.accel_properties import LREAL, REAL
@@ -30,6 +30,10 @@ from support.oracle import oracle_for, output_names
 
 MODELS = ["RateLimiter", "RateLimiterStatic"]
 CI_CYCLES = (20, 80)
+# no shrinking: a failure prints its whole scenario (replayed by support.accel_campaign --replay), and shrinking
+# scenarios that run the FMU takes minutes
+NO_SHRINK = [Phase.explicit, Phase.reuse, Phase.generate]
+HEALTH = [HealthCheck.too_slow, HealthCheck.data_too_large]
 
 
 def agree(a, b):
@@ -44,7 +48,7 @@ def report(scenario, found):
 @pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
-@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(max_examples=40, deadline=None, suppress_health_check=HEALTH, phases=NO_SHRINK)
 @given(data=st.data())
 def test_every_property_holds_on_random_scenarios(model, version, arithmetic, data):
     scenario, segments = run_random(HypothesisChooser(data), model, version, arithmetic, cycles=CI_CYCLES)
@@ -55,7 +59,7 @@ def test_every_property_holds_on_random_scenarios(model, version, arithmetic, da
 @pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
-@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(max_examples=20, deadline=None, suppress_health_check=HEALTH, phases=NO_SHRINK)
 @given(data=st.data())
 def test_model_exchange_gives_the_co_simulation_outputs_and_the_properties(model, version, arithmetic, data):
     """The scenario drawn in Co-Simulation with cycleTime = T, replayed as Model Exchange (a time event at
@@ -110,7 +114,7 @@ def run_against_oracle(scenario):
 @pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
-@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(max_examples=30, deadline=None, suppress_health_check=HEALTH, phases=NO_SHRINK)
 @given(data=st.data())
 def test_accel_max_zero_is_the_block_without_the_acceleration_limit(model, version, arithmetic, data):
     """accelMax = 0 (decelMax 0 or not: it brakes only where accelMax limits): the oracle (rules.md) which
