@@ -291,3 +291,20 @@ def test_1_braking_to_a_lowered_limit_ends_when_the_limit_is_raised_again():
     per_cycle = [{}] * 4 + [{"rateUpPar": 1.0}] + [{"rateUpPar": 10.0}] * 2
     ys = [1.0, 3.0, 6.0, 10.0, 13.0, 17.0, 22.0]
     assert check([trace(ys, values, per_cycle=per_cycle)], LREAL, 1.0) == []
+
+
+def test_1_crossing_0_into_a_lower_limit_too_fast_is_flagged():
+    """Below 0 rateDownNeg = 2 per cycle: the output crosses 0 at a speed of 3 and goes on at 2.5."""
+    values = dict(BASE, u=-10.0, rateDownNeg=2.0, decelMax=1.0)
+    ys = [4.0, 2.0, -1.0, -3.5, -5.5]
+    found = check([trace(ys, values, y0=5.0)], LREAL, 1.0)
+    assert {v.prop for v in found} == {"1"} and "sign of y changed at 0" in found[0].text
+
+
+def test_1_crossing_0_after_decel_max_was_lowered_may_brake_down_to_the_limit():
+    """The same crossing right after decelMax was lowered to 0.5: no way left to slow down to 2 in time; braking
+    at the new decelMax down to the limit is allowed."""
+    values = dict(BASE, u=-10.0, rateDownNeg=2.0, decelMax=1.0)
+    per_cycle = [{}, {}, {"decelMax": 0.5}, {"decelMax": 0.5}, {"decelMax": 0.5}]
+    ys = [4.0, 2.0, -1.0, -3.5, -5.5]
+    assert check([trace(ys, values, y0=5.0, per_cycle=per_cycle)], LREAL, 1.0) == []

@@ -308,8 +308,11 @@ class Checker:
     # -- properties 1 and 2, cycle by cycle --------------------------------
     def velocity_and_acceleration(self, index, cycles, settings, ys, steps, prev, ramping):
         braking_to = None  # property 1's exception: the limit a change lowered below the speed
+        changed_at = 0     # the last cycle whose rates, ratePeriod, zeroRate, accelMax or decelMax changed
         for k in range(1, len(cycles) + 1):
             s = settings[k - 1]
+            if k >= 2 and settings[k - 2].key()[1:7] + settings[k - 2].key()[13:15] != s.key()[1:7] + s.key()[13:15]:
+                changed_at = k
             if not ramping[k] or steps[k] is None:
                 braking_to = None
                 continue
@@ -321,8 +324,13 @@ class Checker:
             # 1. velocity
             if p != 0 and ramping[k - 1] and k >= 2:
                 limit = s.limit(p > 0, yp)
-                # the exception: an input or parameter change lowered the limit at this y below the speed
+                # the exception: an input or parameter change lowered the limit at this y below the speed; or
+                # the output crossed 0 into the other rates' lower limit, and a change of the settings within
+                # the braking time before (a lowered decelMax) may have left no way to slow down to it in time
                 changed = settings[k - 2].limit(p > 0, yp) != limit
+                crossed = k >= 3 and (ys[k - 2] < 0) != (yp < 0)
+                if crossed and changed_at and k - changed_at <= abs(p) / s.b() + 2:
+                    changed = True
                 if limit is not None and changed and not self.holds(abs(p), limit, *mags):
                     braking_to = (p > 0, limit)
             if braking_to is not None:
