@@ -308,3 +308,12 @@ def test_1_crossing_0_after_decel_max_was_lowered_may_brake_down_to_the_limit():
     per_cycle = [{}, {}, {"decelMax": 0.5}, {"decelMax": 0.5}, {"decelMax": 0.5}]
     ys = [4.0, 2.0, -1.0, -3.5, -5.5]
     assert check([trace(ys, values, y0=5.0, per_cycle=per_cycle)], LREAL, 1.0) == []
+
+
+def test_1_the_braking_to_a_lowered_limit_is_judged_without_a_far_targets_allowance():
+    """A rate lowered to 1000 per cycle at a speed of 1500 while the target is 2^60 away (8 ulp of it: 2048, more
+    than the excess): braking at decelMax (200) down to the limit is allowed, also after the target came near."""
+    values = dict(BASE, u=2.0 ** 60, rateUpPar=10000.0, rateDownPar=10000.0, accelMax=1000.0, decelMax=200.0)
+    per_cycle = [{}, {}, {"rateUpPar": 1000.0}] + [{"rateUpPar": 1000.0, "u": 10000.0}] * 3
+    ys = [1000.0, 2500.0, 3800.0, 4900.0, 5900.0, 6900.0]
+    assert check([trace(ys, values, per_cycle=per_cycle)], LREAL, 1.0) == []
