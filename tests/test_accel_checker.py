@@ -24,7 +24,7 @@ def trace(ys, values, T=1.0, y0=0.0, per_cycle=None, outputs=None, settle=False,
         yp = ys[k - 1] if k else y0
         dydt = real(real(y - yp) / real(T))
         ramps = not (all_values[k].get("hold") or all_values[k].get("bypass"))
-        d2 = real(real(dydt - dydt_before) / real(T)) if ramps else 0.0
+        d2 = real(real(dydt - dydt_before) / real(T)) if ramps else 0.0  # rule 6: after any cycle
         here = all_values[k]
         uc = min(max(here["u"], here.get("yMinPar", -math.inf)), here.get("yMaxPar", math.inf))
         later = next((j for j in range(k + 1, len(ys)) if ys[j] == uc and all_values[j] == all_values[k]), None)

@@ -200,10 +200,9 @@ def test_a_negative_acceleration_that_rounds_to_minus_zero_in_real_is_no_error(m
 
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("model", MODELS)
-def test_a_duration_jump_is_not_a_ramping_cycle(model, version):
-    """The duration jump sets the output (y = uc) and the velocity to 0, as rules 1 to 5b do: d2ydt2 is 0 after
-    it (the last cycle was not a ramping one), and the next ramp starts from rest (its first step at most
-    accelMax T^2 = 100 * 0.1^2 = 1)."""
+def test_a_duration_jump_stops_the_output(model, version):
+    """The duration jump sets the output (y = uc) and the velocity to 0: the next ramp starts from rest, its
+    first step at most accelMax T^2 = 100 * 0.1^2 = 1."""
     fmu = Instance(model, version, logging=False)
     try:
         fmu.start(u=0.0, rateUpPar=100.0, rateDownPar=100.0, accelMax=100.0, durationPar=0.3)
@@ -211,7 +210,6 @@ def test_a_duration_jump_is_not_a_ramping_cycle(model, version):
         for _ in range(3):
             fmu.step(0.1)
         assert fmu.get("y") == 10.0 and fmu.get("runningTime") >= 0.3 * (1 - 1e-9)  # the jump, at 3 cycles
-        assert fmu.get("d2ydt2") == 0.0
         fmu.set(u=0.0)
         fmu.step(0.1)
         assert 10.0 - 1.0 * (1 + 1e-12) <= fmu.get("y") < 10.0

@@ -273,9 +273,9 @@ class Checker:
         return "6", None
 
     def interface(self, index, seg, settings, ramping, decided):
-        """dydt = (y - yp) / T in the arithmetic; d2ydt2 = (dydt - dydt_previous) / T after two ramping cycles
-        (in REAL binary32, or binary64 with T rounded or not: the contract does not say which), 0 after a cycle
-        that did not ramp, finite always."""
+        """dydt = (y - yp) / T in the arithmetic; d2ydt2 = (dydt - dydt_previous) / T after a cycle that rule 6
+        decided, the duration's jump included (rules.md, Outputs derived from the last cycle; in REAL binary32,
+        or binary64 with T rounded or not), else 0."""
         real, cycles = self.real, seg.cycles
         for k, (c, s) in enumerate(zip(cycles, settings), start=1):
             out, before = c.out, seg.init_out if k == 1 else cycles[k - 2].out
@@ -287,23 +287,25 @@ class Checker:
             if "d2ydt2" not in out:
                 continue
             d2 = out["d2ydt2"]
-            if not ramping[k]:
+            if decided[k] not in ("6", "jump"):
                 if d2 != 0:
                     self.flag("interface", index, k, f"d2ydt2 = {d2!r} after a cycle decided by rule {decided[k]}, "
                               "not 0")
-            elif not finite(d2):
+                continue
+            if not finite(d2):
                 self.flag("interface", index, k, f"d2ydt2 = {d2!r} is not finite")
-            elif k > 1 and ramping[k - 1]:
-                dydt, dydt_prev = out["dydt"], before["dydt"]
-                if finite(dydt) and finite(dydt_prev):
-                    expected = {real(real(dydt - dydt_prev) / s.T), (dydt - dydt_prev) / s.T}
-                else:
-                    expected = {0.0}
-                if finite(dydt) and finite(dydt_prev):  # or binary64 with the binary64 T
-                    expected.add((dydt - dydt_prev) / self.T)
-                if d2 not in expected:
-                    self.flag("interface", index, k, f"d2ydt2 = {d2!r}, (dydt - dydt_previous) / T = "
-                              f"({dydt!r} - {dydt_prev!r}) / T = {sorted(expected)!r}")
+            if k == 1 or decided[k - 1] not in ("6", "jump"):
+                continue  # after initialisation or another rule: the velocity before is 0 or the jump's, unchecked
+            # rules.md: (dydt - dydt') / T, dydt' the dydt of the cycle before
+            dydt, dydt_prev = out["dydt"], before.get("dydt", 0.0)
+            if finite(dydt) and finite(dydt_prev):
+                expected = {real(real(dydt - dydt_prev) / s.T), (dydt - dydt_prev) / s.T, (dydt - dydt_prev) / self.T}
+                expected = {e if finite(e) else 0.0 for e in expected}
+            else:
+                expected = {0.0}
+            if d2 not in expected:
+                self.flag("interface", index, k, f"d2ydt2 = {d2!r}, (dydt - dydt_previous) / T = "
+                          f"({dydt!r} - {dydt_prev!r}) / T = {sorted(expected)!r}")
 
     # -- properties 1 and 2, cycle by cycle --------------------------------
     def velocity_and_acceleration(self, index, cycles, settings, ys, steps, prev, ramping):
