@@ -9,6 +9,7 @@ each cycle compared, and how long each takes to reach its target.
 (tests/support/oracle.py, the rules in single and double precision)
 instead of the FMUs: the same figures, bit for bit, much slower (minutes).
 """
+
 import argparse
 import copy
 import sys
@@ -70,8 +71,19 @@ class OracleRamp:
     def __init__(self, arithmetic, start, target, rate, period):
         sys.path.insert(0, str(REPO / "tests"))
         from support.oracle import RateLimiterOracle
-        self.oracle = RateLimiterOracle({}, {"arithmetic": arithmetic, "cycleTime": CYCLE, "initMode": 1,
-                                             "initValue": start, "u": target, "rateUpPar": rate, "ratePeriod": period})
+
+        self.oracle = RateLimiterOracle(
+            {},
+            {
+                "arithmetic": arithmetic,
+                "cycleTime": CYCLE,
+                "initMode": 1,
+                "initValue": start,
+                "u": target,
+                "rateUpPar": rate,
+                "ratePeriod": period,
+            },
+        )
         self.cycles = 0
 
     def run(self, cycles):
@@ -152,8 +164,8 @@ def main():
         else:  # the largest difference is where one of them ends
             gaps = []
             for at in sorted({real_cycles, lreal_cycles}):
-                a = value_at(lambda: make(True, ramp), real_end, real_cycles, at)
-                b = value_at(lambda: make(False, ramp), lreal_end, lreal_cycles, at)
+                a = value_at(lambda ramp=ramp: make(True, ramp), real_end, real_cycles, at)
+                b = value_at(lambda ramp=ramp: make(False, ramp), lreal_end, lreal_cycles, at)
                 gaps.append((abs(a - b), abs(a - b) / abs(b), at))
             absolute, relative, at = max(gaps)
             gap = f"{absolute:.6g} ({relative:.1%}) at cycle {at:,}"

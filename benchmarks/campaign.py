@@ -18,6 +18,7 @@ loop of fmpy.simulate_fmu calls, and the workers' peak memory.
 Prints the figures and the targets; exit 1 if a figure misses its target
 (not with --smoke: figures on a few steps mean nothing).
 """
+
 import argparse
 import hashlib
 import io
@@ -53,8 +54,9 @@ def case_inputs(seed, steps):
 
 def write_case(args):
     """One case folder with its reference from fmutrace's runner."""
-    from fmutrace.runner import Runner
-    from fmutrace.traces import write_trace
+    from fmutrace._fmpy import Experiment, Signals
+    from fmutrace._runner import Runner
+    from fmutrace._traces import write_trace
 
     folder, seed, steps, fmu = args
     inputs, start = case_inputs(seed, steps)
@@ -64,7 +66,7 @@ def write_case(args):
     stop = round(steps * STEP, 10)
     (folder / f"{MODEL}_ref.opt").write_text(f"StartTime,0\nStopTime,{stop!r}\nStepSize,{STEP!r}\nRelTol,1e-6\n")
     runner = write_case.runners.get(fmu) or write_case.runners.setdefault(fmu, Runner(Path(fmu).read_bytes()))
-    result = runner.run(0.0, stop, STEP, inputs, start, ["y", "status"])
+    result = runner.run(Experiment(0.0, stop, STEP), Signals(inputs, start, ["y", "status"]))
     write_trace(folder / f"{MODEL}_ref.csv", result)
 
 
@@ -95,12 +97,19 @@ def plain_loop(fmu, folders):
     for folder in folders:
         options = read_ref_opt_file(str(folder / f"{MODEL}_ref.opt"))
         inputs = read_csv(str(folder / f"{MODEL}_in.csv"))
-        start = {k: float(v) for k, v in (line.split(",") for line in
-                                          (folder / f"{MODEL}_start.csv").read_text().split())}
+        start = {
+            k: float(v) for k, v in (line.split(",") for line in (folder / f"{MODEL}_start.csv").read_text().split())
+        }
         with contextlib.redirect_stdout(io.StringIO()):
-            result = simulate_fmu(str(fmu), start_time=options["StartTime"], stop_time=options["StopTime"],
-                                  output_interval=options["StepSize"], input=inputs, start_values=start,
-                                  output=["y", "status"])
+            result = simulate_fmu(
+                str(fmu),
+                start_time=options["StartTime"],
+                stop_time=options["StopTime"],
+                output_interval=options["StepSize"],
+                input=inputs,
+                start_values=start,
+                output=["y", "status"],
+            )
         reference = read_csv(str(folder / f"{MODEL}_ref.csv"))
         passed += all(np.array_equal(result[n], reference[n]) for n in ("y", "status"))
     seconds = (time.perf_counter() - started) / len(folders)
@@ -112,8 +121,23 @@ def plain_loop(fmu, folders):
 def command(fmu, root, jobs, report):
     fmutrace = Path(sys.executable).parent / "fmutrace"
     started = time.perf_counter()
-    done = subprocess.run([str(fmutrace), "compare", str(fmu), str(root), "--jobs", str(jobs), "--report",
-                           str(report), "--plots", "failed"], capture_output=True, text=True, timeout=3600)
+    done = subprocess.run(
+        [
+            str(fmutrace),
+            "compare",
+            str(fmu),
+            str(root),
+            "--jobs",
+            str(jobs),
+            "--report",
+            str(report),
+            "--plots",
+            "failed",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=3600,
+    )
     seconds = time.perf_counter() - started
     if done.returncode != 0:
         raise SystemExit(f"fmutrace compare failed ({done.returncode}): {done.stdout[-2000:]} {done.stderr[-2000:]}")
@@ -139,11 +163,18 @@ def worker_peaks(fmu, folders_root, jobs, report):
 
     import dask
 
-    with dask.config.set({"distributed.worker.profile.enabled": False}), \
-            LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
-        campaign = fmutrace.compare(fmu, folders_root, report=report, plots="failed",
-                                    scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=3600)
+    with (
+        dask.config.set({"distributed.worker.profile.enabled": False}),
+        LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
+        campaign = fmutrace.compare(
+            fmu,
+            folders_root,
+            report=report,
+            plots="failed",
+            run=fmutrace.RunOptions(scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=3600),
+        )
         if not campaign.passed:
             raise SystemExit(campaign.summary()[:3000])
         peaks = client.run(peak_megabytes)
@@ -183,7 +214,8 @@ def main():
     ratio = rate / jobs / plain_rate
     lines = [
         f"Campaign benchmark: {len(folders)} cases of {args.steps} steps, {MODEL} FMI 3, {jobs} cores "
-        f"({platform.machine()}, Python {platform.python_version()}){' (SMOKE: figures meaningless)' if args.smoke else ''}",
+        f"({platform.machine()}, Python {platform.python_version()})"
+        f"{' (SMOKE: figures meaningless)' if args.smoke else ''}",
         f"  cases generated in {generated:.1f} s" if generated else "  cases from an earlier run",
         f"  (a) plain fmpy.simulate_fmu loop, 1 process: {plain * 1e3:.1f} ms per trace, {plain_rate:.1f} traces/s "
         f"({len(sample)} traces)",

@@ -14,6 +14,7 @@ report their peak resident memory (VmHWM). Memory is flat when the peaks
 at all the cases are within 10 % (+ 10 MB) of those at a tenth; exit 1 if
 not (not with --smoke).
 """
+
 import argparse
 import json
 import os
@@ -33,23 +34,43 @@ def child(fmu, cases, report, jobs):
     import dask
     from dask.distributed import Client, LocalCluster
     import fmutrace
-    from fmutrace.executors import LOCAL_CLUSTER, SHORT_LOGS
+    from fmutrace._executors import LOCAL_CLUSTER, SHORT_LOGS
 
     started = time.perf_counter()
-    with dask.config.set({**SHORT_LOGS, **LOCAL_CLUSTER}), \
-            LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
-        campaign = fmutrace.compare(fmu, cases, report=report, plots="failed", scheduler=cluster.scheduler_address,
-                                    shared_files=True, cluster_timeout=7200)
+    with (
+        dask.config.set({**SHORT_LOGS, **LOCAL_CLUSTER}),
+        LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
+        campaign = fmutrace.compare(
+            fmu,
+            cases,
+            report=report,
+            plots="failed",
+            run=fmutrace.RunOptions(scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=7200),
+        )
         workers = sorted(client.run(peak_megabytes).values())
         counts = campaign.counts()
-    print(json.dumps({"cases": sum(counts.values()), "passed": counts["pass"], "client": peak_megabytes(),
-                      "workers": workers, "seconds": time.perf_counter() - started}))
+    print(
+        json.dumps(
+            {
+                "cases": sum(counts.values()),
+                "passed": counts["pass"],
+                "client": peak_megabytes(),
+                "workers": workers,
+                "seconds": time.perf_counter() - started,
+            }
+        )
+    )
 
 
 def measure(fmu, cases, report, jobs):
-    done = subprocess.run([sys.executable, __file__, "--child", str(fmu), str(cases), str(report), str(jobs)],
-                          capture_output=True, text=True, timeout=7200)
+    done = subprocess.run(
+        [sys.executable, __file__, "--child", str(fmu), str(cases), str(report), str(jobs)],
+        capture_output=True,
+        text=True,
+        timeout=7200,
+    )
     if done.returncode:
         raise SystemExit(f"the campaign failed ({done.returncode}): {done.stdout[-2000:]} {done.stderr[-2000:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
@@ -79,21 +100,29 @@ def main():
         tenth.mkdir()
         for folder in sorted((root / "cases").iterdir())[: args.cases // 10]:
             (tenth / folder.name).symlink_to(folder)
-    figures = {name: measure(fmu, folder, root / f"report-{name}", jobs)
-               for name, folder in (("tenth", tenth), ("all", root / "cases"))}
-    lines = [f"Campaign memory: {args.cases} cases of {args.steps} steps, {MODEL} FMI 3, {jobs} workers "
-             f"({platform.machine()}, Python {platform.python_version()})"
-             f"{' (SMOKE: figures meaningless)' if args.smoke else ''}",
-             f"  cases generated in {generated:.0f} s" if generated else "  cases from an earlier run"]
-    for name, f in figures.items():
-        lines.append(f"  {f['cases']} cases ({f['passed']} pass) in {f['seconds']:.0f} s: client (with the scheduler) "
-                     f"{f['client']:.0f} MB, workers {', '.join(f'{w:.0f}' for w in f['workers'])} MB")
+    figures = {
+        name: measure(fmu, folder, root / f"report-{name}", jobs)
+        for name, folder in (("tenth", tenth), ("all", root / "cases"))
+    }
+    lines = [
+        f"Campaign memory: {args.cases} cases of {args.steps} steps, {MODEL} FMI 3, {jobs} workers "
+        f"({platform.machine()}, Python {platform.python_version()})"
+        f"{' (SMOKE: figures meaningless)' if args.smoke else ''}",
+        f"  cases generated in {generated:.0f} s" if generated else "  cases from an earlier run",
+    ]
+    for f in figures.values():
+        lines.append(
+            f"  {f['cases']} cases ({f['passed']} pass) in {f['seconds']:.0f} s: client (with the scheduler) "
+            f"{f['client']:.0f} MB, workers {', '.join(f'{w:.0f}' for w in f['workers'])} MB"
+        )
     print("\n".join(lines))
     if args.smoke:
         return 0
     tenth_figures, all_figures = figures["tenth"], figures["all"]
-    flat = all(all_figures[k] <= FLAT_FACTOR * tenth_figures[k] + FLAT_MEGABYTES for k in ("client",)) and \
-        max(all_figures["workers"]) <= FLAT_FACTOR * max(tenth_figures["workers"]) + FLAT_MEGABYTES
+    flat = (
+        all(all_figures[k] <= FLAT_FACTOR * tenth_figures[k] + FLAT_MEGABYTES for k in ("client",))
+        and max(all_figures["workers"]) <= FLAT_FACTOR * max(tenth_figures["workers"]) + FLAT_MEGABYTES
+    )
     if all_figures["passed"] != args.cases or not flat:
         print("MISSED: " + ("not every case passed" if all_figures["passed"] != args.cases else "memory not flat"))
         return 1

@@ -57,7 +57,9 @@ void *realloc(void *pointer, size_t size) {
     return __libc_realloc(pointer, size);
 }
 
-void free(void *pointer) { __libc_free(pointer); }
+void free(void *pointer) {
+    __libc_free(pointer);
+}
 
 static size_t callbackCalls, callbackBytes;
 
@@ -67,7 +69,9 @@ static void *count_allocate(size_t count, size_t size) {
     return __libc_calloc(count, size);
 }
 
-static void count_free(void *pointer) { __libc_free(pointer); }
+static void count_free(void *pointer) {
+    __libc_free(pointer);
+}
 
 static void log2_message(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
                          fmi2String message, ...) {
@@ -125,13 +129,22 @@ static void load(const char *path) {
         exit(2);
     }
     if (F.version == 2) {
-        LOAD(fmi2Instantiate); LOAD(fmi2FreeInstance); LOAD(fmi2SetupExperiment);
-        LOAD(fmi2EnterInitializationMode); LOAD(fmi2ExitInitializationMode);
-        LOAD(fmi2SetReal); LOAD(fmi2GetReal); LOAD(fmi2DoStep);
+        LOAD(fmi2Instantiate);
+        LOAD(fmi2FreeInstance);
+        LOAD(fmi2SetupExperiment);
+        LOAD(fmi2EnterInitializationMode);
+        LOAD(fmi2ExitInitializationMode);
+        LOAD(fmi2SetReal);
+        LOAD(fmi2GetReal);
+        LOAD(fmi2DoStep);
     } else {
-        LOAD(fmi3InstantiateCoSimulation); LOAD(fmi3FreeInstance);
-        LOAD(fmi3EnterInitializationMode); LOAD(fmi3ExitInitializationMode);
-        LOAD(fmi3SetFloat64); LOAD(fmi3GetFloat64); LOAD(fmi3DoStep);
+        LOAD(fmi3InstantiateCoSimulation);
+        LOAD(fmi3FreeInstance);
+        LOAD(fmi3EnterInitializationMode);
+        LOAD(fmi3ExitInitializationMode);
+        LOAD(fmi3SetFloat64);
+        LOAD(fmi3GetFloat64);
+        LOAD(fmi3DoStep);
     }
 }
 
@@ -144,9 +157,9 @@ static void must(int status, const char *what) {
 
 static void *instantiate(void) {
     void *c = F.version == 2
-        ? F.fmi2Instantiate("bench", fmi2CoSimulation, F.token, "", &callbacks, fmi2False, fmi2False)
-        : F.fmi3InstantiateCoSimulation("bench", F.token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
-                                        NULL, log3_message, NULL);
+                  ? F.fmi2Instantiate("bench", fmi2CoSimulation, F.token, "", &callbacks, fmi2False, fmi2False)
+                  : F.fmi3InstantiateCoSimulation("bench", F.token, NULL, fmi3False, fmi3False, fmi3False, fmi3False,
+                                                  NULL, 0, NULL, log3_message, NULL);
     if (!c) {
         fprintf(stderr, "fmu_bench: instantiation failed\n");
         exit(1);
@@ -177,12 +190,15 @@ static void start(void *c, double cycleTime) {
 }
 
 static void release(void *c) {
-    if (F.version == 2) F.fmi2FreeInstance(c); else F.fmi3FreeInstance(c);
+    if (F.version == 2) F.fmi2FreeInstance(c);
+    else F.fmi3FreeInstance(c);
 }
 
 /* The input: a square wave of +-1000 every 4096 steps, so that the output
  * ramps (rule 6 with its limits) on every step. */
-static double input(uint64_t i) { return (i & 4096) ? -1000.0 : 1000.0; }
+static double input(uint64_t i) {
+    return (i & 4096) ? -1000.0 : 1000.0;
+}
 
 #define H 0.001
 
@@ -278,7 +294,8 @@ static double loop_fmu(uint64_t steps, double cycleTime, int setAndGet, const ch
             u = input(i);
             if (setAndGet) setFloat64(c, &uVr, 1, &u, 1);
             if (doStep(c, (double)i * H, H, fmi3True, &eventHandlingNeeded, &terminateSimulation, &earlyReturn,
-                       &lastSuccessfulTime) != fmi3OK) exit(1);
+                       &lastSuccessfulTime) != fmi3OK)
+                exit(1);
             if (setAndGet) getFloat64(c, &yVr, 1, &y, 1);
             *(volatile double *)&sink = y;
         }
@@ -289,10 +306,59 @@ static double loop_fmu(uint64_t steps, double cycleTime, int setAndGet, const ch
     return t1 - t0;
 }
 
-static double loop_step(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "step"); }
-static double loop_do_step(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 0, "doStep"); }
-static double loop_cycle_1(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "cycles1"); }
-static double loop_cycle_n(uint64_t steps, double cycleTime) { return loop_fmu(steps, cycleTime, 1, "cyclesN"); }
+/* A plant of INSTANCES limiters stepped in turn (set u, doStep, get y of
+ * each per communication point), steps calls of each in all: what a
+ * simulator of many blocks pays, with the instances' memory out of the
+ * cache lines of one. Each instance's square wave has its own phase. */
+#define INSTANCES 1000
+static double loop_instances(uint64_t steps, double cycleTime) {
+    static void *c[INSTANCES];
+    for (int k = 0; k < INSTANCES; k++) {
+        c[k] = instantiate();
+        start(c[k], cycleTime);
+    }
+    const unsigned uVr = F.uVr, yVr = F.yVr;
+    const uint64_t points = steps / INSTANCES + 1;
+    double y = 0;
+    fmi3Boolean eventHandlingNeeded, terminateSimulation, earlyReturn;
+    fmi3Float64 lastSuccessfulTime;
+    CALLGRIND_ZERO_STATS;
+    const double t0 = now();
+    for (uint64_t i = 0; i < points; i++) {
+        for (int k = 0; k < INSTANCES; k++) {
+            double u = input(i + 37 * (uint64_t)k);
+            if (F.version == 2) {
+                F.fmi2SetReal(c[k], &uVr, 1, &u);
+                if (F.fmi2DoStep(c[k], (double)i * H, H, fmi2True) != fmi2OK) exit(1);
+                F.fmi2GetReal(c[k], &yVr, 1, &y);
+            } else {
+                F.fmi3SetFloat64(c[k], &uVr, 1, &u, 1);
+                if (F.fmi3DoStep(c[k], (double)i * H, H, fmi3True, &eventHandlingNeeded, &terminateSimulation,
+                                 &earlyReturn, &lastSuccessfulTime) != fmi3OK)
+                    exit(1);
+                F.fmi3GetFloat64(c[k], &yVr, 1, &y, 1);
+            }
+            *(volatile double *)&sink = y;
+        }
+    }
+    const double t1 = now();
+    CALLGRIND_DUMP_STATS_AT("instances");
+    for (int k = 0; k < INSTANCES; k++) release(c[k]);
+    return (t1 - t0) * (double)steps / (double)(points * INSTANCES);
+}
+
+static double loop_step(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 1, "step");
+}
+static double loop_do_step(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 0, "doStep");
+}
+static double loop_cycle_1(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 1, "cycles1");
+}
+static double loop_cycle_n(uint64_t steps, double cycleTime) {
+    return loop_fmu(steps, cycleTime, 1, "cyclesN");
+}
 
 static int compare(const void *a, const void *b) {
     const double x = *(const double *)a, y = *(const double *)b;
@@ -339,7 +405,8 @@ static void allocations(void) {
                 F.fmi3GetFloat64(c, &F.yVr, 1, &y, 1);
             }
         }
-        printf("allocations_in_%llu_steps %zu calls\n", (unsigned long long)runs[k], mallocCalls + callbackCalls - before);
+        printf("allocations_in_%llu_steps %zu calls\n", (unsigned long long)runs[k],
+               mallocCalls + callbackCalls - before);
         release(c);
     }
 }
@@ -374,10 +441,12 @@ int main(int argc, char **argv) {
     const double kernel = median_ns(loop_kernel, steps, 0.0, repeats);
     const double step = median_ns(loop_step, steps, 0.0, repeats);
     const double doStep = median_ns(loop_do_step, steps, 0.0, repeats);
+    const double instances = median_ns(loop_instances, steps, 0.0, repeats);
     printf("empty_loop_ns %.2f ns/step\n", empty);
     printf("kernel_ns %.2f ns/step\n", kernel);
     printf("step_ns %.2f ns/step\n", step);
     printf("doStep_ns %.2f ns/step\n", doStep);
+    printf("instances%d_ns %.2f ns/step\n", INSTANCES, instances);
     printf("step_over_kernel %.3f ratio\n", step / kernel);
     if (F.cycleVr >= 0) {
         const double one = median_ns(loop_cycle_1, steps / 100 + 1, H, repeats);

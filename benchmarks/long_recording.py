@@ -25,6 +25,7 @@ Targets: 48 h compared (as a case and as a recording) and run in at most
 (not with --smoke, which runs a 36 s recording to keep the script working
 in CI).
 """
+
 import argparse
 import hashlib
 import inspect
@@ -65,8 +66,9 @@ def write_columns(path, columns):
 
 
 def generator_key():
-    return hashlib.sha256((inspect.getsource(recording) + inspect.getsource(write_case)
-                           + inspect.getsource(write_recording)).encode()).hexdigest()[:16]
+    return hashlib.sha256(
+        (inspect.getsource(recording) + inspect.getsource(write_case) + inspect.getsource(write_recording)).encode()
+    ).hexdigest()[:16]
 
 
 def write_recording(path, cycles):
@@ -114,6 +116,7 @@ def measured(command, timeout=None):
     timer = None
     if timeout is not None:
         import threading
+
         timer = threading.Timer(timeout, process.kill)
         timer.start()
     output = process.stdout.read()
@@ -127,7 +130,7 @@ def measured(command, timeout=None):
 
 def read_floor(paths):
     """Child: read the files with fmutrace's reader (chunks of columns, nothing else); prints the rows."""
-    from fmutrace.traces import trace_chunks
+    from fmutrace._traces import trace_chunks
 
     rows = 0
     for path in paths:
@@ -143,8 +146,15 @@ def fmpy_anchor(fmu, case):
     inputs = fmpy.read_csv(str(case / f"{MODEL}_in.csv"))
     stop = float(np.loadtxt(case / f"{MODEL}_ref.opt", delimiter=",", dtype=str)[1, 1])
     started = time.perf_counter()
-    fmpy.simulate_fmu(str(fmu), start_time=0.0, stop_time=stop, output_interval=STEP, input=inputs,
-                      start_values={"rateUpPar": 100.0, "rateDownPar": 100.0}, output=["y"])
+    fmpy.simulate_fmu(
+        str(fmu),
+        start_time=0.0,
+        stop_time=stop,
+        output_interval=STEP,
+        input=inputs,
+        start_values={"rateUpPar": 100.0, "rateDownPar": 100.0},
+        output=["y"],
+    )
     print(time.perf_counter() - started)
 
 
@@ -172,80 +182,143 @@ def main():
     fmu = build / "fmi3" / f"{MODEL}.fmu"
     root = build / "benchmarks" / "long"
     cli = [sys.executable, "-m", "fmutrace"]
-    from fmutrace.longcase import is_long
-    from fmutrace.recordings.stream import is_long_recording
-    from fmutrace.runner import C_STEPS
+    from fmutrace._longcase import is_long
+    from fmutrace._longrecording import is_long_recording
+    from fmutrace._runner import C_STEPS
 
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"Python {platform.python_version()}; fmutrace's step loop in "
-          f"{'C (_steps.c)' if C_STEPS is not None else 'Python (_steps.c is not built)'}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"Python {platform.python_version()}; fmutrace's step loop in "
+        f"{'C (_steps.c)' if C_STEPS is not None else 'Python (_steps.c is not built)'}"
+    )
     rows, missed = [], []
     for hours in sorted(args.hours):
         case, cycles = generate(root, hours)
         report = root / f"{hours:g}h" / "report"
-        seconds, megabytes, status, output, user = measured(cli + ["compare", str(fmu), str(case), "--report",
-                                                                   str(report)])
+        seconds, megabytes, status, output, user = measured(
+            cli + ["compare", str(fmu), str(case), "--report", str(report)]
+        )
         if status != 0:
             raise SystemExit(f"compare of {hours:g} h exited {status}:\n{output[-3000:]}")
         one_file = case.parent / RECORDING
         rec_seconds, rec_megabytes, status, output, rec_user = measured(
-            cli + ["compare", str(fmu), str(one_file), "--set", "rateUpPar=100", "--set", "rateDownPar=100",
-                   "--report", str(case.parent / "report_recording")])
+            cli
+            + [
+                "compare",
+                str(fmu),
+                str(one_file),
+                "--set",
+                "rateUpPar=100",
+                "--set",
+                "rateDownPar=100",
+                "--report",
+                str(case.parent / "report_recording"),
+            ]
+        )
         if status != 0 or f"{cycles} samples" not in output:
             raise SystemExit(f"compare of the {hours:g} h recording exited {status}:\n{output[-3000:]}")
-        for what, report_folder, long in (("case", report, is_long(case, MODEL, None)),
-                                          ("recording", case.parent / "report_recording", is_long_recording(one_file))):
-            streamed = [c.get("streamed", False) for c in json.loads((report_folder / "results.json").read_text())["cases"]]
+        for what, report_folder, long in (
+            ("case", report, is_long(case, MODEL, None)),
+            ("recording", case.parent / "report_recording", is_long_recording(one_file)),
+        ):
+            streamed = [
+                c.get("streamed", False) for c in json.loads((report_folder / "results.json").read_text())["cases"]
+            ]
             if streamed != [long]:  # a long one in chunks (flat memory), a short one (--smoke) in memory
                 raise SystemExit(f"the {hours:g} h {what} was {'not ' * long}streamed")
         run_out = root / f"{hours:g}h" / "run_out.csv"
         run_seconds, run_megabytes, status, output, run_user = measured(
-            cli + ["run", str(fmu), "--input", str(case / f"{MODEL}_in.csv"), "--set", "rateUpPar=100",
-                   "--set", "rateDownPar=100", "--step-size", repr(STEP), "--stop-time", repr(cycles * STEP),
-                   "--output", "y", "-o", str(run_out)])
+            cli
+            + [
+                "run",
+                str(fmu),
+                "--input",
+                str(case / f"{MODEL}_in.csv"),
+                "--set",
+                "rateUpPar=100",
+                "--set",
+                "rateDownPar=100",
+                "--step-size",
+                repr(STEP),
+                "--stop-time",
+                repr(cycles * STEP),
+                "--output",
+                "y",
+                "-o",
+                str(run_out),
+            ]
+        )
         if status != 0:
             raise SystemExit(f"run of {hours:g} h exited {status}:\n{output[-3000:]}")
         read_seconds, read_megabytes, status, output, _ = measured(
-            [sys.executable, __file__, "--child", "read", str(case / f"{MODEL}_in.csv"), str(case / f"{MODEL}_ref.csv")])
+            [sys.executable, __file__, "--child", "read", str(case / f"{MODEL}_in.csv"), str(case / f"{MODEL}_ref.csv")]
+        )
         if status != 0 or int(output.split()[-1]) != 2 * cycles + 1:
             raise SystemExit(f"the reader read {output[-300:]!r}, expected {2 * cycles + 1} rows")
-        rows.append({"hours": hours, "cycles": cycles, "compare_s": seconds, "compare_user_s": user,
-                     "compare_MB": megabytes, "recording_s": rec_seconds, "recording_user_s": rec_user,
-                     "recording_MB": rec_megabytes, "run_s": run_seconds, "run_user_s": run_user,
-                     "run_MB": run_megabytes, "read_s": read_seconds, "read_MB": read_megabytes})
+        rows.append(
+            {
+                "hours": hours,
+                "cycles": cycles,
+                "compare_s": seconds,
+                "compare_user_s": user,
+                "compare_MB": megabytes,
+                "recording_s": rec_seconds,
+                "recording_user_s": rec_user,
+                "recording_MB": rec_megabytes,
+                "run_s": run_seconds,
+                "run_user_s": run_user,
+                "run_MB": run_megabytes,
+                "read_s": read_seconds,
+                "read_MB": read_megabytes,
+            }
+        )
         if hours == max(args.hours) and not args.smoke and hours >= 48:
-            for what, s_, mb in (("compare", seconds, megabytes), ("compare of the one-file recording", rec_seconds,
-                                                                   rec_megabytes), ("run", run_seconds, run_megabytes)):
+            for what, s_, mb in (
+                ("compare", seconds, megabytes),
+                ("compare of the one-file recording", rec_seconds, rec_megabytes),
+                ("run", run_seconds, run_megabytes),
+            ):
                 if s_ > TARGET_SECONDS or mb > TARGET_MEGABYTES:
-                    missed.append(f"{what} of {hours:g} h: {s_:.1f} s, {mb:.0f} MB "
-                                  f"(target {TARGET_SECONDS:g} s, {TARGET_MEGABYTES:g} MB)")
+                    missed.append(
+                        f"{what} of {hours:g} h: {s_:.1f} s, {mb:.0f} MB "
+                        f"(target {TARGET_SECONDS:g} s, {TARGET_MEGABYTES:g} MB)"
+                    )
     print()
-    print("| recording | cycles | compare s (user) | compare MB | one-file recording s (user) | recording MB "
-          "| run s (user) | run MB | read only s | read MB |")
+    print(
+        "| recording | cycles | compare s (user) | compare MB | one-file recording s (user) | recording MB "
+        "| run s (user) | run MB | read only s | read MB |"
+    )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['hours']:g} h | {r['cycles']:,} | {r['compare_s']:.1f} ({r['compare_user_s']:.1f}) | "
-              f"{r['compare_MB']:.0f} | {r['recording_s']:.1f} ({r['recording_user_s']:.1f}) | "
-              f"{r['recording_MB']:.0f} | {r['run_s']:.1f} ({r['run_user_s']:.1f}) | {r['run_MB']:.0f} | "
-              f"{r['read_s']:.1f} | {r['read_MB']:.0f} |")
+        print(
+            f"| {r['hours']:g} h | {r['cycles']:,} | {r['compare_s']:.1f} ({r['compare_user_s']:.1f}) | "
+            f"{r['compare_MB']:.0f} | {r['recording_s']:.1f} ({r['recording_user_s']:.1f}) | "
+            f"{r['recording_MB']:.0f} | {r['run_s']:.1f} ({r['run_user_s']:.1f}) | {r['run_MB']:.0f} | "
+            f"{r['read_s']:.1f} | {r['read_MB']:.0f} |"
+        )
     print("(MB: peak resident memory, VmHWM; user: the process's user CPU seconds)")
 
     shortest = rows[0]
     case = root / f"{shortest['hours']:g}h" / "case"
-    seconds, _, status, output, _ = measured([sys.executable, __file__, "--child", "fmpy", str(fmu), str(case)],
-                                          timeout=args.anchor_timeout)
+    seconds, _, status, output, _ = measured(
+        [sys.executable, __file__, "--child", "fmpy", str(fmu), str(case)], timeout=args.anchor_timeout
+    )
     if status == -9:
         anchor = None
-        print(f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles) did not finish "
-              f"within {args.anchor_timeout:g} s; fmutrace run on it: {shortest['run_s']:.1f} s in all, more than "
-              f"{args.anchor_timeout / shortest['run_s']:.0f} times faster")
+        print(
+            f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles) did not finish "
+            f"within {args.anchor_timeout:g} s; fmutrace run on it: {shortest['run_s']:.1f} s in all, more than "
+            f"{args.anchor_timeout / shortest['run_s']:.0f} times faster"
+        )
     elif status != 0:
         raise SystemExit(f"fmpy.simulate_fmu failed:\n{output[-3000:]}")
     else:
         anchor = float(output.split()[-1])
-        print(f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles): {anchor:.1f} s "
-              f"of simulation ({anchor / shortest['cycles'] * 1e6:.1f} us per cycle); fmutrace run on it: "
-              f"{shortest['run_s']:.1f} s in all, {anchor / shortest['run_s']:.1f} times faster")
+        print(
+            f"\nanchor: fmpy.simulate_fmu on {shortest['hours']:g} h ({shortest['cycles']:,} cycles): {anchor:.1f} s "
+            f"of simulation ({anchor / shortest['cycles'] * 1e6:.1f} us per cycle); fmutrace run on it: "
+            f"{shortest['run_s']:.1f} s in all, {anchor / shortest['run_s']:.1f} times faster"
+        )
     print(json.dumps({"rows": rows, "fmpy_seconds": anchor}))
     for line in missed:
         print(f"MISSED: {line}")

@@ -9,6 +9,7 @@ PassThrough fixture) and through fmpy (against PassThrough).
 its figures mean nothing. Figures are printed, and written to
 <build>/benchmarks/results.md and results.json; no figure fails the run.
 """
+
 import argparse
 import contextlib
 import io
@@ -32,10 +33,16 @@ PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 # the targets (docs/performance.md), and the anchors measured on the Reference FMUs
 # (Feedthrough, -O3) and fmpy
 TARGETS = {
-    "step_instructions": 150, "doStep_instructions": 60, "subcycle_instructions": 25,
+    "step_instructions": 150,
+    "doStep_instructions": 60,
+    "subcycle_instructions": 25,
     # the same budgets for the REAL (binary32) path
-    "real_step_instructions": 150, "real_doStep_instructions": 60, "real_subcycle_instructions": 25,
-    "step_over_kernel": 2.0, "instance_bytes": 1024, "fmpy_ratio": 1.05,
+    "real_step_instructions": 150,
+    "real_doStep_instructions": 60,
+    "real_subcycle_instructions": 25,
+    "step_over_kernel": 2.0,
+    "instance_bytes": 1024,
+    "fmpy_ratio": 1.05,
 }
 ANCHORS = {
     2: {"step_instructions": 539, "doStep_instructions": 118, "fmpy_steps_per_s": 90000},
@@ -67,8 +74,17 @@ def bench_args(build, model, version, steps, repeats, start=None):
     binary, token, vr = model_info(build, model, version)
     extra = [f"{vr[name]}={value!r}" for name, value in (start or {}).items()]
     u, y = PINS[model]
-    return [str(build / "fmu_bench"), str(version), str(binary), token, str(vr[u]), str(vr[y]),
-            str(vr.get("cycleTime", -1)), str(steps), str(repeats)] + extra
+    return [
+        str(build / "fmu_bench"),
+        str(version),
+        str(binary),
+        token,
+        str(vr[u]),
+        str(vr[y]),
+        str(vr.get("cycleTime", -1)),
+        str(steps),
+        str(repeats),
+    ] + extra
 
 
 def parse(output):
@@ -80,8 +96,9 @@ def parse(output):
 
 
 def run_native(build, model, version, steps, repeats):
-    out = subprocess.run(bench_args(build, model, version, steps, repeats), check=True,
-                         capture_output=True, text=True).stdout
+    out = subprocess.run(
+        bench_args(build, model, version, steps, repeats), check=True, capture_output=True, text=True
+    ).stdout
     return parse(out)
 
 
@@ -91,8 +108,12 @@ CALLS = {2: ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"), 3: ("fmi3SetFloat64", 
 
 def inclusive_costs(dump):
     """Instructions of each function, callees included, in one dump."""
-    out = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(dump)],
-                         check=True, capture_output=True, text=True).stdout
+    out = subprocess.run(
+        ["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(dump)],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
     costs = {}
     for line in out.splitlines():
         m = ANNOTATE_LINE.match(line)
@@ -106,9 +127,13 @@ def run_callgrind(build, model, version, steps, start=None):
     the benchmark loop not), for each measured loop."""
     with tempfile.TemporaryDirectory() as tmp:
         out_file = Path(tmp) / "callgrind.out"
-        subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out_file}"]
-                       + bench_args(build, model, version, steps, 1, start),
-                       check=True, capture_output=True, text=True)
+        subprocess.run(
+            ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out_file}"]
+            + bench_args(build, model, version, steps, 1, start),
+            check=True,
+            capture_output=True,
+            text=True,
+        )
         loops = {}
         for dump in Path(tmp).glob("callgrind.out.*"):
             label = re.search(r"^desc: Trigger: Client Request: (\w+)", dump.read_text(), re.M)
@@ -132,16 +157,25 @@ def fmpy_time(fmu, steps, repeats):
     """Median wall time of simulate_fmu with one input signal and y recorded."""
     h = 1e-3
     t = np.arange(steps + 1) * h
-    signal = np.array(list(zip(t, np.where((np.arange(steps + 1) // 4096) % 2, -1000.0, 1000.0))),
-                      dtype=[("time", np.float64), ("u", np.float64)])
+    signal = np.array(
+        list(zip(t, np.where((np.arange(steps + 1) // 4096) % 2, -1000.0, 1000.0), strict=True)),
+        dtype=[("time", np.float64), ("u", np.float64)],
+    )
     times = []
     for _ in range(repeats):
         # fmpy prints a warning for each input left out of the signal: they
         # keep their start values here on purpose
         with contextlib.redirect_stdout(io.StringIO()):
             start = time.perf_counter()
-            simulate_fmu(str(fmu), start_time=0.0, stop_time=steps * h, step_size=h, output_interval=h,
-                         input=signal, output=["y"])
+            simulate_fmu(
+                str(fmu),
+                start_time=0.0,
+                stop_time=steps * h,
+                step_size=h,
+                output_interval=h,
+                input=signal,
+                output=["y"],
+            )
             times.append(time.perf_counter() - start)
     return float(np.median(times))
 
@@ -154,8 +188,11 @@ def run_fmpy(build, version, steps, repeats):
         model_times.append(fmpy_time(model_fmu, steps, 1))
         fixture_times.append(fmpy_time(fixture_fmu, steps, 1))
     model_s, fixture_s = float(np.median(model_times)), float(np.median(fixture_times))
-    return {"fmpy_steps_per_s": steps / model_s, "fmpy_fixture_steps_per_s": steps / fixture_s,
-            "fmpy_ratio": model_s / fixture_s}
+    return {
+        "fmpy_steps_per_s": steps / model_s,
+        "fmpy_fixture_steps_per_s": steps / fixture_s,
+        "fmpy_ratio": model_s / fixture_s,
+    }
 
 
 def check(name, value):
@@ -169,8 +206,12 @@ def table(results, smoke, commands):
     rows = [
         ("instructions, set u + doStep + get y", "step_instructions", "{:.0f}", "<= 150"),
         ("instructions, doStep alone", "doStep_instructions", "{:.0f}", "<= 60"),
-        ("instructions, set u + doStep + get y, limits and Neg rates in use", "features_step_instructions",
-         "{:.0f}", ""),
+        (
+            "instructions, set u + doStep + get y, limits and Neg rates in use",
+            "features_step_instructions",
+            "{:.0f}",
+            "",
+        ),
         ("instructions, doStep alone, limits and Neg rates in use", "features_doStep_instructions", "{:.0f}", ""),
         ("instructions per extra sub-cycle", "subcycle_instructions", "{:.1f}", "<= 25"),
         ("instructions, set u + doStep + get y, REAL (Ramp)", "real_step_instructions", "{:.0f}", "<= 150"),
@@ -180,6 +221,7 @@ def table(results, smoke, commands):
         ("instructions, kernel rl_cycle (floor)", "kernel_instructions", "{:.0f}", ""),
         ("instructions, PassThrough set + doStep + get", "fixture_step_instructions", "{:.0f}", ""),
         ("ns, set u + doStep + get y (median)", "step_ns", "{:.2f}", ""),
+        ("ns, 1,000 instances in turn, set u + doStep + get y of each (median)", "instances1000_ns", "{:.2f}", ""),
         ("ns, kernel rl_cycle call (median)", "kernel_ns", "{:.2f}", ""),
         ("ratio step / kernel", "step_over_kernel", "{:.2f}", "<= 2"),
         ("ns, PassThrough set + doStep + get", "fixture_step_ns", "{:.2f}", ""),
@@ -199,13 +241,18 @@ def table(results, smoke, commands):
             if value is not None and key in TARGETS:
                 met.append(check(key, value))
         if key.startswith("allocations"):
-            same = results[2].get("allocations_in_10_steps") == results[2].get("allocations_in_1000000_steps") and \
-                results[3].get("allocations_in_10_steps") == results[3].get("allocations_in_1000000_steps")
+            same = results[2].get("allocations_in_10_steps") == results[2].get(
+                "allocations_in_1000000_steps"
+            ) and results[3].get("allocations_in_10_steps") == results[3].get("allocations_in_1000000_steps")
             met = ["yes" if same else "NO"]
         anchor = " / ".join(str(ANCHORS[v].get(key, "")) for v in (2, 3)) if key in ANCHORS[2] else ""
-        lines.append(f"| {label} | {cells[0]} | {cells[1]} | {target} | {'NO' if 'NO' in met else ('yes' if met else '')} | {anchor} |")
-    header = [f"Machine: {platform.processor() or platform.machine()}, {platform.node()}, "
-              f"Python {platform.python_version()}{' (SMOKE: figures meaningless)' if smoke else ''}", ""]
+        verdict = "NO" if "NO" in met else ("yes" if met else "")
+        lines.append(f"| {label} | {cells[0]} | {cells[1]} | {target} | {verdict} | {anchor} |")
+    header = [
+        f"Machine: {platform.processor() or platform.machine()}, {platform.node()}, "
+        f"Python {platform.python_version()}{' (SMOKE: figures meaningless)' if smoke else ''}",
+        "",
+    ]
     return "\n".join(header + lines + ["", "Commands:"] + [f"- `{c}`" for c in commands]) + "\n"
 
 
@@ -248,12 +295,31 @@ def main():
                 r[f"real_{key}"] = real[key]
         r.update(run_fmpy(build, version, fmpy_steps, fmpy_repeats))
         results[version] = r
-        print(f"FMI {version}: " + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
-                                             for k, v in sorted(r.items())), flush=True)
-    commands.append(" ".join(["build/fmu_bench", "<2|3>", "<binary.so>", "<token>", "<u_vr>", "<y_vr>",
-                              "<cycleTime_vr>", str(c_steps), str(c_repeats)]) + "  (wall time, allocations)")
-    commands.append(f"valgrind --tool=callgrind build/fmu_bench ... {cg_steps} 1, then callgrind_annotate --inclusive=yes"
-                    "  (instructions per call, callees included)")
+        print(
+            f"FMI {version}: "
+            + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in sorted(r.items())),
+            flush=True,
+        )
+    commands.append(
+        " ".join(
+            [
+                "build/fmu_bench",
+                "<2|3>",
+                "<binary.so>",
+                "<token>",
+                "<u_vr>",
+                "<y_vr>",
+                "<cycleTime_vr>",
+                str(c_steps),
+                str(c_repeats),
+            ]
+        )
+        + "  (wall time, allocations)"
+    )
+    commands.append(
+        f"valgrind --tool=callgrind build/fmu_bench ... {cg_steps} 1, then callgrind_annotate --inclusive=yes"
+        "  (instructions per call, callees included)"
+    )
     commands.append(f"fmpy.simulate_fmu, {fmpy_steps} steps of 1 ms, input u, output y, median of {fmpy_repeats}")
     if not have_valgrind:
         print("valgrind not found: no instruction counts", file=sys.stderr)

@@ -62,7 +62,7 @@ function(add_fmu model version)
              ${gen}/fmi3/buildDescription.xml ${header}
       COMMAND ${Python3_EXECUTABLE} ${GENERATOR} ${toml} ${gen}
               --fmi2-sources ${c_names2} --fmi3-sources ${c_names3}
-      DEPENDS ${toml} ${GENERATOR}
+      DEPENDS ${toml} ${GENERATOR} ${CMAKE_SOURCE_DIR}/LICENSE
       COMMENT "Generating the model descriptions of ${model}")
     add_custom_target(${model}_description DEPENDS ${header})
   endif()
@@ -82,8 +82,11 @@ function(add_fmu model version)
   set(copies
     COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/sources
     COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
-    COMMAND ${CMAKE_COMMAND} -E copy ${sources} ${unit} ${header} ${stage}/sources/)
-  set(entries modelDescription.xml binaries/${platform}/${model}.so)
+    COMMAND ${CMAKE_COMMAND} -E copy ${sources} ${unit} ${header} ${stage}/sources/
+    # the licence, where the FMI 3 standard puts its entry point (FMI 2 names no place; the same there)
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/documentation/licenses
+    COMMAND ${CMAKE_COMMAND} -E copy ${CMAKE_SOURCE_DIR}/LICENSE ${stage}/documentation/licenses/license.txt)
+  set(entries modelDescription.xml binaries/${platform}/${model}.so documentation/licenses/license.txt)
   foreach(s IN LISTS sources unit header)
     get_filename_component(n ${s} NAME)
     list(APPEND entries sources/${n})
@@ -143,6 +146,7 @@ function(add_fmu model version)
     COMMAND zip_normalize ${fmu}
     WORKING_DIRECTORY ${stage}
     DEPENDS zip_normalize ${lib} ${sources} ${unit} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs}
+            ${CMAKE_SOURCE_DIR}/LICENSE
             ${cross_libraries}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})

@@ -2,8 +2,9 @@
 # for every build that compiles them (cmake/Fmu.cmake, cmake/Fuzz.cmake,
 # the cross builds of cmake/cross):
 #   fmu_sources(<var> <Model> <2|3>): the kernel, the model's mapping, the
-#     core and the FMI glue of that version, in the order the FMU's unit
-#     includes them (the model defines fmuModel before the core uses it)
+#     core (with Co-Simulation's step), Model Exchange, FMU states and the
+#     FMI glue of that version, in the order the FMU's unit includes them
+#     (the model defines fmuModel before the core uses it)
 #   fmu_unit(<var> <Model> <2|3> <dir>): writes <dir>/<Model>_fmi<2|3>.c, the
 #     FMU's one translation unit: it includes those sources with RL_UNIT
 #     defined, so that only the fmi* functions have external linkage
@@ -12,13 +13,13 @@
 #   FMU_HEADERS: the headers they include (the source FMU carries them)
 #   FMU_INCLUDE_DIRS: where the unit finds them in the source tree
 set(FMU_HEADERS fmu_src/rate_limiter.h fmu_src/rate_limiter_rules.h fmu_src/model.h fmu_src/fmu_core.h
-                fmu_src/fmi_entries.h
+                fmu_src/fmu_model_exchange.h fmu_src/fmu_state.h fmu_src/fmi_entries.h
                 fmu_src/models/siemens.h fmu_src/models/unified.h)
 set(FMU_INCLUDE_DIRS fmu_src fmu_src/models)
 
 function(fmu_sources out model version)
-  set(${out} fmu_src/rate_limiter.c fmu_src/models/${model}.c fmu_src/fmu_core.c fmu_src/fmi${version}_glue.c
-      PARENT_SCOPE)
+  set(${out} fmu_src/rate_limiter.c fmu_src/models/${model}.c fmu_src/fmu_core.c fmu_src/fmu_model_exchange.c
+      fmu_src/fmu_state.c fmu_src/fmi${version}_glue.c PARENT_SCOPE)
 endfunction()
 
 function(fmu_unit out model version dir)

@@ -64,11 +64,12 @@ if(FUZZ_CLANG)
       # new inputs go to build/fuzz/corpus_<target><suffix>; the repository's corpus is read
       add_test(NAME fuzz_${target}${suffix}
                COMMAND sh -c "mkdir -p '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}${suffix}' && '${binary}' -max_total_time=${FUZZ_SECONDS} -max_len=${FUZZ_MAX_LEN_${target}} -seed=1 -print_final_stats=1 '${CMAKE_BINARY_DIR}/fuzz/corpus_${target}${suffix}' '${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/${target}'")
-      set_tests_properties(fuzz_${target}${suffix} PROPERTIES TIMEOUT 300)
+      set_tests_properties(fuzz_${target}${suffix} PROPERTIES TIMEOUT 300 LABELS fuzz)
     endforeach()
   endforeach()
   add_custom_target(fuzzers ALL DEPENDS ${fuzz_binaries})
   add_dependencies(fuzzers ${fuzz_descriptions})
 else()
   add_test(NAME fuzz COMMAND sh -c "echo 'no clang with libFuzzer (Debian: apt-get install clang-14 libclang-rt-14-dev)'; exit 1")
+  set_tests_properties(fuzz PROPERTIES LABELS fuzz)
 endif()

@@ -8,6 +8,7 @@
 #   libtbb12, unzip                 ecospy, another importer (test_importers, test_closed_loop)
 #   qemu-user                       the aarch64 binaries and harnesses under emulation (test_aarch64)
 #   g++                             the sources compiled as C++ (test_source_fmu)
+#   clang-format-14                 the C sources' layout (ctest lint, .pre-commit-config.yaml)
 # Python packages: tests/requirements.txt (cmake/PythonEnv.cmake).
 # A tool that still cannot be had makes its tests fail and say why.
 
@@ -60,6 +61,14 @@ find_program(CXX_COMPILER g++)
 if(NOT CXX_COMPILER)
   apt_install("No g++ to compile the sources as C++" g++)
   find_program(CXX_COMPILER g++)
+endif()
+
+# clang-format, the lint stage's C layout check (.clang-format): Debian's,
+# the version of the fuzzers' clang
+find_program(CLANG_FORMAT NAMES clang-format-14 clang-format)
+if(NOT CLANG_FORMAT)
+  apt_install("No clang-format for the lint stage" clang-format-14)
+  find_program(CLANG_FORMAT NAMES clang-format-14 clang-format)
 endif()
 
 # The standard's fmi2Functions.h, in build/fmi_headers, for the tests that

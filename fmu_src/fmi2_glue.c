@@ -12,7 +12,7 @@
  * slave never returns fmi2Pending, so there is no stepInProgress. Step
  * Mode is only ever a Co-Simulation instance's, Event Mode and
  * Continuous-Time Mode a Model Exchange instance's; the functions of one
- * interface alone also refuse an instance of the other (BEGIN_ONLY).
+ * interface alone also refuse an instance of the other (BEGIN_ONLY_AS).
  * Beyond the table: the sets of Event Mode are taken in Continuous-Time
  * Mode too, where the standard has only continuous-time inputs (condition
  * 5), as importers such as OMSimulator set every input at each step; the
@@ -22,51 +22,51 @@
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
-#define ERR  MODE_ERROR
+#define ERR MODE_ERROR
 #define EVENT MODE_EVENT
 #define CONT MODE_CONTINUOUS
 #define NO_MODE 0
 
 #define ANY (INST | INIT | STEP | EVENT | CONT | TERM | ERR)
-#define MODES_SetDebugLogging           ANY
-#define MODES_SetupExperiment           (INST)
-#define MODES_EnterInitializationMode   (INST)
-#define MODES_ExitInitializationMode    (INIT)
-#define MODES_Terminate                 (STEP | EVENT | CONT)
-#define MODES_Reset                     ANY
-#define MODES_GetReal                   (INIT | STEP | EVENT | CONT | TERM | ERR)
-#define MODES_GetInteger                MODES_GetReal
-#define MODES_GetBoolean                MODES_GetReal
-#define MODES_GetString                 MODES_GetReal
-#define MODES_SetReal                   (INST | INIT | STEP | EVENT | CONT)
-#define MODES_SetInteger                MODES_SetReal
-#define MODES_SetBoolean                MODES_SetReal
-#define MODES_SetString                 MODES_SetReal
-#define MODES_GetFMUstate               ANY
-#define MODES_SetFMUstate               MODES_GetFMUstate
-#define MODES_FreeFMUstate              MODES_GetFMUstate
-#define MODES_SerializedFMUstateSize    MODES_GetFMUstate
-#define MODES_SerializeFMUstate         MODES_GetFMUstate
-#define MODES_DeSerializeFMUstate       MODES_GetFMUstate
+#define MODES_fmi2SetDebugLogging ANY
+#define MODES_fmi2SetupExperiment (INST)
+#define MODES_fmi2EnterInitializationMode (INST)
+#define MODES_fmi2ExitInitializationMode (INIT)
+#define MODES_fmi2Terminate (STEP | EVENT | CONT)
+#define MODES_fmi2Reset ANY
+#define MODES_fmi2GetReal (INIT | STEP | EVENT | CONT | TERM | ERR)
+#define MODES_fmi2GetInteger MODES_fmi2GetReal
+#define MODES_fmi2GetBoolean MODES_fmi2GetReal
+#define MODES_fmi2GetString MODES_fmi2GetReal
+#define MODES_fmi2SetReal (INST | INIT | STEP | EVENT | CONT)
+#define MODES_fmi2SetInteger MODES_fmi2SetReal
+#define MODES_fmi2SetBoolean MODES_fmi2SetReal
+#define MODES_fmi2SetString MODES_fmi2SetReal
+#define MODES_fmi2GetFMUstate ANY
+#define MODES_fmi2SetFMUstate MODES_fmi2GetFMUstate
+#define MODES_fmi2FreeFMUstate MODES_fmi2GetFMUstate
+#define MODES_fmi2SerializedFMUstateSize MODES_fmi2GetFMUstate
+#define MODES_fmi2SerializeFMUstate MODES_fmi2GetFMUstate
+#define MODES_fmi2DeSerializeFMUstate MODES_fmi2GetFMUstate
 /* Co-Simulation */
-#define MODES_DoStep                    (STEP)
-#define MODES_CancelStep                NO_MODE
-#define MODES_GetStatus                 (STEP | TERM)
-#define MODES_GetRealStatus             MODES_GetStatus
-#define MODES_GetIntegerStatus          MODES_GetStatus
-#define MODES_GetBooleanStatus          MODES_GetStatus
-#define MODES_GetStringStatus           MODES_GetStatus
+#define MODES_fmi2DoStep (STEP)
+#define MODES_fmi2CancelStep NO_MODE
+#define MODES_fmi2GetStatus (STEP | TERM)
+#define MODES_fmi2GetRealStatus MODES_fmi2GetStatus
+#define MODES_fmi2GetIntegerStatus MODES_fmi2GetStatus
+#define MODES_fmi2GetBooleanStatus MODES_fmi2GetStatus
+#define MODES_fmi2GetStringStatus MODES_fmi2GetStatus
 /* Model Exchange */
-#define MODES_EnterEventMode            (EVENT | CONT)
-#define MODES_NewDiscreteStates         (EVENT)
-#define MODES_EnterContinuousTimeMode   (EVENT)
-#define MODES_CompletedIntegratorStep   (CONT)
-#define MODES_SetTime                   (EVENT | CONT) /* Event Mode: a pure discrete-time FMU's next instant */
-#define MODES_SetContinuousStates       (CONT)
-#define MODES_GetEventIndicators        (INIT | EVENT | CONT | TERM | ERR)
-#define MODES_GetContinuousStates       MODES_GetEventIndicators
-#define MODES_GetDerivatives            MODES_GetEventIndicators
-#define MODES_GetNominalsOfContinuousStates (INST | EVENT | CONT | TERM | ERR)
+#define MODES_fmi2EnterEventMode (EVENT | CONT)
+#define MODES_fmi2NewDiscreteStates (EVENT)
+#define MODES_fmi2EnterContinuousTimeMode (EVENT)
+#define MODES_fmi2CompletedIntegratorStep (CONT)
+#define MODES_fmi2SetTime (EVENT | CONT) /* Event Mode: a pure discrete-time FMU's next instant */
+#define MODES_fmi2SetContinuousStates (CONT)
+#define MODES_fmi2GetEventIndicators (INIT | EVENT | CONT | TERM | ERR)
+#define MODES_fmi2GetContinuousStates MODES_fmi2GetEventIndicators
+#define MODES_fmi2GetDerivatives MODES_fmi2GetEventIndicators
+#define MODES_fmi2GetNominalsOfContinuousStates (INST | EVENT | CONT | TERM | ERR)
 
 typedef struct {
     FmuInstance base; /* first: an fmi2Component is an FmuInstance */
@@ -78,24 +78,28 @@ typedef struct {
  * must say why. */
 #define ALWAYS_LOGGED (LOG_ERROR | LOG_WARNING)
 
-#define BEGIN(name)                                                           \
-    FmuInstance *I = (FmuInstance *)instance;                                        \
-    static const char FN[] = "fmi2" #name;                                    \
-    if (!I) return fmi2Error;                                                 \
-    if (!(I->core.mode & (MODES_##name))) return (fmi2Status)fmu_mode_error(I, FN)
+/* The start of every entry point; name is its full name (fmi2DoStep), the modes it may
+ * be called in MODES_<name>. The _AS forms are for macros (fmi_entries.h). */
+#define BEGIN(name) BEGIN_AS(#name, MODES_##name)
+#define BEGIN_AS(function, modes) \
+    FmuInstance *I = (FmuInstance *)instance; \
+    static const char FN[] = function; \
+    if (!I) return fmi2Error; \
+    if (!(I->core.mode & (modes))) return (fmi2Status)fmu_mode_error(I, FN)
 
 /* a function of one interface: an instance of the other is refused */
-#define BEGIN_ONLY(name, fmuType)                                             \
-    BEGIN(name);                                                              \
+#define BEGIN_ONLY_AS(function, modes, fmuType) \
+    BEGIN_AS(function, modes); \
     if (I->modelExchange != ((fmuType) == fmi2ModelExchange)) return (fmi2Status)other_interface(I, FN)
 
 /* a Model Exchange function (fmi_entries.h) */
-#define BEGIN_ME(name) BEGIN_ONLY(name, fmi2ModelExchange)
+#define BEGIN_ME(name) BEGIN_ME_AS(#name, MODES_##name)
+#define BEGIN_ME_AS(function, modes) BEGIN_ONLY_AS(function, modes, fmi2ModelExchange)
 
-#define CHECK(expression)                                                     \
-    do {                                                                      \
-        const FmuStatus status_ = (expression);                               \
-        if (status_ > FMU_WARNING) return (fmi2Status)status_;                \
+#define CHECK(expression) \
+    do { \
+        const FmuStatus status_ = (expression); \
+        if (status_ > FMU_WARNING) return (fmi2Status)status_; \
     } while (0)
 
 FMU_COLD static FmuStatus other_interface(FmuInstance *I, const char *function) {
@@ -118,8 +122,12 @@ static void release_state(FmuInstance *instance, void *memory) {
     ((Fmi2Instance *)instance)->functions.freeMemory(memory);
 }
 
-const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
-const char *fmi2GetVersion(void) { return fmi2Version; }
+const char *fmi2GetTypesPlatform(void) {
+    return fmi2TypesPlatform;
+}
+const char *fmi2GetVersion(void) {
+    return fmi2Version;
+}
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
@@ -173,8 +181,9 @@ void fmi2FreeInstance(fmi2Component instance) {
     release(g);
 }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component instance, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
-    BEGIN(SetDebugLogging);
+fmi2Status fmi2SetDebugLogging(fmi2Component instance, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[]) {
+    BEGIN(fmi2SetDebugLogging);
     return (fmi2Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, ALWAYS_LOGGED);
 }
 
@@ -182,16 +191,16 @@ fmi2Status fmi2SetupExperiment(fmi2Component instance, fmi2Boolean toleranceDefi
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     (void)toleranceDefined;
     (void)tolerance;
-    BEGIN(SetupExperiment);
+    BEGIN(fmi2SetupExperiment);
     return (fmi2Status)fmu_setup_experiment(I, FN, startTime, stopTimeDefined, stopTime);
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component instance) {
-    BEGIN(EnterInitializationMode);
+    BEGIN(fmi2EnterInitializationMode);
     return (fmi2Status)fmu_enter_initialization(I);
 }
 
-LIFECYCLE_ENTRIES(fmi2, fmi2Component)
+LIFECYCLE_ENTRIES(fmi2, fmi2Component, fmi2ExitInitializationMode, fmi2Terminate, fmi2Reset)
 
 /* ---- variable access ---------------------------------------------------- */
 
@@ -203,69 +212,69 @@ LIFECYCLE_ENTRIES(fmi2, fmi2Component)
 
 /* One value is the common call: straight-line code without a frame; any
  * other count goes through the loops (all checked before any is set). */
-#define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI, FROM_FMI)                    \
-    FMU_NOINLINE static fmi2Status get_##NAME(FmuInstance *I, const char *FN, \
-        const fmi2ValueReference vr[], size_t nvr, TYPE value[]) {            \
-        CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
+#define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI, FROM_FMI) \
+    FMU_NOINLINE static fmi2Status GET##_array(FmuInstance *I, const char *FN, const fmi2ValueReference vr[], \
+                                               size_t nvr, TYPE value[]) { \
+        CHECK(fmu_check_array(I, FN, nvr, vr, value)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) value[i] = TO_FMI(fmu_get(I, vr[i])); \
-        return fmi2OK;                                                        \
-    }                                                                         \
-    FMU_NOINLINE static fmi2Status set_##NAME(FmuInstance *I, const char *FN, \
-        const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) {      \
-        CHECK(fmu_check_array(I, FN, nvr, vr, value));                        \
+        return fmi2OK; \
+    } \
+    FMU_NOINLINE static fmi2Status SET##_array(FmuInstance *I, const char *FN, const fmi2ValueReference vr[], \
+                                               size_t nvr, const TYPE value[]) { \
+        CHECK(fmu_check_array(I, FN, nvr, vr, value)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], FROM_FMI(value[i]))); \
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], FROM_FMI(value[i])); \
-        return fmi2OK;                                                        \
-    }                                                                         \
-    fmi2Status fmi2Get##NAME(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
-        BEGIN(Get##NAME);                                                     \
-        double v_;                                                            \
-        if (nvr != 1 || !vr || !value) return get_##NAME(I, FN, vr, nvr, value); \
-        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi2Error;     \
-        value[0] = TO_FMI(v_);                                                \
-        return fmi2OK;                                                        \
-    }                                                                         \
-    fmi2Status fmi2Set##NAME(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
-        BEGIN(Set##NAME);                                                     \
-        if (nvr != 1 || !vr || !value) return set_##NAME(I, FN, vr, nvr, value); \
+        return fmi2OK; \
+    } \
+    fmi2Status GET(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) { \
+        BEGIN_AS(#GET, MODES_##GET); \
+        double v_; \
+        if (nvr != 1 || !vr || !value) return GET##_array(I, FN, vr, nvr, value); \
+        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi2Error; \
+        value[0] = TO_FMI(v_); \
+        return fmi2OK; \
+    } \
+    fmi2Status SET(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, const TYPE value[]) { \
+        BEGIN_AS(#SET, MODES_##SET); \
+        if (nvr != 1 || !vr || !value) return SET##_array(I, FN, vr, nvr, value); \
         return fmu_set_one(I, FN, TYPE_MASK, vr[0], FROM_FMI(value[0])) ? fmi2OK : fmi2Error; \
     }
 
-ACCESSORS(Real, fmi2Real, TYPE_BIT(FMU_REAL), AS_REAL, AS_REAL)
-ACCESSORS(Integer, fmi2Integer, INTEGER_TYPES, AS_INTEGER, AS_REAL)
-ACCESSORS(Boolean, fmi2Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN, BOOLEAN_AS_REAL)
+ACCESSORS(fmi2GetReal, fmi2SetReal, fmi2Real, TYPE_BIT(FMU_REAL), AS_REAL, AS_REAL)
+ACCESSORS(fmi2GetInteger, fmi2SetInteger, fmi2Integer, INTEGER_TYPES, AS_INTEGER, AS_REAL)
+ACCESSORS(fmi2GetBoolean, fmi2SetBoolean, fmi2Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN, BOOLEAN_AS_REAL)
 
 fmi2Status fmi2GetString(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    BEGIN(GetString);
+    BEGIN(fmi2GetString);
     CHECK(fmu_check_array(I, FN, nvr, vr, value));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i]));
     return fmi2OK;
 }
 
 fmi2Status fmi2SetString(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    BEGIN(SetString);
+    BEGIN(fmi2SetString);
     CHECK(fmu_check_array(I, FN, nvr, vr, value));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_BIT(FMU_UNSUPPORTED_TYPE), vr[i], 0.0));
     return fmi2OK;
 }
 
-/* ---- FMU states (fmu_core.c) ---------------------------------------------- */
+/* ---- FMU states (fmu_state.c) --------------------------------------------- */
 
-FMU_STATE_ENTRIES(fmi2, fmi2Component, fmi2FMUstate, fmi2Byte, GetFMUstate, SetFMUstate, FreeFMUstate,
-                  SerializedFMUstateSize, SerializeFMUstate, DeSerializeFMUstate)
+FMU_STATE_ENTRIES(fmi2, fmi2Component, fmi2FMUstate, fmi2Byte, fmi2GetFMUstate, fmi2SetFMUstate, fmi2FreeFMUstate,
+                  fmi2SerializedFMUstateSize, fmi2SerializeFMUstate, fmi2DeSerializeFMUstate)
 
 /* ---- Co-Simulation -------------------------------------------------------- */
 
 fmi2Status fmi2DoStep(fmi2Component instance, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    BEGIN(DoStep);
+    BEGIN(fmi2DoStep);
     return (fmi2Status)fmu_do_step(I, FN, currentCommunicationPoint, communicationStepSize);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component instance) {
-    BEGIN(CancelStep);
+    BEGIN(fmi2CancelStep);
     return fmi2Error; /* unreachable: no mode allows it */
 }
 
@@ -275,28 +284,30 @@ fmi2Status fmi2CancelStep(fmi2Component instance) {
  * is the FMU's time, fmi2Terminated (Boolean) is false. One body: kind
  * is the status kind the getter answers, NO_KIND for none. */
 #define NO_KIND (-1)
-#define STATUS_GETTER(NAME, TYPE, KIND, VALUE)                                \
-    fmi2Status fmi2Get##NAME(fmi2Component instance, const fmi2StatusKind s, TYPE *value) { \
-        BEGIN_ONLY(Get##NAME, fmi2CoSimulation);                              \
-        if ((KIND) == NO_KIND || (int)s != (KIND)) return fmi2Discard;        \
+#define STATUS_GETTER(NAME, TYPE, KIND, VALUE) \
+    fmi2Status NAME(fmi2Component instance, const fmi2StatusKind s, TYPE *value) { \
+        BEGIN_ONLY_AS(#NAME, MODES_##NAME, fmi2CoSimulation); \
+        if ((KIND) == NO_KIND || (int)s != (KIND)) return fmi2Discard; \
         if (!value) return (fmi2Status)fmu_error(I, FN, "the value pointer is NULL"); \
-        *value = VALUE;                                                       \
-        return fmi2OK;                                                        \
+        *value = VALUE; \
+        return fmi2OK; \
     }
 
-STATUS_GETTER(Status, fmi2Status, NO_KIND, fmi2OK)
-STATUS_GETTER(RealStatus, fmi2Real, fmi2LastSuccessfulTime, I->core.time)
-STATUS_GETTER(IntegerStatus, fmi2Integer, NO_KIND, 0)
-STATUS_GETTER(BooleanStatus, fmi2Boolean, fmi2Terminated, fmi2False)
-STATUS_GETTER(StringStatus, fmi2String, NO_KIND, NULL)
+STATUS_GETTER(fmi2GetStatus, fmi2Status, NO_KIND, fmi2OK)
+STATUS_GETTER(fmi2GetRealStatus, fmi2Real, fmi2LastSuccessfulTime, I->core.time)
+STATUS_GETTER(fmi2GetIntegerStatus, fmi2Integer, NO_KIND, 0)
+STATUS_GETTER(fmi2GetBooleanStatus, fmi2Boolean, fmi2Terminated, fmi2False)
+STATUS_GETTER(fmi2GetStringStatus, fmi2String, NO_KIND, NULL)
 
 /* ---- Model Exchange: no continuous states, no event indicators; the cycle
- * ends are time events (fmu_core.h) ------------------------------------- */
+ * ends are time events (fmu_model_exchange.h) ---------------------------- */
 
-MODEL_EXCHANGE_ENTRIES(fmi2, fmi2Component, fmi2Real, fmi2Boolean, GetDerivatives)
+MODEL_EXCHANGE_ENTRIES(fmi2, fmi2Component, fmi2Real, fmi2Boolean, fmi2EnterEventMode, fmi2EnterContinuousTimeMode,
+                       fmi2CompletedIntegratorStep, fmi2SetTime, fmi2SetContinuousStates, fmi2GetContinuousStates,
+                       fmi2GetDerivatives, fmi2GetNominalsOfContinuousStates, fmi2GetEventIndicators)
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component instance, fmi2EventInfo *eventInfo) {
-    BEGIN_ME(NewDiscreteStates);
+    BEGIN_ME(fmi2NewDiscreteStates);
     if (!eventInfo) return (fmi2Status)fmu_error(I, FN, "the eventInfo pointer is NULL");
     bool nextEventTimeDefined;
     CHECK(fmu_update_discrete_states(I, FN, &nextEventTimeDefined, &eventInfo->nextEventTime));
@@ -317,21 +328,32 @@ static fmi2Status unsupported(fmi2Component instance, const char *function, cons
 
 #define NO_DERIVATIVES "this FMU provides no derivatives (see the model description)"
 
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component instance, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
-                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component instance, const fmi2ValueReference vUnknown_ref[],
+                                        size_t nUnknown, const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown; (void)dvUnknown;
+    (void)vUnknown_ref;
+    (void)nUnknown;
+    (void)vKnown_ref;
+    (void)nKnown;
+    (void)dvKnown;
+    (void)dvUnknown;
     return unsupported(instance, "fmi2GetDirectionalDerivative", NO_DERIVATIVES);
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-    (void)vr; (void)nvr; (void)order; (void)value;
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
     return unsupported(instance, "fmi2SetRealInputDerivatives", NO_DERIVATIVES);
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component instance, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
-    (void)vr; (void)nvr; (void)order; (void)value;
+    (void)vr;
+    (void)nvr;
+    (void)order;
+    (void)value;
     return unsupported(instance, "fmi2GetRealOutputDerivatives", NO_DERIVATIVES);
 }

@@ -31,81 +31,85 @@
 /* the super state Initialized */
 #define INITIALIZED (STEP | EVENT | CONT | TERM)
 
-#define MODES_SetDebugLogging           SETTABLE
-#define MODES_EnterInitializationMode   (INST)
-#define MODES_ExitInitializationMode    (INIT)
-#define MODES_Terminate                 (STEP | EVENT | CONT)
-#define MODES_Reset                     SETTABLE
-#define MODES_Get                       (INIT | STEP | EVENT | CONT | TERM)
-#define MODES_Set                       (INST | INIT | STEP | EVENT | CONT)
-#define MODES_GetFMUState               SETTABLE
-#define MODES_SetFMUState               SETTABLE
-#define MODES_FreeFMUState              SETTABLE
-#define MODES_SerializedFMUStateSize    SETTABLE
-#define MODES_SerializeFMUState         SETTABLE
-#define MODES_DeserializeFMUState       SETTABLE
-#define MODES_DoStep                    (STEP)
+#define MODES_fmi3SetDebugLogging SETTABLE
+#define MODES_fmi3EnterInitializationMode (INST)
+#define MODES_fmi3ExitInitializationMode (INIT)
+#define MODES_fmi3Terminate (STEP | EVENT | CONT)
+#define MODES_fmi3Reset SETTABLE
+#define MODES_Get (INIT | STEP | EVENT | CONT | TERM)
+#define MODES_Set (INST | INIT | STEP | EVENT | CONT)
+#define MODES_fmi3GetFMUState SETTABLE
+#define MODES_fmi3SetFMUState SETTABLE
+#define MODES_fmi3FreeFMUState SETTABLE
+#define MODES_fmi3SerializedFMUStateSize SETTABLE
+#define MODES_fmi3SerializeFMUState SETTABLE
+#define MODES_fmi3DeserializeFMUState SETTABLE
+#define MODES_fmi3DoStep (STEP)
 /* Model Exchange */
-#define MODES_EnterEventMode            (CONT)
-#define MODES_UpdateDiscreteStates      (EVENT)
-#define MODES_EnterContinuousTimeMode   (EVENT)
-#define MODES_CompletedIntegratorStep   (CONT)
-#define MODES_SetTime                   (CONT)
-#define MODES_SetContinuousStates       (CONT)
-#define MODES_GetContinuousStateDerivatives (INIT | EVENT | CONT | TERM)
-#define MODES_GetEventIndicators        MODES_GetContinuousStateDerivatives
-#define MODES_GetContinuousStates       MODES_GetContinuousStateDerivatives
-#define MODES_GetNominalsOfContinuousStates (INIT | INITIALIZED)
-#define MODES_GetNumberOfEventIndicators (INST | EVENT | CONT)
-#define MODES_GetNumberOfContinuousStates MODES_GetNumberOfEventIndicators
+#define MODES_fmi3EnterEventMode (CONT)
+#define MODES_fmi3UpdateDiscreteStates (EVENT)
+#define MODES_fmi3EnterContinuousTimeMode (EVENT)
+#define MODES_fmi3CompletedIntegratorStep (CONT)
+#define MODES_fmi3SetTime (CONT)
+#define MODES_fmi3SetContinuousStates (CONT)
+#define MODES_fmi3GetContinuousStateDerivatives (INIT | EVENT | CONT | TERM)
+#define MODES_fmi3GetEventIndicators MODES_fmi3GetContinuousStateDerivatives
+#define MODES_fmi3GetContinuousStates MODES_fmi3GetContinuousStateDerivatives
+#define MODES_fmi3GetNominalsOfContinuousStates (INIT | INITIALIZED)
+#define MODES_fmi3GetNumberOfEventIndicators (INST | EVENT | CONT)
+#define MODES_fmi3GetNumberOfContinuousStates MODES_fmi3GetNumberOfEventIndicators
 /* every fmi3Get<Type> and fmi3Set<Type> */
-#define MODES_GetFloat32                     MODES_Get
-#define MODES_SetFloat32                     MODES_Set
-#define MODES_GetFloat64                     MODES_Get
-#define MODES_SetFloat64                     MODES_Set
-#define MODES_GetInt8                        MODES_Get
-#define MODES_SetInt8                        MODES_Set
-#define MODES_GetUInt8                       MODES_Get
-#define MODES_SetUInt8                       MODES_Set
-#define MODES_GetInt16                       MODES_Get
-#define MODES_SetInt16                       MODES_Set
-#define MODES_GetUInt16                      MODES_Get
-#define MODES_SetUInt16                      MODES_Set
-#define MODES_GetInt32                       MODES_Get
-#define MODES_SetInt32                       MODES_Set
-#define MODES_GetUInt32                      MODES_Get
-#define MODES_SetUInt32                      MODES_Set
-#define MODES_GetInt64                       MODES_Get
-#define MODES_SetInt64                       MODES_Set
-#define MODES_GetUInt64                      MODES_Get
-#define MODES_SetUInt64                      MODES_Set
-#define MODES_GetBoolean                     MODES_Get
-#define MODES_SetBoolean                     MODES_Set
-#define MODES_GetString                      MODES_Get
-#define MODES_SetString                      MODES_Set
-#define MODES_GetBinary                      MODES_Get
-#define MODES_SetBinary                      MODES_Set
+#define MODES_fmi3GetFloat32 MODES_Get
+#define MODES_fmi3SetFloat32 MODES_Set
+#define MODES_fmi3GetFloat64 MODES_Get
+#define MODES_fmi3SetFloat64 MODES_Set
+#define MODES_fmi3GetInt8 MODES_Get
+#define MODES_fmi3SetInt8 MODES_Set
+#define MODES_fmi3GetUInt8 MODES_Get
+#define MODES_fmi3SetUInt8 MODES_Set
+#define MODES_fmi3GetInt16 MODES_Get
+#define MODES_fmi3SetInt16 MODES_Set
+#define MODES_fmi3GetUInt16 MODES_Get
+#define MODES_fmi3SetUInt16 MODES_Set
+#define MODES_fmi3GetInt32 MODES_Get
+#define MODES_fmi3SetInt32 MODES_Set
+#define MODES_fmi3GetUInt32 MODES_Get
+#define MODES_fmi3SetUInt32 MODES_Set
+#define MODES_fmi3GetInt64 MODES_Get
+#define MODES_fmi3SetInt64 MODES_Set
+#define MODES_fmi3GetUInt64 MODES_Get
+#define MODES_fmi3SetUInt64 MODES_Set
+#define MODES_fmi3GetBoolean MODES_Get
+#define MODES_fmi3SetBoolean MODES_Set
+#define MODES_fmi3GetString MODES_Get
+#define MODES_fmi3SetString MODES_Set
+#define MODES_fmi3GetBinary MODES_Get
+#define MODES_fmi3SetBinary MODES_Set
 
 typedef struct {
     FmuInstance base; /* first: an fmi3Instance is an FmuInstance */
     fmi3LogMessageCallback logMessage;
 } Fmi3Instance;
 
-#define BEGIN(name)                                                           \
-    FmuInstance *I = (FmuInstance *)instance;                                 \
-    static const char FN[] = "fmi3" #name;                                    \
-    if (!I) return fmi3Error;                                                 \
-    if (!(I->core.mode & (MODES_##name))) return (fmi3Status)fmu_mode_error(I, FN)
+/* The start of every entry point; name is its full name (fmi3DoStep), the modes it may
+ * be called in MODES_<name>. The _AS forms are for macros (fmi_entries.h). */
+#define BEGIN(name) BEGIN_AS(#name, MODES_##name)
+#define BEGIN_AS(function, modes) \
+    FmuInstance *I = (FmuInstance *)instance; \
+    static const char FN[] = function; \
+    if (!I) return fmi3Error; \
+    if (!(I->core.mode & (modes))) return (fmi3Status)fmu_mode_error(I, FN)
 
 /* a Model Exchange function: a Co-Simulation instance is refused */
-#define BEGIN_ME(name)                                                        \
-    BEGIN(name);                                                              \
+#define BEGIN_ME(name) BEGIN_ME_AS(#name, MODES_##name)
+#define BEGIN_ME_AS(function, modes) \
+    BEGIN_AS(function, modes); \
     if (!I->modelExchange) return (fmi3Status)fmu_error(I, FN, "%s", NO_EVENT_MODE)
 
-#define CHECK(expression)                                                     \
-    do {                                                                      \
-        const FmuStatus status_ = (expression);                               \
-        if (status_ > FMU_WARNING) return (fmi3Status)status_;                \
+#define CHECK(expression) \
+    do { \
+        const FmuStatus status_ = (expression); \
+        if (status_ > FMU_WARNING) return (fmi3Status)status_; \
     } while (0)
 
 #define NO_EVENT_MODE "a Model Exchange function, and this instance was instantiated for Co-Simulation"
@@ -127,7 +131,9 @@ static void release_state(FmuInstance *instance, void *memory) {
     free(memory);
 }
 
-const char *fmi3GetVersion(void) { return fmi3Version; }
+const char *fmi3GetVersion(void) {
+    return fmi3Version;
+}
 
 /* A new instance; NULL, said why, on the first problem: those of every
  * instance, then the interface's own (interfaceRefusal, if not NULL). */
@@ -163,13 +169,16 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
                                          const fmi3ValueReference requiredIntermediateVariables[],
                                          size_t nRequiredIntermediateVariables,
-                                         fmi3InstanceEnvironment instanceEnvironment,
-                                         fmi3LogMessageCallback logMessage,
+                                         fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage,
                                          fmi3IntermediateUpdateCallback intermediateUpdate) {
-    (void)resourcePath; (void)visible; (void)earlyReturnAllowed;
-    (void)requiredIntermediateVariables; (void)intermediateUpdate;
-    const char *reason = eventModeUsed ? NO_CS_EVENT_MODE
-                       : nRequiredIntermediateVariables > 0 ? "this FMU provides no intermediate update" : NULL;
+    (void)resourcePath;
+    (void)visible;
+    (void)earlyReturnAllowed;
+    (void)requiredIntermediateVariables;
+    (void)intermediateUpdate;
+    const char *reason = eventModeUsed                        ? NO_CS_EVENT_MODE
+                         : nRequiredIntermediateVariables > 0 ? "this FMU provides no intermediate update"
+                                                              : NULL;
     return instantiate(reason, false, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
 }
 
@@ -177,7 +186,8 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage) {
-    (void)resourcePath; (void)visible;
+    (void)resourcePath;
+    (void)visible;
     return instantiate(NULL, true, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
 }
 
@@ -185,8 +195,9 @@ void fmi3FreeInstance(fmi3Instance instance) {
     free(instance);
 }
 
-fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories, const fmi3String categories[]) {
-    BEGIN(SetDebugLogging);
+fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
+                               const fmi3String categories[]) {
+    BEGIN(fmi3SetDebugLogging);
     return (fmi3Status)fmu_set_debug_logging(I, FN, loggingOn, nCategories, categories, 0);
 }
 
@@ -194,12 +205,12 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
     (void)toleranceDefined;
     (void)tolerance;
-    BEGIN(EnterInitializationMode);
+    BEGIN(fmi3EnterInitializationMode);
     CHECK(fmu_setup_experiment(I, FN, startTime, stopTimeDefined, stopTime));
     return (fmi3Status)fmu_enter_initialization(I);
 }
 
-LIFECYCLE_ENTRIES(fmi3, fmi3Instance)
+LIFECYCLE_ENTRIES(fmi3, fmi3Instance, fmi3ExitInitializationMode, fmi3Terminate, fmi3Reset)
 
 /* ---- variable access ---------------------------------------------------- */
 
@@ -214,34 +225,33 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
 
 /* One value is the common call: straight-line code without a frame; any
  * other count goes through the loops (all checked before any is set). */
-#define ACCESSORS(NAME, TYPE, TYPE_MASK, TO_FMI)                              \
-    FMU_NOINLINE static fmi3Status get_##NAME(FmuInstance *I, const char *FN, \
-        const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
-        CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
+#define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI) \
+    FMU_NOINLINE static fmi3Status GET##_array(FmuInstance *I, const char *FN, const fmi3ValueReference vr[], \
+                                               size_t nvr, TYPE values[], size_t nValues) { \
+        CHECK(check_arrays(I, FN, vr, nvr, values, nValues)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, TYPE_MASK, vr[i])); \
         for (size_t i = 0; i < nvr; i++) values[i] = TO_FMI(fmu_get(I, vr[i])); \
-        return fmi3OK;                                                        \
-    }                                                                         \
-    FMU_NOINLINE static fmi3Status set_##NAME(FmuInstance *I, const char *FN, \
-        const fmi3ValueReference vr[], size_t nvr, const TYPE values[], size_t nValues) { \
-        CHECK(check_arrays(I, FN, vr, nvr, values, nValues));                 \
+        return fmi3OK; \
+    } \
+    FMU_NOINLINE static fmi3Status SET##_array(FmuInstance *I, const char *FN, const fmi3ValueReference vr[], \
+                                               size_t nvr, const TYPE values[], size_t nValues) { \
+        CHECK(check_arrays(I, FN, vr, nvr, values, nValues)); \
         for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, TYPE_MASK, vr[i], (double)values[i])); \
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], (double)values[i]); \
-        return fmi3OK;                                                        \
-    }                                                                         \
-    fmi3Status fmi3Get##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
-                             TYPE values[], size_t nValues) {                 \
-        BEGIN(Get##NAME);                                                     \
-        double v_;                                                            \
-        if (nvr != 1 || nValues != 1 || !vr || !values) return get_##NAME(I, FN, vr, nvr, values, nValues); \
-        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi3Error;     \
-        values[0] = TO_FMI(v_);                                               \
-        return fmi3OK;                                                        \
-    }                                                                         \
-    fmi3Status fmi3Set##NAME(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, \
-                             const TYPE values[], size_t nValues) {           \
-        BEGIN(Set##NAME);                                                     \
-        if (nvr != 1 || nValues != 1 || !vr || !values) return set_##NAME(I, FN, vr, nvr, values, nValues); \
+        return fmi3OK; \
+    } \
+    fmi3Status GET(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
+        BEGIN_AS(#GET, MODES_##GET); \
+        double v_; \
+        if (nvr != 1 || nValues != 1 || !vr || !values) return GET##_array(I, FN, vr, nvr, values, nValues); \
+        if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi3Error; \
+        values[0] = TO_FMI(v_); \
+        return fmi3OK; \
+    } \
+    fmi3Status SET(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const TYPE values[], \
+                   size_t nValues) { \
+        BEGIN_AS(#SET, MODES_##SET); \
+        if (nvr != 1 || nValues != 1 || !vr || !values) return SET##_array(I, FN, vr, nvr, values, nValues); \
         return fmu_set_one(I, FN, TYPE_MASK, vr[0], (double)values[0]) ? fmi3OK : fmi3Error; \
     }
 
@@ -250,57 +260,57 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
 #define AS_BOOLEAN(x) ((x) != 0)
 #define NO_TYPE TYPE_BIT(FMU_UNSUPPORTED_TYPE)
 
-ACCESSORS(Float64, fmi3Float64, TYPE_BIT(FMU_REAL), AS_FLOAT64)
-ACCESSORS(Int32, fmi3Int32, TYPE_BIT(FMU_INTEGER), (fmi3Int32)AS_INT)
-ACCESSORS(Int64, fmi3Int64, TYPE_BIT(FMU_ENUMERATION), (fmi3Int64)AS_INT)
-ACCESSORS(Boolean, fmi3Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN)
+ACCESSORS(fmi3GetFloat64, fmi3SetFloat64, fmi3Float64, TYPE_BIT(FMU_REAL), AS_FLOAT64)
+ACCESSORS(fmi3GetInt32, fmi3SetInt32, fmi3Int32, TYPE_BIT(FMU_INTEGER), (fmi3Int32)AS_INT)
+ACCESSORS(fmi3GetInt64, fmi3SetInt64, fmi3Int64, TYPE_BIT(FMU_ENUMERATION), (fmi3Int64)AS_INT)
+ACCESSORS(fmi3GetBoolean, fmi3SetBoolean, fmi3Boolean, TYPE_BIT(FMU_BOOLEAN), AS_BOOLEAN)
 /* no variables of these types: any value reference is refused */
-ACCESSORS(Float32, fmi3Float32, NO_TYPE, (fmi3Float32)AS_INT)
-ACCESSORS(Int8, fmi3Int8, NO_TYPE, (fmi3Int8)AS_INT)
-ACCESSORS(UInt8, fmi3UInt8, NO_TYPE, (fmi3UInt8)AS_INT)
-ACCESSORS(Int16, fmi3Int16, NO_TYPE, (fmi3Int16)AS_INT)
-ACCESSORS(UInt16, fmi3UInt16, NO_TYPE, (fmi3UInt16)AS_INT)
-ACCESSORS(UInt32, fmi3UInt32, NO_TYPE, (fmi3UInt32)AS_INT)
-ACCESSORS(UInt64, fmi3UInt64, NO_TYPE, (fmi3UInt64)AS_INT)
+ACCESSORS(fmi3GetFloat32, fmi3SetFloat32, fmi3Float32, NO_TYPE, (fmi3Float32)AS_INT)
+ACCESSORS(fmi3GetInt8, fmi3SetInt8, fmi3Int8, NO_TYPE, (fmi3Int8)AS_INT)
+ACCESSORS(fmi3GetUInt8, fmi3SetUInt8, fmi3UInt8, NO_TYPE, (fmi3UInt8)AS_INT)
+ACCESSORS(fmi3GetInt16, fmi3SetInt16, fmi3Int16, NO_TYPE, (fmi3Int16)AS_INT)
+ACCESSORS(fmi3GetUInt16, fmi3SetUInt16, fmi3UInt16, NO_TYPE, (fmi3UInt16)AS_INT)
+ACCESSORS(fmi3GetUInt32, fmi3SetUInt32, fmi3UInt32, NO_TYPE, (fmi3UInt32)AS_INT)
+ACCESSORS(fmi3GetUInt64, fmi3SetUInt64, fmi3UInt64, NO_TYPE, (fmi3UInt64)AS_INT)
 
-fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         fmi3String values[], size_t nValues) {
-    BEGIN(GetString);
+fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
+                         size_t nValues) {
+    BEGIN(fmi3GetString);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NO_TYPE, vr[i]));
     return fmi3OK;
 }
 
-fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         const fmi3String values[], size_t nValues) {
-    BEGIN(SetString);
+fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
+                         size_t nValues) {
+    BEGIN(fmi3SetString);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NO_TYPE, vr[i], 0.0));
     return fmi3OK;
 }
 
-fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         size_t valueSizes[], fmi3Binary values[], size_t nValues) {
-    BEGIN(GetBinary);
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t valueSizes[],
+                         fmi3Binary values[], size_t nValues) {
+    BEGIN(fmi3GetBinary);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_get(I, FN, NO_TYPE, vr[i]));
     return fmi3OK;
 }
 
-fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                         const size_t valueSizes[], const fmi3Binary values[], size_t nValues) {
-    BEGIN(SetBinary);
+fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const size_t valueSizes[],
+                         const fmi3Binary values[], size_t nValues) {
+    BEGIN(fmi3SetBinary);
     CHECK(check_arrays(I, FN, vr, nvr, values, nValues));
     if (nvr > 0 && !valueSizes) return (fmi3Status)fmu_error(I, FN, "the valueSizes array is NULL");
     for (size_t i = 0; i < nvr; i++) CHECK(fmu_check_set(I, FN, NO_TYPE, vr[i], 0.0));
     return fmi3OK;
 }
 
-/* ---- FMU states (fmu_core.c) ---------------------------------------------- */
+/* ---- FMU states (fmu_state.c) --------------------------------------------- */
 
-FMU_STATE_ENTRIES(fmi3, fmi3Instance, fmi3FMUState, fmi3Byte, GetFMUState, SetFMUState, FreeFMUState,
-                  SerializedFMUStateSize, SerializeFMUState, DeserializeFMUState)
+FMU_STATE_ENTRIES(fmi3, fmi3Instance, fmi3FMUState, fmi3Byte, fmi3GetFMUState, fmi3SetFMUState, fmi3FreeFMUState,
+                  fmi3SerializedFMUStateSize, fmi3SerializeFMUState, fmi3DeserializeFMUState)
 
 /* ---- Co-Simulation -------------------------------------------------------- */
 
@@ -310,7 +320,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    BEGIN(DoStep);
+    BEGIN(fmi3DoStep);
     if (!eventHandlingNeeded || !terminateSimulation || !earlyReturn || !lastSuccessfulTime) {
         return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
     }
@@ -323,15 +333,17 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
 }
 
 /* ---- Model Exchange: no continuous states, no event indicators; the cycle
- * ends are time events (fmu_core.h) ------------------------------------- */
+ * ends are time events (fmu_model_exchange.h) ---------------------------- */
 
-MODEL_EXCHANGE_ENTRIES(fmi3, fmi3Instance, fmi3Float64, fmi3Boolean, GetContinuousStateDerivatives)
+MODEL_EXCHANGE_ENTRIES(fmi3, fmi3Instance, fmi3Float64, fmi3Boolean, fmi3EnterEventMode, fmi3EnterContinuousTimeMode,
+                       fmi3CompletedIntegratorStep, fmi3SetTime, fmi3SetContinuousStates, fmi3GetContinuousStates,
+                       fmi3GetContinuousStateDerivatives, fmi3GetNominalsOfContinuousStates, fmi3GetEventIndicators)
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
                                     fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
                                     fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
                                     fmi3Float64 *nextEventTime) {
-    BEGIN_ME(UpdateDiscreteStates);
+    BEGIN_ME(fmi3UpdateDiscreteStates);
     if (!discreteStatesNeedUpdate || !terminateSimulation || !nominalsOfContinuousStatesChanged ||
         !valuesOfContinuousStatesChanged || !nextEventTimeDefined || !nextEventTime) {
         return (fmi3Status)fmu_error(I, FN, "an output argument pointer is NULL");
@@ -344,16 +356,16 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
     return fmi3OK;
 }
 
-#define NUMBER_OF_NONE(NAME)                                                  \
-    fmi3Status fmi3GetNumberOf##NAME(fmi3Instance instance, size_t *n) {      \
-        BEGIN_ME(GetNumberOf##NAME);                                          \
-        if (!n) return (fmi3Status)fmu_error(I, FN, "the pointer is NULL");   \
-        *n = 0;                                                               \
-        return fmi3OK;                                                        \
+#define NUMBER_OF_NONE(NAME) \
+    fmi3Status NAME(fmi3Instance instance, size_t *n) { \
+        BEGIN_ME_AS(#NAME, MODES_##NAME); \
+        if (!n) return (fmi3Status)fmu_error(I, FN, "the pointer is NULL"); \
+        *n = 0; \
+        return fmi3OK; \
     }
 
-NUMBER_OF_NONE(EventIndicators)
-NUMBER_OF_NONE(ContinuousStates)
+NUMBER_OF_NONE(fmi3GetNumberOfEventIndicators)
+NUMBER_OF_NONE(fmi3GetNumberOfContinuousStates)
 
 /* ---- not provided --------------------------------------------------------- */
 
@@ -369,52 +381,78 @@ static fmi3Status unsupported(fmi3Instance instance, const char *function, const
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
                                                fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                                fmi3InstanceEnvironment instanceEnvironment,
-                                               fmi3LogMessageCallback logMessage,
-                                               fmi3ClockUpdateCallback clockUpdate,
+                                               fmi3LogMessageCallback logMessage, fmi3ClockUpdateCallback clockUpdate,
                                                fmi3LockPreemptionCallback lockPreemption,
                                                fmi3UnlockPreemptionCallback unlockPreemption) {
-    (void)instanceName; (void)instantiationToken; (void)resourcePath; (void)visible;
-    (void)clockUpdate; (void)lockPreemption; (void)unlockPreemption;
+    (void)instanceName;
+    (void)instantiationToken;
+    (void)resourcePath;
+    (void)visible;
+    (void)clockUpdate;
+    (void)lockPreemption;
+    (void)unlockPreemption;
     if (logMessage && loggingOn) logMessage(instanceEnvironment, fmi3Error, "logStatusError", NO_SCHEDULED);
     return NULL;
 }
 
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
-    (void)vr; (void)nvr; (void)values;
+    (void)vr;
+    (void)nvr;
+    (void)values;
     return unsupported(instance, "fmi3GetClock", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
-    (void)vr; (void)nvr; (void)values;
+    (void)vr;
+    (void)nvr;
+    (void)values;
     return unsupported(instance, "fmi3SetClock", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference vr, size_t *n) {
-    (void)vr; (void)n;
+    (void)vr;
+    (void)n;
     return unsupported(instance, "fmi3GetNumberOfVariableDependencies", NO_DERIVATIVES);
 }
 
-fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent, size_t elementIndicesOfDependent[],
-                                       fmi3ValueReference independents[], size_t elementIndicesOfIndependents[],
-                                       fmi3DependencyKind dependencyKinds[], size_t nDependencies) {
-    (void)dependent; (void)elementIndicesOfDependent; (void)independents;
-    (void)elementIndicesOfIndependents; (void)dependencyKinds; (void)nDependencies;
+fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent,
+                                       size_t elementIndicesOfDependent[], fmi3ValueReference independents[],
+                                       size_t elementIndicesOfIndependents[], fmi3DependencyKind dependencyKinds[],
+                                       size_t nDependencies) {
+    (void)dependent;
+    (void)elementIndicesOfDependent;
+    (void)independents;
+    (void)elementIndicesOfIndependents;
+    (void)dependencyKinds;
+    (void)nDependencies;
     return unsupported(instance, "fmi3GetVariableDependencies", NO_DERIVATIVES);
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                         const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                         size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
-    (void)sensitivity; (void)nSensitivity;
+    (void)unknowns;
+    (void)nUnknowns;
+    (void)knowns;
+    (void)nKnowns;
+    (void)seed;
+    (void)nSeed;
+    (void)sensitivity;
+    (void)nSensitivity;
     return unsupported(instance, "fmi3GetDirectionalDerivative", NO_DERIVATIVES);
 }
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
                                     const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
                                     size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
-    (void)sensitivity; (void)nSensitivity;
+    (void)unknowns;
+    (void)nUnknowns;
+    (void)knowns;
+    (void)nKnowns;
+    (void)seed;
+    (void)nSeed;
+    (void)sensitivity;
+    (void)nSensitivity;
     return unsupported(instance, "fmi3GetAdjointDerivative", NO_DERIVATIVES);
 }
 
@@ -428,46 +466,71 @@ fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                   fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
-    (void)vr; (void)nvr; (void)intervals; (void)qualifiers;
+    (void)vr;
+    (void)nvr;
+    (void)intervals;
+    (void)qualifiers;
     return unsupported(instance, "fmi3GetIntervalDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                   fmi3UInt64 counters[], fmi3UInt64 resolutions[], fmi3IntervalQualifier qualifiers[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions; (void)qualifiers;
+                                   fmi3UInt64 counters[], fmi3UInt64 resolutions[],
+                                   fmi3IntervalQualifier qualifiers[]) {
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
+    (void)qualifiers;
     return unsupported(instance, "fmi3GetIntervalFraction", NO_CLOCKS);
 }
 
 fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 shifts[]) {
-    (void)vr; (void)nvr; (void)shifts;
+    (void)vr;
+    (void)nvr;
+    (void)shifts;
     return unsupported(instance, "fmi3GetShiftDecimal", NO_CLOCKS);
 }
 
-fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                fmi3UInt64 counters[], fmi3UInt64 resolutions[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 counters[],
+                                fmi3UInt64 resolutions[]) {
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
     return unsupported(instance, "fmi3GetShiftFraction", NO_CLOCKS);
 }
 
-fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 intervals[]) {
-    (void)vr; (void)nvr; (void)intervals;
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                  const fmi3Float64 intervals[]) {
+    (void)vr;
+    (void)nvr;
+    (void)intervals;
     return unsupported(instance, "fmi3SetIntervalDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                    const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
     return unsupported(instance, "fmi3SetIntervalFraction", NO_CLOCKS);
 }
 
-fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 shifts[]) {
-    (void)vr; (void)nvr; (void)shifts;
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                               const fmi3Float64 shifts[]) {
+    (void)vr;
+    (void)nvr;
+    (void)shifts;
     return unsupported(instance, "fmi3SetShiftDecimal", NO_CLOCKS);
 }
 
 fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                 const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
-    (void)vr; (void)nvr; (void)counters; (void)resolutions;
+    (void)vr;
+    (void)nvr;
+    (void)counters;
+    (void)resolutions;
     return unsupported(instance, "fmi3SetShiftFraction", NO_CLOCKS);
 }
 
@@ -481,11 +544,17 @@ fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                     const fmi3Int32 orders[], fmi3Float64 values[], size_t nValues) {
-    (void)vr; (void)nvr; (void)orders; (void)values; (void)nValues;
+    (void)vr;
+    (void)nvr;
+    (void)orders;
+    (void)values;
+    (void)nValues;
     return unsupported(instance, "fmi3GetOutputDerivatives", NO_DERIVATIVES);
 }
 
-fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
-    (void)clockReference; (void)activationTime;
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
+                                      fmi3Float64 activationTime) {
+    (void)clockReference;
+    (void)activationTime;
     return unsupported(instance, "fmi3ActivateModelPartition", NO_SCHEDULED);
 }

@@ -1,7 +1,8 @@
-/* FMI-version independent part of every FMU: variable access, the cycle
- * scheduler (docs/fmi.md, Time: the communication step is the PLC cycle),
- * FMU states and their serialization, logging.
- * fmi2_glue.c and fmi3_glue.c map the FMI C APIs onto it; a model
+/* FMI-version independent part of every FMU: the instance, variable
+ * access, the cycle scheduler and Co-Simulation's step (docs/fmi.md, Time:
+ * the communication step is the PLC cycle), logging. Model Exchange
+ * (fmu_model_exchange.h) and FMU states (fmu_state.h) build on it.
+ * fmi2_glue.c and fmi3_glue.c map the FMI C APIs onto them; a model
  * (model.h, models/<Model>.c) maps its variables onto the kernel. */
 #ifndef FMU_CORE_H
 #define FMU_CORE_H
@@ -22,13 +23,13 @@ typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } FmuStatu
  * modes it is allowed in. Step Mode is Co-Simulation's, Event Mode and
  * Continuous-Time Mode are Model Exchange's; the others are shared. */
 typedef enum {
-    MODE_INSTANTIATED   = 1 << 0,
+    MODE_INSTANTIATED = 1 << 0,
     MODE_INITIALIZATION = 1 << 1,
-    MODE_STEP           = 1 << 2,
-    MODE_TERMINATED     = 1 << 3,
-    MODE_ERROR          = 1 << 4,
-    MODE_EVENT          = 1 << 5,
-    MODE_CONTINUOUS     = 1 << 6
+    MODE_STEP = 1 << 2,
+    MODE_TERMINATED = 1 << 3,
+    MODE_ERROR = 1 << 4,
+    MODE_EVENT = 1 << 5,
+    MODE_CONTINUOUS = 1 << 6
 } FmuMode;
 
 /* A step that would run more cycles than this is refused (no endless loop
@@ -48,13 +49,13 @@ typedef struct {
     RlState block;
     double startTime;
     double time;
-    uint64_t cycles;        /* cycles run since the start (cycleTime > 0) */
+    uint64_t cycles; /* cycles run since the start (cycleTime > 0) */
     /* Model Exchange: the values as the last event instant left them, which
      * the next cycle runs with (latch), and that instant's time */
     double latched[FMU_MAX_VARIABLES];
     double eventTime;
-    int mode;               /* FmuMode */
-    int reportedStatus;     /* status word last reported in the log */
+    int mode;           /* FmuMode */
+    int reportedStatus; /* status word last reported in the log */
 } FmuCore;
 
 typedef struct FmuInstance FmuInstance;
@@ -66,10 +67,10 @@ struct FmuInstance {
      * from the values at the next step (configure), prepared before a
      * cycle runs (prepareDue) */
     RlPrepared prepared;
-    int modelMode;          /* the model's own, from the same configure */
-    bool configDirty;       /* a parameter or input other than u changed */
+    int modelMode;              /* the model's own, from the same configure */
+    bool configDirty;           /* a parameter or input other than u changed */
     unsigned char outputsStale; /* FMU_STALE_*: what changed since the outputs were published */
-    bool prepareDue;        /* the configuration changed: prepare before the next cycle */
+    bool prepareDue;            /* the configuration changed: prepare before the next cycle */
     /* Step size of the common step (fmu_step_fast), one per arithmetic of
      * the prepared block, so that the step's compare of h also picks the
      * arithmetic: set (the one of the block's arithmetic, the other NaN) by
@@ -78,7 +79,7 @@ struct FmuInstance {
      * changes (fmu_disarm); and its time tolerance, set there too (see
      * there why it never exceeds the general one). */
     double fastPeriodReal, fastPeriodLreal, fastTolerance;
-    double cycleTime;       /* sub-cycle length, 0 = one cycle per step */
+    double cycleTime; /* sub-cycle length, 0 = one cycle per step */
     /* model->inputVr and outputVr, one load nearer. Every model's u is an
      * unranged, non-fixed Real input and its y a Real output (checked
      * against each model's TOML by test_model_description.py), so the
@@ -86,10 +87,10 @@ struct FmuInstance {
     unsigned inputVr, outputVr;
     const ModelDefinition *model;
     FmuLogFunction *logFunction;
-    int logCategories;      /* enabled categories */
-    int errorMode;          /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
-    bool modelExchange;     /* instantiated for Model Exchange, not Co-Simulation */
-    void *environment;      /* the importer's instance environment */
+    int logCategories;  /* enabled categories */
+    int errorMode;      /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
+    bool modelExchange; /* instantiated for Model Exchange, not Co-Simulation */
+    void *environment;  /* the importer's instance environment */
     /* memory for FMU states, as the importer provides it (FMI 2) or not */
     void *(*allocate)(FmuInstance *instance, size_t size);
     void (*release)(FmuInstance *instance, void *memory);
@@ -283,44 +284,27 @@ static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function,
     return fmu_step_fast(instance, t, h) ? FMU_OK : fmu_do_step_general(instance, function, t, h);
 }
 
-/* FMU states, for both FMI versions: the glue converts types only. A state
- * is a tagged copy of the core (a foreign pointer is refused, not read);
- * serialized, it is a header, the payload and a CRC-32. *state NULL: a new
- * state is allocated, else the given one is overwritten. */
-RL_LINKAGE FmuStatus fmu_get_state(FmuInstance *instance, const char *function, void **state);
-RL_LINKAGE FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void *state);
-RL_LINKAGE FmuStatus fmu_free_state(FmuInstance *instance, const char *function, void **state);
-RL_LINKAGE FmuStatus fmu_serialized_state_size(FmuInstance *instance, const char *function, const void *state,
-                                               size_t *size);
-RL_LINKAGE FmuStatus fmu_serialize_state(FmuInstance *instance, const char *function, const void *state,
-                                         unsigned char *out, size_t size);
-RL_LINKAGE FmuStatus fmu_deserialize_state(FmuInstance *instance, const char *function, const unsigned char *in,
-                                           size_t size, void **state);
-
-/* ---- Model Exchange (docs/fmi.md, Model Exchange) ------------------------
- * No continuous states, no event indicators: the cycle ends are time
- * events, and each cycle runs in Event Mode at its end with the values
- * latched when the instant before it was left. */
-
-/* Event Mode entered: an instant at the FMU's time. */
-RL_LINKAGE void fmu_enter_event_mode(FmuInstance *instance);
-/* The event update: the cycles that ended by the FMU's time, with the
- * latched values. *nextEventTime: the next cycle end; none (0, and
- * *nextEventTimeDefined false) without a valid cycle. */
-RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function,
-                                                bool *nextEventTimeDefined, double *nextEventTime);
-/* Continuous-Time Mode entered: the instant is left. */
-RL_LINKAGE void fmu_enter_continuous_time_mode(FmuInstance *instance);
-/* The instant is left (Continuous-Time Mode entered, or the time set anew
- * in Event Mode): its values are those of the next cycle. */
-RL_LINKAGE void fmu_leave_instant(FmuInstance *instance);
-/* fmi2SetTime / fmi3SetTime: a finite time, not before the last event. */
-RL_LINKAGE FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time);
-/* A call that passes arrays of continuous states or event indicators:
- * this FMU has none, so n must be 0. */
-RL_LINKAGE FmuStatus fmu_check_none(FmuInstance *instance, const char *function, const char *what, size_t n,
-                                    const void *array);
-
 RL_LINKAGE const char *fmu_mode_name(int mode);
+
+/* ---- shared with Model Exchange (fmu_model_exchange.c) ------------------ */
+
+/* The kernel's configuration from the current values (the outputs of the
+ * last cycle published first: they need its configuration). */
+RL_LINKAGE FMU_NOINLINE void fmu_configure(FmuInstance *instance);
+/* Model Exchange, after fmu_configure: no cycle without cycleTime. */
+RL_LINKAGE void fmu_refuse_no_cycle(FmuInstance *instance);
+/* Sub-cycling: the cycles that end by the time end; *ran when one ran. */
+RL_LINKAGE FMU_NOINLINE FmuStatus fmu_run_cycles(FmuInstance *instance, const char *function, double end, double h,
+                                                 double u, bool *ran);
+RL_LINKAGE FMU_NOINLINE void fmu_log_status(FmuInstance *instance);
+
+/* A status word that changed since it was last reported is logged once
+ * (fmu_log_status); the call returns OK. */
+static inline FmuStatus fmu_report_status(FmuInstance *instance) {
+    if (instance->prepared.status != instance->core.reportedStatus) {
+        fmu_log_status(instance);
+    }
+    return FMU_OK;
+}
 
 #endif

@@ -61,10 +61,11 @@ typedef struct {
  * configure, publish, status outputs or NULL), with the variable table of
  * its generated header. In an FMU's unit it comes before the core, which
  * uses it (rate_limiter.h, RL_LINKAGE). */
-#define FMU_MODEL(inputVr, outputVr, configure, publish, statusOutputs)                                  \
-    RL_DEFINITION const ModelDefinition fmuModel = { MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables,      \
-                                                     MODEL_VARIABLE_COUNT, inputVr, outputVr, configure, \
-                                                     publish, statusOutputs }
+#define FMU_MODEL(inputVr, outputVr, configure, publish, statusOutputs) \
+    RL_DEFINITION const ModelDefinition fmuModel = { \
+        MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, inputVr, \
+        outputVr,         configure,   publish,        statusOutputs \
+    }
 #ifndef RL_UNIT
 extern const ModelDefinition fmuModel;
 #endif

@@ -30,25 +30,37 @@ int rl_status(const RlConfig *c, int *source) {
 
     const RlValue *rates[4] = { &c->rateUp, &c->rateDown, &c->rateUpNeg, &c->rateDownNeg };
     for (int i = 0; i < 4 && !culprit; i++) {
-        if (isless(rates[i]->value, 0)) { status = RL_STATUS_RATE_NEGATIVE; culprit = rates[i]; }
+        if (isless(rates[i]->value, 0)) {
+            status = RL_STATUS_RATE_NEGATIVE;
+            culprit = rates[i];
+        }
     }
     for (int i = 0; i < 4 && !culprit; i++) {
-        if (isnan(rates[i]->value)) { status = RL_STATUS_RATE_NAN; culprit = rates[i]; }
+        if (isnan(rates[i]->value)) {
+            status = RL_STATUS_RATE_NAN;
+            culprit = rates[i];
+        }
     }
     if (culprit) {
         /* the first match above */
     } else if (!isgreaterequal(c->ratePeriod.value, 0) || !isfinite(c->ratePeriod.value)) {
-        status = RL_STATUS_RATE_PERIOD; culprit = &c->ratePeriod;
+        status = RL_STATUS_RATE_PERIOD;
+        culprit = &c->ratePeriod;
     } else if (!isgreaterequal(c->duration.value, 0)) {
-        status = RL_STATUS_DURATION; culprit = &c->duration;
+        status = RL_STATUS_DURATION;
+        culprit = &c->duration;
     } else if (isgreater(rl_low_limit(c->yMin.value), rl_high_limit(c->yMax.value))) {
-        status = RL_STATUS_LIMITS; culprit = &c->yMin;
+        status = RL_STATUS_LIMITS;
+        culprit = &c->yMin;
     } else if (!(isgreaterequal(c->accelMax.value, 0) && isfinite(c->accelMax.value))) {
-        status = RL_STATUS_ACCELERATION; culprit = &c->accelMax;
+        status = RL_STATUS_ACCELERATION;
+        culprit = &c->accelMax;
     } else if (!(isgreaterequal(c->decelMax.value, 0) && isfinite(c->decelMax.value))) {
-        status = RL_STATUS_ACCELERATION; culprit = &c->decelMax;
+        status = RL_STATUS_ACCELERATION;
+        culprit = &c->decelMax;
     } else if (c->cycleRefused || !isgreaterequal(c->cycleTime.value, 0) || !isfinite(c->cycleTime.value)) {
-        status = RL_STATUS_NO_CYCLE; culprit = &c->cycleTime;
+        status = RL_STATUS_NO_CYCLE;
+        culprit = &c->cycleTime;
     }
     *source = culprit ? culprit->source : 0;
     return status;
@@ -129,9 +141,10 @@ void rl_prepare(RlPrepared *p, const RlConfig *config, double period) {
     const double decelMax = isgreater(c->decelMax.value, 0) ? c->decelMax.value : c->accelMax.value;
     p->accelStep = p->accelLimited ? cycle_square(c->accelMax.value, c, period) : 0.0;
     p->decelStep = p->accelLimited ? cycle_square(decelMax, c, period) : 0.0;
-    p->plain = !p->accelLimited && !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED && !rl_status_is_error(p->status) && !c->hold &&
-               p->yLow == -INFINITY && p->yHigh == INFINITY && p->maxUpNeg == p->maxUp &&
-               p->maxDownNeg == p->maxDown && rl_steady_limit(p->maxUp) && rl_steady_limit(p->maxDown);
+    p->plain = !p->accelLimited && !c->bypass && c->initMode != RL_INIT_INPUT_DELAYED &&
+               !rl_status_is_error(p->status) && !c->hold && p->yLow == -INFINITY && p->yHigh == INFINITY &&
+               p->maxUpNeg == p->maxUp && p->maxDownNeg == p->maxDown && rl_steady_limit(p->maxUp) &&
+               rl_steady_limit(p->maxDown);
     p->durationLimited = isgreater(c->duration.value, 0);
 }
 
@@ -248,7 +261,7 @@ static double leg_time(double length, double rate, const RlPrepared *p) {
         return c->zeroRate == RL_ZERO_RATE_NO_LIMIT ? 0.0 : INFINITY;
     }
     const double perSecond = isgreater(c->ratePeriod.value, 0) ? rl_quotient(rate, c->ratePeriod.value)
-                                                                : rl_quotient(rate, p->period);
+                                                               : rl_quotient(rate, p->period);
     /* a rate that underflows to 0 per second takes for ever, as IEEE has it */
     return perSecond == 0 ? INFINITY : rl_quotient(length, perSecond);
 }
@@ -318,9 +331,11 @@ void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
     o->highLimit = isfinite(y) && isgreaterequal(y, p->yHigh);
     o->lowLimit = isfinite(y) && islessequal(y, p->yLow);
     o->dydt = s->decided != RL_DECIDED_NOTHING && isfinite(y) && isfinite(yp)
-                  ? (real ? rl_dydt_real(y, yp, p->period) : rl_dydt_lreal(y, yp, p->period)) : 0.0;
+                  ? (real ? rl_dydt_real(y, yp, p->period) : rl_dydt_lreal(y, yp, p->period))
+                  : 0.0;
     const bool remains = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc);
     o->remainingTime = !remains ? 0.0 : p->accelLimited ? planned_time(s, p, uc) : remaining_time(s, p, y, uc);
     o->d2ydt2 = !ramped || !isfinite(o->dydt) ? 0.0
-                : real ? rl_d2ydt2_real(o->dydt, s, p->period) : rl_d2ydt2_lreal(o->dydt, s, p->period);
+                : real                        ? rl_d2ydt2_real(o->dydt, s, p->period)
+                                              : rl_d2ydt2_lreal(o->dydt, s, p->period);
 }

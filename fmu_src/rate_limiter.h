@@ -51,15 +51,15 @@
 
 /* Status words (Siemens convention: RL_STATUS_ERROR and above are errors). */
 enum {
-    RL_STATUS_OK                = 0x0000,
-    RL_STATUS_ERROR             = 0x8000, /* the first error word */
-    RL_STATUS_RATE_NEGATIVE     = 0x8200,
-    RL_STATUS_RATE_NAN          = 0x8201,
-    RL_STATUS_RATE_PERIOD       = 0x8202,
-    RL_STATUS_DURATION          = 0x8203,
-    RL_STATUS_LIMITS            = 0x8204,
-    RL_STATUS_ACCELERATION      = 0x8205,
-    RL_STATUS_NO_CYCLE          = 0x8601
+    RL_STATUS_OK = 0x0000,
+    RL_STATUS_ERROR = 0x8000, /* the first error word */
+    RL_STATUS_RATE_NEGATIVE = 0x8200,
+    RL_STATUS_RATE_NAN = 0x8201,
+    RL_STATUS_RATE_PERIOD = 0x8202,
+    RL_STATUS_DURATION = 0x8203,
+    RL_STATUS_LIMITS = 0x8204,
+    RL_STATUS_ACCELERATION = 0x8205,
+    RL_STATUS_NO_CYCLE = 0x8601
 };
 
 enum { RL_ZERO_RATE_HOLD = 1, RL_ZERO_RATE_NO_LIMIT = 2 };
@@ -69,10 +69,12 @@ enum { RL_INIT_VALUE = 1, RL_INIT_INPUT = 2, RL_INIT_INPUT_DELAYED = 3 };
 enum { RL_ARITHMETIC_LREAL = 1, RL_ARITHMETIC_REAL = 2 };
 
 /* Which rule decided the last cycle, for the outputs derived from it */
-enum { RL_DECIDED_NOTHING = 0, /* no cycle yet */
-       RL_DECIDED_OTHER = 1,   /* rules 1 to 5 */
-       RL_DECIDED_HOLD = 2,    /* rule 5b */
-       RL_DECIDED_RAMP = 3 };  /* rule 6, the duration jump included */
+enum {
+    RL_DECIDED_NOTHING = 0, /* no cycle yet */
+    RL_DECIDED_OTHER = 1,   /* rules 1 to 5 */
+    RL_DECIDED_HOLD = 2,    /* rule 5b */
+    RL_DECIDED_RAMP = 3
+}; /* rule 6, the duration jump included */
 
 /* Relative tolerance for time comparisons (cycle ends, duration, delay). */
 #define RL_TIME_TOLERANCE 1e-9
@@ -94,27 +96,27 @@ static inline RlValue rl_value(double value, int source) {
 /* Everything but the signal u: parameters and slowly changing inputs, with
  * "or Par" inputs already resolved (rl_resolve). */
 typedef struct {
-    RlValue rateUp, rateDown;  /* change per ratePeriod */
+    RlValue rateUp, rateDown;       /* change per ratePeriod */
     RlValue rateUpNeg, rateDownNeg; /* the same while the output is < 0 */
-    RlValue yMax, yMin;        /* output limits; NaN: none */
-    bool hold;                 /* rule 5b: freeze the output */
-    RlValue accelMax, decelMax; /* units/s^2; accelMax 0: no acceleration
+    RlValue yMax, yMin;             /* output limits; NaN: none */
+    bool hold;                      /* rule 5b: freeze the output */
+    RlValue accelMax, decelMax;     /* units/s^2; accelMax 0: no acceleration
                                   limit; decelMax 0: braking at accelMax */
-    RlValue ratePeriod;        /* s; 0 = change per cycle */
-    RlValue duration;          /* s; 0 = never jump */
-    RlValue cycleTime;         /* s; only validated here */
-    bool cycleRefused;         /* no valid cycle, whatever cycleTime says (an
+    RlValue ratePeriod;             /* s; 0 = change per cycle */
+    RlValue duration;               /* s; 0 = never jump */
+    RlValue cycleTime;              /* s; only validated here */
+    bool cycleRefused;              /* no valid cycle, whatever cycleTime says (an
                                   invalid callOB): 0x8601 from cycleTime.source */
     bool bypass;
-    double bypassValue;        /* non-finite: output follows u */
-    int zeroRate;              /* RL_ZERO_RATE_* */
-    int initMode;              /* RL_INIT_* */
+    double bypassValue; /* non-finite: output follows u */
+    int zeroRate;       /* RL_ZERO_RATE_* */
+    int initMode;       /* RL_INIT_* */
     double initValue;
-    double initDelay;          /* s */
+    double initDelay; /* s */
     /* true: a non-finite u passes at once (rule 1). false (Siemens): u is
      * only compared with the output, so NaN holds and +-inf ramps. */
     bool passNonFinite;
-    bool limitInitialOutput;   /* the initial output within [yMin, yMax] */
+    bool limitInitialOutput; /* the initial output within [yMin, yMax] */
     /* REAL (rules.md, Arithmetic): the signal path in binary32. rl_prepare
      * rounds the values that enter it; u is rounded each cycle (rl_input). */
     bool real;
@@ -123,22 +125,22 @@ typedef struct {
 /* Per-configuration values derived once, not every cycle. */
 typedef struct {
     RlConfig config;
-    double period;             /* T the limits were computed for */
-    double maxUp, maxDown;     /* per-cycle limits; +inf = no limit */
+    double period;               /* T the limits were computed for */
+    double maxUp, maxDown;       /* per-cycle limits; +inf = no limit */
     double maxUpNeg, maxDownNeg; /* the same while the output is < 0 */
     /* REAL: maxUp and maxDown as the binary32 values they are (rl_prepare
      * rounds what they come from), so that rule 6 reads them unconverted */
     float maxUpReal, maxDownReal;
-    double yLow, yHigh;        /* output limits; -inf and +inf for none */
-    double durationReached;    /* runningTime at or above this jumps */
-    double initDelayEnd;       /* elapsed time up to which initMode 3 tracks */
+    double yLow, yHigh;     /* output limits; -inf and +inf for none */
+    double durationReached; /* runningTime at or above this jumps */
+    double initDelayEnd;    /* elapsed time up to which initMode 3 tracks */
     int status;
-    int statusSource;          /* id of the variable that caused status */
-    bool plain;                /* only rule 6 can decide a cycle with a
+    int statusSource;     /* id of the variable that caused status */
+    bool plain;           /* only rule 6 can decide a cycle with a
                                   finite u and y, towards u itself, at the
                                   same limits whatever the output's sign
                                   (rl_prepare says when) */
-    bool durationLimited;      /* duration > 0 */
+    bool durationLimited; /* duration > 0 */
     /* rules.md, Acceleration limit: accelMax > 0 and no error; then the
      * largest change of the step per cycle while it grows (accelStep =
      * accelMax * T * T) and while it shrinks (decelStep), in the
@@ -153,8 +155,8 @@ typedef struct {
 typedef struct {
     double y;
     double uPrevious;
-    double yPrevious;          /* y before the last cycle */
-    unsigned char decided;     /* RL_DECIDED_*: what decided the last cycle */
+    double yPrevious;      /* y before the last cycle */
+    unsigned char decided; /* RL_DECIDED_*: what decided the last cycle */
     uint64_t runCycles;
     double runPeriod;
     double runBase;
@@ -252,8 +254,7 @@ static inline float rl_binary32(double x) {
 
 /* m * 2^e, m 0 or in [0.25, 2], reaches 2^DBL_MAX_EXP: it overflows. */
 static inline bool rl_overflows(double m, int e) {
-    return m != 0 &&
-           (e > DBL_MAX_EXP + 2 || (e >= DBL_MAX_EXP - 1 && isgreaterequal(m, ldexp(1.0, DBL_MAX_EXP - e))));
+    return m != 0 && (e > DBL_MAX_EXP + 2 || (e >= DBL_MAX_EXP - 1 && isgreaterequal(m, ldexp(1.0, DBL_MAX_EXP - e))));
 }
 
 /* a * b for a, b not NaN */
@@ -333,7 +334,7 @@ static inline double rl_two_product(double a, double b, double *error) {
  * its sign taken from the exact terms. */
 static inline bool rl_stops_within(double s, double b, double e) {
     double n = floor(s / b);
-    if (fma(n, b, -s) > 0) n -= 1;        /* n * b <= s < (n + 1) * b */
+    if (fma(n, b, -s) > 0) n -= 1; /* n * b <= s < (n + 1) * b */
     else if (fma(n + 1, b, -s) <= 0) n += 1;
     double pe, qe, e1, e2;
     const double p = rl_two_product(n + 1, s, &pe), q = rl_two_product(b, n * (n + 1) / 2, &qe);
@@ -436,12 +437,12 @@ RL_LINKAGE void rl_run(RlState *state, const RlPrepared *prepared, double u, uin
  * cost the cycles nothing. prepared must be the
  * configuration the last cycle ran with. */
 typedef struct {
-    bool rampActive;           /* rule 6 decided it and left y != uc */
+    bool rampActive;               /* rule 6 decided it and left y != uc */
     bool limitingUp, limitingDown; /* rule 6 ramped and that limit cut the step */
-    bool highLimit, lowLimit;  /* y finite and at or beyond yMax / yMin */
-    double dydt;               /* (y - yp) / T; 0 if either is not finite */
-    double remainingTime;      /* s the ramp still needs to reach uc */
-    double d2ydt2;             /* (dydt - dydt of the cycle before) / T */
+    bool highLimit, lowLimit;      /* y finite and at or beyond yMax / yMin */
+    double dydt;                   /* (y - yp) / T; 0 if either is not finite */
+    double remainingTime;          /* s the ramp still needs to reach uc */
+    double d2ydt2;                 /* (dydt - dydt of the cycle before) / T */
 } RlOutputs;
 
 RL_LINKAGE void rl_outputs(const RlState *state, const RlPrepared *prepared, RlOutputs *outputs);

@@ -102,7 +102,8 @@ static inline RL_NUM RL_NAME(rl_stoppable_step)(RL_NUM e, RL_NUM b) {
     const RL_NUM q = RL_NAME(rl_quotient)(e, b);
     if (!isless(q, RL_BRAKING_COUNTED * RL_BRAKING_COUNTED)) {
         /* s * s / (2 * b) = e, less b for the cycles' head start */
-        const RL_NUM root = RL_NAME(rl_product)((RL_NUM)sqrt(2.0 * (double)b), (RL_NUM)sqrt((double)e));
+        const RL_NUM root = RL_NAME(rl_product)(
+            (RL_NUM)rl_binary32_or_not(sqrt(rl_product(2.0, (double)b)), sizeof(RL_NUM)), (RL_NUM)sqrt((double)e));
         const RL_NUM s = RL_NAME(rl_sum)(root, -b);
         return isgreater(s, 0) ? s : 0;
     }
@@ -129,13 +130,13 @@ static inline RL_NUM RL_NAME(rl_zone_step)(RL_NUM z, RL_NUM v, RL_NUM b) {
     const RL_NUM q = RL_NAME(rl_quotient)(z, b), w = RL_NAME(rl_quotient)(v, b);
     if (!isless(q, RL_BRAKING_COUNTED * RL_BRAKING_COUNTED) || !isless(w, RL_BRAKING_COUNTED)) {
         /* s * s = v * v + 2 * b * z, less b; in binary64, quiet */
-        const double s2 = rl_sum(rl_product((double)v, (double)v), rl_product(2.0 * (double)b, (double)z));
+        const double s2 = rl_sum(rl_product((double)v, (double)v), rl_product(rl_product(2.0, (double)b), (double)z));
         const RL_NUM s = RL_NAME(rl_sum)((RL_NUM)rl_binary32_or_not(sqrt(s2), sizeof(RL_NUM)), -b);
         return isgreater(s, v) ? s : v;
     }
     /* the largest K >= 1 with (K - 1) * w + K * (K - 1) / 2 <= q */
-    RL_NUM k = (RL_NUM)floor(((1 - 2 * (double)w) + sqrt((2 * (double)w - 1) * (2 * (double)w - 1) +
-                                                          8 * ((double)w + (double)q))) / 2);
+    RL_NUM k = (RL_NUM)floor(
+        ((1 - 2 * (double)w) + sqrt((2 * (double)w - 1) * (2 * (double)w - 1) + 8 * ((double)w + (double)q))) / 2);
     if (k < 1) k = 1;
     if (k > 1 && isgreater(RL_NAME(rl_zone_reach)(k, v, b), z)) {
         k = k - 1;
@@ -168,7 +169,7 @@ static inline RL_NUM RL_NAME(rl_advance)(RL_NUM y, RL_NUM delta) {
         return RL_NAME(rl_sum)(y, delta);
     }
     double error;
-    const double exact = rl_two_sum((double)y, (double)delta, &error); /* + error */
+    const double exact = rl_two_sum((double)y, (double)delta, &error);     /* + error */
     const RL_NUM next = (RL_NUM)rl_binary32_or_not(exact, sizeof(RL_NUM)); /* y + delta, rounded once */
     const double beyond = ((double)next - exact) - error;
     if (isgreater(delta, 0) ? isgreater(beyond, 0) : isless(beyond, 0)) {
@@ -184,7 +185,9 @@ static inline RL_NUM RL_NAME(rl_advance)(RL_NUM y, RL_NUM delta) {
  * velocity limit of the zone beyond 0 before reaching it; it lands on uc
  * itself when within the rounding of it, and is otherwise rounded towards
  * y, so that rounding never takes the output further than planned. */
-static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous, const RlPrepared *p) {
+/* Out of line: rule 6's other paths stay small enough to inline. */
+static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous,
+                                                                   const RlPrepared *p) {
     const RL_NUM a = (RL_NUM)p->accelStep, b = (RL_NUM)p->decelStep;
     const RL_NUM e = RL_NAME(rl_sum)(uc, -y);
     /* towards the target; at the target, the way the output moves */
@@ -200,8 +203,8 @@ static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous
     } else {
         /* the fastest the bounds allow: accelerate, or turn within the cycle */
         RL_NUM fastest = !isless(moving, 0) ? RL_NAME(rl_sum)(moving, a)
-                         : isinf(b)        ? a
-                                           : RL_NAME(rl_product)(a, RL_NAME(rl_quotient)(RL_NAME(rl_sum)(b, moving), b));
+                         : isinf(b)         ? a
+                                    : RL_NAME(rl_product)(a, RL_NAME(rl_quotient)(RL_NAME(rl_sum)(b, moving), b));
         fastest = RL_NAME(rl_min)(fastest, limit);
         /* a slower zone ahead, before the target: slow down in time */
         const bool zoneAhead = up ? negative && !isless(uc, 0) : !negative && isless(uc, 0);
@@ -216,7 +219,8 @@ static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous
         /* the target: stop at or before it, decided exactly */
         if (!RL_NAME(rl_stops_within)(fastest, b, distance)) {
             RL_NUM stoppable = RL_NAME(rl_stoppable_step)(distance, b);
-            for (int i = 0; i < 8 && isgreater(stoppable, 0) && !RL_NAME(rl_stops_within)(stoppable, b, distance); i++) {
+            for (int i = 0; i < 8 && isgreater(stoppable, 0) && !RL_NAME(rl_stops_within)(stoppable, b, distance);
+                 i++) {
                 stoppable = RL_NEXT_TOWARDS(stoppable, 0); /* the step's rounding, taken back */
             }
             fastest = RL_NAME(rl_min)(fastest, stoppable);
@@ -239,7 +243,7 @@ static inline RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous
 
 /* The step of the last cycle, as the acceleration limit's velocity at this
  * cycle's length: 0 after a cycle that did not ramp or jumped. */
-static inline RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
+static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepared *p) {
     if (s->decided != RL_DECIDED_RAMP || (p->durationLimited && rl_running_time(s) >= p->durationReached) ||
         !isfinite(s->y) || !isfinite(s->yPrevious)) {
         return 0;
@@ -323,7 +327,8 @@ static inline bool RL_NAME(rl_ramp_steady)(RlState *s, const RlPrepared *p, doub
 
 /* rl_run's cycles after the first, u held and plain: each is rule 6
  * without its resets; once y reaches u nothing changes any more. */
-static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, double uHeld, uint64_t first, uint64_t last) {
+static inline void RL_NAME(rl_run_steady)(RlState *s, const RlPrepared *p, double uHeld, uint64_t first,
+                                          uint64_t last) {
     const RL_NUM u = (RL_NUM)uHeld, maxUp = RL_MAX_UP(p), maxDown = RL_MAX_DOWN(p);
     RL_NUM y = (RL_NUM)s->y, yp = (RL_NUM)s->yPrevious, ypp = (RL_NUM)s->yBefore;
     uint64_t cycles = s->runCycles;

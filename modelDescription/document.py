@@ -9,6 +9,7 @@ writes documentation/index.html and documentation/ramp.png, and the icon:
 model.png (FMI 2) or terminalsAndIcons/icon.png (FMI 3). Runs with the
 project's venv (fmpy, matplotlib); PNGs carry no time stamps.
 """
+
 import contextlib
 import html
 import io
@@ -18,6 +19,7 @@ import sys
 import textwrap
 import tomllib
 from pathlib import Path
+from xml.etree import ElementTree
 
 import matplotlib
 
@@ -34,12 +36,18 @@ def status_codes(source):
     are written."""
     text = Path(source).read_text()
     names = dict(re.findall(r"(RL_STATUS_\w+)\s*=\s*(0x[0-9A-Fa-f]+)", Path(source).with_suffix(".h").read_text()))
-    return [(int(names[name], 16), meaning) for name, meaning in re.findall(r'case (RL_STATUS_\w+): return "([^"]*)";', text)]
+    return [
+        (int(names[name], 16), meaning)
+        for name, meaning in re.findall(r'case (RL_STATUS_\w+): return "([^"]*)";', text)
+    ]
 
 
 def signal_names(model):
-    variables = model["variable"]
-    first = lambda causality: next(v["name"] for v in variables if v["causality"] == causality and v["type"] == "Real")
+    """The first Real input and the first Real output: the ramp plot's signals."""
+
+    def first(causality):
+        return next(v["name"] for v in model["variable"] if v["causality"] == causality and v["type"] == "Real")
+
     return first("input"), first("output")
 
 
@@ -47,11 +55,21 @@ def ramp_plot(model, stage, path):
     u, y = signal_names(model)
     times = [0.0, 1.0, 5.0]
     values = [0.0, 2.0, -1.0]
-    signal = np.array(list(zip(times, values)) + [(8.0, -1.0)], dtype=[("time", np.float64), (u, np.float64)])
+    signal = np.array(
+        list(zip(times, values, strict=True)) + [(8.0, -1.0)], dtype=[("time", np.float64), (u, np.float64)]
+    )
     start = dict(model.get("documentation", {}).get("example", {}))
     with contextlib.redirect_stdout(io.StringIO()):  # fmpy's notes on inputs left at their start values
-        result = simulate_fmu(str(stage), start_time=0.0, stop_time=8.0, output_interval=0.1, input=signal,
-                              start_values=start, output=[y], fmi_type="CoSimulation")
+        result = simulate_fmu(
+            str(stage),
+            start_time=0.0,
+            stop_time=8.0,
+            output_interval=0.1,
+            input=signal,
+            start_values=start,
+            output=[y],
+            fmi_type="CoSimulation",
+        )
     figure, axes = plt.subplots(figsize=(6, 3), dpi=100)
     axes.step(signal["time"], signal[u], where="post", linestyle="--", color="0.5", label=f"{u} (input)")
     axes.plot(result["time"], result[y], color="C0", label=f"{y} (output)")
@@ -72,7 +90,9 @@ def icon(model, path):
     axes.set_xlim(0, 1)
     axes.set_ylim(0, 1)
     axes.axis("off")
-    axes.add_patch(plt.Rectangle((0.04, 0.04), 0.92, 0.92, fill=True, facecolor="white", edgecolor="#1f4e79", linewidth=3))
+    axes.add_patch(
+        plt.Rectangle((0.04, 0.04), 0.92, 0.92, fill=True, facecolor="white", edgecolor="#1f4e79", linewidth=3)
+    )
     axes.plot([0.15, 0.35, 0.35, 0.85], [0.3, 0.3, 0.8, 0.8], color="0.6", linestyle="--", linewidth=1.5)
     axes.plot([0.15, 0.35, 0.65, 0.85], [0.3, 0.3, 0.8, 0.8], color="#1f4e79", linewidth=3)
     axes.text(0.5, 0.12, model["model"]["identifier"][:14], ha="center", va="center", fontsize=7)
@@ -88,30 +108,61 @@ def cell(value):
     return html.escape(str(value)) if value is not None else ""
 
 
-def page(model, version, codes):
+def licence(stage):
+    """The copyright and licence the staged model description names (modelDescription/generate.py writes
+    them), as HTML."""
+    root = ElementTree.parse(stage / "modelDescription.xml").getroot()
+    return (
+        f"<p>{html.escape(root.get('copyright'))}. Licence: {html.escape(root.get('license'))}; "
+        '<a href="licenses/license.txt">its text</a>.</p>'
+    )
+
+
+def page(model, version, codes, licence_html):
     m = model["model"]
+    style = (
+        "body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}\n"
+        "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.2em .5em;text-align:left;"
+        "vertical-align:top}"
+    )
+    header = "".join(
+        f"<th>{name}</th>"
+        for name in ("name", "value reference", "causality", "variability", "type", "start", "unit", "description")
+    )
     rows = "\n".join(
         f"<tr><td><code>{cell(v['name'])}</code></td><td>{v['vr']}</td><td>{v['causality']}</td>"
         f"<td>{v['variability']}</td><td>{cell(v.get('declaredType', v['type']))}</td><td>{cell(v.get('start'))}</td>"
         f"<td>{cell(v.get('unit'))}</td><td>{cell(v.get('description'))}</td></tr>"
-        for v in model["variable"])
+        for v in model["variable"]
+    )
     enums = "".join(
         f"<h3>{html.escape(name)}</h3><p>{cell(e.get('description'))}</p><ul>"
-        + "".join(f"<li><code>{i['value']}</code> {cell(i['name'])}: {cell(i.get('description'))}</li>" for i in e["items"])
-        + "</ul>" for name, e in model.get("enumerations", {}).items())
+        + "".join(
+            f"<li><code>{i['value']}</code> {cell(i['name'])}: {cell(i.get('description'))}</li>" for i in e["items"]
+        )
+        + "</ul>"
+        for name, e in model.get("enumerations", {}).items()
+    )
     has_status = any(v["name"] in ("status", "error") for v in model["variable"])
-    status = ("<h2>Status codes</h2><table><tr><th>status</th><th>meaning</th></tr>"
-              + "".join(f"<tr><td><code>16#{code:04X}</code></td><td>{html.escape(text)}</td></tr>" for code, text in codes)
-              + "</table><p>16#8000 and above are errors: the output holds its last value, a warning names the cause "
-                "in the log, and the status clears when the cause is gone.</p>") if has_status else ""
+    status = (
+        (
+            "<h2>Status codes</h2><table><tr><th>status</th><th>meaning</th></tr>"
+            + "".join(
+                f"<tr><td><code>16#{code:04X}</code></td><td>{html.escape(text)}</td></tr>" for code, text in codes
+            )
+            + "</table><p>16#8000 and above are errors: the output holds its last value, a warning names the cause "
+            "in the log, and the status clears when the cause is gone.</p>"
+        )
+        if has_status
+        else ""
+    )
     de = m.get("defaultExperiment", {})
     return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{html.escape(m['identifier'])}</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}}
-table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:.2em .5em;text-align:left;vertical-align:top}}</style>
+<html lang="en"><head><meta charset="utf-8"><title>{html.escape(m["identifier"])}</title>
+<style>{style}</style>
 </head><body>
-<h1>{html.escape(m['identifier'])}</h1>
-<p>{html.escape(m.get('description', ''))}. FMI {version}.0 Co-Simulation.</p>
+<h1>{html.escape(m["identifier"])}</h1>
+<p>{html.escape(m.get("description", ""))}. FMI {version}.0 Co-Simulation.</p>
 <h2>What it does</h2>
 <p>Each communication step stands for the PLC's cyclic interrupt: in every cycle the output moves towards the
 input by at most the rising or falling rate times the cycle length, or follows it at once where the block's
@@ -120,18 +171,20 @@ block runs whole PLC cycles of that length inside each communication step; time 
 so long runs do not drift.</p>
 <p><img src="ramp.png" alt="A typical ramp: the output follows a step of the input at the limited rates"></p>
 <h2>Variables</h2>
-<table><tr><th>name</th><th>value reference</th><th>causality</th><th>variability</th><th>type</th><th>start</th><th>unit</th><th>description</th></tr>
+<table><tr>{header}</tr>
 {rows}
 </table>
 {enums}
 {status}
 <h2>Default experiment</h2>
-<p>start {cell(de.get('startTime'))} s, stop {cell(de.get('stopTime'))} s, step {cell(de.get('stepSize'))} s.</p>
+<p>start {cell(de.get("startTime"))} s, stop {cell(de.get("stopTime"))} s, step {cell(de.get("stepSize"))} s.</p>
 <h2>Errors</h2>
 <p>A call that cannot be carried out (wrong state, unknown or wrong-type variable, a value outside its range, a
 step size that is not finite and positive, a communication point that is not the FMU's time) returns an error
 with one log message naming the function and the reason; the instance keeps its last good values and can be
 recovered with a saved FMU state or reset.</p>
+<h2>Licence</h2>
+{licence_html}
 </body></html>
 """
 
@@ -141,7 +194,9 @@ def main(toml, stage, version, status_source):
     stage = Path(stage).resolve()
     docs = stage / "documentation"
     docs.mkdir(parents=True, exist_ok=True)
-    (docs / "index.html").write_text(page(model, int(version), status_codes(status_source)), encoding="utf-8")
+    (docs / "index.html").write_text(
+        page(model, int(version), status_codes(status_source), licence(stage)), encoding="utf-8"
+    )
     ramp_plot(model, stage, docs / "ramp.png")
     if int(version) == 2:
         icon(model, stage / "model.png")

@@ -9,6 +9,7 @@ writes OUTDIR/fmi2/modelDescription.xml, OUTDIR/fmi3/modelDescription.xml,
 OUTDIR/fmi3/buildDescription.xml and OUTDIR/<Model>_variables.h.
 Only the Python standard library is used, so the build needs nothing else.
 """
+
 import argparse
 import hashlib
 import math
@@ -20,12 +21,27 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 GENERATION_TOOL = "rate-limiter-fmus modelDescription/generate.py"
-MODEL_HEADER = Path(__file__).resolve().parent.parent / "fmu_src" / "model.h"
+REPO = Path(__file__).resolve().parent.parent
+MODEL_HEADER = REPO / "fmu_src" / "model.h"
+# the licence: LICENSE ships in every FMU as documentation/licenses/license.txt (cmake/Fmu.cmake), the entry
+# point the FMI 3 standard names; both versions' descriptions name it
+LICENSE = REPO / "LICENSE"
+LICENSE_IN_FMU = "documentation/licenses/license.txt"
+
+
+def licence_attributes():
+    """copyright and license of fmiModelDescription (FMI 2 and FMI 3), from the LICENSE file."""
+    text = LICENSE.read_text(encoding="utf-8")
+    if not text.startswith("BSD 2-Clause License\n"):
+        sys.exit(f"{LICENSE}: not the BSD 2-Clause licence that generate.py names")
+    copyright_line = next(line for line in text.splitlines() if line.startswith("Copyright (c) "))
+    return {"copyright": copyright_line, "license": f"BSD-2-Clause (the text: {LICENSE_IN_FMU})"}
 
 
 def max_variables():
     """The size of the core's variable table (FMU_MAX_VARIABLES)."""
     return int(re.search(r"#define FMU_MAX_VARIABLES (\d+)", MODEL_HEADER.read_text()).group(1))
+
 
 TYPES = {"Real", "Integer", "Boolean", "Enumeration"}
 CAUSALITIES = {"independent", "parameter", "input", "output"}
@@ -53,8 +69,10 @@ def load(path):
         if v["causality"] in ("input", "parameter") and "start" not in v:
             sys.exit(f"{where}: inputs and parameters need a start value")
         if isinstance(v.get("start"), float) and math.isinf(v["start"]):
-            sys.exit(f"{where}: an infinite start value (FMI Library and OMSimulator refuse it); "
-                     "the largest finite double (1.7976931348623157e308) can mean 'no limit'")
+            sys.exit(
+                f"{where}: an infinite start value (FMI Library and OMSimulator refuse it); "
+                "the largest finite double (1.7976931348623157e308) can mean 'no limit'"
+            )
         if v["causality"] in ("output", "independent") and "start" in v:
             sys.exit(f"{where}: outputs are calculated and take no start value")
         if v.get("unit") and v["unit"] not in UNITS:
@@ -65,8 +83,10 @@ def load(path):
     if not variables or variables[0]["name"] != "time" or variables[0]["causality"] != "independent":
         sys.exit(f"{path}: value reference 0 must be the independent variable time (the core publishes it there)")
     if len(variables) > max_variables():
-        sys.exit(f"{path}: {len(variables)} variables; the core's table holds {max_variables()} "
-                 f"(FMU_MAX_VARIABLES in {MODEL_HEADER.name})")
+        sys.exit(
+            f"{path}: {len(variables)} variables; the core's table holds {max_variables()} "
+            f"(FMU_MAX_VARIABLES in {MODEL_HEADER.name})"
+        )
     return model
 
 
@@ -99,8 +119,26 @@ def c_number(value):
 
 
 def attributes(**pairs):
-    return "".join(f" {k}={quoteattr(xml_number(v) if not isinstance(v, str) else v)}"
-                   for k, v in pairs.items() if v is not None)
+    return "".join(
+        f" {k}={quoteattr(xml_number(v) if not isinstance(v, str) else v)}" for k, v in pairs.items() if v is not None
+    )
+
+
+def variable_attributes(v):
+    """A variable's own attributes (FMI 2's ScalarVariable; FMI 3's variable element begins with them)."""
+    return dict(
+        name=v["name"],
+        valueReference=v["vr"],
+        description=v.get("description"),
+        causality=v["causality"],
+        variability=v["variability"],
+    )
+
+
+def type_attributes(v):
+    """Its type's attributes (FMI 2's type element; FMI 3's variable element ends with them)."""
+    keys = ("declaredType", "unit", "min", "max", "start")
+    return {key: v.get(key) for key in keys}
 
 
 def used_units(model):
@@ -120,41 +158,53 @@ def common_head(model, version):
     if enums:
         out.append("  <TypeDefinitions>")
         for name, enum in enums.items():
-            items = "".join(f"\n{'      ' if version == 2 else '    '}  <Item{attributes(name=i['name'], value=i['value'], description=i.get('description'))}/>"
-                            for i in enum["items"])
+            indent = "        " if version == 2 else "      "
+            items = "".join(
+                f"\n{indent}<Item{attributes(name=i['name'], value=i['value'], description=i.get('description'))}/>"
+                for i in enum["items"]
+            )
             if version == 2:
                 out.append(f"    <SimpleType{attributes(name=name, description=enum.get('description'))}>")
                 out.append(f"      <Enumeration>{items}\n      </Enumeration>")
                 out.append("    </SimpleType>")
             else:
-                out.append(f"    <EnumerationType{attributes(name=name, description=enum.get('description'))}>{items}\n    </EnumerationType>")
+                enumeration = attributes(name=name, description=enum.get("description"))
+                out.append(f"    <EnumerationType{enumeration}>{items}\n    </EnumerationType>")
         out.append("  </TypeDefinitions>")
     out.append("  <LogCategories>")
     for name, description in LOG_CATEGORIES:
         out.append(f"    <Category{attributes(name=name, description=description)}/>")
     out.append("  </LogCategories>")
     de = m.get("defaultExperiment", {})
-    out.append(f"  <DefaultExperiment{attributes(startTime=de.get('startTime'), stopTime=de.get('stopTime'), stepSize=de.get('stepSize'))}/>")
+    experiment = attributes(startTime=de.get("startTime"), stopTime=de.get("stopTime"), stepSize=de.get("stepSize"))
+    out.append(f"  <DefaultExperiment{experiment}/>")
     return out
 
 
 def fmi2_description(model, guid, sources):
     m = model["model"]
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<fmiModelDescription fmiVersion="2.0"{attributes(modelName=m["identifier"], guid=guid, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat" numberOfEventIndicators="0">',
-           # Model Exchange (docs/fmi.md): no states, no event indicators, the cycle ends are time events
-           f'  <ModelExchange{attributes(modelIdentifier=m["identifier"])} completedIntegratorStepNotNeeded="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">']
-    source_files = ["    <SourceFiles>"] + [f"      <File{attributes(name=s)}/>" for s in sources] + ["    </SourceFiles>"]
+    root = attributes(modelName=m["identifier"], guid=guid, description=m["description"], **licence_attributes())
+    states = 'canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false"'
+    identifier = attributes(modelIdentifier=m["identifier"])
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="2.0"{root}{attributes(generationTool=GENERATION_TOOL)}'
+        ' variableNamingConvention="flat" numberOfEventIndicators="0">',
+        # Model Exchange (docs/fmi.md): no states, no event indicators, the cycle ends are time events
+        f'  <ModelExchange{identifier} completedIntegratorStepNotNeeded="true" {states}>',
+    ]
+    source_files = (
+        ["    <SourceFiles>"] + [f"      <File{attributes(name=s)}/>" for s in sources] + ["    </SourceFiles>"]
+    )
     out += source_files + ["  </ModelExchange>"]
-    out += [f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" canBeInstantiatedOnlyOncePerProcess="false">']
+    out += [f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}>']
     out += source_files + ["  </CoSimulation>"]
     out += common_head(model, 2)
     out.append("  <ModelVariables>")
     for index, v in enumerate(model["variable"], start=1):
         out.append(f"    <!-- index {index} -->")
-        out.append(f'    <ScalarVariable{attributes(name=v["name"], valueReference=v["vr"], description=v.get("description"), causality=v["causality"], variability=v["variability"])}>')
-        element = v["type"]
-        out.append(f'      <{element}{attributes(declaredType=v.get("declaredType"), unit=v.get("unit"), min=v.get("min"), max=v.get("max"), start=v.get("start"))}/>')
+        out.append(f"    <ScalarVariable{attributes(**variable_attributes(v))}>")
+        out.append(f"      <{v['type']}{attributes(**type_attributes(v))}/>")
         out.append("    </ScalarVariable>")
     out.append("  </ModelVariables>")
     outputs = [i for i, v in enumerate(model["variable"], start=1) if v["causality"] == "output"]
@@ -172,15 +222,27 @@ def fmi2_description(model, guid, sources):
 
 def fmi3_description(model, instantiation_token):
     m = model["model"]
-    out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<fmiModelDescription fmiVersion="3.0"{attributes(modelName=m["identifier"], instantiationToken=instantiation_token, description=m["description"], generationTool=GENERATION_TOOL)} variableNamingConvention="flat">',
-           f'  <ModelExchange{attributes(modelIdentifier=m["identifier"])} needsCompletedIntegratorStep="false" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false"/>',
-           f'  <CoSimulation{attributes(modelIdentifier=m["identifier"])} canHandleVariableCommunicationStepSize="true" canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false" hasEventMode="false" providesIntermediateUpdate="false"/>']
+    root = attributes(
+        modelName=m["identifier"],
+        instantiationToken=instantiation_token,
+        description=m["description"],
+        **licence_attributes(),
+    )
+    states = 'canGetAndSetFMUState="true" canSerializeFMUState="true" canBeInstantiatedOnlyOncePerProcess="false"'
+    identifier = attributes(modelIdentifier=m["identifier"])
+    out = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="3.0"{root}{attributes(generationTool=GENERATION_TOOL)}'
+        ' variableNamingConvention="flat">',
+        f'  <ModelExchange{identifier} needsCompletedIntegratorStep="false" {states}/>',
+        f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}'
+        ' hasEventMode="false" providesIntermediateUpdate="false"/>',
+    ]
     out += common_head(model, 3)
     out.append("  <ModelVariables>")
     for v in model["variable"]:
         element = FMI3_ELEMENT[v["type"]]
-        out.append(f'    <{element}{attributes(name=v["name"], valueReference=v["vr"], description=v.get("description"), causality=v["causality"], variability=v["variability"], declaredType=v.get("declaredType"), unit=v.get("unit"), min=v.get("min"), max=v.get("max"), start=v.get("start"))}/>')
+        out.append(f"    <{element}{attributes(**variable_attributes(v), **type_attributes(v))}/>")
     out.append("  </ModelVariables>")
     outputs = [v["vr"] for v in model["variable"] if v["causality"] == "output"]
     out.append("  <ModelStructure>")
@@ -197,8 +259,10 @@ def fmi3_build_description(model, sources):
     includes the rest and keeps everything but the FMI functions static."""
     identifier = model["model"]["identifier"]
     files = "\n".join(f"      <SourceFile{attributes(name=s)}/>" for s in sources)
-    description = (f"Any platform. A shared library defines no FMI3_FUNCTION_PREFIX; linked into one binary "
-                   f"with other FMUs, each FMU's is its modelIdentifier and _ ({identifier}_)")
+    description = (
+        f"Any platform. A shared library defines no FMI3_FUNCTION_PREFIX; linked into one binary "
+        f"with other FMUs, each FMU's is its modelIdentifier and _ ({identifier}_)"
+    )
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <fmiBuildDescription fmiVersion="3.0">
   <BuildConfiguration{attributes(modelIdentifier=identifier, description=description)}>
@@ -211,8 +275,18 @@ def fmi3_build_description(model, sources):
 
 
 C_TYPE = {"Real": "FMU_REAL", "Integer": "FMU_INTEGER", "Boolean": "FMU_BOOLEAN", "Enumeration": "FMU_ENUMERATION"}
-C_CAUSALITY = {"independent": "FMU_INDEPENDENT", "parameter": "FMU_PARAMETER", "input": "FMU_INPUT", "output": "FMU_OUTPUT"}
-C_VARIABILITY = {"continuous": "FMU_CONTINUOUS", "discrete": "FMU_DISCRETE", "fixed": "FMU_FIXED", "tunable": "FMU_TUNABLE"}
+C_CAUSALITY = {
+    "independent": "FMU_INDEPENDENT",
+    "parameter": "FMU_PARAMETER",
+    "input": "FMU_INPUT",
+    "output": "FMU_OUTPUT",
+}
+C_VARIABILITY = {
+    "continuous": "FMU_CONTINUOUS",
+    "discrete": "FMU_DISCRETE",
+    "fixed": "FMU_FIXED",
+    "tunable": "FMU_TUNABLE",
+}
 
 
 def c_header(model, instantiation_token, toml_name):
@@ -226,8 +300,10 @@ def c_header(model, instantiation_token, toml_name):
         if v["type"] == "Enumeration":
             values = [i["value"] for i in model["enumerations"][v["declaredType"]]["items"]]
             low, high = max(min(values), low), min(max(values), high)
-        rows.append(f'    {{ "{v["name"]}", {C_TYPE[v["type"]]}, {C_CAUSALITY[v["causality"]]}, '
-                    f'{C_VARIABILITY[v["variability"]]}, {c_number(v.get("start", 0.0))}, {c_number(low)}, {c_number(high)} }},')
+        rows.append(
+            f'    {{ "{v["name"]}", {C_TYPE[v["type"]]}, {C_CAUSALITY[v["causality"]]}, '
+            f"{C_VARIABILITY[v['variability']]}, {c_number(v.get('start', 0.0))}, {c_number(low)}, {c_number(high)} }},"
+        )
     table = "\n".join(rows)
     return f"""/* Generated by modelDescription/generate.py from {toml_name}; do not edit. */
 #ifndef {guard}

@@ -11,6 +11,7 @@ at the system's step size): OMSimulator refuses a system without one. The zip's 
 
     ssp.py <system.toml> <build dir> <out.ssp>
 """
+
 import sys
 import tomllib
 import zipfile
@@ -23,8 +24,14 @@ SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
-TYPES = {"Real": "Real", "Float64": "Real", "Integer": "Integer", "Int32": "Integer", "Boolean": "Boolean",
-         "String": "String"}
+TYPES = {
+    "Real": "Real",
+    "Float64": "Real",
+    "Integer": "Integer",
+    "Int32": "Integer",
+    "Boolean": "Boolean",
+    "String": "String",
+}
 KINDS = {"input": "input", "output": "output", "parameter": "parameter"}
 STAMP = (2000, 1, 1, 0, 0, 0)
 
@@ -33,7 +40,7 @@ def connector(variable):
     kind = KINDS[variable.causality]
     type_name = TYPES.get(variable.type)
     if type_name is None:  # an enumeration: its type's name
-        element = f'<ssc:Enumeration name={quoteattr(variable.declaredType.name)}/>'
+        element = f"<ssc:Enumeration name={quoteattr(variable.declaredType.name)}/>"
     else:
         element = f"<ssc:{type_name}/>"
     return f'          <ssd:Connector name={quoteattr(variable.name)} kind="{kind}">{element}</ssd:Connector>'
@@ -57,53 +64,79 @@ def package(system_toml, build_dir, out):
     for component in spec["component"]:
         fmu = Path(build_dir) / component["fmu"]
         variables = {v.name: v for v in read_model_description(str(fmu)).modelVariables}
-        names = [n for n in variables if n in connected.get(component["name"], []) or n in component["parameters"]
-                 or variables[n].causality == "output"]
+        names = [
+            n
+            for n in variables
+            if n in connected.get(component["name"], [])
+            or n in component["parameters"]
+            or variables[n].causality == "output"
+        ]
         connectors = [connector(variables[n]) for n in names if variables[n].causality in KINDS]
         ssv_name = f"resources/{component['name']}.ssv"
         files[ssv_name] = "\n".join(
-            ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<ssv:ParameterSet xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" version="1.0" name={quoteattr(system["name"])}>',
-             "  <ssv:Parameters>"]
+            [
+                '<?xml version="1.0" encoding="UTF-8"?>',
+                f'<ssv:ParameterSet xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" version="1.0"'
+                f" name={quoteattr(system['name'])}>",
+                "  <ssv:Parameters>",
+            ]
             + [parameter_value(variables[n], v) for n, v in component["parameters"].items()]
-            + ["  </ssv:Parameters>", "</ssv:ParameterSet>", ""])
+            + ["  </ssv:Parameters>", "</ssv:ParameterSet>", ""]
+        )
         files[f"resources/{fmu.name}"] = fmu.read_bytes()
-        components.append("\n".join(
-            [f'      <ssd:Component name={quoteattr(component["name"])} type="application/x-fmu-sharedlibrary" '
-             f'source="resources/{fmu.name}">',
-             "        <ssd:Connectors>"] + connectors + [
-             "        </ssd:Connectors>",
-             "        <ssd:ParameterBindings>",
-             f'          <ssd:ParameterBinding source="{ssv_name}"/>',
-             "        </ssd:ParameterBindings>",
-             "      </ssd:Component>"]))
+        components.append(
+            "\n".join(
+                [
+                    f'      <ssd:Component name={quoteattr(component["name"])} type="application/x-fmu-sharedlibrary" '
+                    f'source="resources/{fmu.name}">',
+                    "        <ssd:Connectors>",
+                ]
+                + connectors
+                + [
+                    "        </ssd:Connectors>",
+                    "        <ssd:ParameterBindings>",
+                    f'          <ssd:ParameterBinding source="{ssv_name}"/>',
+                    "        </ssd:ParameterBindings>",
+                    "      </ssd:Component>",
+                ]
+            )
+        )
     connections = []
     for c in spec["connection"]:
         (start, start_connector), (end, end_connector) = c["from"].split(".", 1), c["to"].split(".", 1)
-        connections.append(f'      <ssd:Connection startElement="{start}" startConnector="{start_connector}" '
-                           f'endElement="{end}" endConnector="{end_connector}"/>')
+        connections.append(
+            f'      <ssd:Connection startElement="{start}" startConnector="{start_connector}" '
+            f'endElement="{end}" endConnector="{end_connector}"/>'
+        )
     files["SystemStructure.ssd"] = "\n".join(
-        ['<?xml version="1.0" encoding="UTF-8"?>',
-         f'<ssd:SystemStructureDescription xmlns:ssc="{SSC}" xmlns:ssd="{SSD}" xmlns:oms="{OMS}" version="1.0" '
-         f'name={quoteattr(system["name"])}>',
-         f'  <ssd:System name={quoteattr(system["name"])} description={quoteattr(system["description"])}>',
-         "    <ssd:Elements>"] + components + [
-         "    </ssd:Elements>",
-         "    <ssd:Connections>"] + connections + [
-         "    </ssd:Connections>",
-         "    <ssd:Annotations>",
-         '      <ssc:Annotation type="org.openmodelica">',
-         "        <oms:Annotations>",
-         "          <oms:SimulationInformation>",
-         f'            <oms:FixedStepMaster description="oms-ma" stepSize="{system["stepSize"]!r}" '
-         'relativeTolerance="1e-06"/>',
-         "          </oms:SimulationInformation>",
-         "        </oms:Annotations>",
-         "      </ssc:Annotation>",
-         "    </ssd:Annotations>",
-         "  </ssd:System>",
-         f'  <ssd:DefaultExperiment startTime="{system["startTime"]!r}" stopTime="{system["stopTime"]!r}"/>',
-         "</ssd:SystemStructureDescription>", ""])
+        [
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            f'<ssd:SystemStructureDescription xmlns:ssc="{SSC}" xmlns:ssd="{SSD}" xmlns:oms="{OMS}" version="1.0" '
+            f"name={quoteattr(system['name'])}>",
+            f"  <ssd:System name={quoteattr(system['name'])} description={quoteattr(system['description'])}>",
+            "    <ssd:Elements>",
+        ]
+        + components
+        + ["    </ssd:Elements>", "    <ssd:Connections>"]
+        + connections
+        + [
+            "    </ssd:Connections>",
+            "    <ssd:Annotations>",
+            '      <ssc:Annotation type="org.openmodelica">',
+            "        <oms:Annotations>",
+            "          <oms:SimulationInformation>",
+            f'            <oms:FixedStepMaster description="oms-ma" stepSize="{system["stepSize"]!r}" '
+            'relativeTolerance="1e-06"/>',
+            "          </oms:SimulationInformation>",
+            "        </oms:Annotations>",
+            "      </ssc:Annotation>",
+            "    </ssd:Annotations>",
+            "  </ssd:System>",
+            f'  <ssd:DefaultExperiment startTime="{system["startTime"]!r}" stopTime="{system["stopTime"]!r}"/>',
+            "</ssd:SystemStructureDescription>",
+            "",
+        ]
+    )
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
         for name in sorted(files):

@@ -11,6 +11,7 @@ differs from what the TOML files give (the test runs it so); with --write
 it rewrites them (cmake --build build --target docs), and a model that has
 no table yet gets a section with one at the end. Standard library only.
 """
+
 import argparse
 import re
 import sys
@@ -53,8 +54,10 @@ def table(model):
     variables = model["variable"]
     vendor = any("vendor" in v for v in variables)
     if vendor:
-        rows = ["| vendor pin | data type | default | FMU variable | FMI type | causality | start | unit |",
-                "|---|---|---|---|---|---|---|---|"]
+        rows = [
+            "| vendor pin | data type | default | FMU variable | FMI type | causality | start | unit |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
     else:
         rows = ["| name | vr | causality | type | start | unit | meaning |", "|---|---|---|---|---|---|---|"]
     for v in variables:
@@ -64,11 +67,15 @@ def table(model):
         unit = v.get("unit", "")
         if vendor:
             pin = v.get("vendor", {})
-            rows.append(f"| {pin.get('pin', '')} | {pin.get('type', '')} | {pin.get('default', '')} | "
-                        f"`{v['name']}` (vr {v['vr']}) | {fmi_type(v, model)} | {causality(v)} | {start} | {unit} |")
+            rows.append(
+                f"| {pin.get('pin', '')} | {pin.get('type', '')} | {pin.get('default', '')} | "
+                f"`{v['name']}` (vr {v['vr']}) | {fmi_type(v, model)} | {causality(v)} | {start} | {unit} |"
+            )
         else:
-            rows.append(f"| `{v['name']}` | {v['vr']} | {causality(v)} | {fmi_type(v, model)} | {start} | {unit} | "
-                        f"{v.get('description', '')} |")
+            rows.append(
+                f"| `{v['name']}` | {v['vr']} | {causality(v)} | {fmi_type(v, model)} | {start} | {unit} | "
+                f"{v.get('description', '')} |"
+            )
     return "\n".join(rows) + "\n"
 
 
@@ -78,11 +85,14 @@ def render(document, models):
         if name not in models:
             sys.exit(f"{name}: no TOML file given for this table")
         return match.group(1) + table(models[name]) + match.group(4)
+
     text = MARKER.sub(replace, document)
     tabled = {m.group(2) for m in MARKER.finditer(document)}
     for name in sorted(set(models) - tabled):
-        text += (f"\n### {name}\n\n{models[name]['model']['description']}\n\n"
-                 f"<!-- generated: variables {name} -->\n{table(models[name])}<!-- end generated -->\n")
+        text += (
+            f"\n### {name}\n\n{models[name]['model']['description']}\n\n"
+            f"<!-- generated: variables {name} -->\n{table(models[name])}<!-- end generated -->\n"
+        )
     return text
 
 
@@ -103,7 +113,11 @@ def main():
             args.document.write_text(fresh, encoding="utf-8")
         return 0
     if fresh != text:
-        stale = [m.group(2) for m, n in zip(MARKER.finditer(text), MARKER.finditer(fresh)) if m.group(0) != n.group(0)]
+        stale = [
+            m.group(2)
+            for m, n in zip(MARKER.finditer(text), MARKER.finditer(fresh), strict=False)
+            if m.group(0) != n.group(0)
+        ]
         stale += sorted(set(models) - {m.group(2) for m in MARKER.finditer(text)})
         print(f"{args.document}: stale tables {stale}; run cmake --build build --target docs")
         return 1

@@ -1,4 +1,5 @@
 """Fixtures shared by test files: a Dask distributed cluster on loopback."""
+
 import json
 import subprocess
 import sys
@@ -27,30 +28,40 @@ def cluster(tmp_path):
 
     def start(args, log):
         with open(log, "wb") as out:
-            return subprocess.Popen([str(BIN / "dask")] + args + common, stdin=subprocess.DEVNULL, stdout=out,
-                                    stderr=subprocess.STDOUT)
+            return subprocess.Popen(
+                [str(BIN / "dask")] + args + common, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT
+            )
 
-    processes = [start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(scheduler_file)],
-                       logs[0])]
+    processes = [
+        start(["scheduler", "--host", "127.0.0.1", "--port", "0", "--scheduler-file", str(scheduler_file)], logs[0])
+    ]
     try:
         deadline = time.monotonic() + START_SECONDS
         while not (scheduler_file.exists() and scheduler_file.stat().st_size):
             assert processes[0].poll() is None, f"the Dask scheduler exited: {log_tail(logs[0])}"
-            assert time.monotonic() < deadline, \
+            assert time.monotonic() < deadline, (
                 f"the Dask scheduler wrote no address within {START_SECONDS} s: {log_tail(logs[0])}"
+            )
             time.sleep(0.1)
         address = json.loads(scheduler_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
-        for name, log in zip(("worker-a", "worker-b"), logs[1:]):
-            processes.append(start(["worker", address, "--nworkers", "1", "--nthreads", "1", "--name", name,
-                                    "--host", "127.0.0.1"], log))
+        for name, log in zip(("worker-a", "worker-b"), logs[1:], strict=True):
+            processes.append(
+                start(
+                    ["worker", address, "--nworkers", "1", "--nthreads", "1", "--name", name, "--host", "127.0.0.1"],
+                    log,
+                )
+            )
         from dask.distributed import Client
+
         with Client(address, timeout=START_SECONDS) as client:
             try:
                 client.wait_for_workers(2, timeout=START_SECONDS)
             except TimeoutError:
-                raise AssertionError(f"two Dask workers did not join within {START_SECONDS} s: "
-                                     + " | ".join(log_tail(log) for log in logs)) from None
+                raise AssertionError(
+                    f"two Dask workers did not join within {START_SECONDS} s: "
+                    + " | ".join(log_tail(log) for log in logs)
+                ) from None
         yield address
     finally:
         for p in reversed(processes):

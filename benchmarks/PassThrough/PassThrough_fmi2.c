@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#ifndef FIXTURE_VARIABLES_H  /* another fixture built from these sources names its own */
+#ifndef FIXTURE_VARIABLES_H /* another fixture built from these sources names its own */
 #define FIXTURE_VARIABLES_H "PassThrough_variables.h"
 #endif
 #include FIXTURE_VARIABLES_H
@@ -15,13 +15,20 @@ typedef struct {
     double values[MODEL_VARIABLE_COUNT];
 } Instance;
 
-const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
-const char *fmi2GetVersion(void) { return fmi2Version; }
+const char *fmi2GetTypesPlatform(void) {
+    return fmi2TypesPlatform;
+}
+const char *fmi2GetVersion(void) {
+    return fmi2Version;
+}
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
                               fmi2Boolean visible, fmi2Boolean loggingOn) {
-    (void)instanceName; (void)fmuResourceLocation; (void)visible; (void)loggingOn;
+    (void)instanceName;
+    (void)fmuResourceLocation;
+    (void)visible;
+    (void)loggingOn;
     if (fmuType != fmi2CoSimulation || !fmuGUID || strcmp(fmuGUID, MODEL_TOKEN) != 0 || !functions) return NULL;
     Instance *instance = functions->allocateMemory(1, sizeof *instance);
     if (instance) instance->functions = *functions;
@@ -33,21 +40,37 @@ void fmi2FreeInstance(fmi2Component c) {
     if (instance) instance->functions.freeMemory(instance);
 }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
-    (void)c; (void)loggingOn; (void)nCategories; (void)categories;
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[]) {
+    (void)c;
+    (void)loggingOn;
+    (void)nCategories;
+    (void)categories;
     return fmi2OK;
 }
 
-fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
-                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    (void)toleranceDefined; (void)tolerance; (void)stopTimeDefined; (void)stopTime;
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,
+                               fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    (void)toleranceDefined;
+    (void)tolerance;
+    (void)stopTimeDefined;
+    (void)stopTime;
     ((Instance *)c)->values[VR_time] = startTime;
     return fmi2OK;
 }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
-fmi2Status fmi2ExitInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
-fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    (void)c;
+    return fmi2OK;
+}
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    (void)c;
+    return fmi2OK;
+}
+fmi2Status fmi2Terminate(fmi2Component c) {
+    (void)c;
+    return fmi2OK;
+}
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     Instance *instance = c;
@@ -71,9 +94,11 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
     Instance *instance = c;
-#ifdef FIXTURE_FAULTS  /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
+#ifdef FIXTURE_FAULTS /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
     if (instance->values[VR_u] == 13.0) raise(SIGSEGV);
-    if (instance->values[VR_u] == 17.0) for (;;) { }
+    if (instance->values[VR_u] == 17.0)
+        for (;;) {
+        }
 #endif
     instance->values[VR_y] = instance->values[VR_u];
     instance->values[VR_time] = currentCommunicationPoint + communicationStepSize;

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
-#ifndef FIXTURE_VARIABLES_H  /* another fixture built from these sources names its own */
+#ifndef FIXTURE_VARIABLES_H /* another fixture built from these sources names its own */
 #define FIXTURE_VARIABLES_H "PassThrough_variables.h"
 #endif
 #include FIXTURE_VARIABLES_H
@@ -14,43 +14,66 @@ typedef struct {
     double values[MODEL_VARIABLE_COUNT];
 } Instance;
 
-const char *fmi3GetVersion(void) { return fmi3Version; }
+const char *fmi3GetVersion(void) {
+    return fmi3Version;
+}
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                          fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
                                          const fmi3ValueReference requiredIntermediateVariables[],
                                          size_t nRequiredIntermediateVariables,
-                                         fmi3InstanceEnvironment instanceEnvironment,
-                                         fmi3LogMessageCallback logMessage,
+                                         fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage,
                                          fmi3IntermediateUpdateCallback intermediateUpdate) {
-    (void)instanceName; (void)resourcePath; (void)visible; (void)loggingOn; (void)eventModeUsed;
-    (void)earlyReturnAllowed; (void)requiredIntermediateVariables; (void)nRequiredIntermediateVariables;
-    (void)instanceEnvironment; (void)logMessage; (void)intermediateUpdate;
+    (void)instanceName;
+    (void)resourcePath;
+    (void)visible;
+    (void)loggingOn;
+    (void)eventModeUsed;
+    (void)earlyReturnAllowed;
+    (void)requiredIntermediateVariables;
+    (void)nRequiredIntermediateVariables;
+    (void)instanceEnvironment;
+    (void)logMessage;
+    (void)intermediateUpdate;
     if (!instantiationToken || strcmp(instantiationToken, MODEL_TOKEN) != 0) return NULL;
     return calloc(1, sizeof(Instance));
 }
 
-void fmi3FreeInstance(fmi3Instance instance) { free(instance); }
+void fmi3FreeInstance(fmi3Instance instance) {
+    free(instance);
+}
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
                                const fmi3String categories[]) {
-    (void)instance; (void)loggingOn; (void)nCategories; (void)categories;
+    (void)instance;
+    (void)loggingOn;
+    (void)nCategories;
+    (void)categories;
     return fmi3OK;
 }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
-    (void)toleranceDefined; (void)tolerance; (void)stopTimeDefined; (void)stopTime;
+    (void)toleranceDefined;
+    (void)tolerance;
+    (void)stopTimeDefined;
+    (void)stopTime;
     ((Instance *)instance)->values[VR_time] = startTime;
     return fmi3OK;
 }
 
-fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) { (void)instance; return fmi3OK; }
-fmi3Status fmi3Terminate(fmi3Instance instance) { (void)instance; return fmi3OK; }
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
+    (void)instance;
+    return fmi3OK;
+}
+fmi3Status fmi3Terminate(fmi3Instance instance) {
+    (void)instance;
+    return fmi3OK;
+}
 
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                          const fmi3Float64 values[], size_t nValues) {
+fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
+                          size_t nValues) {
     (void)nValues;
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] != VR_u) return fmi3Error;
@@ -59,8 +82,8 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
     return fmi3OK;
 }
 
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                          fmi3Float64 values[], size_t nValues) {
+fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
+                          size_t nValues) {
     (void)nValues;
     for (size_t i = 0; i < nvr; i++) {
         if (vr[i] >= MODEL_VARIABLE_COUNT) return fmi3Error;
@@ -74,9 +97,11 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     (void)noSetFMUStatePriorToCurrentPoint;
     Instance *self = instance;
-#ifdef FIXTURE_FAULTS  /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
+#ifdef FIXTURE_FAULTS /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
     if (self->values[VR_u] == 13.0) raise(SIGSEGV);
-    if (self->values[VR_u] == 17.0) for (;;) { }
+    if (self->values[VR_u] == 17.0)
+        for (;;) {
+        }
 #endif
     self->values[VR_y] = self->values[VR_u];
     self->values[VR_time] = currentCommunicationPoint + communicationStepSize;

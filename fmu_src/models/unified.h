@@ -52,29 +52,31 @@ static inline void unified_publish(const UnifiedVariables *vr, const RlState *bl
 }
 
 /* The table of a unified block's variables, from its generated header */
-#define UNIFIED_VARIABLES                                                                                         \
-    { VR_hold, VR_ratePeriod, VR_cycleTime, VR_bypass, VR_zeroRate, VR_initMode, VR_initValue, VR_initDelay,       \
-      VR_arithmetic, VR_accelMax, VR_decelMax, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp,       \
-      VR_limitingDown, VR_highLimit, VR_lowLimit, VR_remainingTime, VR_d2ydt2 }
+#define UNIFIED_VARIABLES \
+    { \
+        VR_hold, VR_ratePeriod, VR_cycleTime, VR_bypass, VR_zeroRate, VR_initMode, VR_initValue, VR_initDelay, \
+            VR_arithmetic, VR_accelMax, VR_decelMax, VR_y, VR_rampActive, VR_runningTime, VR_dydt, VR_limitingUp, \
+            VR_limitingDown, VR_highLimit, VR_lowLimit, VR_remainingTime, VR_d2ydt2 \
+    }
 
 /* The mapping of a unified block and its fmuModel (u in, y out):
  * resolve(v, c) sets rateUp, rateDown, yMax, yMin, duration and bypassValue
  * the model's own way; the rates below 0 fall back to the resolved rates,
  * and the rest is shared. */
-#define UNIFIED_MAPPING(resolve)                                                                               \
-    static const UnifiedVariables unifiedVariables = UNIFIED_VARIABLES;                                        \
-    static int model_configure(const double *v, RlConfig *c) {                                                 \
-        resolve(v, c);                                                                                         \
-        c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source);           \
+#define UNIFIED_MAPPING(resolve) \
+    static const UnifiedVariables unifiedVariables = UNIFIED_VARIABLES; \
+    static int model_configure(const double *v, RlConfig *c) { \
+        resolve(v, c); \
+        c->rateUpNeg = rl_resolve(v[VR_rateUpNeg], VR_rateUpNeg, c->rateUp.value, c->rateUp.source); \
         c->rateDownNeg = rl_resolve(v[VR_rateDownNeg], VR_rateDownNeg, c->rateDown.value, c->rateDown.source); \
-        unified_configure(&unifiedVariables, v, c);                                                            \
-        return 0;                                                                                              \
-    }                                                                                                          \
-    static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {    \
-        (void)modelMode;                                                                                       \
-        unified_publish(&unifiedVariables, block, prepared, v);                                                \
-    }                                                                                                          \
-    static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus };               \
+        unified_configure(&unifiedVariables, v, c); \
+        return 0; \
+    } \
+    static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) { \
+        (void)modelMode; \
+        unified_publish(&unifiedVariables, block, prepared, v); \
+    } \
+    static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus }; \
     FMU_MODEL(VR_u, VR_y, model_configure, model_publish, &statusOutputs)
 
 #endif

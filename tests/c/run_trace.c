@@ -113,7 +113,8 @@ static void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String c
 
 static void *instantiate3(const char *token) {
     if (model_exchange) return f3.instantiate_me("trace", token, NULL, fmi3False, fmi3False, NULL, logger3);
-    return f3.instantiate("trace", token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL, logger3, NULL);
+    return f3.instantiate("trace", token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL, logger3,
+                          NULL);
 }
 static int update3(void *c, double *next) {
     fmi3Boolean again, stop, nominals, values, defined = fmi3False;
@@ -121,9 +122,15 @@ static int update3(void *c, double *next) {
     if (!defined) *next = NAN;
     return status;
 }
-static int continuous3(void *c) { return f3.continuous(c); }
-static int set_time3(void *c, double t) { return f3.set_time(c, t); }
-static int event3(void *c) { return f3.event(c); }
+static int continuous3(void *c) {
+    return f3.continuous(c);
+}
+static int set_time3(void *c, double t) {
+    return f3.set_time(c, t);
+}
+static int event3(void *c) {
+    return f3.event(c);
+}
 static int init3(void *c, double start) {
     int status = f3.enter(c, fmi3False, 0.0, start, fmi3False, 0.0);
     return status <= STATUS_WARNING ? (int)f3.leave(c) : status;
@@ -212,8 +219,8 @@ static Fmi load_fmi3(void) {
     f3.state_size = (fmi3SerializedFMUStateSizeTYPE *)function("fmi3SerializedFMUStateSize");
     f3.serialize = (fmi3SerializeFMUStateTYPE *)function("fmi3SerializeFMUState");
     f3.deserialize = (fmi3DeserializeFMUStateTYPE *)function("fmi3DeserializeFMUState");
-    const Fmi fmi = { instantiate3, update3, continuous3, set_time3, event3, init3, step3, set_float3, set_int3, set_bool3, get_float3, get_int3, get_bool3,
-                      save3, load3, free3 };
+    const Fmi fmi = { instantiate3, update3,   continuous3, set_time3, event3,    init3, step3, set_float3,
+                      set_int3,     set_bool3, get_float3,  get_int3,  get_bool3, save3, load3, free3 };
     return fmi;
 }
 
@@ -245,7 +252,7 @@ static struct {
 } f2;
 
 static void logger2(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
-                 fmi2String message, ...) {
+                    fmi2String message, ...) {
     (void)env;
     (void)name;
     (void)status;
@@ -266,9 +273,15 @@ static int update2(void *c, double *next) {
     *next = info.nextEventTimeDefined ? info.nextEventTime : NAN;
     return status;
 }
-static int continuous2(void *c) { return f2.continuous(c); }
-static int set_time2(void *c, double t) { return f2.set_time(c, t); }
-static int event2(void *c) { return f2.event(c); }
+static int continuous2(void *c) {
+    return f2.continuous(c);
+}
+static int set_time2(void *c, double t) {
+    return f2.set_time(c, t);
+}
+static int event2(void *c) {
+    return f2.event(c);
+}
 static int init2(void *c, double start) {
     int status = f2.setup(c, fmi2False, 0.0, start, fmi2False, 0.0);
     if (status <= STATUS_WARNING) status = f2.enter(c);
@@ -314,7 +327,8 @@ static int save2(void *c, unsigned char *bytes, size_t capacity, size_t *size) {
     fmi2FMUstate state = NULL;
     int status = f2.get_state(c, &state);
     if (status <= STATUS_WARNING) status = f2.state_size(c, state, size);
-    if (status <= STATUS_WARNING) status = *size <= capacity ? f2.serialize(c, state, (fmi2Byte *)bytes, *size) : STATUS_ERROR;
+    if (status <= STATUS_WARNING)
+        status = *size <= capacity ? f2.serialize(c, state, (fmi2Byte *)bytes, *size) : STATUS_ERROR;
     f2.free_state(c, &state);
     return status;
 }
@@ -352,8 +366,8 @@ static Fmi load_fmi2(void) {
     f2.state_size = (fmi2SerializedFMUstateSizeTYPE *)function("fmi2SerializedFMUstateSize");
     f2.serialize = (fmi2SerializeFMUstateTYPE *)function("fmi2SerializeFMUstate");
     f2.deserialize = (fmi2DeSerializeFMUstateTYPE *)function("fmi2DeSerializeFMUstate");
-    const Fmi fmi = { instantiate2, update2, continuous2, set_time2, event2, init2, step2, set_float2, set_int2, set_bool2, get_float2, get_int2, get_bool2,
-                      save2, load2, free2 };
+    const Fmi fmi = { instantiate2, update2,   continuous2, set_time2, event2,    init2, step2, set_float2,
+                      set_int2,     set_bool2, get_float2,  get_int2,  get_bool2, save2, load2, free2 };
     return fmi;
 }
 
@@ -444,7 +458,8 @@ int main(int argc, char **argv) {
         else break;
     }
     if (argc - a != 2) {
-        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] [--model-exchange] [--prefix <P>] <binary> <token> < script\n");
+        fprintf(stderr, "usage: run_trace [--fmi2] [--trap] [--keep-going] [--model-exchange] [--prefix <P>] <binary> "
+                        "<token> < script\n");
         return 2;
     }
     if (!open_library(argv[a])) return 2;

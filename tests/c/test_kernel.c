@@ -33,10 +33,23 @@ static void check_bits(const char *file, int line, const char *what, double actu
     printf("%s:%d: %s is %+.17g, expected %+.17g (bit for bit)\n", file, line, what, actual, expected);
 }
 
-enum { SRC_RATE_UP = 2, SRC_RATE_DOWN = 3, SRC_DURATION = 6, SRC_RATE_UP_PAR = 7, SRC_RATE_DOWN_PAR = 8,
-       SRC_DURATION_PAR = 10, SRC_RATE_PERIOD = 11, SRC_CYCLE_TIME = 13, SRC_RATE_UP_NEG = 23,
-       SRC_RATE_DOWN_NEG = 24, SRC_Y_MAX = 25, SRC_Y_MIN = 26, SRC_Y_MAX_PAR = 28, SRC_Y_MIN_PAR = 29,
-       SRC_FOLLOWS = 99 /* a Neg rate not set: the other one's value */ };
+enum {
+    SRC_RATE_UP = 2,
+    SRC_RATE_DOWN = 3,
+    SRC_DURATION = 6,
+    SRC_RATE_UP_PAR = 7,
+    SRC_RATE_DOWN_PAR = 8,
+    SRC_DURATION_PAR = 10,
+    SRC_RATE_PERIOD = 11,
+    SRC_CYCLE_TIME = 13,
+    SRC_RATE_UP_NEG = 23,
+    SRC_RATE_DOWN_NEG = 24,
+    SRC_Y_MAX = 25,
+    SRC_Y_MIN = 26,
+    SRC_Y_MAX_PAR = 28,
+    SRC_Y_MIN_PAR = 29,
+    SRC_FOLLOWS = 99 /* a Neg rate not set: the other one's value */
+};
 
 /* The unified block's defaults: rates 1 per 1 s, no duration, init = input. */
 static RlConfig defaults(void) {
@@ -135,17 +148,17 @@ static void test_rule0_limits(void) {
     c.rateUp.value = 10.0;
     c.rateDown.value = 4.0;
     c.ratePeriod.value = 2.0;
-    rl_prepare(&p, resolved(&c), 0.5);           /* 10 * 0.5 / 2 and 4 * 0.5 / 2 */
+    rl_prepare(&p, resolved(&c), 0.5); /* 10 * 0.5 / 2 and 4 * 0.5 / 2 */
     CHECK_EQ(p.maxUp, 2.5);
     CHECK_EQ(p.maxDown, 1.0);
-    c.ratePeriod.value = 0.0;          /* per cycle, whatever T */
+    c.ratePeriod.value = 0.0; /* per cycle, whatever T */
     rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, 10.0);
     CHECK_EQ(p.maxDown, 4.0);
-    c.rateUp.value = INFINITY;         /* +inf: no limit */
+    c.rateUp.value = INFINITY; /* +inf: no limit */
     rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, INFINITY);
-    c.rateUp.value = 0.0;              /* 0: hold (zeroRate 1) ... */
+    c.rateUp.value = 0.0; /* 0: hold (zeroRate 1) ... */
     rl_prepare(&p, resolved(&c), 0.5);
     CHECK_EQ(p.maxUp, 0.0);
     c.zeroRate = RL_ZERO_RATE_NO_LIMIT; /* ... or no limit (zeroRate 2) */
@@ -169,27 +182,35 @@ static void test_status_codes(void) {
     CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
     CHECK_EQ(source, 0);
 
-    c = defaults(); c.rateDown.value = -1.0;
+    c = defaults();
+    c.rateDown.value = -1.0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
-    c = defaults(); c.rateUp = (RlValue){ -0.5, SRC_RATE_UP };
+    c = defaults();
+    c.rateUp = (RlValue){ -0.5, SRC_RATE_UP };
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_UP);
-    c = defaults(); c.rateUp.value = -INFINITY;
+    c = defaults();
+    c.rateUp.value = -INFINITY;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
 
-    c = defaults(); c.rateUp.value = NAN;
+    c = defaults();
+    c.rateUp.value = NAN;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8201);
     CHECK_EQ(source, SRC_RATE_UP_PAR);
-    c = defaults(); c.rateDown.value = NAN;
+    c = defaults();
+    c.rateDown.value = NAN;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8201);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
     /* first match wins: a negative rate before a NaN one */
-    c = defaults(); c.rateUp.value = NAN; c.rateDown.value = -1.0;
+    c = defaults();
+    c.rateUp.value = NAN;
+    c.rateDown.value = -1.0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
 
-    c = defaults(); c.ratePeriod.value = -1.0;
+    c = defaults();
+    c.ratePeriod.value = -1.0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
     CHECK_EQ(source, SRC_RATE_PERIOD);
     c.ratePeriod.value = INFINITY;
@@ -197,16 +218,18 @@ static void test_status_codes(void) {
     c.ratePeriod.value = NAN;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
 
-    c = defaults(); c.duration = (RlValue){ -3.0, SRC_DURATION };
+    c = defaults();
+    c.duration = (RlValue){ -3.0, SRC_DURATION };
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     CHECK_EQ(source, SRC_DURATION);
     c.duration = (RlValue){ NAN, SRC_DURATION_PAR };
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     CHECK_EQ(source, SRC_DURATION_PAR);
-    c.duration.value = INFINITY;       /* never reached, but valid */
+    c.duration.value = INFINITY; /* never reached, but valid */
     CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
 
-    c = defaults(); c.cycleTime.value = -0.01;
+    c = defaults();
+    c.cycleTime.value = -0.01;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
     CHECK_EQ(source, SRC_CYCLE_TIME);
     c.cycleTime.value = INFINITY;
@@ -215,14 +238,20 @@ static void test_status_codes(void) {
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
 
     /* the table's order: rate before ratePeriod before duration before cycle */
-    c = defaults(); c.cycleTime.value = -1; c.duration.value = -1; c.ratePeriod.value = -1;
+    c = defaults();
+    c.cycleTime.value = -1;
+    c.duration.value = -1;
+    c.ratePeriod.value = -1;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8202);
     c.ratePeriod.value = 1;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
     c.duration.value = 0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8601);
     /* each status word's text, as the FMUs log it */
-    static const struct { int status; const char *text; } texts[] = {
+    static const struct {
+        int status;
+        const char *text;
+    } texts[] = {
         { 0x0000, "no error" },
         { 0x8200, "a rate is negative" },
         { 0x8201, "a rate is NaN after falling back to its parameter" },
@@ -251,7 +280,7 @@ static void test_initialisation(void) {
     start(&b, &c, 3.0, 1.0);
     CHECK_EQ(b.state.y, 7.0);
     CHECK_EQ(rl_running_time(&b.state), 0.0);
-    CHECK_EQ(cycle(&b, 3.0), 6.0);     /* ramps down from initValue at 1/s */
+    CHECK_EQ(cycle(&b, 3.0), 6.0); /* ramps down from initValue at 1/s */
     c.initMode = RL_INIT_INPUT;
     start(&b, &c, 3.0, 1.0);
     CHECK_EQ(b.state.y, 3.0);
@@ -267,12 +296,12 @@ static void test_rule1_non_finite_input(void) {
     start(&b, &c, 0.0, 1.0);
     CHECK_EQ(cycle(&b, 10.0), 1.0);
     CHECK_EQ(rl_running_time(&b.state), 1.0);
-    CHECK_TRUE(isnan(cycle(&b, NAN)));       /* passes at once */
+    CHECK_TRUE(isnan(cycle(&b, NAN)));        /* passes at once */
     CHECK_EQ(rl_running_time(&b.state), 0.0); /* and resets runningTime */
     CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(cycle(&b, INFINITY), INFINITY);
     CHECK_EQ(cycle(&b, -INFINITY), -INFINITY);
-    CHECK_EQ(cycle(&b, 5.0), 5.0);            /* rule 4: valid after invalid */
+    CHECK_EQ(cycle(&b, 5.0), 5.0); /* rule 4: valid after invalid */
 
     /* rule 1 wins over a configuration error (rule 5) and bypass (rule 2) */
     c.rateUp.value = -1.0;
@@ -290,11 +319,11 @@ static void test_siemens_comparison(void) {
     c.rateUp.value = c.rateDown.value = 2.0;
     start(&b, &c, 0.0, 1.0);
     CHECK_EQ(cycle(&b, 10.0), 2.0);
-    CHECK_EQ(cycle(&b, NAN), 2.0);            /* neither > nor <: hold */
+    CHECK_EQ(cycle(&b, NAN), 2.0); /* neither > nor <: hold */
     CHECK_EQ(cycle(&b, NAN), 2.0);
-    CHECK_EQ(cycle(&b, INFINITY), 4.0);       /* ramps towards +inf */
+    CHECK_EQ(cycle(&b, INFINITY), 4.0); /* ramps towards +inf */
     CHECK_EQ(cycle(&b, -INFINITY), 2.0);
-    CHECK_EQ(cycle(&b, 3.0), 3.0);            /* a number again: ramps */
+    CHECK_EQ(cycle(&b, 3.0), 3.0); /* a number again: ramps */
 }
 
 static void test_rule2_bypass(void) {
@@ -305,19 +334,19 @@ static void test_rule2_bypass(void) {
     c.bypass = true;
     c.bypassValue = 8.0;
     reconfigure(&b, &c);
-    CHECK_EQ(cycle(&b, 10.0), 8.0);           /* jumps to bypassValue */
+    CHECK_EQ(cycle(&b, 10.0), 8.0); /* jumps to bypassValue */
     CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 0.0);
-    c.bypassValue = NAN;                      /* no bypass value: y = u */
+    c.bypassValue = NAN; /* no bypass value: y = u */
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 4.0), 4.0);
-    c.bypassValue = INFINITY;                 /* not finite: y = u */
+    c.bypassValue = INFINITY; /* not finite: y = u */
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 4.5), 4.5);
     c.bypassValue = -2.0;
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 4.5), -2.0);
-    c.bypass = false;                         /* released: ramps from -2 */
+    c.bypass = false; /* released: ramps from -2 */
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 4.5), -1.0);
     CHECK_TRUE(outputs(&b).rampActive);
@@ -336,11 +365,11 @@ static void test_rule3_init_delay(void) {
     c.initMode = RL_INIT_INPUT_DELAYED;
     c.initDelay = 0.3;
     start(&b, &c, 0.0, 0.1);
-    CHECK_EQ(cycle(&b, 5.0), 5.0);            /* ends at 0.1 */
-    CHECK_EQ(cycle(&b, -5.0), -5.0);          /* 0.2 */
-    CHECK_EQ(cycle(&b, 6.0), 6.0);            /* 3 * 0.1 = 0.30000000000000004: at 0.3 within rounding */
+    CHECK_EQ(cycle(&b, 5.0), 5.0);   /* ends at 0.1 */
+    CHECK_EQ(cycle(&b, -5.0), -5.0); /* 0.2 */
+    CHECK_EQ(cycle(&b, 6.0), 6.0);   /* 3 * 0.1 = 0.30000000000000004: at 0.3 within rounding */
     CHECK_TRUE(!outputs(&b).rampActive);
-    CHECK_EQ(cycle(&b, 10.0), 6.1);           /* 0.4: ramps at 1/s */
+    CHECK_EQ(cycle(&b, 10.0), 6.1); /* 0.4: ramps at 1/s */
     CHECK_TRUE(outputs(&b).rampActive);
     /* initMode 2 ignores initDelay */
     c.initMode = RL_INIT_INPUT;
@@ -353,12 +382,12 @@ static void test_rule3_init_delay(void) {
     start(&b, &c, 0.0, 0.1);
     cycle(&b, 0.0);
     cycle(&b, 0.0);
-    CHECK_EQ(cycle(&b, 5.0), 0.1);            /* ends at 0.3: past the delay, ramps */
+    CHECK_EQ(cycle(&b, 5.0), 0.1); /* ends at 0.3: past the delay, ramps */
     c.initDelay = 30.0 - 5e-9;
     start(&b, &c, 0.0, 10.0);
     cycle(&b, 0.0);
     cycle(&b, 0.0);
-    CHECK_EQ(cycle(&b, 500.0), 500.0);        /* ends at 30: within 1e-9 * 10 s, tracks */
+    CHECK_EQ(cycle(&b, 500.0), 500.0); /* ends at 30: within 1e-9 * 10 s, tracks */
     CHECK_EQ(cycle(&b, 0.0), 490.0);
     /* the edge itself: a cycle ending at exactly initDelay + 1e-9 * T tracks */
     c.initDelay = 0.3;
@@ -417,7 +446,7 @@ static void test_rule5_configuration_error_holds(void) {
     CHECK_EQ(cycle(&b, 10.0), 1.0);
     CHECK_EQ(cycle(&b, -3.0), 1.0);
     CHECK_TRUE(!outputs(&b).rampActive);
-    c.rateDown.value = 1.0;                   /* fixed: ramps on from the held value */
+    c.rateDown.value = 1.0; /* fixed: ramps on from the held value */
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, -3.0), 0.0);
 }
@@ -428,17 +457,17 @@ static void test_rule6_ramp(void) {
     c.rateUp.value = 2.0;
     c.rateDown.value = 0.5;
     start(&b, &c, 0.0, 0.5);
-    CHECK_EQ(cycle(&b, 3.0), 1.0);            /* +2/s * 0.5 s */
+    CHECK_EQ(cycle(&b, 3.0), 1.0); /* +2/s * 0.5 s */
     CHECK_TRUE(outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 0.5);
     CHECK_EQ(cycle(&b, 3.0), 2.0);
     CHECK_EQ(rl_running_time(&b.state), 1.0);
-    CHECK_EQ(cycle(&b, 3.0), 3.0);            /* reaches u, no overshoot */
+    CHECK_EQ(cycle(&b, 3.0), 3.0); /* reaches u, no overshoot */
     CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 1.5);
-    CHECK_EQ(cycle(&b, 3.0), 3.0);            /* y == u: the timer value remains */
+    CHECK_EQ(cycle(&b, 3.0), 3.0); /* y == u: the timer value remains */
     CHECK_EQ(rl_running_time(&b.state), 1.5);
-    CHECK_EQ(cycle(&b, 2.5), 2.75);           /* -0.5/s * 0.5 s; new u resets the timer */
+    CHECK_EQ(cycle(&b, 2.5), 2.75); /* -0.5/s * 0.5 s; new u resets the timer */
     CHECK_EQ(rl_running_time(&b.state), 0.5);
     CHECK_EQ(cycle(&b, 2.5), 2.5);
     CHECK_EQ(cycle(&b, 2.5), 2.5);
@@ -469,7 +498,7 @@ static void test_rule6_duration(void) {
         CHECK_TRUE(b.state.y < 100.0);
     }
     CHECK_EQ(rl_running_time(&b.state), 29 * 0.1);
-    CHECK_EQ(cycle(&b, 100.0), 100.0);        /* 30 cycles of 0.1 s reach 3 s */
+    CHECK_EQ(cycle(&b, 100.0), 100.0); /* 30 cycles of 0.1 s reach 3 s */
     CHECK_TRUE(!outputs(&b).rampActive);
     CHECK_EQ(rl_running_time(&b.state), 30 * 0.1);
     CHECK_EQ(cycle(&b, 100.0), 100.0);
@@ -486,7 +515,7 @@ static void test_rule6_duration(void) {
     CHECK_EQ(cycle(&b, 5.0), 5.0);
     CHECK_TRUE(!outputs(&b).limitingUp);
     start(&b, &c, 0.0, shorter);
-    CHECK_EQ(cycle(&b, 5.0), shorter);        /* 1 per 1 s for one cycle */
+    CHECK_EQ(cycle(&b, 5.0), shorter); /* 1 per 1 s for one cycle */
     CHECK_TRUE(outputs(&b).limitingUp);
     start(&b, &c, 0.0, edge / 2);
     rl_run(&b.state, &b.prepared, 5.0, 1, 2, edge / 2);
@@ -514,20 +543,20 @@ static void test_rule6_duration(void) {
  * limit is its own target (uc = min(max(u, yMin), yMax) likewise). */
 static void test_signed_zeros(void) {
     Block b;
-    RlConfig c = defaults();                  /* 1 per cycle of 1 s */
+    RlConfig c = defaults(); /* 1 per cycle of 1 s */
     start(&b, &c, 0.0, 1.0);
-    CHECK_BITS(cycle(&b, -0.0), 0.0);         /* u == yp: y = yp */
+    CHECK_BITS(cycle(&b, -0.0), 0.0); /* u == yp: y = yp */
     start(&b, &c, -0.0, 1.0);
     CHECK_BITS(cycle(&b, 0.0), -0.0);
     start(&b, &c, -1.0, 1.0);
-    CHECK_BITS(cycle(&b, -0.0), -0.0);        /* min(u, -1 + 1 = +0.0): u */
+    CHECK_BITS(cycle(&b, -0.0), -0.0); /* min(u, -1 + 1 = +0.0): u */
     start(&b, &c, 1.0, 1.0);
-    CHECK_BITS(cycle(&b, -0.0), -0.0);        /* max(u, 1 - 1 = +0.0): u */
-    c.yMin.value = 0.0;                       /* u == yMin: uc = u */
+    CHECK_BITS(cycle(&b, -0.0), -0.0); /* max(u, 1 - 1 = +0.0): u */
+    c.yMin.value = 0.0;                /* u == yMin: uc = u */
     start(&b, &c, 1.0, 1.0);
     CHECK_BITS(cycle(&b, -0.0), -0.0);
     c = defaults();
-    c.yMax.value = -0.0;                      /* u == yMax: uc = u */
+    c.yMax.value = -0.0; /* u == yMax: uc = u */
     start(&b, &c, -1.0, 1.0);
     CHECK_BITS(cycle(&b, 0.0), 0.0);
 }
@@ -539,7 +568,7 @@ static void test_running_time_period_change(void) {
     start(&b, &c, 0.0, 0.25);
     cycle(&b, 1.0);
     cycle(&b, 1.0);
-    b.period = 0.5;                           /* variable steps: T changes */
+    b.period = 0.5; /* variable steps: T changes */
     reconfigure(&b, &c);
     rl_cycle(&b.state, &b.prepared, 1.0, 1.0);
     CHECK_EQ(rl_running_time(&b.state), 1.0); /* 0.25 + 0.25 + 0.5 */
@@ -575,58 +604,58 @@ static void test_fast_paths_equal_rules(void) {
     const double rates[] = { 0.0, 0.3, 1e308, -1.0 };
     const double durations[] = { 0.0, 0.05, 1.0 };
     const double starts[] = { 0.0, NAN, INFINITY };
-    const double inputs[][2] = { { 5.0, -5.0 }, { -5.0, 5.0 }, { 0.1, 0.1 }, { NAN, 2.0 }, { INFINITY, -INFINITY },
-                                 { 1e308, -1e308 } };
+    const double inputs[][2] = { { 5.0, -5.0 }, { -5.0, 5.0 },           { 0.1, 0.1 },
+                                 { NAN, 2.0 },  { INFINITY, -INFINITY }, { 1e308, -1e308 } };
     const unsigned long counts[] = { 1, 2, 7, 50 };
     const double T = 0.01;
     for (size_t r = 0; r < 4; r++)
-    for (size_t d = 0; d < 3; d++)
-    for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
-    for (int init = RL_INIT_VALUE; init <= RL_INIT_INPUT_DELAYED; init++)
-    for (int flags = 0; flags < 4; flags++)
-    for (size_t y0 = 0; y0 < 3; y0++)
-    for (size_t in = 0; in < 6; in++)
-    for (size_t n = 0; n < 4; n++)
-    for (int extra = 0; extra < 6; extra++)
-    for (int real = 0; real <= 1; real++) {
-        RlConfig c = defaults();
-        c.real = real;
-        c.rateUp.value = rates[r];
-        c.rateDown.value = rates[(r + 1) % 4];
-        c.duration.value = durations[d];
-        c.zeroRate = zero;
-        c.initMode = init;
-        c.initValue = starts[y0];
-        c.initDelay = 0.02;
-        c.bypass = flags & 1;
-        c.passNonFinite = flags & 2;
-        /* output limits, rates below 0 and hold in play, one at a time (each must clear plain): other
+        for (size_t d = 0; d < 3; d++)
+            for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
+                for (int init = RL_INIT_VALUE; init <= RL_INIT_INPUT_DELAYED; init++)
+                    for (int flags = 0; flags < 4; flags++)
+                        for (size_t y0 = 0; y0 < 3; y0++)
+                            for (size_t in = 0; in < 6; in++)
+                                for (size_t n = 0; n < 4; n++)
+                                    for (int extra = 0; extra < 6; extra++)
+                                        for (int real = 0; real <= 1; real++) {
+                                            RlConfig c = defaults();
+                                            c.real = real;
+                                            c.rateUp.value = rates[r];
+                                            c.rateDown.value = rates[(r + 1) % 4];
+                                            c.duration.value = durations[d];
+                                            c.zeroRate = zero;
+                                            c.initMode = init;
+                                            c.initValue = starts[y0];
+                                            c.initDelay = 0.02;
+                                            c.bypass = flags & 1;
+                                            c.passNonFinite = flags & 2;
+                                            /* output limits, rates below 0 and hold in play, one at a time (each must clear plain): other
          * rates below 0, a high or a low limit, hold */
-        if (extra == 1) c.rateUpNeg = (RlValue){ 0.7, SRC_RATE_UP_NEG };
-        if (extra == 2) c.rateDownNeg = (RlValue){ 2.0, SRC_RATE_DOWN_NEG };
-        if (extra == 3) c.yMax.value = 2.0;
-        if (extra == 4) c.yMin.value = -3.0;
-        if (extra == 5) c.hold = true;
-        RlPrepared p;
-        rl_prepare(&p, resolved(&c), T);
-        RlState run, cycles, rules;
-        rl_init(&run, &p, 1.0);
-        cycles = rules = run;
-        uint64_t first = 1;
-        for (int k = 0; k < 2; k++) { /* two inputs in turn: resets too */
-            const double u = inputs[in][k];
-            const uint64_t last = first + counts[n] - 1;
-            rl_run(&run, &p, u, first, last, T);
-            for (uint64_t m = first; m <= last; m++) {
-                rl_cycle(&cycles, &p, u, (double)m * T);
-                rl_cycle_rules(&rules, &p, rl_input(&p, u), (double)m * T);
-            }
-            check_same_state(&run, &cycles);
-            check_same_state(&cycles, &rules);
-            check_same_outputs(&run, &rules, &p);
-            first = last + 1;
-        }
-    }
+                                            if (extra == 1) c.rateUpNeg = (RlValue){ 0.7, SRC_RATE_UP_NEG };
+                                            if (extra == 2) c.rateDownNeg = (RlValue){ 2.0, SRC_RATE_DOWN_NEG };
+                                            if (extra == 3) c.yMax.value = 2.0;
+                                            if (extra == 4) c.yMin.value = -3.0;
+                                            if (extra == 5) c.hold = true;
+                                            RlPrepared p;
+                                            rl_prepare(&p, resolved(&c), T);
+                                            RlState run, cycles, rules;
+                                            rl_init(&run, &p, 1.0);
+                                            cycles = rules = run;
+                                            uint64_t first = 1;
+                                            for (int k = 0; k < 2; k++) { /* two inputs in turn: resets too */
+                                                const double u = inputs[in][k];
+                                                const uint64_t last = first + counts[n] - 1;
+                                                rl_run(&run, &p, u, first, last, T);
+                                                for (uint64_t m = first; m <= last; m++) {
+                                                    rl_cycle(&cycles, &p, u, (double)m * T);
+                                                    rl_cycle_rules(&rules, &p, rl_input(&p, u), (double)m * T);
+                                                }
+                                                check_same_state(&run, &cycles);
+                                                check_same_state(&cycles, &rules);
+                                                check_same_outputs(&run, &rules, &p);
+                                                first = last + 1;
+                                            }
+                                        }
 }
 
 /* rl_run of an empty range (first > last) runs no cycle */
@@ -657,47 +686,47 @@ static void test_steady_ramp_equals_rules(void) {
                                          /* at rest while T shrinks, then a new u at that T */
                                          { 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0 } };
     for (size_t r = 0; r < 3; r++)
-    for (size_t d = 0; d < 3; d++)
-    for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
-    for (size_t in = 0; in < ROWS; in++)
-    for (int repeat = 1; repeat <= 12; repeat += 11)
-    for (int real = 0; real <= 1; real++) {
-        RlConfig c = defaults();
-        c.real = real;
-        c.rateUp.value = rates[r];
-        c.rateDown.value = rates[(r + 2) % 3];
-        c.duration.value = durations[d];
-        c.zeroRate = zero;
-        RlPrepared p;
-        RlState steady, rules;
-        rl_prepare(&p, resolved(&c), periods[0]);
-        rl_init(&steady, &p, 1.0);
-        rules = steady;
-        bool held = false; /* the FMU's fastPeriod: steady steps allowed */
-        double elapsed = 0.0;
-        for (size_t k = 0; k < STEPS; k++) {
-            if (k == 0 || periods[k] != periods[k - 1]) {
-                rl_prepare(&p, resolved(&c), periods[k]);
-                held = false;
-            }
-            for (int n = 0; n < repeat; n++) {
-                const double u = inputs[in][k];
-                elapsed += periods[k];
-                /* as the FMU: the common step unless u is not finite in the arithmetic */
-                if (!(held && rl_ramp_steady(&steady, &p, u))) {
-                    rl_cycle(&steady, &p, u, elapsed);
-                }
-                held = p.plain && isfinite(steady.y) && steady.decided == RL_DECIDED_RAMP;
-                if (held) rl_hold_period(&steady, periods[k]);
-                rl_cycle_rules(&rules, &p, rl_input(&p, u), elapsed);
-                CHECK_EQ(steady.y, rules.y);
-                CHECK_EQ(steady.uPrevious, rules.uPrevious);
-                CHECK_EQ(steady.yPrevious, rules.yPrevious);
-                CHECK_EQ(steady.decided, rules.decided);
-                CHECK_EQ(rl_running_time(&steady), rl_running_time(&rules));
-            }
-        }
-    }
+        for (size_t d = 0; d < 3; d++)
+            for (int zero = RL_ZERO_RATE_HOLD; zero <= RL_ZERO_RATE_NO_LIMIT; zero++)
+                for (size_t in = 0; in < ROWS; in++)
+                    for (int repeat = 1; repeat <= 12; repeat += 11)
+                        for (int real = 0; real <= 1; real++) {
+                            RlConfig c = defaults();
+                            c.real = real;
+                            c.rateUp.value = rates[r];
+                            c.rateDown.value = rates[(r + 2) % 3];
+                            c.duration.value = durations[d];
+                            c.zeroRate = zero;
+                            RlPrepared p;
+                            RlState steady, rules;
+                            rl_prepare(&p, resolved(&c), periods[0]);
+                            rl_init(&steady, &p, 1.0);
+                            rules = steady;
+                            bool held = false; /* the FMU's fastPeriod: steady steps allowed */
+                            double elapsed = 0.0;
+                            for (size_t k = 0; k < STEPS; k++) {
+                                if (k == 0 || periods[k] != periods[k - 1]) {
+                                    rl_prepare(&p, resolved(&c), periods[k]);
+                                    held = false;
+                                }
+                                for (int n = 0; n < repeat; n++) {
+                                    const double u = inputs[in][k];
+                                    elapsed += periods[k];
+                                    /* as the FMU: the common step unless u is not finite in the arithmetic */
+                                    if (!(held && rl_ramp_steady(&steady, &p, u))) {
+                                        rl_cycle(&steady, &p, u, elapsed);
+                                    }
+                                    held = p.plain && isfinite(steady.y) && steady.decided == RL_DECIDED_RAMP;
+                                    if (held) rl_hold_period(&steady, periods[k]);
+                                    rl_cycle_rules(&rules, &p, rl_input(&p, u), elapsed);
+                                    CHECK_EQ(steady.y, rules.y);
+                                    CHECK_EQ(steady.uPrevious, rules.uPrevious);
+                                    CHECK_EQ(steady.yPrevious, rules.yPrevious);
+                                    CHECK_EQ(steady.decided, rules.decided);
+                                    CHECK_EQ(rl_running_time(&steady), rl_running_time(&rules));
+                                }
+                            }
+                        }
 }
 
 /* The common step onto a zero target of the other sign: a limited step
@@ -707,24 +736,24 @@ static void test_steady_ramp_equals_rules(void) {
 static void test_steady_ramp_onto_a_zero_of_the_other_sign(void) {
     const double starts[] = { -1.0, 1.0 }; /* up from -1, down from +1, by 1 per cycle */
     for (int real = 0; real <= 1; real++)
-    for (size_t k = 0; k < 2; k++) {
-        RlConfig c = defaults();
-        c.real = real;
-        c.rateUp.value = 2.0;   /* 2 per s for a cycle of 0.5 s: exactly 1 per cycle */
-        c.rateDown.value = 2.0;
-        RlPrepared p;
-        RlState steady, rules;
-        rl_prepare(&p, resolved(&c), 0.5);
-        rl_init(&steady, &p, starts[k]);
-        rl_cycle(&steady, &p, starts[k], 0.5); /* a decided cycle arms the common step */
-        CHECK_TRUE(p.plain && steady.decided == RL_DECIDED_RAMP);
-        rules = steady;
-        rl_hold_period(&steady, 0.5);
-        CHECK_TRUE(rl_ramp_steady(&steady, &p, -0.0));
-        rl_cycle_rules(&rules, &p, rl_input(&p, -0.0), 1.0);
-        CHECK_BITS(rules.y, -0.0);
-        CHECK_BITS(steady.y, rules.y);
-    }
+        for (size_t k = 0; k < 2; k++) {
+            RlConfig c = defaults();
+            c.real = real;
+            c.rateUp.value = 2.0; /* 2 per s for a cycle of 0.5 s: exactly 1 per cycle */
+            c.rateDown.value = 2.0;
+            RlPrepared p;
+            RlState steady, rules;
+            rl_prepare(&p, resolved(&c), 0.5);
+            rl_init(&steady, &p, starts[k]);
+            rl_cycle(&steady, &p, starts[k], 0.5); /* a decided cycle arms the common step */
+            CHECK_TRUE(p.plain && steady.decided == RL_DECIDED_RAMP);
+            rules = steady;
+            rl_hold_period(&steady, 0.5);
+            CHECK_TRUE(rl_ramp_steady(&steady, &p, -0.0));
+            rl_cycle_rules(&rules, &p, rl_input(&p, -0.0), 1.0);
+            CHECK_BITS(rules.y, -0.0);
+            CHECK_BITS(steady.y, rules.y);
+        }
 }
 
 /* ---- rules.md, Output limits, rates below 0 and hold ------------------ */
@@ -743,20 +772,25 @@ static void test_status_section6(void) {
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8200);
     CHECK_EQ(source, SRC_RATE_DOWN_PAR);
     /* a NaN Neg rate that does not fall back (the Siemens advanced block) */
-    c = defaults(); c.rateUpNeg = (RlValue){ NAN, SRC_RATE_UP_NEG };
+    c = defaults();
+    c.rateUpNeg = (RlValue){ NAN, SRC_RATE_UP_NEG };
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8201);
     CHECK_EQ(source, SRC_RATE_UP_NEG);
     /* 0x8204: yMin > yMax, after 0x8203 and before 0x8601 */
-    c = defaults(); c.yMax = (RlValue){ 1.0, SRC_Y_MAX }; c.yMin = (RlValue){ 2.0, SRC_Y_MIN_PAR };
+    c = defaults();
+    c.yMax = (RlValue){ 1.0, SRC_Y_MAX };
+    c.yMin = (RlValue){ 2.0, SRC_Y_MIN_PAR };
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8204);
     CHECK_EQ(source, SRC_Y_MIN_PAR);
     c.cycleTime.value = -1.0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8204);
     c.duration.value = -1.0;
     CHECK_EQ(rl_status(resolved(&c), &source), 0x8203);
-    c = defaults(); c.yMax.value = NAN; c.yMin.value = 5.0;     /* NaN: no limit, never inverted */
+    c = defaults();
+    c.yMax.value = NAN;
+    c.yMin.value = 5.0; /* NaN: no limit, never inverted */
     CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
-    c.yMax.value = 5.0;                                          /* equal limits are fine */
+    c.yMax.value = 5.0; /* equal limits are fine */
     CHECK_EQ(rl_status(resolved(&c), &source), RL_STATUS_OK);
     CHECK_TRUE(strlen(rl_status_text(0x8204)) > 0);
 }
@@ -766,11 +800,11 @@ static void test_rates_by_sign(void) {
     RlConfig c = with_rates(2.0, 1.0, 4.0, 0.5, -1.0);
     start(&b, &c, 3.0, 0.5);
     CHECK_TRUE(!b.prepared.plain);
-    CHECK_EQ(cycle(&b, 3.0), -0.5);     /* below 0: rateUpNeg * 0.5 */
+    CHECK_EQ(cycle(&b, 3.0), -0.5); /* below 0: rateUpNeg * 0.5 */
     CHECK_EQ(cycle(&b, 3.0), 0.0);
-    CHECK_EQ(cycle(&b, 3.0), 1.0);      /* at 0: rateUp * 0.5 */
-    CHECK_EQ(cycle(&b, -3.0), -1.0);    /* from 1 >= 0: rateDown * 0.5 = 2 */
-    CHECK_EQ(cycle(&b, -3.0), -1.25);   /* below 0: rateDownNeg * 0.5 */
+    CHECK_EQ(cycle(&b, 3.0), 1.0);    /* at 0: rateUp * 0.5 */
+    CHECK_EQ(cycle(&b, -3.0), -1.0);  /* from 1 >= 0: rateDown * 0.5 = 2 */
+    CHECK_EQ(cycle(&b, -3.0), -1.25); /* below 0: rateDownNeg * 0.5 */
     /* a Neg rate equal to the other keeps the fast paths */
     c = defaults();
     start(&b, &c, 0.0, 0.5);
@@ -782,52 +816,60 @@ static void test_output_limits(void) {
     RlConfig c = defaults();
     start(&b, &c, 5.0, 0.5);
     CHECK_EQ(b.state.y, 5.0);
-    c.yMax.value = 2.0;                 /* tightened below y: ramps into the band */
+    c.yMax.value = 2.0; /* tightened below y: ramps into the band */
     reconfigure(&b, &c);
     CHECK_TRUE(!b.prepared.plain);
     CHECK_EQ(cycle(&b, 5.0), 4.5);
     CHECK_TRUE(outputs(&b).highLimit && outputs(&b).limitingDown && outputs(&b).rampActive);
     for (int k = 0; k < 5; k++) cycle(&b, 5.0);
-    CHECK_EQ(b.state.y, 2.0);           /* settles at the limit */
+    CHECK_EQ(b.state.y, 2.0); /* settles at the limit */
     CHECK_TRUE(outputs(&b).highLimit && !outputs(&b).rampActive && !outputs(&b).limitingDown);
-    c.yMin.value = 3.0;                 /* inverted: status, hold */
+    c.yMin.value = 3.0; /* inverted: status, hold */
     reconfigure(&b, &c);
     CHECK_EQ(b.prepared.status, 0x8204);
     CHECK_EQ(cycle(&b, -5.0), 2.0);
     CHECK_TRUE(outputs(&b).lowLimit && outputs(&b).highLimit);
-    c.yMax.value = NAN;                 /* NaN after fallback: no limit */
+    c.yMax.value = NAN; /* NaN after fallback: no limit */
     reconfigure(&b, &c);
-    CHECK_EQ(cycle(&b, -5.0), 2.5);     /* target max(-5, 3) = 3 */
+    CHECK_EQ(cycle(&b, -5.0), 2.5); /* target max(-5, 3) = 3 */
     CHECK_TRUE(!outputs(&b).highLimit && outputs(&b).lowLimit);
     /* rules 1 to 4 ignore the limits */
     c.passNonFinite = true;
     CHECK_EQ(cycle(&b, INFINITY), INFINITY);
-    CHECK_TRUE(!outputs(&b).highLimit && !outputs(&b).lowLimit);  /* not finite */
+    CHECK_TRUE(!outputs(&b).highLimit && !outputs(&b).lowLimit); /* not finite */
     c.bypass = true;
     c.bypassValue = -7.0;
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 1.0), -7.0);
     /* the initial output is limited, unless asked not to or inverted */
-    c = defaults(); c.yMin.value = 1.0;
+    c = defaults();
+    c.yMin.value = 1.0;
     start(&b, &c, -4.0, 1.0);
     CHECK_EQ(b.state.y, 1.0);
     c.limitInitialOutput = false;
     start(&b, &c, -4.0, 1.0);
     CHECK_EQ(b.state.y, -4.0);
-    c = defaults(); c.yMin.value = 1.0; c.yMax.value = 0.0;
+    c = defaults();
+    c.yMin.value = 1.0;
+    c.yMax.value = 0.0;
     start(&b, &c, -4.0, 1.0);
     CHECK_EQ(b.state.y, -4.0);
     /* ... and only a finite one: an infinite initial output stays as it is */
-    c = defaults(); c.yMin.value = -1.0; c.yMax.value = 2.0;
+    c = defaults();
+    c.yMin.value = -1.0;
+    c.yMax.value = 2.0;
     start(&b, &c, INFINITY, 1.0);
     CHECK_EQ(b.state.y, INFINITY);
     start(&b, &c, -INFINITY, 1.0);
     CHECK_EQ(b.state.y, -INFINITY);
-    c.initMode = RL_INIT_VALUE; c.initValue = INFINITY;
+    c.initMode = RL_INIT_VALUE;
+    c.initValue = INFINITY;
     start(&b, &c, 0.0, 1.0);
     CHECK_EQ(b.state.y, INFINITY);
     /* a NaN u stays NaN as the target (the Siemens comparison holds) */
-    c = defaults(); c.passNonFinite = false; c.yMax.value = 2.0;
+    c = defaults();
+    c.passNonFinite = false;
+    c.yMax.value = 2.0;
     start(&b, &c, 1.0, 1.0);
     CHECK_EQ(cycle(&b, NAN), 1.0);
 }
@@ -844,14 +886,14 @@ static void test_rule5b_hold(void) {
     reconfigure(&b, &c);
     CHECK_TRUE(!b.prepared.plain);
     CHECK_EQ(cycle(&b, 10.0), 1.0);
-    CHECK_EQ(cycle(&b, 20.0), 1.0);     /* u changes: still frozen, runningTime too */
+    CHECK_EQ(cycle(&b, 20.0), 1.0); /* u changes: still frozen, runningTime too */
     CHECK_EQ(rl_running_time(&b.state), 1.0);
     CHECK_TRUE(!outputs(&b).rampActive && !outputs(&b).limitingUp);
     CHECK_EQ(outputs(&b).dydt, 0.0);
     CHECK_EQ(outputs(&b).remainingTime, 19.0); /* as if hold were off: (20 - 1) / 1 */
     c.hold = false;
     reconfigure(&b, &c);
-    CHECK_EQ(cycle(&b, 20.0), 1.5);     /* u as in the last cycle: runningTime goes on */
+    CHECK_EQ(cycle(&b, 20.0), 1.5); /* u as in the last cycle: runningTime goes on */
     CHECK_EQ(rl_running_time(&b.state), 1.5);
     /* an error holds first (rule 5 before 5b) */
     c.hold = true;
@@ -869,11 +911,11 @@ static void test_derived_outputs(void) {
     c.initMode = RL_INIT_VALUE;
     c.initValue = -2.0;
     start(&b, &c, 3.0, 0.5);
-    RlOutputs o = outputs(&b);          /* before any cycle */
+    RlOutputs o = outputs(&b); /* before any cycle */
     CHECK_EQ(o.dydt, 0.0);
     CHECK_EQ(o.remainingTime, 0.0);
     CHECK_TRUE(!o.rampActive && !o.limitingUp && !o.limitingDown);
-    cycle(&b, 3.0);                     /* -1.5: 1.5 / 1 below 0, 3 / 2 above */
+    cycle(&b, 3.0); /* -1.5: 1.5 / 1 below 0, 3 / 2 above */
     o = outputs(&b);
     CHECK_EQ(o.dydt, 1.0);
     CHECK_EQ(o.remainingTime, 3.0);
@@ -887,34 +929,39 @@ static void test_derived_outputs(void) {
     c.zeroRate = RL_ZERO_RATE_NO_LIMIT;
     c.rateUp.value = 0.0;
     reconfigure(&b, &c);
-    cycle(&b, 3.0);                     /* both unlimited: the jump */
+    cycle(&b, 3.0); /* both unlimited: the jump */
     CHECK_EQ(b.state.y, 3.0);
     CHECK_EQ(outputs(&b).remainingTime, 0.0);
-    CHECK_EQ(outputs(&b).dydt, 9.0);    /* (3 - -1.5) / 0.5 */
+    CHECK_EQ(outputs(&b).dydt, 9.0); /* (3 - -1.5) / 0.5 */
     /* ratePeriod 0: the rate is per cycle, per second rate / T */
-    c = defaults(); c.ratePeriod.value = 0.0; c.rateDown.value = 0.5;
+    c = defaults();
+    c.ratePeriod.value = 0.0;
+    c.rateDown.value = 0.5;
     start(&b, &c, 2.0, 0.25);
     cycle(&b, 0.0);
     CHECK_EQ(b.state.y, 1.5);
-    CHECK_EQ(outputs(&b).remainingTime, 0.75);  /* 1.5 / (0.5 / 0.25) */
+    CHECK_EQ(outputs(&b).remainingTime, 0.75); /* 1.5 / (0.5 / 0.25) */
     CHECK_EQ(outputs(&b).dydt, -2.0);
     CHECK_TRUE(outputs(&b).limitingDown);
     /* a rate per ratePeriod of 2 s: 1 per 2 s is 0.5 per second */
-    c = defaults(); c.ratePeriod.value = 2.0;
+    c = defaults();
+    c.ratePeriod.value = 2.0;
     start(&b, &c, 0.0, 1.0);
     CHECK_EQ(cycle(&b, 3.0), 0.5);
-    CHECK_EQ(outputs(&b).remainingTime, 5.0);   /* 2.5 / 0.5 */
+    CHECK_EQ(outputs(&b).remainingTime, 5.0); /* 2.5 / 0.5 */
     /* the duration caps it: what is left of it, when that is less */
-    c = defaults(); c.duration.value = 3.0;
+    c = defaults();
+    c.duration.value = 3.0;
     start(&b, &c, 0.0, 0.5);
     cycle(&b, 10.0);
-    CHECK_EQ(outputs(&b).remainingTime, 2.5);   /* min(9.5, 3 - 0.5) */
+    CHECK_EQ(outputs(&b).remainingTime, 2.5); /* min(9.5, 3 - 0.5) */
     c.duration.value = 100.0;
     start(&b, &c, 0.0, 0.5);
     cycle(&b, 10.0);
-    CHECK_EQ(outputs(&b).remainingTime, 9.5);   /* min(9.5, 100 - 0.5) */
+    CHECK_EQ(outputs(&b).remainingTime, 9.5); /* min(9.5, 100 - 0.5) */
     /* held past a duration cut below runningTime: nothing is left, 0 */
-    c = defaults(); c.duration.value = 10.0;
+    c = defaults();
+    c.duration.value = 10.0;
     start(&b, &c, 0.0, 1.0);
     cycle(&b, 10.0);
     cycle(&b, 10.0);
@@ -922,23 +969,27 @@ static void test_derived_outputs(void) {
     c.duration.value = 1.5;
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 10.0), 2.0);
-    CHECK_EQ(outputs(&b).remainingTime, 0.0);   /* min(8, max(0, 1.5 - 2)) */
-    c = defaults(); c.duration.value = 1.0;
+    CHECK_EQ(outputs(&b).remainingTime, 0.0); /* min(8, max(0, 1.5 - 2)) */
+    c = defaults();
+    c.duration.value = 1.0;
     start(&b, &c, 0.0, 0.5);
     cycle(&b, 10.0);
-    CHECK_EQ(outputs(&b).remainingTime, 0.5);   /* min(9.5, 1 - 0.5) */
+    CHECK_EQ(outputs(&b).remainingTime, 0.5); /* min(9.5, 1 - 0.5) */
     cycle(&b, 10.0);
-    CHECK_EQ(b.state.y, 10.0);                  /* the jump */
+    CHECK_EQ(b.state.y, 10.0); /* the jump */
     CHECK_TRUE(!outputs(&b).limitingUp);
-    CHECK_EQ(outputs(&b).dydt, 19.0);           /* (10 - 0.5) / 0.5 */
+    CHECK_EQ(outputs(&b).dydt, 19.0); /* (10 - 0.5) / 0.5 */
     /* a leg at a rate of 0 that does not limit takes no time; the other
      * one its own: 2 down to -3, 1.5 above 0 at 1/s */
-    c = defaults(); c.zeroRate = RL_ZERO_RATE_NO_LIMIT; c.rateDownNeg = (RlValue){ 0.0, SRC_RATE_DOWN_NEG };
+    c = defaults();
+    c.zeroRate = RL_ZERO_RATE_NO_LIMIT;
+    c.rateDownNeg = (RlValue){ 0.0, SRC_RATE_DOWN_NEG };
     start(&b, &c, 2.0, 0.5);
     CHECK_EQ(cycle(&b, -3.0), 1.5);
     CHECK_EQ(outputs(&b).remainingTime, 1.5);
     /* a leg of no length takes no time, even at a rate of 0 that holds */
-    c = defaults(); c.rateUpNeg = (RlValue){ 0.0, SRC_RATE_UP_NEG };
+    c = defaults();
+    c.rateUpNeg = (RlValue){ 0.0, SRC_RATE_UP_NEG };
     start(&b, &c, 2.0, 0.5);
     CHECK_EQ(cycle(&b, 5.0), 2.5);
     CHECK_EQ(outputs(&b).remainingTime, 2.5);
@@ -957,20 +1008,22 @@ static void test_derived_outputs(void) {
  * down: below 0 at the Neg rate, above at the other. Rates per 1 s: up 1,
  * upNeg 0.5, down 2, downNeg 4; T = 0.25; y after one cycle from y0. */
 static void test_remaining_time_legs(void) {
-    static const struct { double y0, u, y, remaining; } ways[] = {
-        { -3.0, -1.0, -2.875, 3.75 },   /* up, both below 0: 1.875 / 0.5 */
-        { -3.0, -0.5, -2.875, 4.75 },   /* 2.375 / 0.5 */
-        { -3.0, 0.5, -2.875, 6.25 },    /* 2.875 / 0.5 + 0.5 / 1 */
-        { -0.5, 2.0, -0.375, 2.75 },    /* 0.375 / 0.5 + 2 / 1 */
-        { 1.0, 3.0, 1.25, 1.75 },       /* both above: 1.75 / 1 */
-        { 3.0, 1.0, 2.5, 0.75 },        /* down, both above 0: 1.5 / 2 */
-        { 3.0, 0.5, 2.5, 1.0 },         /* 2 / 2 */
-        { 3.0, -0.5, 2.5, 1.375 },      /* 2.5 / 2 + 0.5 / 4 */
-        { 0.75, -2.0, 0.25, 0.625 },    /* 0.25 / 2 + 2 / 4 */
-        { -1.0, -3.0, -2.0, 0.25 },     /* both below: 1 / 4 */
-        { -0.5, -3.0, -1.5, 0.375 },    /* 1.5 / 4 */
-        { 0.125, 2.0, 0.375, 1.625 },   /* up from above 0: 1.625 / 1 */
-        { 0.25, -3.0, -0.25, 0.6875 },  /* down from below 0: 2.75 / 4 */
+    static const struct {
+        double y0, u, y, remaining;
+    } ways[] = {
+        { -3.0, -1.0, -2.875, 3.75 },  /* up, both below 0: 1.875 / 0.5 */
+        { -3.0, -0.5, -2.875, 4.75 },  /* 2.375 / 0.5 */
+        { -3.0, 0.5, -2.875, 6.25 },   /* 2.875 / 0.5 + 0.5 / 1 */
+        { -0.5, 2.0, -0.375, 2.75 },   /* 0.375 / 0.5 + 2 / 1 */
+        { 1.0, 3.0, 1.25, 1.75 },      /* both above: 1.75 / 1 */
+        { 3.0, 1.0, 2.5, 0.75 },       /* down, both above 0: 1.5 / 2 */
+        { 3.0, 0.5, 2.5, 1.0 },        /* 2 / 2 */
+        { 3.0, -0.5, 2.5, 1.375 },     /* 2.5 / 2 + 0.5 / 4 */
+        { 0.75, -2.0, 0.25, 0.625 },   /* 0.25 / 2 + 2 / 4 */
+        { -1.0, -3.0, -2.0, 0.25 },    /* both below: 1 / 4 */
+        { -0.5, -3.0, -1.5, 0.375 },   /* 1.5 / 4 */
+        { 0.125, 2.0, 0.375, 1.625 },  /* up from above 0: 1.625 / 1 */
+        { 0.25, -3.0, -0.25, 0.6875 }, /* down from below 0: 2.75 / 4 */
     };
     for (size_t i = 0; i < sizeof ways / sizeof ways[0]; i++) {
         Block b;
@@ -984,19 +1037,17 @@ static void test_remaining_time_legs(void) {
 /* The derived outputs after each kind of cycle. Rates per cycle of 1 s:
  * up and down 1, upNeg and downNeg 0.5, picked by the sign of yp. */
 static void test_derived_outputs_by_cycle(void) {
-    static const struct { double yp, u, y; bool limitingUp, limitingDown; } steps[] = {
-        { -2.0, -1.25, -1.5, true, false },   /* below 0: 0.5 per cycle */
-        { -0.5, 0.25, 0.0, true, false },
-        { 0.0, 0.75, 0.75, false, false },    /* 0 and above: 1 per cycle */
-        { 0.5, 1.25, 1.25, false, false },
-        { 2.0, 2.75, 2.75, false, false },
-        { 2.0, 3.0, 3.0, false, false },      /* the step ends on u: not cut */
-        { -2.0, -2.75, -2.5, false, true },
-        { -0.5, -1.25, -1.0, false, true },
-        { 0.0, -0.75, -0.75, false, false },
-        { 0.5, -0.25, -0.25, false, false },
-        { 2.0, 1.25, 1.25, false, false },
-        { 2.0, 1.0, 1.0, false, false },
+    static const struct {
+        double yp, u, y;
+        bool limitingUp, limitingDown;
+    } steps[] = {
+        { -2.0, -1.25, -1.5, true, false },                                     /* below 0: 0.5 per cycle */
+        { -0.5, 0.25, 0.0, true, false },    { 0.0, 0.75, 0.75, false, false }, /* 0 and above: 1 per cycle */
+        { 0.5, 1.25, 1.25, false, false },   { 2.0, 2.75, 2.75, false, false },
+        { 2.0, 3.0, 3.0, false, false }, /* the step ends on u: not cut */
+        { -2.0, -2.75, -2.5, false, true },  { -0.5, -1.25, -1.0, false, true },
+        { 0.0, -0.75, -0.75, false, false }, { 0.5, -0.25, -0.25, false, false },
+        { 2.0, 1.25, 1.25, false, false },   { 2.0, 1.0, 1.0, false, false },
     };
     Block b;
     RlConfig c;
@@ -1014,14 +1065,16 @@ static void test_derived_outputs_by_cycle(void) {
     reconfigure(&b, &c);
     CHECK_EQ(cycle(&b, 0.0), 2.0);
     CHECK_TRUE(!outputs(&b).limitingDown);
-    c = defaults(); c.duration.value = 1.0;
+    c = defaults();
+    c.duration.value = 1.0;
     start(&b, &c, 10.0, 0.5);
     CHECK_EQ(cycle(&b, 0.0), 9.5);
     CHECK_TRUE(outputs(&b).limitingDown);
     CHECK_EQ(cycle(&b, 0.0), 0.0);
     CHECK_TRUE(!outputs(&b).limitingDown);
     /* lowLimit: at yMin or below, finite */
-    c = defaults(); c.yMin.value = 1.0;
+    c = defaults();
+    c.yMin.value = 1.0;
     start(&b, &c, 3.0, 1.0);
     CHECK_EQ(cycle(&b, 0.0), 2.0);
     CHECK_TRUE(!outputs(&b).lowLimit);
@@ -1030,14 +1083,17 @@ static void test_derived_outputs_by_cycle(void) {
     CHECK_EQ(cycle(&b, -INFINITY), -INFINITY);
     CHECK_TRUE(!outputs(&b).lowLimit);
     /* dydt after a jump of rules 1 to 4 (bypass): the jump per second */
-    c = defaults(); c.bypass = true; c.bypassValue = 8.0;
+    c = defaults();
+    c.bypass = true;
+    c.bypassValue = 8.0;
     start(&b, &c, 1.0, 0.5);
     CHECK_EQ(cycle(&b, 1.0), 8.0);
     CHECK_EQ(outputs(&b).dydt, 14.0);
     /* Siemens comparison: ramping towards +inf, remainingTime is 0 (uc not
      * finite); at no limit the output reaches +inf, dydt 0; an output at
      * +inf above a new yMax stays there, remainingTime 0 (y not finite) */
-    c = defaults(); c.passNonFinite = false;
+    c = defaults();
+    c.passNonFinite = false;
     start(&b, &c, 0.0, 1.0);
     CHECK_EQ(cycle(&b, INFINITY), 1.0);
     CHECK_EQ(outputs(&b).remainingTime, 0.0);
@@ -1081,8 +1137,13 @@ static void test_without_section6(void) {
  * (an instance reset, a block reused) starts afresh. */
 static void test_init_of_a_used_state(void) {
     RlConfig c = defaults();
-    RlState s = { .y = 7.0, .uPrevious = 8.0, .yPrevious = 9.0, .decided = RL_DECIDED_RAMP, .runCycles = 5,
-                  .runPeriod = 0.5, .runBase = 3.0 };
+    RlState s = { .y = 7.0,
+                  .uPrevious = 8.0,
+                  .yPrevious = 9.0,
+                  .decided = RL_DECIDED_RAMP,
+                  .runCycles = 5,
+                  .runPeriod = 0.5,
+                  .runBase = 3.0 };
     RlPrepared p;
     rl_prepare(&p, &c, 1.0);
     rl_init(&s, &p, 2.0);
@@ -1101,7 +1162,7 @@ static void test_init_of_a_used_state(void) {
  * from 2^128 - 2^103 on (halfway above FLT_MAX) an infinity */
 static void test_binary32_entry(void) {
     CHECK_BITS((double)rl_binary32(0.01), 0.009999999776482582);
-    CHECK_BITS((double)rl_binary32(1.0 + ldexp(1.0, -24)), 1.0);              /* a tie: to even */
+    CHECK_BITS((double)rl_binary32(1.0 + ldexp(1.0, -24)), 1.0); /* a tie: to even */
     CHECK_BITS((double)rl_binary32(1.0 + 3 * ldexp(1.0, -24)), 1.0 + ldexp(1.0, -22));
     CHECK_BITS((double)rl_binary32(RL_FLOAT_OVERFLOW), INFINITY);
     CHECK_BITS((double)rl_binary32(-RL_FLOAT_OVERFLOW), -INFINITY);
@@ -1173,20 +1234,24 @@ static void test_real_entry_values(void) {
         RlConfig c = defaults();
         c.real = real;
         RlPrepared p;
-        c.rateUp.value = -1e-50;                       /* -0 in binary32: not negative */
+        c.rateUp.value = -1e-50; /* -0 in binary32: not negative */
         rl_prepare(&p, resolved(&c), 0.1);
         CHECK_EQ(p.status, real ? RL_STATUS_OK : RL_STATUS_RATE_NEGATIVE);
-        CHECK_EQ(p.maxUp, real ? 0.0 : -1e-50 * 0.1);  /* a rate of 0 holds */
-        c = defaults(); c.real = real;
-        c.ratePeriod.value = 1e39;                     /* +inf in binary32 */
+        CHECK_EQ(p.maxUp, real ? 0.0 : -1e-50 * 0.1); /* a rate of 0 holds */
+        c = defaults();
+        c.real = real;
+        c.ratePeriod.value = 1e39; /* +inf in binary32 */
         rl_prepare(&p, resolved(&c), 0.1);
         CHECK_EQ(p.status, real ? RL_STATUS_RATE_PERIOD : RL_STATUS_OK);
-        c = defaults(); c.real = real;
-        c.yMax.value = 1.0; c.yMin.value = 1.00000001; /* the same float */
+        c = defaults();
+        c.real = real;
+        c.yMax.value = 1.0;
+        c.yMin.value = 1.00000001; /* the same float */
         rl_prepare(&p, resolved(&c), 0.1);
         CHECK_EQ(p.status, real ? RL_STATUS_OK : RL_STATUS_LIMITS);
         /* a u beyond the float range passes as +inf (rule 1); a finite one ramps */
-        c = defaults(); c.real = real;
+        c = defaults();
+        c.real = real;
         Block b;
         start(&b, &c, 0.0, 0.1);
         CHECK_BITS(cycle(&b, 1e39), real ? INFINITY : 0.1);
@@ -1202,7 +1267,8 @@ static void test_real_entry_values(void) {
         start(&b, &c, 0.0, 0.1);
         CHECK_BITS(b.state.y, real ? 0.10000000149011612 : 0.1);
         /* the limit: rate * T / ratePeriod, each step in binary32 */
-        c = defaults(); c.real = real;
+        c = defaults();
+        c.real = real;
         c.rateUp.value = 3.0;
         c.ratePeriod.value = 0.7;
         rl_prepare(&p, resolved(&c), 0.1);
@@ -1243,7 +1309,8 @@ static void test_quiet_arithmetic(void) {
         -8.98846567431158e307 /* -2^1023 */, 1.3407807929942597e154 /* 2^512 */, -1.3407807929942597e154,
         1.3407807929942596e154 /* 2^512 - ulp */, 1.9958403095347196e292 /* DBL_MAX * 2^-53 */,
         9.979201547673598e291 /* 2^970 - ulp */, 0.9999999999999999 /* 1 - 2^-53 */, 1.9999999999999998 /* 2 - 2^-52 */,
-        INFINITY, -INFINITY };
+        INFINITY, -INFINITY
+    };
     const int n = (int)(sizeof values / sizeof values[0]);
     int raised = 0;
     for (int i = 0; i < n; i++) {

@@ -91,12 +91,19 @@ static int messages;
 
 static void log2_message(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
                          fmi2String message, ...) {
-    (void)env; (void)name; (void)category; (void)status; (void)message;
+    (void)env;
+    (void)name;
+    (void)category;
+    (void)status;
+    (void)message;
     messages++;
 }
 
 static void log3_message(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
-    (void)env; (void)status; (void)category; (void)message;
+    (void)env;
+    (void)status;
+    (void)category;
+    (void)message;
     messages++;
 }
 
@@ -104,12 +111,12 @@ static void log3_message(fmi3InstanceEnvironment env, fmi3Status status, fmi3Str
 
 static int failures;
 
-#define CHECK(condition)                                                      \
-    do {                                                                      \
-        if (!(condition)) {                                                   \
-            failures++;                                                       \
-            fprintf(stderr, "%s:%d: %s\n", __FILE__, __LINE__, #condition);  \
-        }                                                                     \
+#define CHECK(condition) \
+    do { \
+        if (!(condition)) { \
+            failures++; \
+            fprintf(stderr, "%s:%d: %s\n", __FILE__, __LINE__, #condition); \
+        } \
     } while (0)
 
 /* ---- the FMU --------------------------------------------------------- */
@@ -127,8 +134,8 @@ static void *instantiate(const char *name) {
     if (version == 2) {
         return F2(fmi2Instantiate)(name, fmi2CoSimulation, token, "", &callbacks, fmi2False, fmi2False);
     }
-    return F3(fmi3InstantiateCoSimulation)(name, token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
-                                           NULL, log3_message, NULL);
+    return F3(fmi3InstantiateCoSimulation)(name, token, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0, NULL,
+                                           log3_message, NULL);
 }
 
 static void *instantiate_model_exchange(const char *name) {
@@ -143,7 +150,8 @@ static int set_real(void *c, unsigned vr, double value) {
 }
 
 static void release(void *c) {
-    if (version == 2) F2(fmi2FreeInstance)(c); else F3(fmi3FreeInstance)(c);
+    if (version == 2) F2(fmi2FreeInstance)(c);
+    else F3(fmi3FreeInstance)(c);
 }
 
 static int start(void *c) {
@@ -178,7 +186,9 @@ static int set_debug_logging(void *c, size_t n, const char *const categories[]) 
                         : F3(fmi3SetDebugLogging)(c, fmi3True, n, categories);
 }
 
-static double input(int k, int i) { return ((k + i) % 7) * 1.5 - 4.0; }
+static double input(int k, int i) {
+    return ((k + i) % 7) * 1.5 - 4.0;
+}
 
 /* ---- 1. a full simulation, every kind of call ------------------------- */
 
@@ -347,8 +357,8 @@ static void instantiate_free(long cycles) {
     }
     CHECK(liveBlocks == blocks);
     CHECK(callbackBlocks == callbackLive);
-    printf("instantiate/free cycles %ld, live blocks after %ld (before %ld)\n", cycles,
-           liveBlocks + callbackBlocks, blocks + callbackLive);
+    printf("instantiate/free cycles %ld, live blocks after %ld (before %ld)\n", cycles, liveBlocks + callbackBlocks,
+           blocks + callbackLive);
 }
 
 /* ---- 3. many instances alive at once ----------------------------------- */

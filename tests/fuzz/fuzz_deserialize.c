@@ -20,10 +20,16 @@
 #include QUOTED(MODEL_VARIABLES)
 
 static void logger2(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2String c, fmi2String m, ...) {
-    (void)e; (void)n; (void)s; (void)c; (void)m;
+    (void)e;
+    (void)n;
+    (void)s;
+    (void)c;
+    (void)m;
 }
 
-static void *allocate(size_t n, size_t size) { return calloc(n, size); }
+static void *allocate(size_t n, size_t size) {
+    return calloc(n, size);
+}
 
 static const fmi2CallbackFunctions callbacks = { logger2, allocate, free, NULL, NULL };
 
@@ -53,14 +59,17 @@ static void run2(const uint8_t *data, size_t size, int modelExchange) {
 }
 
 static void logger3(fmi3InstanceEnvironment e, fmi3Status s, fmi3String c, fmi3String m) {
-    (void)e; (void)s; (void)c; (void)m;
+    (void)e;
+    (void)s;
+    (void)c;
+    (void)m;
 }
 
 static void run3(const uint8_t *data, size_t size, int modelExchange) {
     fmi3Instance c = modelExchange
-        ? fmi3InstantiateModelExchange("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, NULL, logger3)
-        : fmi3InstantiateCoSimulation("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
-                                      NULL, logger3, NULL);
+                         ? fmi3InstantiateModelExchange("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, NULL, logger3)
+                         : fmi3InstantiateCoSimulation("fuzz", MODEL_TOKEN, NULL, fmi3False, fmi3False, fmi3False,
+                                                       fmi3False, NULL, 0, NULL, logger3, NULL);
     fmi3EnterInitializationMode(c, fmi3False, 0, 0, fmi3False, 0);
     fmi3ExitInitializationMode(c);
     fmi3FMUState state = NULL;

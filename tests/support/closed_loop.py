@@ -10,6 +10,7 @@ RateLimiter y and plant x after every step.
 The ssp-* runs read build/ssp/RateLimiterLoop.ssp (FMI 2 FMUs) instead of
 coupling the FMUs here.
 """
+
 import sys
 import tomllib
 from pathlib import Path
@@ -34,8 +35,10 @@ def ssp_path(build):
 
 
 def paths(build, version):
-    return (Path(build) / f"fmi{version}" / "RateLimiter.fmu",
-            Path(build) / "fixtures" / f"fmi{version}" / "FirstOrderLag.fmu")
+    return (
+        Path(build) / f"fmi{version}" / "RateLimiter.fmu",
+        Path(build) / "fixtures" / f"fmi{version}" / "FirstOrderLag.fmu",
+    )
 
 
 def run_fmpy(build, version):
@@ -82,8 +85,13 @@ def libcosim_rows(execution, rl, plant, vr_rl, vr_plant):
     rows = []
     for k in range(N):
         execution.step(1)
-        rows.append(((k + 1) * H, observer.last_real_values(rl, [vr_rl["y"]])[0],
-                     observer.last_real_values(plant, [vr_plant["x"]])[0]))
+        rows.append(
+            (
+                (k + 1) * H,
+                observer.last_real_values(rl, [vr_rl["y"]])[0],
+                observer.last_real_values(plant, [vr_plant["x"]])[0],
+            )
+        )
     return rows
 
 
@@ -165,11 +173,20 @@ def run_ssp_fmpy(build, version):
     parameter_set = read_ssv(str(ssp_path(build)), resource=ssd.system.elements[0].parameterBindings[0].source)
     parameter_set.parameters = parameters
     result = simulate_ssp(str(ssp_path(build)), stop_time=N * H, step_size=H, parameter_set=parameter_set)
-    return [(float(t), float(y), float(x)) for t, y, x in zip(result["time"], result["rl.y"], result["plant.x"])][1:]
+    return [
+        (float(t), float(y), float(x))
+        for t, y, x in zip(result["time"], result["rl.y"], result["plant.x"], strict=True)
+    ][1:]
 
 
-RUNNERS = {"fmpy": run_fmpy, "ecospy": run_ecospy, "libcosimpy": run_libcosimpy, "ssp-ecospy": run_ssp_ecospy,
-           "ssp-libcosimpy": run_ssp_libcosimpy, "ssp-fmpy": run_ssp_fmpy}
+RUNNERS = {
+    "fmpy": run_fmpy,
+    "ecospy": run_ecospy,
+    "libcosimpy": run_libcosimpy,
+    "ssp-ecospy": run_ssp_ecospy,
+    "ssp-libcosimpy": run_ssp_libcosimpy,
+    "ssp-fmpy": run_ssp_fmpy,
+}
 
 
 def main(importer, version, build, out):

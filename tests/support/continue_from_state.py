@@ -1,10 +1,10 @@
-"""Helper process for test_state: deserialize an FMU state into a fresh
+"""Helper process for fmu/test_state.py: deserialize an FMU state into a fresh
 instance, continue a run, print the outputs as exact hex floats (JSON)."""
+
 import json
 import sys
 
-from support.fmu_driver import Instance
-from test_state import run_steps, state_api
+from support.fmu_driver import Instance, run_steps, state_api
 
 version, state_file, steps = int(sys.argv[1]), sys.argv[2], json.loads(sys.argv[3])
 fmu = Instance("RateLimiter", version)

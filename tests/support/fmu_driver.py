@@ -1,5 +1,6 @@
 """A thin, version-neutral driver over fmpy's low-level FMI 2 / FMI 3 API
 that keeps every log message the FMU sends, for the tests."""
+
 import ctypes
 import os
 from pathlib import Path
@@ -7,8 +8,14 @@ from pathlib import Path
 from fmpy import extract, read_model_description
 from fmpy import calloc, free
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import (FMU2Model, FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
+from fmpy.fmi2 import (
+    FMU2Model,
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 REPO = Path(__file__).resolve().parents[2]
@@ -36,8 +43,7 @@ def unzipped(model, version):
 class Instance:
     """One FMU instance. Values are read and written by variable name."""
 
-    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None,
-                 model_exchange=False):
+    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None, model_exchange=False):
         self.version = version
         self.model_exchange = model_exchange
         self.unzipdir = unzipdir or unzipped(model, version)
@@ -48,7 +54,8 @@ class Instance:
         identifier = self.md.coSimulation.modelIdentifier
         if version == 2:
             self.fmu = (FMU2Model if model_exchange else FMU2Slave)(
-                guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name)
+                guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name
+            )
             self.callbacks = fmi2CallbackFunctions()
             self.callbacks.logger = fmi2CallbackLoggerTYPE(self._log2)
             self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
@@ -56,7 +63,8 @@ class Instance:
             self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging)
         else:
             self.fmu = (FMU3Model if model_exchange else FMU3Slave)(
-                guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name)
+                guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name
+            )
             self.fmu.instantiate(loggingOn=logging, logMessage=self._log3)
 
     def _log2(self, environment, name, status, category, message):
@@ -71,11 +79,19 @@ class Instance:
     def _accessors(self, variable):
         f, kind = self.fmu, variable.type
         if self.version == 2:
-            table = {"Real": (f.getReal, f.setReal), "Integer": (f.getInteger, f.setInteger),
-                     "Enumeration": (f.getInteger, f.setInteger), "Boolean": (f.getBoolean, f.setBoolean)}
+            table = {
+                "Real": (f.getReal, f.setReal),
+                "Integer": (f.getInteger, f.setInteger),
+                "Enumeration": (f.getInteger, f.setInteger),
+                "Boolean": (f.getBoolean, f.setBoolean),
+            }
         else:
-            table = {"Float64": (f.getFloat64, f.setFloat64), "Int32": (f.getInt32, f.setInt32),
-                     "Enumeration": (f.getInt64, f.setInt64), "Boolean": (f.getBoolean, f.setBoolean)}
+            table = {
+                "Float64": (f.getFloat64, f.setFloat64),
+                "Int32": (f.getInt32, f.setInt32),
+                "Enumeration": (f.getInt64, f.setInt64),
+                "Boolean": (f.getBoolean, f.setBoolean),
+            }
         return table[kind]
 
     def set(self, **values):
@@ -130,9 +146,19 @@ class Instance:
             status = do_step(self.fmu.component, t, h, 1)
         else:
             do_step = dll.fmi3DoStep
-            do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [ctypes.c_void_p] * 4
-            status = do_step(self.fmu.component, t, h, True, ctypes.byref(flag), ctypes.byref(flag),
-                             ctypes.byref(flag), ctypes.byref(when))
+            do_step.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_bool] + [
+                ctypes.c_void_p
+            ] * 4
+            status = do_step(
+                self.fmu.component,
+                t,
+                h,
+                True,
+                ctypes.byref(flag),
+                ctypes.byref(flag),
+                ctypes.byref(flag),
+                ctypes.byref(when),
+            )
         if status <= 1:
             self.t = t + h
         return status
@@ -174,19 +200,41 @@ def state_api(fmu):
     """The FMU-state functions of fmpy's slave, by one name for both versions."""
     f = fmu.fmu
     if fmu.version == 2:
-        return {"get": f.getFMUstate, "set": f.setFMUstate, "free": f.freeFMUstate,
-                "serialize": f.serializeFMUstate, "deserialize": f.deSerializeFMUstate}
-    return {"get": f.getFMUState, "set": f.setFMUState, "free": f.freeFMUState,
-            "serialize": f.serializeFMUState, "deserialize": f.deserializeFMUState}
+        return {
+            "get": f.getFMUstate,
+            "set": f.setFMUstate,
+            "free": f.freeFMUstate,
+            "serialize": f.serializeFMUstate,
+            "deserialize": f.deSerializeFMUstate,
+        }
+    return {
+        "get": f.getFMUState,
+        "set": f.setFMUState,
+        "free": f.freeFMUState,
+        "serialize": f.serializeFMUState,
+        "deserialize": f.deserializeFMUState,
+    }
 
 
 # the FMU-state functions' exported names, for calls through ctypes
-STATE_FUNCTIONS = {2: {"get": "fmi2GetFMUstate", "set": "fmi2SetFMUstate", "size": "fmi2SerializedFMUstateSize",
-                       "serialize": "fmi2SerializeFMUstate", "deserialize": "fmi2DeSerializeFMUstate",
-                       "free": "fmi2FreeFMUstate"},
-                   3: {"get": "fmi3GetFMUState", "set": "fmi3SetFMUState", "size": "fmi3SerializedFMUStateSize",
-                       "serialize": "fmi3SerializeFMUState", "deserialize": "fmi3DeserializeFMUState",
-                       "free": "fmi3FreeFMUState"}}
+STATE_FUNCTIONS = {
+    2: {
+        "get": "fmi2GetFMUstate",
+        "set": "fmi2SetFMUstate",
+        "size": "fmi2SerializedFMUstateSize",
+        "serialize": "fmi2SerializeFMUstate",
+        "deserialize": "fmi2DeSerializeFMUstate",
+        "free": "fmi2FreeFMUstate",
+    },
+    3: {
+        "get": "fmi3GetFMUState",
+        "set": "fmi3SetFMUState",
+        "size": "fmi3SerializedFMUStateSize",
+        "serialize": "fmi3SerializeFMUState",
+        "deserialize": "fmi3DeserializeFMUState",
+        "free": "fmi3FreeFMUState",
+    },
+}
 
 
 def run_steps(fmu, steps, names=STATE_OUTPUTS):

@@ -7,7 +7,9 @@ fails one test, not the suite.
 
     python -m support.importers <ecospy|libcosimpy|fmpy-fixed[-no-enumerations]> <scenario folder> <fmu> <result.csv>
 """
+
 import sys
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -77,7 +79,7 @@ def run_ecospy(scenario, fmu):
 
     simulation.init(o["StartTime"], "initial")
     rows = [(times[0], *[get(n) for n in scenario.outputs])]
-    for t, end in zip(times[:-1], times[1:]):
+    for t, end in pairwise(times):
         for name, value in input_values(scenario, t).items():
             set_value(name, value)
         simulation.step()
@@ -139,7 +141,7 @@ def run_libcosimpy(scenario, fmu):
     # libcosim initialises the slave in its first step and offers no
     # reading before it: the row at StartTime is not observable here
     rows = []
-    for t, end in zip(times[:-1], times[1:]):
+    for t, end in pairwise(times):
         for name, value in input_values(scenario, t).items():
             set_value(name, value)
         execution.step(1)
@@ -168,7 +170,7 @@ def run_fmpy_fixed(scenario, fmu, drop_enumerations=False):
     keep = (lambda k: variables[k].type != "Enumeration") if drop_enumerations else (lambda k: True)
     fmu_instance.start(start_time=times[0], **{k: typed(variables[k], v) for k, v in initial.items() if keep(k)})
     rows = [(times[0], *[fmu_instance.get(n) for n in scenario.outputs])]
-    for t, end in zip(times[:-1], times[1:]):
+    for t, end in pairwise(times):
         fmu_instance.set(**{k: typed(variables[k], v) for k, v in input_values(scenario, t).items() if keep(k)})
         fmu_instance.step(end - t)
         rows.append((end, *[fmu_instance.get(n) for n in scenario.outputs]))
@@ -176,8 +178,12 @@ def run_fmpy_fixed(scenario, fmu, drop_enumerations=False):
     return rows
 
 
-IMPORTERS = {"ecospy": run_ecospy, "libcosimpy": run_libcosimpy, "fmpy-fixed": run_fmpy_fixed,
-             "fmpy-fixed-no-enumerations": lambda s, f: run_fmpy_fixed(s, f, drop_enumerations=True)}
+IMPORTERS = {
+    "ecospy": run_ecospy,
+    "libcosimpy": run_libcosimpy,
+    "fmpy-fixed": run_fmpy_fixed,
+    "fmpy-fixed-no-enumerations": lambda s, f: run_fmpy_fixed(s, f, drop_enumerations=True),
+}
 
 
 def main(importer, folder, fmu, out):

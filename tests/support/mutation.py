@@ -28,6 +28,7 @@ Every outcome is appended to build/mutation/journal.jsonl as it is known.
 mutants of the same sources (tests are only ever added: a kill stands),
 and the survivors of the same tests; it tests the rest.
 """
+
 import argparse
 import hashlib
 import json
@@ -50,18 +51,36 @@ from support.process import Timeout, kill_all, run
 
 REPO = Path(__file__).resolve().parents[2]
 SOURCE = REPO / "fmu_src"
-FILES = ("rate_limiter.c", "rate_limiter.h", "rate_limiter_rules.h", "fmu_core.c", "fmi_entries.h", "fmi2_glue.c",
-         "fmi3_glue.c")
+FILES = (
+    "rate_limiter.c",
+    "rate_limiter.h",
+    "rate_limiter_rules.h",
+    "fmu_core.c",
+    "fmu_model_exchange.c",
+    "fmu_state.c",
+    "fmi_entries.h",
+    "fmi2_glue.c",
+    "fmi3_glue.c",
+)
 KERNEL = ("rate_limiter.c", "rate_limiter.h", "rate_limiter_rules.h")
 EQUIVALENTS = REPO / "tests" / "equivalent_mutants.txt"
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 # pytest files, most kills per second first (the run stops at the first failure; ordered from the journal of
 # the full run's first 1,300 mutants of fmu_core.c: test_misuse.py caught 163 in 2 s of tests,
 # test_conformance.py 54 in 11 s)
-TESTS = ("test_misuse.py", "test_reference.py", "test_state.py", "test_model_exchange.py", "test_bad_arguments.py",
-         "test_conformance.py",
-         "test_vendor_interpretations.py", "test_long_runs.py", "test_model_description.py", "test_random.py",
-         "test_hostile.py")
+TESTS = (
+    "fmu/test_misuse.py",
+    "fmu/test_reference.py",
+    "fmu/test_state.py",
+    "fmu/test_model_exchange.py",
+    "fmu/test_bad_arguments.py",
+    "fmu/test_conformance.py",
+    "fmu/test_vendor_interpretations.py",
+    "fmu/test_long_runs.py",
+    "repo/test_model_description.py",
+    "fmu/test_random.py",
+    "fmu/test_hostile.py",
+)
 # outcomes a resumed run keeps: they depend on the sources and the build's flags alone, or (killed) stand
 # because tests are only added
 KEPT = ("stillborn", "equivalent", "killed")
@@ -79,8 +98,13 @@ def hash_files(h, paths):
 
 def tests_digest(sanitized):
     """The tests a survivor survived: every file under tests/ but the list of equivalents."""
-    tests = (p for p in (REPO / "tests").rglob("*") if p.is_file() and p != EQUIVALENTS and
-             not any(part.startswith((".", "__pycache__")) for part in p.relative_to(REPO).parts))
+    tests = (
+        p
+        for p in (REPO / "tests").rglob("*")
+        if p.is_file()
+        and p != EQUIVALENTS
+        and not any(part.startswith((".", "__pycache__")) for part in p.relative_to(REPO).parts)
+    )
     return hash_files(hashlib.sha256(b"sanitized" if sanitized else b""), tests).hexdigest()
 
 
@@ -96,17 +120,17 @@ def inputs_digest(build_dir):
 
 @dataclass
 class Mutant:
-    file: str       # name in fmu_src
-    line: int       # 1-based
+    file: str  # name in fmu_src
+    line: int  # 1-based
     before: str
     after: str
-    text: str       # the whole mutated file
-    key: str = ""   # file | before | after: what tests/equivalent_mutants.txt names
-    outcome: str = ""   # stillborn, equivalent, listed, killed, survived
-    detail: str = ""    # the compiler's or the killing test's word
-    digest: str = ""    # the mutated objects' hash
+    text: str  # the whole mutated file
+    key: str = ""  # file | before | after: what tests/equivalent_mutants.txt names
+    outcome: str = ""  # stillborn, equivalent, listed, killed, survived
+    detail: str = ""  # the compiler's or the killing test's word
+    digest: str = ""  # the mutated objects' hash
     identity: str = ""  # its name in the journal: this mutant of these sources with these flags
-    above: tuple = ()   # the lines above it, nearest first: tell apart mutants of lines that read the same
+    above: tuple = ()  # the lines above it, nearest first: tell apart mutants of lines that read the same
 
     def __post_init__(self):
         self.key = f"fmu_src/{self.file} | {self.before.strip()} | {self.after.strip()}"
@@ -138,8 +162,13 @@ def generate(file, work, venv_bin):
     if not (folder / "done").exists():
         shutil.rmtree(folder, ignore_errors=True)
         folder.mkdir(parents=True)
-        run([str(universalmutator(venv_bin)), str(SOURCE / file), "c", "--noCheck", "--mutantDir", str(folder)],
-            cwd=folder, timeout=600, what=f"universalmutator on {file}", check=True)
+        run(
+            [str(universalmutator(venv_bin)), str(SOURCE / file), "c", "--noCheck", "--mutantDir", str(folder)],
+            cwd=folder,
+            timeout=600,
+            what=f"universalmutator on {file}",
+            check=True,
+        )
         (folder / "done").touch()
     lines = original.splitlines(keepends=True)
     mutants = []
@@ -149,11 +178,19 @@ def generate(file, work, venv_bin):
         changed = text.splitlines(keepends=True)
         if len(changed) != len(lines):
             continue  # universalmutator changes one line; anything else is not one of ours
-        diff = [i for i, (a, b) in enumerate(zip(lines, changed)) if a != b]
+        diff = [i for i, (a, b) in enumerate(zip(lines, changed, strict=True)) if a != b]
         if len(diff) == 1:
             i = diff[0]
-            mutants.append(Mutant(file, i + 1, lines[i].rstrip("\n"), changed[i].rstrip("\n"), text,
-                                  above=tuple(line.strip() for line in reversed(lines[max(0, i - 3):i]))))
+            mutants.append(
+                Mutant(
+                    file,
+                    i + 1,
+                    lines[i].rstrip("\n"),
+                    changed[i].rstrip("\n"),
+                    text,
+                    above=tuple(line.strip() for line in reversed(lines[max(0, i - 3) : i])),
+                )
+            )
     return mutants
 
 
@@ -175,8 +212,9 @@ def read_equivalents(path=None):
             if not {"file", "before", "after"} <= set(block) <= {"file", "before", "after", "above"}:
                 raise SystemExit(f"{path}:{number}: 'why:' without its file, '-' and '+' lines")
             for after in block["after"]:
-                key = " | ".join([f"{block['file']} | {block['before'].strip()} | {after.strip()}"] +
-                                 block.get("above", []))
+                key = " | ".join(
+                    [f"{block['file']} | {block['before'].strip()} | {after.strip()}"] + block.get("above", [])
+                )
                 if key in entries:
                     raise SystemExit(f"{path}:{number}: this mutant is listed already")
                 entries[key] = line[7:]
@@ -209,14 +247,17 @@ class Builder:
                 self.files[name] = source
         # the units of the product: the FMUs' and the kernel's own (the C tests link it)
         self.units = sorted(u for u in self.commands if not u.startswith("tests/"))
-        self.links = {t: (build_dir / "CMakeFiles" / f"{t}.dir" / "link.txt").read_text().split() for t in self.targets()}
+        self.links = {
+            t: (build_dir / "CMakeFiles" / f"{t}.dir" / "link.txt").read_text().split() for t in self.targets()
+        }
 
     def includes(self, unit):
         """The files of fmu_src a unit compiles: an FMU's unit, those it includes; a file of fmu_src, itself."""
         if unit.startswith("fmu_src/"):
             return {Path(unit).name}
-        return {line.split('"')[1] for line in self.files[unit].read_text().splitlines()
-                if line.startswith('#include "')}
+        return {
+            line.split('"')[1] for line in self.files[unit].read_text().splitlines() if line.startswith('#include "')
+        }
 
     @staticmethod
     def targets():
@@ -225,12 +266,14 @@ class Builder:
     def compile(self, tree, unit, output):
         """Compile <unit> with the build's flags; tree stands in for the source tree (a unit of fmu_src or
         tests/c is compiled from there; an FMU's unit in the build tree includes its files from there)."""
-        args = [str(tree / unit) if a == str(REPO / unit) else a.replace(str(SOURCE), str(tree / "fmu_src"))
-                for a in self.commands[unit]]
+        args = [
+            str(tree / unit) if a == str(REPO / unit) else a.replace(str(SOURCE), str(tree / "fmu_src"))
+            for a in self.commands[unit]
+        ]
         for flag in ("-MT", "-MF"):  # no dependency files
             if flag in args:
                 i = args.index(flag)
-                del args[i:i + 2]
+                del args[i : i + 2]
         args = [a for a in args if a != "-MD"]
         args[args.index("-o") + 1] = str(output)
         # the object code must not depend on where the tree is (the last map that matches wins)
@@ -328,8 +371,10 @@ def fmu_bytes(build_dir, model, version, library):
     source = build_dir / f"fmi{version}" / f"{model}.fmu"
     inside = f"binaries/{PLATFORM[version]}/{model}.so"
     with zipfile.ZipFile(source) as z_in:
-        entries = [(info.filename, library.read_bytes() if info.filename == inside else z_in.read(info))
-                   for info in z_in.infolist()]
+        entries = [
+            (info.filename, library.read_bytes() if info.filename == inside else z_in.read(info))
+            for info in z_in.infolist()
+        ]
     return entries
 
 
@@ -379,11 +424,19 @@ class Sanitized:
             harnesses.append(("the kernel's C tests", [str(out / "test_kernel")]))
         for version in (2, 3):
             if mutant.file != f"fmi{5 - version}_glue.c":  # else that version's binaries are the original ones
-                harnesses.append((f"test_lifecycle (FMI {version})",
-                                  lifecycle_command(builder, objects, out / "stage" / f"fmi{version}", version)))
+                harnesses.append(
+                    (
+                        f"test_lifecycle (FMI {version})",
+                        lifecycle_command(builder, objects, out / "stage" / f"fmi{version}", version),
+                    )
+                )
         for what, args in harnesses:
-            kill = harness_kill(f"{what} with the sanitizers", args, KERNEL_SECONDS * 5,
-                                lambda line: "ERROR:" in line or "runtime error" in line)
+            kill = harness_kill(
+                f"{what} with the sanitizers",
+                args,
+                KERNEL_SECONDS * 5,
+                lambda line: "ERROR:" in line or "runtime error" in line,
+            )
             if kill:
                 return kill
         return "survived", ""
@@ -400,8 +453,9 @@ def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None)
         if mutant.file in KERNEL:
             kernel = tree / "test_kernel"
             builder.link("test_kernel", objects, kernel)
-            kill = harness_kill("the kernel's C tests", [str(kernel)], KERNEL_SECONDS,
-                                lambda line: ", expected " in line)
+            kill = harness_kill(
+                "the kernel's C tests", [str(kernel)], KERNEL_SECONDS, lambda line: ", expected " in line
+            )
             if kill:
                 return kill
         for version in (2, 3):
@@ -419,14 +473,28 @@ def test_mutant(mutant, index, builder, base, work, venv_python, sanitized=None)
                     for name, data in fmu_bytes(builder.build, model, version, library):
                         z_out.writestr(name, data)
             if mutant.file not in KERNEL or mutant.file.endswith(".h"):
-                kill = harness_kill(f"test_lifecycle (FMI {version})",
-                                    lifecycle_command(builder, objects, tree / "stage" / f"fmi{version}", version),
-                                    KERNEL_SECONDS, lambda line: False)
+                kill = harness_kill(
+                    f"test_lifecycle (FMI {version})",
+                    lifecycle_command(builder, objects, tree / "stage" / f"fmi{version}", version),
+                    KERNEL_SECONDS,
+                    lambda line: False,
+                )
                 if kill:
                     return kill
         env = dict(os.environ, RL_BUILD_DIR=str(build), RL_ORACLE_CACHE=str(work / "oracle"))
-        args = [str(venv_python), "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "--hypothesis-seed=0",
-                "-o", "timeout=300", *TESTS]
+        args = [
+            str(venv_python),
+            "-m",
+            "pytest",
+            "-x",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "--hypothesis-seed=0",
+            "-o",
+            "timeout=300",
+            *TESTS,
+        ]
         try:
             done = run(args, cwd=REPO / "tests", env=env, timeout=PYTEST_SECONDS, what="pytest")
         except Timeout:
@@ -454,8 +522,9 @@ class Journal:
                     record = json.loads(line)
                 except json.JSONDecodeError:
                     continue  # a line cut by a kill
-                if record.get("outcome") in KEPT or (record.get("outcome") == "survived" and
-                                                     record.get("tests") == tests):
+                if record.get("outcome") in KEPT or (
+                    record.get("outcome") == "survived" and record.get("tests") == tests
+                ):
                     self.kept[record["identity"]] = (record["outcome"], record["detail"])
         path.parent.mkdir(parents=True, exist_ok=True)
         self.file = open(path, "a" if resume else "w")
@@ -485,18 +554,30 @@ def main(argv=None):
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--report", type=Path, help="write every mutant's outcome here (JSON)")
-    parser.add_argument("--check-listed", action="store_true",
-                        help="test the listed equivalents too: each must survive")
+    parser.add_argument(
+        "--check-listed", action="store_true", help="test the listed equivalents too: each must survive"
+    )
     parser.add_argument("--listed", action="store_true", help="test only the listed equivalents")
-    parser.add_argument("--only", nargs="+", metavar="TEXT",
-                        help="test only the mutants whose label (file:line: before  =>  after) contains one of these")
-    parser.add_argument("--sanitizer-build", type=Path,
-                        help="a build tree with -DRL_SANITIZE=ON (default: <build-dir>/sanitize, if built)")
-    parser.add_argument("--resume", action="store_true",
-                        help="keep the journal's stillborn, equivalent and killed outcomes, and its survivors of "
-                             "the same tests; test the rest")
-    parser.add_argument("--status", action="store_true",
-                        help="with --resume: print the table from the journal alone, testing nothing")
+    parser.add_argument(
+        "--only",
+        nargs="+",
+        metavar="TEXT",
+        help="test only the mutants whose label (file:line: before  =>  after) contains one of these",
+    )
+    parser.add_argument(
+        "--sanitizer-build",
+        type=Path,
+        help="a build tree with -DRL_SANITIZE=ON (default: <build-dir>/sanitize, if built)",
+    )
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help="keep the journal's stillborn, equivalent and killed outcomes, and its survivors of "
+        "the same tests; test the rest",
+    )
+    parser.add_argument(
+        "--status", action="store_true", help="with --resume: print the table from the journal alone, testing nothing"
+    )
     args = parser.parse_args(argv)
 
     def stop(signum, frame):  # the tests running go too; the journal has every outcome known so far
@@ -525,8 +606,11 @@ def main(argv=None):
         mutants = [m for m in mutants if any(text in m.label() for text in args.only)]
     if args.sample is not None and args.sample < len(mutants):
         mutants = sorted(random.Random(args.seed).sample(mutants, args.sample), key=lambda m: (m.file, m.line))
-    print(f"{generated} mutants of {', '.join(args.files)}; testing {len(mutants)}"
-          + (f" (seeded sample, seed {args.seed})" if args.sample is not None else ""), flush=True)
+    print(
+        f"{generated} mutants of {', '.join(args.files)}; testing {len(mutants)}"
+        + (f" (seeded sample, seed {args.seed})" if args.sample is not None else ""),
+        flush=True,
+    )
 
     sanitizer_build = (args.sanitizer_build or build_dir / "sanitize").resolve()
     sanitizing = (sanitizer_build / "test_lifecycle").exists()
@@ -598,8 +682,15 @@ def main(argv=None):
     print(summary(mutants))
     failures = report_failures(mutants)
     if args.report:
-        args.report.write_text(json.dumps([dict(file=m.file, line=m.line, before=m.before, after=m.after,
-                                                 outcome=m.outcome, detail=m.detail) for m in mutants], indent=1))
+        args.report.write_text(
+            json.dumps(
+                [
+                    dict(file=m.file, line=m.line, before=m.before, after=m.after, outcome=m.outcome, detail=m.detail)
+                    for m in mutants
+                ],
+                indent=1,
+            )
+        )
     print(f"{time.monotonic() - started:.0f} s")
     return 1 if failures or stale else 0
 
@@ -637,14 +728,19 @@ def summary(mutants):
         counts[m.file][m.outcome] += 1
         counts["all"][m.outcome] += 1
     untested = counts["all"]["untested"] > 0  # --status
-    rows = ["| file | mutants | stillborn | same object code | listed equivalent | killed | survived | score |"
-            + (" untested |" if untested else ""), "|---|---|---|---|---|---|---|---|" + ("---|" if untested else "")]
+    rows = [
+        "| file | mutants | stillborn | same object code | listed equivalent | killed | survived | score |"
+        + (" untested |" if untested else ""),
+        "|---|---|---|---|---|---|---|---|" + ("---|" if untested else ""),
+    ]
     for file in [f for f in FILES if f in counts] + ["all"]:
         c = counts[file]
         live = c["killed"] + c["survived"]
         score = f"{100 * c['killed'] / live:.1f} %" if live else "-"
-        rows.append(f"| {file} | {sum(c.values())} | {c['stillborn']} | {c['equivalent']} | {c['listed']} "
-                    f"| {c['killed']} | {c['survived']} | {score} |" + (f" {c['untested']} |" if untested else ""))
+        rows.append(
+            f"| {file} | {sum(c.values())} | {c['stillborn']} | {c['equivalent']} | {c['listed']} "
+            f"| {c['killed']} | {c['survived']} | {score} |" + (f" {c['untested']} |" if untested else "")
+        )
     return "\n".join(rows)
 
 

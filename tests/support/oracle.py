@@ -16,6 +16,8 @@ in binary64 is that operation correctly rounded in binary32: binary64 has
 more than twice binary32's precision plus two bits, so the double rounding
 is innocuous (test_oracle.py checks it against numpy's float32 scalars).
 """
+
+import copy
 import functools
 import hashlib
 import json
@@ -26,6 +28,8 @@ import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy
 
 TOL = 1e-9
 
@@ -64,18 +68,52 @@ def time_ms(seconds):
     exact and ties to even, as C's nearbyint), used as ms / 1000."""
     return round(seconds * 1000.0) / 1000.0
 
+
 PARAMETER_DEFAULTS = {
-    "rateUpPar": 1.0, "rateDownPar": 1.0, "bypassValuePar": math.nan, "durationPar": 0.0,
-    "ratePeriod": 1.0, "zeroRate": 1, "cycleTime": 0.0, "initMode": 2, "initValue": 0.0, "initDelay": 0.0,
-    "yMaxPar": sys.float_info.max, "yMinPar": -sys.float_info.max, "arithmetic": LREAL,
+    "rateUpPar": 1.0,
+    "rateDownPar": 1.0,
+    "bypassValuePar": math.nan,
+    "durationPar": 0.0,
+    "ratePeriod": 1.0,
+    "zeroRate": 1,
+    "cycleTime": 0.0,
+    "initMode": 2,
+    "initValue": 0.0,
+    "initDelay": 0.0,
+    "yMaxPar": sys.float_info.max,
+    "yMinPar": -sys.float_info.max,
+    "arithmetic": LREAL,
+    "accelMax": 0.0,
+    "decelMax": 0.0,
 }
 INPUT_DEFAULTS = {
-    "u": 0.0, "rateUp": math.nan, "rateDown": math.nan, "bypass": False, "bypassValue": math.nan,
-    "duration": math.nan, "rateUpNeg": math.nan, "rateDownNeg": math.nan, "yMax": math.nan, "yMin": math.nan,
+    "u": 0.0,
+    "rateUp": math.nan,
+    "rateDown": math.nan,
+    "bypass": False,
+    "bypassValue": math.nan,
+    "duration": math.nan,
+    "rateUpNeg": math.nan,
+    "rateDownNeg": math.nan,
+    "yMax": math.nan,
+    "yMin": math.nan,
     "hold": False,
 }
-OUTPUTS = ("y", "rampActive", "runningTime", "error", "status", "subFunctionStatus", "dydt", "limitingUp",
-           "limitingDown", "highLimit", "lowLimit", "remainingTime")
+OUTPUTS = (
+    "y",
+    "rampActive",
+    "runningTime",
+    "error",
+    "status",
+    "subFunctionStatus",
+    "dydt",
+    "limitingUp",
+    "limitingDown",
+    "highLimit",
+    "lowLimit",
+    "remainingTime",
+    "d2ydt2",
+)
 
 
 def finite(x):
@@ -119,11 +157,12 @@ class RateLimiterOracle:
         self.y = y
         self.yp = y
         self.u_prev = u
-        self.decided_by = None          # rule that decided the last cycle: "1-5", "5b", "6"
+        self.decided_by = None  # rule that decided the last cycle: "1-5", "5b", "6"
         self.jumped = False
         self.T = math.nan
         self.rates_used = (math.nan, math.nan)
         self.run_cycles, self.run_T, self.run_base = 0, 0.0, 0.0
+        self.ypp, self.T_before = y, 0.0  # the cycle before the last: its yp and T
         self.status, self.culprit = self.evaluate_status()
         self.last = self.evaluate_outputs()
 
@@ -160,22 +199,28 @@ class RateLimiterOracle:
         return Resolved(self.real(value), name)
 
     def rates(self):
-        return (self.resolve("rateUp"), self.resolve("rateDown"), self.resolve_neg("rateUpNeg"),
-                self.resolve_neg("rateDownNeg"))
+        return (
+            self.resolve("rateUp"),
+            self.resolve("rateDown"),
+            self.resolve_neg("rateUpNeg"),
+            self.resolve_neg("rateDownNeg"),
+        )
 
     def limits(self):
         """yMin and yMax after fallback; NaN, an infinity or the largest
         finite double (its negative for yMin) means no limit (rules.md, rule 0)."""
         low, high = self.resolve("yMin").value, self.resolve("yMax").value
-        return (-math.inf if math.isnan(low) or low <= -sys.float_info.max else low,
-                math.inf if math.isnan(high) or high >= sys.float_info.max else high)
+        return (
+            -math.inf if math.isnan(low) or low <= -sys.float_info.max else low,
+            math.inf if math.isnan(high) or high >= sys.float_info.max else high,
+        )
 
     def evaluate_status(self):
         rates = self.rates()
         period = self.rate_period()
         duration = self.resolve_time("duration")
         cycle = self.values["cycleTime"]
-        for rate in rates:                       # rateUp, rateDown, rateUpNeg, rateDownNeg
+        for rate in rates:  # rateUp, rateDown, rateUpNeg, rateDownNeg
             if rate.value < 0:
                 return 0x8200, rate.name
         for rate in rates:
@@ -188,6 +233,10 @@ class RateLimiterOracle:
         low, high = self.limits()
         if low > high:
             return 0x8204, self.resolve("yMin").name
+        for name in ("accelMax", "decelMax"):
+            value = self.real(self.values[name])
+            if not (finite(value) and value >= 0):
+                return 0x8205, name
         if not finite(cycle) or cycle < 0 or not self.values.get("cycleValid", True):
             return 0x8601, "cycleTime"
         return 0, None
@@ -218,33 +267,63 @@ class RateLimiterOracle:
         return low if u < low else high if u > high else u
 
     # -- one cycle (rules 1 to 6) ------------------------------------------
+    # -- rules.md, Acceleration limit ------------------------------------------
+    def accelerating(self):
+        return self.status < 0x8000 and self.real(self.values["accelMax"]) > 0
+
+    def cycle_steps(self, T):
+        """a = accelMax * T * T, b = decelMax (or accelMax) * T * T"""
+        real = self.real
+        accel = real(self.values["accelMax"])
+        decel = real(self.values["decelMax"])
+        decel = decel if decel > 0 else accel
+        A = Arithmetic(real)
+        return A.mul(A.mul(accel, real(T)), real(T)), A.mul(A.mul(decel, real(T)), real(T))
+
+    def previous_step(self, T):
+        """the last cycle's step at this cycle's length; 0 after a cycle rule 6
+        did not decide, or at or past the duration's jump"""
+        duration = self.resolve_time("duration").value
+        if self.decided_by != "6" or (duration > 0 and self.running_time >= duration * (1 - TOL)):
+            return 0.0
+        if not (finite(self.y) and finite(self.yp)):
+            return 0.0
+        A = Arithmetic(self.real)
+        step = A.add(self.y, -self.yp)
+        T_last = self.T
+        if T_last == T or not T_last > 0:
+            return step
+        return A.mul(step, A.div(self.real(T), self.real(T_last)))
+
     def cycle(self, T, elapsed):
         v = self.values
         real = self.real
         u = real(v["u"])
         yp = self.y
+        previous = self.previous_step(T) if self.accelerating() else 0.0
+        self.ypp, self.T_before = self.yp, self.T if finite(self.T) else 0.0
         self.yp, self.T = yp, T
         self.jumped = False
         decided_by = "1-5"
-        if not self.compare_only and not finite(u):                      # rule 1
+        if not self.compare_only and not finite(u):  # rule 1
             y = u
             self.running_reset()
-        elif v["bypass"]:                                                # rule 2
+        elif v["bypass"]:  # rule 2
             bypass_value = self.resolve("bypassValue").value
             y = bypass_value if finite(bypass_value) else u
             self.running_reset()
         elif v["initMode"] == 3 and elapsed <= v["initDelay"] + TOL * T:  # rule 3
             y = u
             self.running_reset()
-        elif not finite(yp) and finite(u):                               # rule 4
+        elif not finite(yp) and finite(u):  # rule 4
             y = u
             self.running_reset()
-        elif self.status >= 0x8000:                                      # rule 5
+        elif self.status >= 0x8000:  # rule 5
             y = yp
-        elif v["hold"]:                                                  # rule 5b
+        elif v["hold"]:  # rule 5b
             y = yp
             decided_by = "5b"
-        else:                                                            # rule 6
+        else:  # rule 6
             decided_by = "6"
             uc = self.target(u)
             up, down, up_neg, down_neg = self.rates()
@@ -261,6 +340,14 @@ class RateLimiterOracle:
             if duration > 0 and self.running_time >= duration * (1 - TOL):
                 y = uc
                 self.jumped = True
+            elif self.accelerating():
+                limits = (max_up, max_down) + tuple(
+                    self.per_cycle_limit(rate.value, T) for rate in ((up_neg, down_neg) if yp >= 0 else (up, down))
+                )
+                if yp < 0:  # (maxUp, maxDown) of yp >= 0, then those of yp < 0
+                    limits = (limits[2], limits[3], limits[0], limits[1])
+                a, b = self.cycle_steps(T)
+                y = accel_step(Arithmetic(real), yp, uc, previous, a, b, limits)
             elif uc > yp:
                 y = min(uc, real(yp + max_up))
             elif uc < yp:
@@ -300,16 +387,20 @@ class RateLimiterOracle:
         the other; each leg's length / rate per second."""
         up, down, up_neg, down_neg = self.rates()
         if uc > y:
-            legs = [(min(uc, 0.0) - y, up_neg.value) if y < 0 else (0.0, up_neg.value),
-                    (uc - max(y, 0.0), up.value) if uc > 0 else (0.0, up.value)]
+            legs = [
+                (min(uc, 0.0) - y, up_neg.value) if y < 0 else (0.0, up_neg.value),
+                (uc - max(y, 0.0), up.value) if uc > 0 else (0.0, up.value),
+            ]
         else:
-            legs = [(min(y, 0.0) - uc, down_neg.value) if uc < 0 else (0.0, down_neg.value),
-                    (y - max(uc, 0.0), down.value) if y > 0 else (0.0, down.value)]
+            legs = [
+                (min(y, 0.0) - uc, down_neg.value) if uc < 0 else (0.0, down_neg.value),
+                (y - max(uc, 0.0), down.value) if y > 0 else (0.0, down.value),
+            ]
         period = self.rate_period()
         total = 0.0
         for length, rate in legs:
             if length <= 0:
-                continue                         # not part of the way
+                continue  # not part of the way
             if rate == 0:
                 total += math.inf if self.values["zeroRate"] == 1 else 0.0
                 continue
@@ -320,6 +411,36 @@ class RateLimiterOracle:
         if duration > 0:
             total = min(total, max(0.0, duration - self.running_time))
         return total
+
+    def d2ydt2(self, dydt):
+        """(dydt - the dydt of the cycle before) / T"""
+        real = self.real
+        moved = real(self.yp - self.ypp)
+        before = 0.0 if moved == 0 else real(divide(moved, real(self.T_before)))
+        if not finite(before):
+            return 0.0
+        change = real(dydt - before)
+        return real(divide(change, real(self.T))) if finite(change) else 0.0
+
+    def planned_time(self, uc):
+        """The block's own plan: rule 6's cycles ahead on a copy at the same
+        inputs until y == uc, n * T; +inf when the output cannot move from
+        rest, or after 2^26 cycles."""
+        ahead = copy.deepcopy(self)
+        if ahead.decided_by == "5b":
+            ahead.decided_by = "1-5"  # hold stops the output
+        ahead.values["hold"] = False
+        ahead.values["bypass"] = False
+        cycles = 0
+        T = self.T
+        while ahead.y != uc and cycles < 2**26:
+            before = ahead.y
+            at_rest = ahead.decided_by != "6" or ahead.y == ahead.yp
+            ahead.cycle(T, math.inf)
+            cycles += 1
+            if at_rest and ahead.y == before:
+                return math.inf
+        return cycles * T if ahead.y == uc else math.inf
 
     def outputs(self):
         return dict(self.last)
@@ -335,7 +456,14 @@ class RateLimiterOracle:
         real = self.real
         remaining = 0.0
         if self.decided_by in ("6", "5b") and y != uc and finite(y) and finite(uc):
-            remaining = self.remaining_time(y, uc)
+            remaining = self.planned_time(uc) if self.accelerating() else self.remaining_time(y, uc)
+        dydt = real(divide(real(y - yp), real(self.T))) if self.decided_by and finite(y) and finite(yp) else 0.0
+        if self.accelerating():
+            limiting_up = ramped and y < uc and real(yp + max_up) <= y
+            limiting_down = ramped and y > uc and real(yp - max_down) >= y
+        else:
+            limiting_up = ramped and real(yp + max_up) < uc
+            limiting_down = ramped and real(yp - max_down) > uc
         return {
             "y": y,
             "rampActive": by_rule_6 and y != uc,
@@ -343,14 +471,16 @@ class RateLimiterOracle:
             "error": error,
             "status": self.status,
             "subFunctionStatus": self.vr[self.culprit] if error else 0,
-            "dydt": real(divide(real(y - yp), real(self.T))) if self.decided_by and finite(y) and finite(yp) else 0.0,
-            "limitingUp": ramped and real(yp + max_up) < uc,
-            "limitingDown": ramped and real(yp - max_down) > uc,
+            "dydt": dydt,
+            "limitingUp": limiting_up,
+            "limitingDown": limiting_down,
             "highLimit": finite(y) and y >= high,
             "lowLimit": finite(y) and y <= low,
             "remainingTime": remaining,
+            "d2ydt2": self.d2ydt2(dydt) if by_rule_6 and finite(dydt) else 0.0,
             # what a vendor mapping needs of the same cycle
-            "_yp": yp, "_mode": self.values.get("mode"),
+            "_yp": yp,
+            "_mode": self.values.get("mode"),
         }
 
 
@@ -362,15 +492,32 @@ def siemens(v):
     ob = v["callOB"]
     ob_valid = 30 <= ob <= 38 or ob >= 123
     unified = {
-        "u": v["value"], "rateUp": v["setChangeRate"], "rateDown": v["setChangeRate"],
-        "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
-        "bypass": v["enDefaultOutValue"], "bypassValue": v["defaultOutValue"], "bypassValuePar": nan,
+        "u": v["value"],
+        "rateUp": v["setChangeRate"],
+        "rateDown": v["setChangeRate"],
+        "rateUpPar": nan,
+        "rateDownPar": nan,
+        "ratePeriod": 1.0,
+        "zeroRate": 1,
+        "bypass": v["enDefaultOutValue"],
+        "bypassValue": v["defaultOutValue"],
+        "bypassValuePar": nan,
         # an invalid callOB is reported by the status; the cycles are still cycleTime's
-        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"], "cycleValid": ob_valid,
-        "initMode": 1, "initValue": 0.0, "initDelay": 0.0,
+        "duration": 0.0,
+        "durationPar": 0.0,
+        "cycleTime": v["cycleTime"],
+        "cycleValid": ob_valid,
+        "initMode": 1,
+        "initValue": 0.0,
+        "initDelay": 0.0,
     }
-    culprits = {"rateUp": "setChangeRate", "rateDown": "setChangeRate", "rateUpPar": "setChangeRate",
-                "rateDownPar": "setChangeRate", "cycleTime": "cycleTime" if ob_valid else "callOB"}
+    culprits = {
+        "rateUp": "setChangeRate",
+        "rateDown": "setChangeRate",
+        "rateUpPar": "setChangeRate",
+        "rateDownPar": "setChangeRate",
+        "cycleTime": "cycleTime" if ob_valid else "callOB",
+    }
     return unified, culprits
 
 
@@ -379,27 +526,55 @@ def irmn4(v):
     duration = v["Duration"]
     duration_par = v["DurationPar"]
     unified = {
-        "u": v["In"], "rateUp": v["UpRate"], "rateDown": v["DownRate"], "rateUpPar": v["UpRatePar"],
-        "rateDownPar": v["DownRatePar"], "ratePeriod": 1.0, "zeroRate": 2,
-        "bypass": v["EnableBypass"], "bypassValue": v["BypassValue"], "bypassValuePar": v["BypassValuePar"],
+        "u": v["In"],
+        "rateUp": v["UpRate"],
+        "rateDown": v["DownRate"],
+        "rateUpPar": v["UpRatePar"],
+        "rateDownPar": v["DownRatePar"],
+        "ratePeriod": 1.0,
+        "zeroRate": 2,
+        "bypass": v["EnableBypass"],
+        "bypassValue": v["BypassValue"],
+        "bypassValuePar": v["BypassValuePar"],
         # the block's range: a longer Duration is 259200 s
         "duration": min(duration, 259200.0) if not math.isnan(duration) else nan,
-        "durationPar": min(duration_par, 259200.0), "cycleTime": v["cycleTime"],
-        "initMode": 1 if restart else 2, "initValue": v["SavedOut"], "initDelay": 0.0,
+        "durationPar": min(duration_par, 259200.0),
+        "cycleTime": v["cycleTime"],
+        "initMode": 1 if restart else 2,
+        "initValue": v["SavedOut"],
+        "initDelay": 0.0,
         "arithmetic": REAL,  # the IRMN4 family's analog pins are 32-bit floats
     }
-    culprits = {"rateUp": "UpRate", "rateDown": "DownRate", "rateUpPar": "UpRatePar",
-                "rateDownPar": "DownRatePar", "duration": "Duration", "durationPar": "DurationPar",
-                "cycleTime": "cycleTime"}
+    culprits = {
+        "rateUp": "UpRate",
+        "rateDown": "DownRate",
+        "rateUpPar": "UpRatePar",
+        "rateDownPar": "DownRatePar",
+        "duration": "Duration",
+        "durationPar": "DurationPar",
+        "cycleTime": "cycleTime",
+    }
     return unified, culprits
 
 
 def codesys(v):
     unified = {
-        "u": v["rIn"], "rateUp": v["rVariation"], "rateDown": v["rVariation"], "rateUpPar": nan,
-        "rateDownPar": nan, "ratePeriod": time_ms(v["tTime"]), "zeroRate": 1, "bypass": False, "bypassValue": nan,
-        "bypassValuePar": nan, "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"],
-        "initMode": v["eInitial"], "initValue": v["rInitValue"], "initDelay": time_ms(v["tInitDelay"]),
+        "u": v["rIn"],
+        "rateUp": v["rVariation"],
+        "rateDown": v["rVariation"],
+        "rateUpPar": nan,
+        "rateDownPar": nan,
+        "ratePeriod": time_ms(v["tTime"]),
+        "zeroRate": 1,
+        "bypass": False,
+        "bypassValue": nan,
+        "bypassValuePar": nan,
+        "duration": 0.0,
+        "durationPar": 0.0,
+        "cycleTime": v["cycleTime"],
+        "initMode": v["eInitial"],
+        "initValue": v["rInitValue"],
+        "initDelay": time_ms(v["tInitDelay"]),
         "arithmetic": REAL,  # REAL pins, TIME in milliseconds
     }
     culprits = {"rateUp": "rVariation", "rateDown": "rVariation", "ratePeriod": "tTime", "cycleTime": "cycleTime"}
@@ -423,18 +598,44 @@ def siemens_advanced(v):
     else:
         mode, value = "ramp", nan
     unified = {
-        "u": v["autoValue"], "rateUp": v["setPosUpRateLim"], "rateDown": v["setPosDownRateLim"],
+        "u": v["autoValue"],
+        "rateUp": v["setPosUpRateLim"],
+        "rateDown": v["setPosDownRateLim"],
         # quadrants by the output's magnitude: negUp falls below 0, negDown rises
-        "rateDownNeg": v["setNegUpRateLim"], "rateUpNeg": v["setNegDownRateLim"],
-        "rateUpPar": nan, "rateDownPar": nan, "ratePeriod": 1.0, "zeroRate": 1,
-        "yMax": v["setHighLim"], "yMin": v["setLowLim"], "yMaxPar": nan, "yMinPar": nan, "hold": False,
-        "bypass": mode != "ramp", "bypassValue": value, "bypassValuePar": nan,
-        "duration": 0.0, "durationPar": 0.0, "cycleTime": v["cycleTime"], "cycleValid": ob_valid,
-        "initMode": 1, "initValue": 0.0, "initDelay": 0.0, "mode": mode,
+        "rateDownNeg": v["setNegUpRateLim"],
+        "rateUpNeg": v["setNegDownRateLim"],
+        "rateUpPar": nan,
+        "rateDownPar": nan,
+        "ratePeriod": 1.0,
+        "zeroRate": 1,
+        "yMax": v["setHighLim"],
+        "yMin": v["setLowLim"],
+        "yMaxPar": nan,
+        "yMinPar": nan,
+        "hold": False,
+        "bypass": mode != "ramp",
+        "bypassValue": value,
+        "bypassValuePar": nan,
+        "duration": 0.0,
+        "durationPar": 0.0,
+        "cycleTime": v["cycleTime"],
+        "cycleValid": ob_valid,
+        "initMode": 1,
+        "initValue": 0.0,
+        "initDelay": 0.0,
+        "mode": mode,
     }
-    culprits = {"rateUp": "setPosUpRateLim", "rateDown": "setPosDownRateLim", "rateUpNeg": "setNegDownRateLim",
-                "rateDownNeg": "setNegUpRateLim", "rateUpPar": "setPosUpRateLim", "rateDownPar": "setPosDownRateLim",
-                "yMin": "setLowLim", "yMinPar": "setLowLim", "cycleTime": "cycleTime" if ob_valid else "callOB"}
+    culprits = {
+        "rateUp": "setPosUpRateLim",
+        "rateDown": "setPosDownRateLim",
+        "rateUpNeg": "setNegDownRateLim",
+        "rateDownNeg": "setNegUpRateLim",
+        "rateUpPar": "setPosUpRateLim",
+        "rateDownPar": "setPosDownRateLim",
+        "yMin": "setLowLim",
+        "yMinPar": "setLowLim",
+        "cycleTime": "cycleTime" if ob_valid else "callOB",
+    }
     return unified, culprits
 
 
@@ -448,7 +649,7 @@ def unified_static(v):
 
 
 def siemens_advanced_outputs(out, unified):
-    negative = out["_yp"] < 0          # the quadrant the rate was picked by
+    negative = out["_yp"] < 0  # the quadrant the rate was picked by
     reset = out["_mode"] == "reset"
     return {
         "outputValue": out["y"],
@@ -458,30 +659,55 @@ def siemens_advanced_outputs(out, unified):
         "negDownRateLim": out["limitingUp"] and negative,
         "highLim": out["highLimit"] and not reset,
         "lowLim": out["lowLimit"] and not reset,
-        "error": out["error"], "status": out["status"], "subfunctionStatus": out["subFunctionStatus"],
+        "error": out["error"],
+        "status": out["status"],
+        "subfunctionStatus": out["subFunctionStatus"],
     }
 
 
 VENDORS = {
     "RateLimiterStatic": {
-        "translate": unified_static, "compare_only": False, "outputs": {name: name for name in OUTPUTS},
+        "translate": unified_static,
+        "compare_only": False,
+        "outputs": {name: name for name in OUTPUTS},
     },
     "LGF_LimRateOfChangeCI": {
-        "translate": siemens, "compare_only": True,
-        "outputs": {"delayedValue": "y", "error": "error", "status": "status", "subFunctionStatus": "subFunctionStatus"},
+        "translate": siemens,
+        "compare_only": True,
+        "outputs": {
+            "delayedValue": "y",
+            "error": "error",
+            "status": "status",
+            "subFunctionStatus": "subFunctionStatus",
+        },
     },
     "RateLimit": {
-        "translate": irmn4, "compare_only": False,
+        "translate": irmn4,
+        "compare_only": False,
         "outputs": {"Out": "y", "RunningTime": "runningTime"},
     },
     "LGF_LimRateOfChangeAdvancedCI": {
-        "translate": siemens_advanced, "compare_only": True, "neg_fallback": False, "limit_initial": False,
+        "translate": siemens_advanced,
+        "compare_only": True,
+        "neg_fallback": False,
+        "limit_initial": False,
         "outputs": siemens_advanced_outputs,
-        "output_names": ["outputValue", "posUpRateLim", "posDownRateLim", "negUpRateLim", "negDownRateLim",
-                         "highLim", "lowLim", "error", "status", "subfunctionStatus"],
+        "output_names": [
+            "outputValue",
+            "posUpRateLim",
+            "posDownRateLim",
+            "negUpRateLim",
+            "negDownRateLim",
+            "highLim",
+            "lowLim",
+            "error",
+            "status",
+            "subfunctionStatus",
+        ],
     },
     "Ramp": {
-        "translate": codesys, "compare_only": False,
+        "translate": codesys,
+        "compare_only": False,
         "outputs": {"rOut": "y", "xRampActive": "rampActive"},
     },
 }
@@ -496,8 +722,11 @@ def start_values(model):
     file (the single source of every variable)."""
     with open(MODEL_DESCRIPTIONS / f"{model}.toml", "rb") as f:
         variables = tomllib.load(f)["variable"]
-    return {v["name"]: bool(v.get("start", False)) if v["type"] == "Boolean" else v.get("start", 0.0)
-            for v in variables if v["causality"] in ("input", "parameter")}
+    return {
+        v["name"]: bool(v.get("start", False)) if v["type"] == "Boolean" else v.get("start", 0.0)
+        for v in variables
+        if v["causality"] in ("input", "parameter")
+    }
 
 
 class VendorOracle:
@@ -510,10 +739,14 @@ class VendorOracle:
         self.values = dict(start_values(model))
         self.values.update(start or {})
         unified, culprits = self.spec["translate"](self.values)
-        self.unified = RateLimiterOracle(self.culprit_vrs(culprits), unified, start_time,
-                                         compare_only=self.spec["compare_only"],
-                                         neg_fallback=self.spec.get("neg_fallback", True),
-                                         limit_initial=self.spec.get("limit_initial", True))
+        self.unified = RateLimiterOracle(
+            self.culprit_vrs(culprits),
+            unified,
+            start_time,
+            compare_only=self.spec["compare_only"],
+            neg_fallback=self.spec.get("neg_fallback", True),
+            limit_initial=self.spec.get("limit_initial", True),
+        )
 
     def culprit_vrs(self, culprits):
         return {name: self.vendor_vr[vendor] for name, vendor in culprits.items()}
@@ -549,6 +782,7 @@ def kept(function):
     """function's results kept for its arguments; with RL_ORACLE_CACHE (a folder; the mutation runner
     sets it) also on disk between processes, under the hash of this file, the name and the arguments,
     so that a slow oracle run is worked once for many runs of the same tests."""
+
     @functools.lru_cache(maxsize=None)
     def wrapper(*args):
         folder = os.environ.get("RL_ORACLE_CACHE")
@@ -564,4 +798,173 @@ def kept(function):
         partial.write_text(json.dumps(result))
         os.replace(partial, path)  # a reader sees the whole result or none
         return result
+
     return wrapper
+
+
+# -- rules.md, Acceleration limit ----------------------------------------------
+# Written from that section: the steps per cycle in the arithmetic (`real`
+# rounds every operation), the feasibility of a step decided in exact
+# rational arithmetic (Fraction) where the rules say exactly.
+
+from fractions import Fraction  # noqa: E402
+
+
+class Arithmetic:
+    """The operations of one arithmetic: LREAL (binary64) or REAL (binary32)."""
+
+    def __init__(self, real):
+        self.real = real
+        self.binary32 = real is f32
+        self.mant_dig, self.min_exp = (24, -125) if self.binary32 else (53, -1021)
+        self.largest = f32(3.4028234663852886e38) if self.binary32 else sys.float_info.max
+        self.roundoff = 2.0**-self.mant_dig
+        self.counted = 2.0 ** (self.mant_dig // 2)  # below this many cycles of braking, counts are exact
+
+    def ulp(self, x):
+        e = math.frexp(x)[1] if x != 0 else self.min_exp
+        return 2.0 ** (max(e, self.min_exp) - self.mant_dig)
+
+    def towards(self, x, y):
+        """the neighbour of x towards y in the arithmetic"""
+        if not self.binary32:
+            return math.nextafter(x, y)
+        return float(numpy.nextafter(numpy.float32(x), numpy.float32(y)))
+
+    def add(self, a, b):
+        r = self.real
+        try:
+            return r(a + b)
+        except OverflowError:
+            return math.copysign(math.inf, a)
+
+    def mul(self, a, b):
+        try:
+            return self.real(a * b)
+        except OverflowError:
+            return math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+    def div(self, a, b):
+        return self.real(divide(a, b))
+
+
+def braking_distance(A, s, b):
+    """B(s) = n * (s - b * (n + 1) / 2), n = floor(s / b); 0 for s <= b"""
+    if not s > b:
+        return 0.0
+    if math.isinf(s):
+        return s
+    n = A.real(math.floor(A.div(s, b)))
+    return A.mul(n, A.add(s, -(A.mul(b, A.real(n + 1)) / 2)))
+
+
+def stops_within(A, s, b, e):
+    """s + B(s) <= e: exactly in the rules' range, else as written"""
+    if not s > b or math.isinf(b):
+        return s <= e
+    if s < 1e300 and e < 1e300 and b > 1e-290 and A.div(s, b) < 2.0**26:
+        S, B, E = Fraction(s), Fraction(b), Fraction(e)
+        n = math.floor(S / B)
+        return (n + 1) * S - B * (n * (n + 1) // 2) - E <= 0
+    return A.add(s, braking_distance(A, s, b)) <= e
+
+
+def triangle(A, b, n):
+    return A.mul(A.mul(b, n), A.real(n + 1)) / 2
+
+
+def stoppable_step(A, e, b):
+    """S(E): the largest step from which braking stops within e"""
+    if math.isinf(b):
+        return e
+    q = A.div(e, b)
+    if not q < A.counted * A.counted:
+        root = A.mul(A.real(math.sqrt(2.0 * b)), A.real(math.sqrt(e)))
+        s = A.add(root, -b)
+        return s if s > 0 else 0.0
+    n = A.real(math.floor((math.sqrt(8 * q + 1) - 1) / 2))
+    if triangle(A, b, n) > e:
+        n = A.real(n - 1)
+    elif triangle(A, b, A.real(n + 1)) <= e:
+        n = A.real(n + 1)
+    return A.add(A.real(e / A.real(n + 1)), A.mul(A.real(b / 2), n))
+
+
+def zone_step(A, z, v, b):
+    """Z(z, L0): the largest step after which braking at b reaches L0 within z"""
+    if math.isinf(b) or math.isinf(v):
+        return math.inf
+    q, w = A.div(z, b), A.div(v, b)
+    if not (q < A.counted * A.counted) or not (w < A.counted):
+        s2 = v * v + 2.0 * b * z  # binary64, an overflow an infinity
+        s = A.add(A.real(math.sqrt(s2)), -b)
+        return s if s > v else v
+
+    def reach(k):  # (K - 1) * L0 + b * (K - 1) * K / 2
+        return A.add(A.mul(A.real(k - 1), v), triangle(A, b, A.real(k - 1)))
+
+    k = A.real(math.floor(((1 - 2 * w) + math.sqrt((2 * w - 1) * (2 * w - 1) + 8 * (w + q))) / 2))
+    k = max(k, 1.0)
+    if k > 1 and reach(k) > z:
+        k = A.real(k - 1)
+    elif reach(A.real(k + 1)) <= z:
+        k = A.real(k + 1)
+    if k <= 1:
+        return A.add(v, b)
+    return min(A.add(v, A.mul(k, b)), A.add(A.real(z / A.real(k - 1)), A.mul(A.real(b / 2), A.real(k - 2))))
+
+
+def advance(A, y, delta):
+    """y + delta rounded to nearest, then towards y if that went past the exact sum"""
+    if not (abs(y) < 1e300 and abs(delta) < 1e300):
+        return A.add(y, delta)
+    nearest = A.add(y, delta)
+    beyond = Fraction(nearest) - (Fraction(y) + Fraction(delta))
+    if (delta > 0 and beyond > 0) or (delta <= 0 and beyond < 0):
+        return A.towards(nearest, y)
+    return nearest
+
+
+def accel_step(A, yp, uc, v, a, b, limits):
+    """One cycle of rules.md, Acceleration limit, steps 1 to 6. limits:
+    (maxUp, maxDown, maxUpNeg, maxDownNeg) per cycle."""
+    max_up, max_down, max_up_neg, max_down_neg = limits
+    e = A.add(uc, -yp)
+    up = e > 0 or (e == 0 and v > 0)  # 1
+    distance = e if up else -e
+    if math.isinf(distance):
+        distance = A.largest
+    moving = v if up else -v
+    negative = yp < 0
+    limit = (max_up_neg if negative else max_up) if up else (max_down_neg if negative else max_down)
+    if moving < 0 and -moving > b:  # 2
+        step = A.add(moving, b)
+    else:
+        if moving >= 0:  # 3
+            fastest = A.add(moving, a)
+        else:
+            fastest = a if math.isinf(b) else A.mul(a, A.div(A.add(b, moving), b))
+        fastest = min(fastest, limit)
+        zone_ahead = (negative and not uc < 0) if up else (not negative and uc < 0)  # 4
+        if zone_ahead:
+            zone_limit = max_up if up else max_down_neg
+            z = -yp if negative else yp
+            z = A.add(z, -A.add(A.mul(z, 8 * A.roundoff), 2 * A.ulp(z) if up else 0.0))
+            if zone_limit < fastest:
+                fastest = zone_limit if z < 0 else min(fastest, zone_step(A, z, zone_limit, b))
+        if not stops_within(A, fastest, b, distance):  # 5
+            stoppable = stoppable_step(A, distance, b)
+            for _ in range(8):
+                if not (stoppable > 0 and not stops_within(A, stoppable, b, distance)):
+                    break
+                stoppable = A.towards(stoppable, 0.0)
+            fastest = min(fastest, stoppable)
+        if moving > b:
+            braked = advance(A, moving, -b)
+            step = braked if fastest < braked else fastest
+        else:
+            step = fastest
+    scale = uc if abs(uc) > abs(yp) else yp  # 6
+    if abs(A.add(step, -distance)) <= 4 * A.ulp(scale):
+        return uc
+    return advance(A, yp, step if up else -step)

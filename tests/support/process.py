@@ -5,6 +5,7 @@ the timeout it kills the child, then reads its pipes to the end, and a
 grandchild that inherited them (a server the child started) keeps them open
 for ever. Here the child gets a session of its own, its output goes to
 files, and on timeout the whole session is killed."""
+
 import os
 import signal
 import subprocess
@@ -72,10 +73,14 @@ def run(args, *, timeout, what, check=False, **popen):
         stdout = out.read().decode(errors="replace")
         stderr = err.read().decode(errors="replace")
     if timed_out:
-        raise Timeout(f"{what}: no end within {timeout} s, killed\n"
-                      f"command: {' '.join(map(str, args))}\nstdout:\n{tail(stdout)}\nstderr:\n{tail(stderr)}")
+        raise Timeout(
+            f"{what}: no end within {timeout} s, killed\n"
+            f"command: {' '.join(map(str, args))}\nstdout:\n{tail(stdout)}\nstderr:\n{tail(stderr)}"
+        )
     finished = Finished(list(args), process.returncode, stdout, stderr)
     if check and finished.returncode != 0:
-        raise AssertionError(f"{what}: exit status {finished.returncode}\n"
-                             f"command: {' '.join(map(str, args))}\nstdout:\n{tail(stdout)}\nstderr:\n{tail(stderr)}")
+        raise AssertionError(
+            f"{what}: exit status {finished.returncode}\n"
+            f"command: {' '.join(map(str, args))}\nstdout:\n{tail(stdout)}\nstderr:\n{tail(stderr)}"
+        )
     return finished

@@ -1,4 +1,5 @@
 """Comparing fmutrace reports without their timings."""
+
 import re
 
 

@@ -1,7 +1,9 @@
 """Reference scenarios as scripts of tests/c/run_trace.c, the C harness
 built for each platform: natively on x86_64 Linux (with floating-point
 traps too), under qemu-user for aarch64 Linux, under wine for Windows."""
+
 import os
+from itertools import pairwise
 
 from support.fmu_driver import BUILD_DIR
 from support.importers import input_values
@@ -10,8 +12,11 @@ from support.scenarios import same
 
 QEMU = [os.environ.get("RL_QEMU_AARCH64") or "qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
 KINDS = {"Float64": "F", "Real": "F", "Int32": "I", "Integer": "I", "Enumeration": "L", "Boolean": "B"}
-HARNESS = {"x86_64-linux": [str(BUILD_DIR / "run_trace")], "linux64": [str(BUILD_DIR / "run_trace")],
-           "aarch64-linux": QEMU + [str(BUILD_DIR / "aarch64" / "run_trace")]}
+HARNESS = {
+    "x86_64-linux": [str(BUILD_DIR / "run_trace")],
+    "linux64": [str(BUILD_DIR / "run_trace")],
+    "aarch64-linux": QEMU + [str(BUILD_DIR / "aarch64" / "run_trace")],
+}
 SUFFIX = {"x86_64-linux": ".so", "linux64": ".so", "aarch64-linux": ".so", "x86_64-windows": ".dll"}
 
 
@@ -38,8 +43,12 @@ def script_parts(scenario, md, times=None):
     head = [set_line(name, value) for name, value in scenario.start_values.items()]
     head += [set_line(name, value) for name, value in input_values(scenario, start).items()]
     head += [f"init {start.hex()}"] + gets
-    blocks = [[set_line(name, value) for name, value in input_values(scenario, t).items()]
-              + [f"step {t.hex()} {(end - t).hex()}"] + gets for t, end in zip(times, times[1:])]
+    blocks = [
+        [set_line(name, value) for name, value in input_values(scenario, t).items()]
+        + [f"step {t.hex()} {(end - t).hex()}"]
+        + gets
+        for t, end in pairwise(times)
+    ]
     return head, blocks
 
 
@@ -53,12 +62,19 @@ def run_script(platform, stage, model, token, text, tmp_path, what, wine=None, o
     of the staged FMU (wine: the environment of a wine prefix, for Windows;
     options: run_trace's, e.g. --fmi2 for the linux64 binary, --trap)."""
     (tmp_path / "script").write_text(text)
-    command = HARNESS.get(platform) or [os.path.join(wine["WINE_DIR"], "wine64"),
-                                        str(BUILD_DIR / "windows" / "run_trace.exe")]
+    command = HARNESS.get(platform) or [
+        os.path.join(wine["WINE_DIR"], "wine64"),
+        str(BUILD_DIR / "windows" / "run_trace.exe"),
+    ]
     with open(tmp_path / "script") as script_file:
-        done = run_bounded(command + list(options) +
-                           [str(stage / "binaries" / platform / f"{model}{SUFFIX[platform]}"), token],
-                           timeout=300, stdin=script_file, what=what, cwd=tmp_path, env=wine)
+        done = run_bounded(
+            command + list(options) + [str(stage / "binaries" / platform / f"{model}{SUFFIX[platform]}"), token],
+            timeout=300,
+            stdin=script_file,
+            what=what,
+            cwd=tmp_path,
+            env=wine,
+        )
     assert done.returncode == 0, done.stderr
     return [line.strip() for line in done.stdout.splitlines()]
 
@@ -78,10 +94,13 @@ def reference_script(scenario, md):
     reference off the grid is a step there, as fmutrace runs it), and the
     check that run_trace's output lines give the hand-worked reference."""
     o = scenario.options
-    grid = [o["StartTime"] + k * o["StepSize"] for k in range(round((o["StopTime"] - o["StartTime"]) / o["StepSize"]) + 1)]
+    grid = [
+        o["StartTime"] + k * o["StepSize"] for k in range(round((o["StopTime"] - o["StartTime"]) / o["StepSize"]) + 1)
+    ]
 
     def on_grid(t):  # a reference time within 1e-9 of a grid point is that point
         return next((g for g in grid if abs(g - t) <= 1e-9 * max(1.0, abs(t))), t)
+
     reference_times = [on_grid(float(t)) for t in scenario.reference["time"]]
     times = sorted(set(grid) | set(reference_times))
     names = list(scenario.outputs)
@@ -92,6 +111,9 @@ def reference_script(scenario, md):
         for row, t in enumerate(reference_times):
             for k, name in enumerate(names):
                 text = lines[row_of[t] * len(names) + k]
-                value = float.fromhex(text) if text.startswith(("0x", "-0x", "inf", "-inf", "nan", "-nan")) else int(text)
+                value = (
+                    float.fromhex(text) if text.startswith(("0x", "-0x", "inf", "-inf", "nan", "-nan")) else int(text)
+                )
                 assert same(value, scenario.reference[name][row]), (name, t, text, scenario.reference[name][row])
+
     return script(scenario, md, times), check

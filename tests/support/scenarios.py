@@ -1,11 +1,12 @@
 """The project's reference scenarios (tests/scenarios/<Model>/<name>/),
 read, run and compared by fmutrace, the product code the main job runs."""
+
 import math
 from functools import lru_cache
 from pathlib import Path
 
 from fmutrace import Exact, Fmu, compare_traces, load_case
-from fmutrace.simulation import run_fmpy
+from fmutrace._fmpy import Experiment, Signals, run_fmpy
 
 from support.fmu_driver import BUILD_DIR
 
@@ -37,9 +38,13 @@ def simulate(scenario, fmu, fmi_type="CoSimulation", **start_values):
     """The scenario through fmpy.simulate_fmu on the FMU file fmu, as
     fmi_type, its start values updated by start_values."""
     o = scenario.options
-    return run_fmpy(str(fmu), None, start_time=o["StartTime"], stop_time=o["StopTime"], step_size=o["StepSize"],
-                    inputs=scenario.inputs, start_values={**dict(scenario.start_values), **start_values},
-                    outputs=scenario.outputs, relative_tolerance=o["RelTol"], fmi_type=fmi_type)
+    return run_fmpy(
+        str(fmu),
+        None,
+        Experiment(o["StartTime"], o["StopTime"], o["StepSize"], o["RelTol"]),
+        Signals(scenario.inputs, {**dict(scenario.start_values), **start_values}, scenario.outputs),
+        fmi_type,
+    )
 
 
 def compare(scenario, result, reference=None):
@@ -51,5 +56,6 @@ def compare(scenario, result, reference=None):
 def same(value, expected):
     """Bit for bit (any NaN matches any NaN)."""
     value, expected = float(value), float(expected)
-    return (math.isnan(value) and math.isnan(expected)) or \
-        (value == expected and math.copysign(1, value) == math.copysign(1, expected))
+    return (math.isnan(value) and math.isnan(expected)) or (
+        value == expected and math.copysign(1, value) == math.copysign(1, expected)
+    )

@@ -18,6 +18,7 @@ failure.
 The server's port is fixed (rpclib's 8080) and machine-wide, so the runs of
 every test process on the machine are serialised by one lock file
 (port_lock) and the port must be free before a start."""
+
 import contextlib
 import fcntl
 import os
@@ -32,10 +33,10 @@ from fmpy.util import add_remoting
 
 from support.process import Timeout, kill_session, run, tail
 
-PORT = 8080                 # rpc::constants::DEFAULT_PORT in fmpy's server and client
-START_SECONDS = 60          # wine's start on a busy machine, measured at 1 to 15 s
+PORT = 8080  # rpc::constants::DEFAULT_PORT in fmpy's server and client
+START_SECONDS = 60  # wine's start on a busy machine, measured at 1 to 15 s
 ATTEMPTS = 2
-CLIENT = "client_tcp"       # fmpy's client in "server started externally" mode
+CLIENT = "client_tcp"  # fmpy's client in "server started externally" mode
 
 
 @contextlib.contextmanager
@@ -60,8 +61,13 @@ def stop_wineserver(env, wine_dir):
 
 
 def make_prefix(env, wine_dir):
-    run([str(Path(wine_dir) / "wine64"), "wineboot", "--init"], timeout=300, what="wineboot --init (the wine prefix)",
-        env=env, check=True)
+    run(
+        [str(Path(wine_dir) / "wine64"), "wineboot", "--init"],
+        timeout=300,
+        what="wineboot --init (the wine prefix)",
+        env=env,
+        check=True,
+    )
     stop_wineserver(env, wine_dir)
 
 
@@ -110,8 +116,9 @@ def remoting_copy(fmu_dir, target):
     identifier = re.search(r'modelIdentifier="([^"]+)"', description.read_text()).group(1)
     add_remoting(str(target), host_platform="linux64", remote_platform="win64")
     (target / "binaries" / "linux64" / f"{identifier}.so").rename(target / "binaries" / "linux64" / f"{CLIENT}.so")
-    description.write_text(description.read_text().replace(f'modelIdentifier="{identifier}"',
-                                                           f'modelIdentifier="{CLIENT}"'))
+    description.write_text(
+        description.read_text().replace(f'modelIdentifier="{identifier}"', f'modelIdentifier="{CLIENT}"')
+    )
     return target / "binaries" / "win64" / f"{identifier}.dll"
 
 
@@ -131,24 +138,35 @@ class RemotingServer:
     def _start_once(self):
         busy = owners(listeners(PORT))
         if listeners(PORT):
-            raise AssertionError(f"port {PORT} (fmpy's remoting port) is already listened on by {busy or 'an unknown process'}; "
-                                 "a client would talk to that server instead of ours")
+            raise AssertionError(
+                f"port {PORT} (fmpy's remoting port) is already listened on by {busy or 'an unknown process'}; "
+                "a client would talk to that server instead of ours"
+            )
         with open(self.log, "ab") as log:
-            self.process = subprocess.Popen([str(Path(self.wine_dir) / "wine64"), str(self.server_exe), str(self.dll)],
-                                            stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-                                            env=self.env, start_new_session=True)
+            self.process = subprocess.Popen(
+                [str(Path(self.wine_dir) / "wine64"), str(self.server_exe), str(self.dll)],
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env=self.env,
+                start_new_session=True,
+            )
         deadline = time.monotonic() + self.start_seconds
         while time.monotonic() < deadline:
             if self.process.poll() is not None:
-                raise AssertionError(f"the remoting server under wine exited with status {self.process.returncode} "
-                                     f"before it listened on port {PORT}; it printed:\n{self.output()}")
+                raise AssertionError(
+                    f"the remoting server under wine exited with status {self.process.returncode} "
+                    f"before it listened on port {PORT}; it printed:\n{self.output()}"
+                )
             # wine keeps a process's sockets in its wineserver
             holders = owners(listeners(PORT))
             if any(session_of(pid) == self.process.pid or "wineserver" in command for pid, command in holders.items()):
                 return
             time.sleep(0.1)
-        raise Timeout(f"the remoting server under wine did not listen on port {PORT} within {self.start_seconds} s; "
-                      f"it printed:\n{self.output()}")
+        raise Timeout(
+            f"the remoting server under wine did not listen on port {PORT} within {self.start_seconds} s; "
+            f"it printed:\n{self.output()}"
+        )
 
     def stop(self):
         if self.process is not None:

@@ -49,25 +49,21 @@ typedef struct {
 #define ALWAYS_INLINE static inline
 #endif
 
-static int fmi2_values_call(const fmutrace_calls *c, void *component, char *values)
-{
+static int fmi2_values_call(const fmutrace_calls *c, void *component, char *values) {
     return ((fmi2_values)c->function)(component, c->vrs, c->count, values);
 }
 
-static int fmi3_values_call(const fmutrace_calls *c, void *component, char *values)
-{
+static int fmi3_values_call(const fmutrace_calls *c, void *component, char *values) {
     return ((fmi3_values)c->function)(component, c->vrs, c->count, values, c->count);
 }
 
-static int fmi2_step(any_function do_step, void *component, double t, double h, step_flags *flags)
-{
+static int fmi2_step(any_function do_step, void *component, double t, double h, step_flags *flags) {
     (void)flags;
     return ((fmi2_do_step)do_step)(component, t, h, 1);
 }
 
 /* A step that asks to terminate or returns early counts as an Error. */
-static int fmi3_step(any_function do_step, void *component, double t, double h, step_flags *f)
-{
+static int fmi3_step(any_function do_step, void *component, double t, double h, step_flags *f) {
     int status = ((fmi3_do_step)do_step)(component, t, h, true, &f->event, &f->terminate, &f->early, &f->last);
     return f->terminate || f->early ? 3 : status;
 }
@@ -83,23 +79,19 @@ typedef int (*step_call)(any_function, void *, double, double, step_flags *);
 ALWAYS_INLINE size_t run_steps(values_call values, step_call step, any_function do_step, void *component,
                                const double *times, const double *sizes, size_t steps, const long long *set_at,
                                const fmutrace_calls *setters, size_t n_setters, const fmutrace_calls *getters,
-                               size_t n_getters)
-{
-    step_flags flags = {false, false, false, 0.0};
+                               size_t n_getters) {
+    step_flags flags = { false, false, false, 0.0 };
     for (size_t k = 0; k < steps; k++) {
         int status = 0;
         if (set_at[k] >= 0) {
             for (size_t i = 0; i < n_setters; i++)
-                status |= values(&setters[i], component,
-                                 setters[i].rows + (ptrdiff_t)set_at[k] * setters[i].row_bytes);
-            if (status > 1)
-                return k;
+                status |= values(&setters[i], component, setters[i].rows + (ptrdiff_t)set_at[k] * setters[i].row_bytes);
+            if (status > 1) return k;
         }
         status = step(do_step, component, times[k], sizes[k], &flags);
         for (size_t i = 0; i < n_getters; i++)
             status |= values(&getters[i], component, getters[i].rows + (ptrdiff_t)k * getters[i].row_bytes);
-        if (status > 1)
-            return k;
+        if (status > 1) return k;
     }
     return steps;
 }
@@ -107,9 +99,8 @@ ALWAYS_INLINE size_t run_steps(values_call values, step_call step, any_function 
 /* run_steps with the calls of FMI version fmi_version (2 or 3). */
 FMUTRACE_EXPORT size_t fmutrace_steps(int fmi_version, any_function do_step, void *component, const double *times,
                                       const double *sizes, size_t steps, const long long *set_at,
-                                      const fmutrace_calls *setters, size_t n_setters,
-                                      const fmutrace_calls *getters, size_t n_getters)
-{
+                                      const fmutrace_calls *setters, size_t n_setters, const fmutrace_calls *getters,
+                                      size_t n_getters) {
     if (fmi_version == 3)
         return run_steps(fmi3_values_call, fmi3_step, do_step, component, times, sizes, steps, set_at, setters,
                          n_setters, getters, n_getters);
@@ -117,10 +108,10 @@ FMUTRACE_EXPORT size_t fmutrace_steps(int fmi_version, any_function do_step, voi
                      getters, n_getters);
 }
 
-static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_steps", "fmutrace's step loop (called through cffi)",
-                                    -1, NULL, NULL, NULL, NULL, NULL};
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_steps", "fmutrace's step loop (called through cffi)", -1, NULL, NULL, NULL, NULL, NULL
+};
 
-PyMODINIT_FUNC PyInit__steps(void)
-{
+PyMODINIT_FUNC PyInit__steps(void) {
     return PyModule_Create(&module);
 }

@@ -6,22 +6,24 @@
 Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
 simulation, 2 bad input); compare's is its worst case's.
 """
+
 import argparse
 import contextlib
 import sys
 
 from . import __version__
-from .campaign import compare
-from .errors import ExitStatus, InputError, SimulationError
-from .fmu import Fmu, is_fmu_file
-from .longcase import simulate_long
-from .outcome import Status
+from ._campaign import compare
+from ._executors import RunOptions
+from ._errors import ExitStatus, InputError, SimulationError
+from ._fmu import Fmu, is_fmu_file
+from ._longcase import simulate_long
+from ._simulation import SimulationOptions, simulate
+from ._outcome import Status
 from .recordings import is_recording
-from .recordings.align import TIMINGS
-from .recordings.case import TIME_UNITS
-from .simulation import simulate
-from .traces import write_trace
-from .worker import PLOT_ALL_UP_TO, PLOTS
+from .recordings._align import TIMINGS
+from .recordings._options import TIME_UNITS, RecordingOptions
+from ._traces import write_trace
+from ._worker import PLOT_ALL_UP_TO, PLOTS
 
 EXAMPLES = """examples:
   fmutrace run build/fmi3/RateLimiter.fmu --input u.csv --set rateUpPar=2 --step-size 0.1 -o y.csv
@@ -66,89 +68,158 @@ def _positive_int(text):
 
 
 def parser():
-    main = argparse.ArgumentParser(prog="fmutrace", description="Replay CSV traces through FMI 2 and FMI 3 "
-                                   "co-simulation FMUs with fmpy and report where they differ from references.",
-                                   epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    main = argparse.ArgumentParser(
+        prog="fmutrace",
+        description="Replay CSV traces through FMI 2 and FMI 3 "
+        "co-simulation FMUs with fmpy and report where they differ from references.",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     main.add_argument("--version", action="version", version=f"fmutrace {__version__}")
     commands = main.add_subparsers(dest="command", required=True, metavar="{run,compare}")
 
-    run = commands.add_parser("run", help="simulate an FMU on a CSV input and write the result",
-                              description="Simulate an FMU on CSV inputs and write the result as CSV.")
+    run = commands.add_parser(
+        "run",
+        help="simulate an FMU on a CSV input and write the result",
+        description="Simulate an FMU on CSV inputs and write the result as CSV.",
+    )
     run.add_argument("fmu", metavar="FMU")
     run.add_argument("--input", metavar="IN.csv", help="input signals (a row holds from its time on)")
-    run.add_argument("--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[],
-                     help="a start value (repeatable)")
+    run.add_argument(
+        "--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[], help="a start value (repeatable)"
+    )
     run.add_argument("--start-time", type=float, metavar="S", help="default: the input's first time")
     run.add_argument("--stop-time", type=float, metavar="S", help="default: the input's last time")
     run.add_argument("--step-size", type=float, metavar="H", help="communication step (default: the FMU's)")
     run.add_argument("--output-interval", type=float, metavar="H", help="a whole multiple of the step size")
-    run.add_argument("--output", metavar="NAME", action="append", help="a variable to record (repeatable; "
-                     "default: the outputs)")
+    run.add_argument(
+        "--output", metavar="NAME", action="append", help="a variable to record (repeatable; default: the outputs)"
+    )
     run.add_argument("-o", dest="out", metavar="OUT.csv", help="result file (default: standard output)")
 
-    cmp = commands.add_parser("compare", help="replay cases and recordings and compare with their references",
-                              description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
-                              "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
-                              "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
-                              "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF4, WinCC data logs, "
-                              "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
-                              "Exact (bit for bit) unless a tolerance or a tube is given.")
-    cmp.add_argument("paths", nargs="+", metavar="FMU|CASE|RECORDING", help=".fmu files, then case folders or "
-                     "folders holding them (searched recursively), or recordings (files, or a folder of one "
-                     "recording's files)")
-    cmp.add_argument("--report", metavar="DIR", help="write index.html, summary.md, results.json, the results "
-                     "and plots here")
+    cmp = commands.add_parser(
+        "compare",
+        help="replay cases and recordings and compare with their references",
+        description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
+        "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
+        "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
+        "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF4, WinCC data logs, "
+        "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
+        "Exact (bit for bit) unless a tolerance or a tube is given.",
+    )
+    cmp.add_argument(
+        "paths",
+        nargs="+",
+        metavar="FMU|CASE|RECORDING",
+        help=".fmu files, then case folders or "
+        "folders holding them (searched recursively), or recordings (files, or a folder of one "
+        "recording's files)",
+    )
+    cmp.add_argument(
+        "--report", metavar="DIR", help="write index.html, summary.md, results.json, the results and plots here"
+    )
     cmp.add_argument("--rel-tol", type=_non_negative, default=0.0, metavar="R")
     cmp.add_argument("--abs-tol", type=_non_negative, default=0.0, metavar="A")
-    cmp.add_argument("--tube-time", type=_non_negative, metavar="S", help="tube half-width in time (with "
-                     "--tube-value), for traces sampled at other instants")
+    cmp.add_argument(
+        "--tube-time",
+        type=_non_negative,
+        metavar="S",
+        help="tube half-width in time (with --tube-value), for traces sampled at other instants",
+    )
     cmp.add_argument("--tube-value", type=_non_negative, metavar="V", help="tube half-width in value")
     cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
-    cmp.add_argument("--jobs", type=_positive_int, metavar="N", help="local worker processes (default: one per "
-                     "core for 20 cases or more, else this process)")
+    cmp.add_argument(
+        "--jobs",
+        type=_positive_int,
+        metavar="N",
+        help="local worker processes (default: one per core for 20 cases or more, else this process)",
+    )
     cmp.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
-    cmp.add_argument("--shared-files", action="store_true", help="the scheduler's workers see the case folders at "
-                     "the same paths (else they are sent the files)")
-    cmp.add_argument("--plots", choices=PLOTS, help="which cases get a plot and a result CSV in the report "
-                     f"(default: all for up to {PLOT_ALL_UP_TO} cases, else the failed ones)")
-    cmp.add_argument("--case-timeout", type=_non_negative, metavar="S", help="seconds a case may run: one over it "
-                     "is stopped and reported (the cases then run in child processes)")
+    cmp.add_argument(
+        "--shared-files",
+        action="store_true",
+        help="the scheduler's workers see the case folders at the same paths (else they are sent the files)",
+    )
+    cmp.add_argument(
+        "--plots",
+        choices=PLOTS,
+        help="which cases get a plot and a result CSV in the report "
+        f"(default: all for up to {PLOT_ALL_UP_TO} cases, else the failed ones)",
+    )
+    cmp.add_argument(
+        "--case-timeout",
+        type=_non_negative,
+        metavar="S",
+        help="seconds a case may run: one over it is stopped and reported (the cases then run in child processes)",
+    )
     cmp.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
     cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
-    cmp.add_argument("--resume", action="store_true", help="take the cases the report's journal holds from it and "
-                     "run the others (after a stopped campaign; needs --report)")
+    cmp.add_argument(
+        "--resume",
+        action="store_true",
+        help="take the cases the report's journal holds from it and "
+        "run the others (after a stopped campaign; needs --report)",
+    )
     rec = cmp.add_argument_group("recordings", "how recordings are read (docs/recordings.md)")
-    rec.add_argument("--step-size", type=_positive, metavar="H", help="the PLC's cycle in seconds (default: the "
-                     "recording's sample time, else its finest interval between samples)")
-    rec.add_argument("--map", metavar="VARIABLE=CHANNEL", action="append", type=_assignment, default=[],
-                     help="the channel that is the FMU's variable (repeatable; default: the channel whose name's "
-                     "last component is the variable's name)")
-    rec.add_argument("--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[],
-                     help="a start value of the FMU (repeatable)")
-    rec.add_argument("--time-unit", choices=TIME_UNITS, help="the unit of the recording's time stamps (default: "
-                     "what the export says, else what their size says: FILETIME, Unix ms, else seconds)")
-    rec.add_argument("--timing", choices=TIMINGS, default="cycle", help="cycle (default): a row is the input a "
-                     "cycle read and the output it produced, as recorders write it; fmi: a row's output is the "
-                     "output at its time, as fmpy and FMI cross-check files write it")
+    rec.add_argument(
+        "--step-size",
+        type=_positive,
+        metavar="H",
+        help="the PLC's cycle in seconds (default: the "
+        "recording's sample time, else its finest interval between samples)",
+    )
+    rec.add_argument(
+        "--map",
+        metavar="VARIABLE=CHANNEL",
+        action="append",
+        type=_assignment,
+        default=[],
+        help="the channel that is the FMU's variable (repeatable; default: the channel whose name's "
+        "last component is the variable's name)",
+    )
+    rec.add_argument(
+        "--set",
+        metavar="NAME=VALUE",
+        action="append",
+        type=_assignment,
+        default=[],
+        help="a start value of the FMU (repeatable)",
+    )
+    rec.add_argument(
+        "--time-unit",
+        choices=TIME_UNITS,
+        help="the unit of the recording's time stamps (default: "
+        "what the export says, else what their size says: FILETIME, Unix ms, else seconds)",
+    )
+    rec.add_argument(
+        "--timing",
+        choices=TIMINGS,
+        default="cycle",
+        help="cycle (default): a row is the input a "
+        "cycle read and the output it produced, as recorders write it; fmi: a row's output is the "
+        "output at its time, as fmpy and FMI cross-check files write it",
+    )
     return main
 
 
 def run_command(args, out):
+    options = SimulationOptions(
+        dict(args.set), args.start_time, args.stop_time, args.step_size, args.output_interval, args.output
+    )
     if args.input and args.output_interval is None:  # a long input runs chunk by chunk, written as it goes
         with open(args.out, "w", newline="\n") if args.out else contextlib.nullcontext(out) as stream:
-            written = simulate_long(args.fmu, args.input, stream, dict(args.set), args.start_time, args.stop_time,
-                                    args.step_size, args.output)
+            written = simulate_long(args.fmu, args.input, stream, options)
         if written is not None:
             if args.out:
-                print(f"{written} samples of {len(args.output or Fmu(args.fmu).outputs)} signals written to "
-                      f"{args.out}", file=out)
+                print(
+                    f"{written} samples of {len(args.output or Fmu(args.fmu).outputs)} signals written to {args.out}",
+                    file=out,
+                )
             return ExitStatus.SUCCESS
-    result = simulate(args.fmu, input=args.input, start_values=dict(args.set), start_time=args.start_time,
-                      stop_time=args.stop_time, step_size=args.step_size, output_interval=args.output_interval,
-                      outputs=args.output)
+    result = simulate(args.fmu, args.input, **vars(options))
     if args.out:
         write_trace(args.out, result)
-        print(f"{len(result)} samples of {len(result.dtype.names) - 1} signals written to {args.out}", file=out)
+        print(f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {args.out}", file=out)
     else:
         write_trace(out, result)
     return ExitStatus.SUCCESS
@@ -163,13 +234,35 @@ def compare_command(args, out):
         raise InputError("no case folder given: name the folders of cases after the FMUs")
     if args.resume and not args.report:
         raise InputError("--resume continues the campaign of a report folder: give it with --report")
-    result = compare(fmus, cases, report=args.report, rel_tol=args.rel_tol, abs_tol=args.abs_tol,
-                     tube_time=args.tube_time, tube_value=args.tube_value, junit=args.junit, jobs=args.jobs,
-                     scheduler=args.scheduler, shared_files=args.shared_files, plots=args.plots,
-                     case_timeout=args.case_timeout, cluster_timeout=args.cluster_timeout, resume=args.resume,
-                     step_size=args.step_size, maps=args.map, start_values=dict(args.set), time_unit=args.time_unit,
-                     timing=args.timing)
-    for o in result.failed(results=False) if not any(map(is_recording, cases)) else result.cases.light():
+    recordings = any(map(is_recording, cases))
+    run = RunOptions(
+        jobs=args.jobs,
+        scheduler=args.scheduler,
+        shared_files=args.shared_files,
+        case_timeout=args.case_timeout,
+        cluster_timeout=args.cluster_timeout,
+    )
+    # the recordings group's flags read recordings; with case folders alone the command ignores them, as it did
+    recording = (
+        RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set)
+        if recordings
+        else RecordingOptions()
+    )
+    result = compare(
+        fmus,
+        cases,
+        rel_tol=args.rel_tol,
+        abs_tol=args.abs_tol,
+        tube_time=args.tube_time,
+        tube_value=args.tube_value,
+        report=args.report,
+        junit=args.junit,
+        plots=args.plots,
+        resume=args.resume,
+        run=run,
+        recording=recording,
+    )
+    for o in result.failed(results=False) if not recordings else result.cases.light():
         if o.status == Status.INVALID:
             print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
             continue

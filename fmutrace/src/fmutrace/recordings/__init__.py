@@ -1,5 +1,5 @@
 """Recordings as controllers' recorders export them, read into one
-normalised, columnar Recording (recordings.model) whatever the recorder.
+normalised, columnar Recording (recordings._model) whatever the recorder.
 
 The format is recognised from the content, in this order (the first that
 fits reads the file):
@@ -13,13 +13,15 @@ fits reads the file):
 
 A file none of them fits is a TraceError that says, for each, why not.
 """
-import os
 
-from ..errors import InputError, TraceError
-from . import mdf, tables, text as texts, twincat, vendors
-from .matching import Plan, last_component, plan
-from .model import Channel, Recording
-from .timebase import OFF_CYCLE, normalise
+import os
+from pathlib import Path
+
+from .._errors import InputError, TraceError
+from . import _mdf as mdf, _tables as tables, _text as texts, _twincat as twincat, _vendors as vendors
+from ._matching import Plan, last_component, plan
+from ._model import Channel, Recording
+from ._timebase import OFF_CYCLE, normalise
 
 TEXT_FORMATS = (
     ("Beckhoff TwinCAT Scope View CSV", twincat.sniff, twincat.read),
@@ -30,8 +32,19 @@ TEXT_FORMATS = (
 )
 FORMAT_NAMES = ("ASAM MDF4",) + tuple(name for name, _, _ in TEXT_FORMATS)
 
-__all__ = ["Channel", "FORMAT_NAMES", "OFF_CYCLE", "Plan", "Recording", "is_recording", "last_component",
-           "normalise", "plan", "read_file", "read_recording"]
+__all__ = [
+    "Channel",
+    "FORMAT_NAMES",
+    "OFF_CYCLE",
+    "Plan",
+    "Recording",
+    "is_recording",
+    "last_component",
+    "normalise",
+    "plan",
+    "read_file",
+    "read_recording",
+]
 
 
 def read_file(path):
@@ -60,8 +73,11 @@ def _files(paths):
     for path in paths:
         path = os.fspath(path)
         if os.path.isdir(path):
-            inside = sorted(os.path.join(path, n) for n in os.listdir(path)
-                            if not n.startswith(".") and os.path.isfile(os.path.join(path, n)))
+            inside = sorted(
+                os.path.join(path, n)
+                for n in os.listdir(path)
+                if not n.startswith(".") and os.path.isfile(os.path.join(path, n))
+            )
             if not inside:
                 raise InputError(f"{path}: an empty folder")
             files.extend(inside)
@@ -76,7 +92,8 @@ def read_recording(paths):
     """A list of Recordings of the files and folders given: each file is
     one recording, except single-point histories (Niagara), which together
     make one (given as their files or as their folder)."""
-    recordings, points = [], []
+    recordings: list[Recording] = []
+    points: list[Recording] = []
     for path in _files([paths] if isinstance(paths, (str, os.PathLike)) else paths):
         recording = read_file(path)
         (points if recording.format == "Niagara history export" else recordings).append(recording)
@@ -103,3 +120,33 @@ def is_recording(path):
                 return False
         return True
     return False
+
+
+def recording_paths(paths):
+    """The recordings among paths given to compare: [(path, name)], where
+    path is one file or folder, or several single-point files (Niagara)
+    joined by os.pathsep: together they make one recording."""
+    items, points = [], []
+    for path in paths:
+        path = os.fspath(path)
+        if os.path.isfile(path) and _is_single_point(path):
+            points.append(path)
+        else:
+            items.append((path, Path(path).name))
+    if points:
+        name = Path(points[0]).parent.name if len(points) > 1 else Path(points[0]).name
+        items.append((os.pathsep.join(points), name))
+    return items
+
+
+def _is_single_point(path):
+    try:
+        with open(path, "rb") as file:
+            head = file.read(4096)
+    except OSError:
+        return False
+    try:
+        decoded, _ = texts.decode(path, head)
+    except InputError:
+        return False
+    return vendors.sniff_niagara(texts.Text(path, decoded, "")) is None

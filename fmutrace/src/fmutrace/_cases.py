@@ -1,0 +1,239 @@
+"""Cases in the FMI cross-check layout: a folder that holds, for the model
+<Model> of the FMU,
+
+  <Model>_ref.csv    the reference trace (required)
+  <Model>_in.csv     input signals (optional); a row holds from its time on
+  <Model>_ref.opt    StartTime, StopTime, StepSize, RelTol (optional: the
+                     reference's first and last time, the FMU's default step)
+  <Model>_start.csv  start values, one "name,value" line each (optional)
+  README.md          its first line describes the case (optional)
+
+Every file is checked against the FMU before anything runs: a problem is
+an InputError naming the file, line and column.
+"""
+
+import os
+from array import array
+from os import PathLike
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ._comparison import Comparison, Mode, compare_traces
+from ._errors import InputError, TraceError
+from ._fmu import Fmu
+from ._traces import data_lines, parse_number, read_text, read_trace, split_cells
+
+OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
+FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
+
+
+@dataclass
+class Case:
+    name: str  # its folder, relative to the folder searched
+    model: str
+    folder: Path
+    options: dict  # StartTime, StopTime, StepSize, RelTol
+    start_values: dict  # name -> value of the variable's type
+    inputs: np.ndarray | None  # structured array, or None
+    reference: np.ndarray  # structured array
+    description: str = ""
+
+    @property
+    def outputs(self):
+        """The reference's signals: what is recorded and compared."""
+        return [n for n in self.reference.dtype.names or () if n != "time"]
+
+    def comparison(self, result, mode: Mode) -> Comparison:
+        """The FMU's result against the reference, in mode (a recording
+        compares each signal on its own samples)."""
+        return compare_traces(result, self.reference, mode)
+
+
+def read_options(path, text, reference, fmu):
+    options = {"RelTol": 1e-6}
+    for number, line in data_lines(text or ""):
+        cells = split_cells(line, ",")
+        if len(cells) != 2:
+            raise TraceError(path, number, 1, f"expected 'Name,value', found {line.strip()!r}")
+        key, literal = cells
+        if key not in OPTIONS:
+            raise TraceError(path, number, 1, f"unknown option {key!r} (known: {', '.join(OPTIONS)})")
+        value = parse_number(literal)
+        if value is None or value != value:
+            raise TraceError(path, number, 2, f"{key} {literal!r} is not a number")
+        options[key] = value
+    options.setdefault("StartTime", float(reference["time"][0]))
+    options.setdefault("StopTime", float(reference["time"][-1]))
+    if "StepSize" not in options:
+        if fmu.default_step is None:
+            raise InputError(
+                f"{path}: no StepSize: the file is missing or has none, and {fmu.label} gives no default step size"
+            )
+        options["StepSize"] = fmu.default_step
+    where = path if text is not None else f"{path} (defaults)"
+    if not options["StepSize"] > 0:
+        raise TraceError(where, 0, 0, f"StepSize {options['StepSize']!r} must be greater than 0")
+    if not options["StopTime"] > options["StartTime"]:
+        raise TraceError(
+            where, 0, 0, f"StopTime {options['StopTime']!r} must be after StartTime {options['StartTime']!r}"
+        )
+    return options
+
+
+def read_start_values(path, text, fmu):
+    """The start values of a "name,value" file, each checked against the
+    FMU's variable (type, range)."""
+    values = {}
+    for number, line in data_lines(text or ""):
+        cells = split_cells(line, "," if line.count(",") else ";")
+        if len(cells) != 2:
+            raise TraceError(path, number, 1, f"expected 'name,value', found {line.strip()!r}")
+        name, literal = cells
+        if name not in fmu.variables:
+            raise TraceError(path, number, 1, f"{name!r} is not a variable of {fmu.label}")
+        try:
+            values[name] = fmu.start_value(name, literal)
+        except InputError as error:
+            raise TraceError(path, number, 2, str(error)) from None
+    return values
+
+
+def case_texts(folder, model):
+    """{file name: text} of the case's files that exist (what a worker
+    without this file system needs)."""
+    texts = {}
+    for suffix in FILES:
+        name = suffix if suffix == "README.md" else f"{model}{suffix}"
+        path = os.path.join(folder, name)
+        try:
+            texts[name] = read_text(path)
+        except TraceError:
+            if os.path.exists(path):  # there but unreadable: say so
+                raise
+    return texts
+
+
+def load_case(folder: str | PathLike, fmu: Fmu, name: str | None = None, texts: dict | None = None) -> Case:
+    """The case in folder for fmu's model, checked against the FMU; the
+    files' texts may be given (texts from case_texts), else they are read."""
+    folder = Path(folder)
+    model = fmu.model
+    texts = case_texts(folder, model) if texts is None else texts
+
+    def text(file_name):
+        return texts.get(file_name)
+
+    ref_name = f"{model}_ref.csv"
+    if ref_name not in texts:
+        raise TraceError(folder / ref_name, 0, 0, "no such file")
+    reference = read_trace(folder / ref_name, fmu.variable_problem, text(ref_name))
+    in_name = f"{model}_in.csv"
+    inputs = read_trace(folder / in_name, fmu.input_problem, text(in_name)) if in_name in texts else None
+    readme = (text("README.md") or "").strip().splitlines()
+    return Case(
+        name=name or folder.name,
+        model=model,
+        folder=folder,
+        options=read_options(folder / f"{model}_ref.opt", text(f"{model}_ref.opt"), reference, fmu),
+        start_values=read_start_values(folder / f"{model}_start.csv", text(f"{model}_start.csv"), fmu),
+        inputs=inputs,
+        reference=reference,
+        description=readme[0].lstrip("# ").strip() if readme else "",
+    )
+
+
+class CaseList(Sequence):
+    """(folder, name) of each case, sorted by name, kept compact for
+    campaigns of many cases: a case costs its name's text and two bytes
+    (which folder searched); its folder, the one searched joined with the
+    name, is made again when asked for. The few cases whose folder is not
+    that (a case folder given itself, a name prefixed) keep it as text."""
+
+    def __init__(self, roots, names, root_of, folders):
+        self.roots = roots  # the folders searched, as text
+        self.names, self.root_of = names, root_of  # per case: its name, the index of its root
+        self.folders = folders  # case index -> folder, where it is not root/name
+
+    def __len__(self):
+        return len(self.names)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        folder, name = self.text(index)
+        return Path(folder), name
+
+    def text(self, index):
+        """(folder, name) with the folder as text: Path interns every part
+        of a path for good, a campaign of many cases must not."""
+        name = self.names[index]
+        folder = self.folders.get(index % len(self.names))  # (a negative index counts from the end)
+        return (os.path.join(self.roots[self.root_of[index]], name) if folder is None else folder), name
+
+
+def find_cases(paths: Sequence[str | PathLike], model: str) -> CaseList:
+    """[(folder, name)] of the cases of model under paths, each a case
+    folder itself or a folder searched recursively (through linked folders
+    too, each folder once), sorted by name: the folder's path below the one
+    searched (its own name for a case folder given itself). A CaseList."""
+    target = f"{model}_ref.csv"
+    seen: set[tuple[int, int]] = set()
+    names: list[str] = []
+    root_of, folders, roots = array("H"), {}, []
+    # names: only folders searched together can give one twice
+    taken: set[str] | None = set() if len(paths) > 1 else None
+    for path in paths:
+        root = os.fspath(path)
+        if not os.path.isdir(root):
+            raise InputError(f"{path}: no such folder")
+        root_name = os.path.basename(os.path.realpath(root))
+        roots.append(root)
+        for relative in _walk(root, "", target, seen):
+            name = relative or root_name
+            if taken is not None:
+                if name in taken:  # the same name below two folders given
+                    name = f"{root_name}/{name}"
+                taken.add(name)
+            if name != relative:  # its folder is not root/name
+                folders[len(names)] = os.path.join(root, relative) if relative else root
+            names.append(name)
+            root_of.append(len(roots) - 1)
+    order = sorted(range(len(names)), key=names.__getitem__)
+    return CaseList(
+        roots,
+        [names[i] for i in order],
+        array("H", (root_of[i] for i in order)),
+        {new: folders[old] for new, old in enumerate(order) if old in folders},
+    )
+
+
+def _walk(folder, relative, file_name, seen):
+    """The paths below the root (relative) of the folders from folder on
+    that hold file_name, each folder once (seen: their identities), by the
+    first path to it in sorted order. Depth first, holding the names of one
+    folder's subfolders per level: memory grows with the depth and the
+    widest folder's names, not with the whole tree."""
+    try:
+        status = os.stat(folder)
+        identity = (status.st_dev << 64) | status.st_ino
+        if identity in seen:
+            return
+        with os.scandir(folder) as entries:
+            subfolders = sorted(e.name for e in entries if e.name != file_name and _is_folder(e))
+    except OSError:
+        return
+    seen.add(identity)
+    if os.path.isfile(os.path.join(folder, file_name)):
+        yield relative
+    for name in subfolders:
+        yield from _walk(os.path.join(folder, name), f"{relative}/{name}" if relative else name, file_name, seen)
+
+
+def _is_folder(entry):
+    try:
+        return entry.is_dir()
+    except OSError:
+        return False

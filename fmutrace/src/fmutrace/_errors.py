@@ -1,0 +1,37 @@
+"""What goes wrong, as exceptions that carry the command's exit status.
+The statuses are decided here, once; a campaign's is its worst case's
+(outcome.Status)."""
+
+from enum import IntEnum
+
+
+class ExitStatus(IntEnum):
+    SUCCESS = 0  # compare: every case passes
+    FAILURE = 1  # a result differs from its reference, or the FMU failed
+    BAD_INPUT = 2  # usage, a file, an option: nothing a simulation can mend
+
+
+class InputError(ValueError):
+    """Bad input that no simulation can mend."""
+
+    exit_code = ExitStatus.BAD_INPUT
+
+
+class TraceError(InputError):
+    """Bad input in a file: the file, the line and column (1-based, 0 if
+    none) and what is wrong. str() is the message users see."""
+
+    def __init__(self, path, line: int, column: int, message: str):
+        self.path, self.line, self.column, self.message = str(path), line, column, message
+        where = str(path)
+        if line:
+            where += f", line {line}"
+        if column:
+            where += f", column {column}"
+        super().__init__(f"{where}: {message}")
+
+
+class SimulationError(RuntimeError):
+    """The FMU failed (an FMI error status, a crash of the call)."""
+
+    exit_code = ExitStatus.FAILURE

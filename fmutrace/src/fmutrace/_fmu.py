@@ -1,0 +1,178 @@
+"""What fmutrace needs to know of an FMU: its variables (to check a trace's
+columns and start values before anything runs) and its default
+experiment; and the FMU unpacked once per process for fmpy."""
+
+import hashlib
+import math
+import os
+import shutil
+from os import PathLike
+import tempfile
+import zipfile
+from pathlib import Path
+
+from fmpy import extract, read_model_description
+
+from ._errors import InputError
+from ._traces import BOOLEAN_WORDS
+
+INTEGER_RANGES = {
+    "Integer": (-(2**31), 2**31 - 1),
+    "Int8": (-(2**7), 2**7 - 1),
+    "UInt8": (0, 2**8 - 1),
+    "Int16": (-(2**15), 2**15 - 1),
+    "UInt16": (0, 2**16 - 1),
+    "Int32": (-(2**31), 2**31 - 1),
+    "UInt32": (0, 2**32 - 1),
+    "Int64": (-(2**63), 2**63 - 1),
+    "UInt64": (0, 2**64 - 1),
+}
+REAL_TYPES = ("Real", "Float32", "Float64")  # FMI 2 and FMI 3 floating-point types
+
+
+class Fmu:
+    """An FMU file and its model description."""
+
+    def __init__(self, path: str | PathLike, model_description=None):
+        """path: the .fmu file; model_description: fmpy's, if read already
+        (a worker has it from the unpacked FMU)."""
+        self.path = Path(path)
+        if model_description is None:
+            if not self.path.is_file():
+                raise InputError(f"{path}: no such FMU file")
+            try:
+                model_description = read_model_description(str(self.path))
+            except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
+                raise InputError(f"{path}: not an FMU ({error})") from None
+        self.model_description = md = model_description
+        if md.coSimulation is None:
+            raise InputError(f"{path}: {md.modelName} has no Co-Simulation interface")
+        self.model = md.modelName
+        self.fmi_version = int(md.fmiVersion.split(".")[0])
+        self.label = f"{self.model} (FMI {self.fmi_version})"
+        self.variables = {v.name: v for v in md.modelVariables}
+        experiment = md.defaultExperiment
+        self.default_start = _float(experiment and experiment.startTime)
+        self.default_stop = _float(experiment and experiment.stopTime)
+        self.default_step = _float(experiment and experiment.stepSize)
+
+    @property
+    def outputs(self):
+        return [v.name for v in self.model_description.modelVariables if v.causality == "output"]
+
+    def input_problem(self, name):
+        """Why name cannot be an input column (None if it can): fmpy sets
+        inputs and tunable parameters from the input table."""
+        variable = self.variables.get(name)
+        if variable is None:
+            return f"unknown column {name!r}: {self.label} has no variable of that name"
+        if variable.causality != "input" and variable.variability != "tunable":
+            return (
+                f"column {name!r} is a {variable.variability} {variable.causality} of {self.label}: "
+                "only inputs and tunable parameters can change during a run"
+            )
+        return None
+
+    def variable_problem(self, name):
+        """Why name cannot be a reference or output column (None if it can)."""
+        if name not in self.variables:
+            return f"column {name!r} is not a variable of {self.label}"
+        return None
+
+    def start_value(self, name, value):
+        """value (text or a Python value) as the start value of variable
+        name, checked against its type and range; InputError if not."""
+        variable = self.variables.get(name)
+        if variable is None:
+            raise InputError(f"{name!r} is not a variable of {self.label}")
+        if (
+            variable.causality not in ("parameter", "structuralParameter", "input")
+            or variable.variability == "constant"
+        ):
+            raise InputError(
+                f"{name!r} is a {variable.variability} {variable.causality} of {self.label}: only "
+                "parameters and inputs have start values to set"
+            )
+        text = str(value).strip()
+        kind = variable.type
+        if kind == "Boolean":
+            word = text.lower()
+            if word not in BOOLEAN_WORDS and word not in ("0", "1"):
+                raise InputError(f"{name} is a Boolean: {text!r} is not true, false, 0 or 1")
+            return word in ("true", "1")
+        if kind == "String":
+            return str(value)
+        if kind in REAL_TYPES:
+            try:
+                number = float(text)
+            except ValueError:
+                raise InputError(f"{name} is a {kind}: {text!r} is not a number") from None
+            self._check_range(variable, number, text)
+            return number
+        try:
+            number = float(text)
+        except ValueError:
+            number = math.nan
+        if not number.is_integer():
+            raise InputError(f"{name} is an {kind}: {text!r} is not a whole number")
+        number = int(number)
+        if kind == "Enumeration":
+            items = {int(item.value): item.name for item in variable.declaredType.items}
+            if number not in items:
+                raise InputError(
+                    f"{name} is an enumeration {variable.declaredType.name}: {number} is not one of its "
+                    f"values ({', '.join(f'{v} {n}' for v, n in sorted(items.items()))})"
+                )
+        else:
+            low, high = INTEGER_RANGES.get(kind, (-math.inf, math.inf))
+            if not low <= number <= high:
+                raise InputError(f"{name} is an {kind}: {text} is outside its range [{low}, {high}]")
+        self._check_range(variable, number, text)
+        return number
+
+    def _check_range(self, variable, number, text):
+        declared = variable.declaredType
+        low = _float(variable.min if variable.min is not None else declared and declared.min)
+        high = _float(variable.max if variable.max is not None else declared and declared.max)
+        if (
+            (low is not None and number < low)
+            or (high is not None and number > high)
+            or (math.isnan(number) and (low is not None or high is not None))
+        ):
+            bounds = f"[{'-inf' if low is None else f'{low:g}'}, {'inf' if high is None else f'{high:g}'}]"
+            raise InputError(f"{variable.name} = {text} is outside its range {bounds}")
+
+
+def _float(value):
+    if value is None or value == "":
+        return None
+    return float(value)
+
+
+_unpacked: dict[str, tuple] = {}
+
+
+def unpacked(fmu_bytes):
+    """(folder, model description) of an FMU given as bytes, unzipped once
+    per process into a folder named by its content."""
+    key = hashlib.sha256(fmu_bytes).hexdigest()[:20]
+    if key not in _unpacked:
+        folder = Path(tempfile.gettempdir()) / f"fmutrace-{key}"
+        if not (folder / "modelDescription.xml").exists():
+            archive = folder.with_name(f"{folder.name}.{os.getpid()}.fmu")
+            archive.write_bytes(fmu_bytes)
+            try:
+                partial = extract(str(archive), unzipdir=str(folder.with_name(f"{folder.name}.{os.getpid()}.part")))
+                try:
+                    os.replace(partial, folder)
+                except OSError:  # another process was first: theirs is the same
+                    shutil.rmtree(partial, ignore_errors=True)
+            finally:
+                archive.unlink()
+        _unpacked[key] = (str(folder), read_model_description(str(folder)))
+    return _unpacked[key]
+
+
+def is_fmu_file(path):
+    path = Path(path)
+    return path.is_file() and path.suffix.lower() == ".fmu" and zipfile.is_zipfile(path)

@@ -1,0 +1,202 @@
+"""A campaign's journal: results.jsonl in the report folder, one line per
+finished case, appended and flushed as each case finishes, so that a
+campaign whose client is killed loses nothing it finished; `--resume`
+reads it back and runs only the rest. The folder is locked while a
+campaign writes it: a second campaign into the same folder is refused.
+
+The first line describes the campaign (comparison, plots, the FMUs by
+content hash); a resumed campaign must be the same campaign. A line cut
+short by a kill is ignored (its case runs again).
+"""
+
+import hashlib
+import json
+import os
+import sys
+from pathlib import Path
+
+from ._comparison import Mode
+from ._errors import InputError
+from ._outcome import CaseOutcome, Outcomes
+from ._traces import read_trace
+
+JOURNAL = "results.jsonl"
+LOCK = ".fmutrace.lock"
+
+
+if sys.platform == "win32":
+    import msvcrt
+
+    def _try_lock(file):
+        """Locks the file's first byte without waiting; OSError if another process holds it."""
+        file.seek(0)
+        msvcrt.locking(file.fileno(), msvcrt.LK_NBLCK, 1)
+
+    def _unlock(file):
+        file.seek(0)
+        msvcrt.locking(file.fileno(), msvcrt.LK_UNLCK, 1)
+else:
+    import fcntl
+
+    def _try_lock(file):
+        """Locks the file without waiting; OSError if another process holds it."""
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+    def _unlock(file):
+        fcntl.flock(file, fcntl.LOCK_UN)
+
+
+class ReportLock:
+    """An exclusive lock on a report folder, on a file in it (flock on
+    POSIX, a locked byte on Windows): the lock goes with the process that
+    holds it, however it ends. The holder's pid is written after the
+    locked byte (Windows refuses a read of a byte another process locked)."""
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.path = self.folder / LOCK
+        self.file = open(self.path, "a+")
+        try:
+            _try_lock(self.file)
+        except OSError:
+            self.file.seek(1)
+            holder = self.file.read().strip() or "another process"
+            self.file.close()
+            raise InputError(
+                f"{self.folder}: another campaign is writing this report folder ({holder}); wait for "
+                "it to finish or choose another folder"
+            ) from None
+        self.file.seek(0)
+        self.file.truncate()
+        self.file.write(f" pid {os.getpid()}\n")
+        self.file.flush()
+
+    def release(self):
+        if not self.file.closed:
+            self.file.seek(1)
+            self.file.truncate()
+            _unlock(self.file)
+            self.file.close()
+
+
+def campaign_key(fmu_bytes: dict, mode: Mode, plots: str, recordings: dict | None = None) -> dict:
+    """What makes a campaign the same campaign: its FMUs (by content), comparison, plots and how
+    recordings are read."""
+    key = {
+        "mode": mode.name,
+        "tolerance": mode.settings(),
+        "plots": plots,
+        "fmus": sorted(hashlib.sha256(data).hexdigest() for data in fmu_bytes.values()),
+    }
+    if recordings:
+        key["recordings"] = recordings
+    return key
+
+
+def case_key(fmu_file, folder):
+    return f"{fmu_file}|{os.path.realpath(folder)}"
+
+
+class Journal:
+    """results.jsonl: read back for a resume, appended to as cases finish.
+    A case's entry is found again by where its line starts (done, record):
+    the campaign keeps that offset, not the outcome."""
+
+    def __init__(self, folder, key, resume):
+        self.path = Path(folder) / JOURNAL
+        self.done: dict[str, int] | None = {}  # key -> offset of the case's line, of a campaign resumed
+        if resume and self.path.exists():
+            with open(self.path, "rb") as journal:
+                header = _parse(journal.readline())
+                if header is not None and header.get("campaign") != key:
+                    raise InputError(
+                        f"{self.path}: made by a campaign with other FMUs or options; resume it with "
+                        "the same ones, or start afresh without --resume"
+                    )
+                offset = journal.tell()
+                for line in journal:
+                    entry = _parse(line)
+                    if entry is not None and "key" in entry:
+                        self.done[entry["key"]] = offset
+                    offset += len(line)
+            self.file = open(self.path, "ab")
+            if self.file.tell() and not _ends_a_line(self.path):
+                self.file.write(b"\n")  # close a line cut short by the kill: the next entry starts afresh
+            if header is None:
+                self._write({"campaign": key})
+        else:
+            self.file = open(self.path, "wb")
+            self._write({"campaign": key})
+        self.reader = open(self.path, "rb")
+
+    def _write(self, entry):
+        offset = self.file.tell()
+        self.file.write(json.dumps(entry).encode() + b"\n")
+        self.file.flush()  # in the OS's hands: a killed client loses nothing written
+        return offset
+
+    def record(self, key, entry):
+        """Append a finished case; the offset of its line."""
+        return self._write(dict(entry, key=key))
+
+    def entry(self, offset):
+        self.reader.seek(offset)
+        return json.loads(self.reader.readline())
+
+    def close(self):
+        self.file.close()
+        self.reader.close()
+
+
+def _ends_a_line(path):
+    with open(path, "rb") as journal:
+        journal.seek(-1, os.SEEK_END)
+        return journal.read(1) == b"\n"
+
+
+def _parse(line):
+    try:
+        return json.loads(line)
+    except ValueError:
+        return None  # cut short by a kill
+
+
+class JournaledOutcomes(Outcomes):
+    """The outcomes of a campaign with a report folder, read from its
+    journal when asked: the client keeps where each case's line starts (8
+    bytes a case), so its memory does not grow with the campaign. A case
+    with a result CSV in the report gets its result read from it (bit for
+    bit the one written); light() leaves the results out."""
+
+    def __init__(self, report_dir, journal_path, offsets, fmu_folders):
+        self.report_dir, self.path = Path(report_dir), Path(journal_path)
+        self.offsets, self.fmu_folders = offsets, fmu_folders
+
+    def __len__(self):
+        return len(self.offsets)
+
+    def _outcome(self, journal, offset, results=True):
+        journal.seek(offset)
+        entry = json.loads(journal.readline())
+        outcome = CaseOutcome.from_json(entry, self.fmu_folders[entry["fmu_file"]])
+        if results and outcome.csv:
+            outcome.result = read_trace(self.report_dir / outcome.csv)
+        return outcome
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        with open(self.path, "rb") as journal:
+            return self._outcome(journal, self.offsets[index])
+
+    def _outcomes(self, results):
+        with open(self.path, "rb") as journal:
+            for offset in self.offsets:
+                yield self._outcome(journal, offset, results)
+
+    def __iter__(self):
+        return self._outcomes(results=True)
+
+    def light(self):
+        return self._outcomes(results=False)

@@ -1,0 +1,431 @@
+"""A long case (a recorder's hours of cycles as a cross-check case) read,
+simulated, compared and plotted chunk by chunk, in memory that does not
+grow with its length.
+
+The reference and the inputs are read by pyarrow in chunks
+(traces.trace_chunks), the FMU runs chunk after chunk on one instance
+(Runner.run_chunks), each reference chunk is compared as soon as the
+result reaches it, and the figure's lines are envelopes filled as they
+go (plot.Envelope). The verdict is the in-memory path's (worker.run_case
+with comparison.compare_traces), bit for bit, from the comparison
+module's own rules (its samples matched by comparison.aligned, the
+verdict accumulated by comparison.Verdict): every signal's counts, its
+first deviation and its largest, and a reference time the result lacks
+(a test runs both on the same cases). A tube compares each result sample
+with the reference around it: the reference is kept from the row before
+that window to a row after it (Tube.band on that window gives the whole
+reference's bounds). A case this path cannot take (a file that is not
+the plain CSV dialect, an input the fast loop cannot replay, a failing
+FMU) goes to the in-memory path, which reads it or explains it:
+`run_long_case` returns None then, before anything is reported.
+"""
+
+import contextlib
+import os
+import time
+from collections.abc import Callable, Iterator
+from typing import TextIO
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ._cases import read_options, read_start_values
+from ._comparison import Band, Mode, Pointwise, Tube, Verdict, aligned
+from ._errors import InputError, SimulationError
+from ._fmpy import Experiment, Signals
+from ._fmu import Fmu
+from ._outcome import CaseOutcome, Status
+from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
+from ._progress import SampleProgress
+from ._runner import STEPS_PER_CHUNK, FastLoopFailed, Runner
+from ._simulation import SimulationOptions, resolved
+from ._traces import CHUNK_BYTES, LONG_CASE_BYTES, NotPlain, TraceWriter, read_text, trace_chunks
+
+
+def is_long(folder, model, texts) -> bool:
+    """Whether the case in folder is run chunk by chunk (its files are here and large)."""
+    if texts is not None:
+        return False
+    try:
+        return os.path.getsize(os.path.join(folder, f"{model}_ref.csv")) >= LONG_CASE_BYTES
+    except OSError:
+        return False
+
+
+def _signal_names(trace: np.ndarray) -> tuple[str, ...]:
+    """The names of a trace's columns after its time."""
+    return tuple(trace.dtype.names or ())[1:]
+
+
+def _last_time(path):
+    """The time in the last data line of a plain CSV file (its first cell),
+    however long that line is."""
+    with open(path, "rb") as file:
+        end = file.seek(0, os.SEEK_END)
+        size = 4096
+        while True:
+            begin = max(0, end - size)
+            file.seek(begin)
+            lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
+            if len(lines) >= 2 or begin == 0:  # a line break before the last line: it is whole
+                return float(lines[-1].split(b",")[0])
+            size *= 4
+
+
+@dataclass(frozen=True)
+class Streaming:
+    """How a long case streams: where its result goes, the size of its
+    pieces (tests make them small), its progress bar."""
+
+    result_file: str | None = None  # the result written here as it is made (for the report), or None
+    steps_per_chunk: int = STEPS_PER_CHUNK  # steps run between two result chunks
+    chunk_bytes: int = CHUNK_BYTES  # CSV text per chunk of a case's files
+    block_bytes: int | None = None  # text per block of a recording's lines (None: recordings._stream's)
+    progress: SampleProgress | None = None  # (None: one on standard error)
+
+
+@dataclass
+class ChunkedCase:
+    """A case given as chunks: input_chunks (None: no inputs) and
+    ref_chunks are consecutive structured arrays, time first."""
+
+    name: str
+    title: str  # the figure's
+    options: dict  # StartTime, StopTime, StepSize, RelTol
+    start_values: dict
+    input_names: tuple
+    input_chunks: Iterator | None
+    ref_chunks: Iterator
+    outputs: list
+    t_end: float  # the figure's last time
+    # what the outcome's messages add after the comparison's: more_messages(passed, deviations)
+    more_messages: Callable | None = None
+    started: float = field(default_factory=time.perf_counter)
+
+
+def run_long_case(folder, name, target, settings, streaming: Streaming = Streaming()):
+    """The CaseOutcome of the case in folder on target (a _worker.Target),
+    chunk by chunk; None if this path cannot take it (the in-memory path
+    then runs it)."""
+    started = time.perf_counter()
+    folder = Path(folder)
+    fmu, labels = target.fmu, target.labels
+    model = fmu.model
+    ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
+    try:
+        texts = {}  # the small files' texts (the reference and the inputs are read in chunks)
+        for file_name in (f"{model}_ref.opt", f"{model}_start.csv", "README.md"):
+            if (folder / file_name).exists():
+                texts[file_name] = read_text(folder / file_name)
+        first_ref = next(trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=1 << 16))
+        bounds = np.zeros(2, dtype=[("time", np.float64)])
+        bounds["time"] = [first_ref["time"][0], _last_time(ref_path)]
+        options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
+        start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
+        input_names: tuple[str, ...] = ()
+        if in_path.exists():
+            first_in = next(trace_chunks(in_path, fmu.input_problem, chunk_bytes=1 << 16))
+            input_names = _signal_names(first_in)
+            if len(first_in) < 2:
+                return None
+    except (InputError, NotPlain, OSError, ValueError, StopIteration):
+        return None
+    outputs = list(_signal_names(first_ref))
+    stop = options["StopTime"]
+    readme = (texts.get("README.md") or "").strip().splitlines()
+    description = readme[0].lstrip("# ").strip() if readme else ""
+
+    def inputs():
+        yield from trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+
+    title = f"{name} on {labels['fmu']}" + (f": {description}" if description else "")
+    case = ChunkedCase(
+        name,
+        title,
+        options,
+        start_values,
+        input_names,
+        inputs() if input_names else None,
+        trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes),
+        outputs,
+        max(stop, bounds["time"][1]),
+        started=started,
+    )
+    return stream_case(case, target, settings, streaming)
+
+
+def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Streaming()):
+    """The CaseOutcome of a case given as chunks on target (a
+    _worker.Target); None if this path cannot take it (a chunk raises
+    NotPlain, the fast loop cannot replay it), before anything is
+    reported."""
+    options, outputs, input_names = case.options, case.outputs, case.input_names
+    start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
+    n = round((stop - start) / step)
+    bar = streaming.progress or SampleProgress(n + 1)
+    state = _Comparer(case, settings.mode, bar)
+
+    def inputs(chunks):
+        for chunk in chunks:
+            for s in input_names:
+                state.envelopes[("input", s)].add(chunk["time"], chunk[s])
+            yield chunk
+
+    results = target.runner.run_chunks(
+        Experiment(start, stop, step, options["RelTol"]),
+        Signals(inputs(case.input_chunks) if case.input_chunks is not None else None, case.start_values, outputs),
+        input_names,
+        streaming.steps_per_chunk,
+    )
+    with contextlib.ExitStack() as stack:
+        stack.callback(bar.close)
+        stack.callback(results.close)  # given up or done: the run's chunks and pointers go now, not with the frame
+        if streaming.result_file:
+            state.out = stack.enter_context(open(streaming.result_file, "w", newline="\n"))
+        state.results = results
+        try:
+            if isinstance(settings.mode, Tube):
+                for chunk in case.ref_chunks:
+                    state.tube_rows(chunk)
+                state.tube_rows(None)
+            else:
+                held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
+                for chunk in case.ref_chunks:
+                    if held is not None:
+                        chunk = np.concatenate([held, chunk])
+                    held = chunk[-1:]
+                    state.compare_rows(chunk[:-1], chunk["time"][-1])
+                if held is not None:
+                    state.compare_rows(held, np.nan)
+            state.result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
+            if state.reached != n + 1:
+                raise FastLoopFailed("the run ended early")
+        except (FastLoopFailed, NotPlain):
+            return None
+    return state.outcome(case, target.labels, settings)
+
+
+class _Comparer:
+    """A chunked case's comparison as it goes: the result's window, each
+    signal's verdict, the figure's envelopes and its zoom."""
+
+    def __init__(self, case: ChunkedCase, mode: Mode, bar: SampleProgress):
+        options, outputs = case.options, case.outputs
+        self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
+        self.n = round((options["StopTime"] - self.start) / self.step)
+        self.signals = {name: Verdict(name) for name in outputs}
+        self.envelopes = {
+            key: Envelope(self.start, case.t_end)
+            for key in [("ref", s) for s in outputs]
+            + [("result", s) for s in outputs]
+            + [("deviation", s) for s in outputs]
+            + [("input", s) for s in case.input_names]
+        }
+        self.zoom_at: float | None = None  # the first failing sample's time, the zoom's lines around it
+        self.zoom_lines: list | None = None
+        self.recent: dict[str, tuple] = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower,
+        # upper, deviation)
+        self.absent = 0  # reference times without a result sample: their count, the first's time
+        self.first_absent: float | None = None
+        self.window: list[tuple[int, np.ndarray]] = []  # result chunks not yet compared: (first index, chunk)
+        self.reached = 0  # result samples made
+        self.results: Iterator[np.ndarray] = iter(())  # the run's chunks
+        self.out: TextIO | None = None  # the result file
+        self.writer: TraceWriter | None = None
+        self.bar = bar
+        self.reference: np.ndarray | None = None  # a tube's: the reference rows its next samples look around
+        self.t_first: float | None = None  # the reference's first time
+        self.compared = 0  # a tube's: the result samples compared
+
+    def result_until(self, k):
+        """The result window through sample k (or the end)."""
+        while self.reached <= k:
+            chunk = next(self.results, None)
+            if chunk is None:
+                return
+            self.window.append((self.reached, chunk))
+            self.reached += len(chunk)
+            for s in self.outputs:
+                self.envelopes[("result", s)].add(chunk["time"], chunk[s])
+            if self.out is not None:
+                self.writer = self.writer or TraceWriter(self.out, chunk.dtype.names)
+                self.writer.write(chunk)
+            self.bar.update(self.reached)
+
+    def compare_rows(self, rows, next_time):
+        """Compares reference rows (next_time: the time of the row after the
+        last, NaN if none) with the result, as Pointwise.bands does on the
+        whole: comparison.aligned on the result samples around the rows' times."""
+        if not len(rows):
+            return
+        start, step, n, window = self.start, self.step, self.n, self.window
+        times = rows["time"]
+        for s in self.outputs:
+            self.envelopes[("ref", s)].add(times, rows[s])
+        # the communication points start + k * step from two before the first time to two after the last
+        first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2], 0, n)
+        first, last = int(first), int(last)
+        self.result_until(last)
+        while len(window) > 1 and window[1][0] <= first:
+            window.pop(0)  # chunks before the first sample needed
+        base = window[0][0]
+        result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
+        result = result[first - base : last - base + 1]
+        if not len(result):
+            raise FastLoopFailed("the run ended early")
+        index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
+        missing = np.flatnonzero(index == -1)
+        if len(missing):
+            if self.first_absent is None:
+                self.first_absent = float(times[missing[0]])
+            self.absent += len(missing)
+        use = index >= 0
+        if not use.any():
+            return
+        assert isinstance(self.mode, Pointwise)  # (stream_case gives a tube's rows to tube_rows)
+        picked, compared_times, bands = result[index[use]], times[use], {}
+        for s in self.outputs:
+            expected = rows[s][use].astype(np.float64)
+            values = picked[s].astype(np.float64)
+            lower, upper, ok = self.mode.bounds(values, expected)
+            with np.errstate(invalid="ignore", over="ignore"):
+                bands[s] = Band(compared_times, values, lower, upper, ok, values - expected)
+        self._add(bands)
+
+    def tube_rows(self, rows):
+        """A tube's comparison as Tube.bands makes it on the whole: adds
+        reference rows (None: there are no more) and compares the result
+        samples whose look-around window they cover, each against the
+        reference from its time - the tube's time to its time + the tube's
+        time (the window: from the row before that on, to a row after it)."""
+        mode = self.mode
+        assert isinstance(mode, Tube)
+        if rows is not None and len(rows):
+            for s in self.outputs:
+                self.envelopes[("ref", s)].add(rows["time"], rows[s])
+            self.t_first = float(rows["time"][0]) if self.t_first is None else self.t_first
+            self.reference = rows if self.reference is None else np.concatenate([self.reference, rows])
+        if self.reference is None or self.t_first is None:
+            return
+        reference = self.reference
+        last = float(reference["time"][-1])
+        # the samples whose window ends before the last row (or all of them once the reference is whole)
+        covered = np.inf if rows is None else last - mode.time
+        while True:
+            if self.compared >= self.reached:
+                before = self.reached
+                self.result_until(self.reached)
+                if self.reached == before:
+                    return  # the run has no more samples
+            window = self.window
+            while len(window) > 1 and window[1][0] <= self.compared:
+                window.pop(0)  # chunks compared already
+            base = window[0][0]
+            result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
+            result = result[self.compared - base :]
+            take = int(np.searchsorted(result["time"], covered, side="left"))
+            if take:
+                span = (self.t_first, last if rows is None else np.inf)
+                self._add({s: mode.band(result[:take], reference, s, span) for s in self.outputs})
+                self.compared += take
+            if take < len(result):
+                break
+        # the rows the next sample's window needs: from the one before its time - the tube's time on
+        keep = int(np.searchsorted(reference["time"], float(result["time"][take]) - mode.time, side="left")) - 1
+        self.reference = reference[max(keep, 0) :]
+
+    def _add(self, bands):
+        """Each signal's band on the compared samples; the zoom at the first failing one."""
+        failing_now = []
+        for s in self.outputs:
+            band = bands[s]
+            if not len(band.times):
+                continue
+            verdict = self.signals[s].deviation
+            before = verdict.failed
+            self.signals[s].add(band)
+            self.envelopes[("deviation", s)].add(band.times, band.deviation)
+            if self.zoom_lines is None and verdict.failed > before and verdict.time is not None:
+                failing_now.append(verdict.time)
+            self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation)
+        if failing_now and self.zoom_lines is None:
+            at = min(failing_now)
+            self.zoom_at, self.zoom_lines = at, []
+            for s in self.outputs:
+                if s not in self.recent:
+                    continue
+                t, v, lo, up, dev = self.recent[s]
+                k = int(np.searchsorted(t, at))
+                w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
+                self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w]))
+
+    def outcome(self, case: ChunkedCase, labels, settings):
+        """The case's CaseOutcome once every reference row was compared."""
+        outputs, envelopes = self.outputs, self.envelopes
+        deviations = [self.signals[s].deviation for s in outputs]
+        outcome = CaseOutcome(case.name, **labels, streamed=True)
+        problem = ""
+        if self.absent:
+            problem = f"the result has no sample at t={self.first_absent!r} ({self.absent} reference times without one)"
+        passed = not problem and all(d.passed for d in deviations)
+        outcome.status = Status.PASS if passed else Status.FAIL
+        outcome.deviations = [d for d in deviations if not d.passed]
+        outcome.messages = [problem] if problem else [d.describe() for d in deviations if not d.passed]
+        if case.more_messages is not None:
+            outcome.messages += case.more_messages(passed, outcome.deviations)
+        if settings.plots == "all" or (settings.plots == "failed" and not passed):
+            figure = Figure(
+                case.title,
+                [(s, *envelopes[("input", s)].line()) for s in case.input_names],
+                [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
+                [(s, *envelopes[("deviation", s)].line()) for s in outputs],
+                (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
+            )
+            outcome.png = draw(figure, settings.mode, labels["fmu"])
+        outcome.seconds = time.perf_counter() - case.started
+        return outcome
+
+
+def simulate_long(fmu_path, input_path, out, options: SimulationOptions, streaming: Streaming = Streaming()):
+    """fmutrace run on a long input file, chunk by chunk: the result (as
+    simulation.simulate gives it, the same bits) written to the text
+    stream out as it is made; its samples, or None if this path cannot
+    take it (an input it does not read, a trace the fast loop cannot
+    replay, a failing FMU): simulate then runs it and explains."""
+    try:
+        if os.path.getsize(input_path) < LONG_CASE_BYTES:
+            return None
+        fmu = Fmu(fmu_path)
+        first_in = next(trace_chunks(input_path, fmu.input_problem, chunk_bytes=1 << 16))
+        if len(first_in) < 2:
+            return None
+        span = (first_in["time"][0], _last_time(input_path))
+        experiment, signals = resolved(fmu, options, span)  # the defaults as simulate resolves them
+    except (InputError, NotPlain, OSError, ValueError, StopIteration):
+        return None  # simulate explains
+    runner = Runner(fmu.path.read_bytes())
+    start, step = experiment.start, experiment.step
+    bar = streaming.progress or SampleProgress(round((experiment.stop - start) / step) + 1)
+    written, writer = 0, None
+    try:
+        inputs = trace_chunks(input_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+        for chunk in runner.run_chunks(
+            experiment,
+            Signals(inputs, signals.start_values, signals.outputs),
+            _signal_names(first_in),
+            streaming.steps_per_chunk,
+        ):
+            if writer is None:
+                writer = TraceWriter(out, chunk.dtype.names)
+            writer.write(chunk)
+            written += len(chunk)
+            bar.update(written)
+    except (FastLoopFailed, NotPlain) as error:
+        if written:  # too late to leave it to simulate: the result is half written
+            raise SimulationError(f"the simulation failed at t={start + (written - 1) * step!r}: {error}") from None
+        return None
+    finally:
+        bar.close()
+        runner.close()
+    return written

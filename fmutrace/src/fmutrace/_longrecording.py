@@ -1,0 +1,138 @@
+"""A long one-file recording (a table export) run and compared as it is
+read block by block (recordings._stream reads it) through the long-case
+path (_longcase.stream_case), in memory that does not grow with its
+length; its notes and messages are the in-memory path's, word for word."""
+
+import os
+
+import numpy as np
+
+from ._errors import InputError
+from ._longcase import ChunkedCase, Streaming, stream_case
+from ._recorded import first_differs
+from ._traces import LONG_CASE_BYTES, NotPlain
+from .recordings import _stream as stream, _timebase as timebase
+from .recordings._align import off_cycle_note
+from .recordings._matching import plan
+
+
+def is_long_recording(path) -> bool:
+    """Whether the recording at path is one file large enough to be streamed."""
+    try:
+        return os.path.isfile(path) and os.path.getsize(path) >= LONG_CASE_BYTES
+    except OSError:
+        return False
+
+
+def run_long_recording(path, name, target, settings, streaming: Streaming = Streaming()):
+    """The CaseOutcome of the one-file recording at path on target (a
+    _worker.Target), read with settings.recording, streamed; None if this
+    path cannot take it (the in-memory path then reads it)."""
+    fmu, options, block_bytes = target.fmu, settings.recording, streaming.block_bytes
+    try:
+        table = stream.Table(path, fmu, options)
+        recording = table.recording
+        matched = plan(recording, fmu.variables, fmu.label, options.maps)
+        if not matched.compares:
+            return None
+        step = recording.step_size
+        shift = 1 if options.timing == "cycle" else 0
+        cycles = stream.time_column_pass(table, step, block_bytes)
+        start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
+    except (NotPlain, InputError, OSError, ValueError):
+        return None
+    drives, compares = matched.drives, matched.compares
+    stop = max(cycles.last + shift, 1) * step
+    pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": []}
+    row = 0  # the next block's first row, which is its cycle (stream.time_column_pass)
+
+    def parse():
+        """Reads the next block into both queues; False at the end."""
+        nonlocal row
+        block = next(blocks, None)
+        if block is None:
+            return False
+        _, cells, line_numbers, times = block
+        index = np.arange(row, row + len(times))
+        row += len(times)
+        if drives:
+            chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
+            chunk["time"] = index * step
+            for variable, channel in drives:
+                chunk[variable] = table.values(cells, line_numbers, channel.name)
+            pending["inputs"].append(chunk)
+        chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in compares])
+        chunk["time"] = (index + shift) * step
+        for variable, channel in compares:
+            chunk[variable] = table.values(cells, line_numbers, channel.name)
+        pending["refs"].append(chunk)
+        return True
+
+    def queue(kind):
+        while True:
+            if pending[kind]:
+                yield pending[kind].pop(0)
+            elif not parse():
+                while pending[kind]:
+                    yield pending[kind].pop(0)
+                return
+
+    blocks = table.blocks(block_bytes)
+
+    def more_messages(passed, deviations):
+        notes = []
+        if cycles.off:
+            line, time = cycles.first_off
+            notes = [
+                off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
+                for _, channel in drives + compares
+            ]
+        notes += matched.describe()
+        unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
+        description = (
+            f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
+            f"step {step:g} s ({recording.step_source})"
+        )
+        if passed:
+            return [description] + notes
+        return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
+
+    case = ChunkedCase(
+        name,
+        f"{name} on {target.labels['fmu']}: {recording.format}",
+        {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6},
+        start_values,
+        tuple(v for v, _ in drives),
+        queue("inputs") if drives else None,
+        queue("refs"),
+        [v for v, _ in compares],
+        stop,
+        more_messages,
+    )
+    return stream_case(case, target, settings, streaming)
+
+
+def _explain(table, deviations, channels, step, shift):
+    """RecordedCase.explain's messages: each failing signal's recorded sample at its first deviation."""
+    wanted = {}
+    for deviation in deviations:
+        if deviation.name in channels and deviation.time is not None:
+            wanted[deviation.name] = int(round(deviation.time / step)) - shift
+    found = {}
+    row = 0
+    if wanted:
+        for _, cells, line_numbers, times in table.blocks():
+            for name, cycle in wanted.items():
+                if name not in found and row <= cycle < row + len(times):
+                    i = cycle - row
+                    value = table.values(cells, line_numbers, channels[name].name)[i]
+                    found[name] = (int(line_numbers[i]), float(times[i]), float(value))
+            row += len(times)
+            if len(found) == len(wanted):
+                break
+    messages = []
+    for deviation in deviations:
+        if deviation.name in found:
+            line, time, value = found[deviation.name]
+            messages.append(first_differs(deviation, wanted[deviation.name], f"{table.path}, line {line}", time, value))
+    return messages

@@ -1,0 +1,267 @@
+"""A case's figure for the report: its inputs, each compared signal
+(reference, result, and the band where the mode draws one) and the
+deviation, as PNG bytes; for a failing case beside it the same zoomed on
+the first deviation.
+
+A line of millions of samples is drawn decimated to what the figure can
+show: per pixel column the first and last sample and the smallest and
+largest value (Envelope), so the picture is the same and its cost does
+not grow with the length. A long case fills its envelopes chunk by chunk."""
+
+import importlib
+import io
+import threading
+
+import numpy as np
+
+from ._comparison import Comparison, Mode
+
+WIDTH_INCHES, DPI = 8.0, 80
+COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
+ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
+
+
+class Envelope:
+    """A line over [t0, t1] decimated to COLUMNS pixel columns: per column
+    the first and the last sample and the smallest and the largest value
+    (NaN ignored), filled from consecutive chunks of (times, values)."""
+
+    def __init__(self, t0: float, t1: float, columns: int = COLUMNS):
+        self.t0, self.span, self.columns = float(t0), max(float(t1) - float(t0), 1e-300), columns
+        self.first_t = np.full(columns, np.nan)
+        self.first_v = np.full(columns, np.nan)
+        self.last_t = np.full(columns, np.nan)
+        self.last_v = np.full(columns, np.nan)
+        self.low = np.full(columns, np.nan)
+        self.high = np.full(columns, np.nan)
+
+    def add(self, times, values):
+        """Samples in time order, after those added before."""
+        if not len(times):
+            return
+        values = np.asarray(values, dtype=np.float64)
+        column = np.clip(((times - self.t0) / self.span * self.columns).astype(np.int64), 0, self.columns - 1)
+        starts = np.flatnonzero(np.concatenate(([True], column[1:] != column[:-1])))
+        ends = np.concatenate((starts[1:], [len(times)])) - 1
+        c = column[starts]
+        with np.errstate(invalid="ignore"):
+            low, high = np.fmin.reduceat(values, starts), np.fmax.reduceat(values, starts)
+        new = np.isnan(self.first_t[c])
+        self.first_t[c[new]], self.first_v[c[new]] = times[starts[new]], values[starts[new]]
+        self.last_t[c], self.last_v[c] = times[ends], values[ends]
+        self.low[c], self.high[c] = np.fmin(self.low[c], low), np.fmax(self.high[c], high)
+
+    def line(self):
+        """(times, values) to draw: per filled column its first sample, its
+        range at its middle, its last sample."""
+        filled = ~np.isnan(self.first_t)
+        middle = (self.first_t + self.last_t) / 2
+        times = np.stack([self.first_t, middle, middle, self.last_t], axis=1)[filled].ravel()
+        values = np.stack([self.first_v, self.low, self.high, self.last_v], axis=1)[filled].ravel()
+        return times, values
+
+
+def decimated(times, values, t0=None, t1=None):
+    """(times, values) of a whole line, decimated when it has more samples
+    than its pixel columns can show."""
+    if len(times) <= 4 * COLUMNS:
+        return times, values
+    envelope = Envelope(times[0] if t0 is None else t0, times[-1] if t1 is None else t1)
+    envelope.add(times, values)
+    return envelope.line()
+
+
+class Figure:
+    """What a case's figure shows, each line already decimated:
+    inputs [(name, times, values)], signals [(name, (ref times, values),
+    (result times, values), band or None)], deviations [(name, times,
+    values)], and zoom: None, or the same three around the first
+    deviation (full resolution)."""
+
+    def __init__(self, title, inputs, signals, deviations, zoom=None):
+        self.title, self.inputs, self.signals, self.deviations, self.zoom = title, inputs, signals, deviations, zoom
+
+
+def case_figure(case, result, comparison: Comparison, label: str) -> Figure:
+    """The Figure of a case run in memory."""
+    title = f"{case.name} on {label}" + (f": {case.description}" if case.description else "")
+    stop = case.options["StopTime"]
+    inputs = []
+    if case.inputs is not None:
+        for name in case.inputs.dtype.names[1:]:
+            inputs.append(
+                (
+                    name,
+                    *decimated(
+                        np.append(case.inputs["time"], stop), np.append(case.inputs[name], case.inputs[name][-1])
+                    ),
+                )
+            )
+    ref = case.reference
+    signals, deviations = [], []
+    for name in case.outputs:
+        band = comparison.bands.get(name)
+        shown_band = None
+        if band is not None and len(band.times) > 4 * COLUMNS:
+            lower, upper = decimated(band.times, band.lower), decimated(band.times, band.upper)
+            shown_band = (lower[0], lower[1], upper[1])
+        elif band is not None:
+            shown_band = (band.times, band.lower, band.upper)
+        signals.append((name, decimated(ref["time"], ref[name]), decimated(result["time"], result[name]), shown_band))
+        if band is not None:
+            deviations.append((name, *decimated(band.times, band.deviation)))
+    return Figure(title, inputs, signals, deviations, zoom_of(comparison))
+
+
+def zoom_of(comparison: Comparison):
+    """The zoom on the first deviation of a failing comparison (None if it
+    passes): (its time, [(name, times, result, lower, upper, deviation)] of
+    every signal's compared samples around it)."""
+    failing = [d for d in comparison.deviations if not d.passed and d.time is not None]
+    if not failing:
+        return None
+    first = min(failing, key=lambda d: d.time)
+    lines = []
+    for name, band in comparison.bands.items():
+        k = int(np.searchsorted(band.times, first.time))
+        window = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
+        lines.append(
+            (
+                name,
+                band.times[window],
+                band.values[window],
+                band.lower[window],
+                band.upper[window],
+                band.deviation[window],
+            )
+        )
+    return first.time, lines
+
+
+def plot_case(case, result, comparison: Comparison, mode: Mode, label: str) -> bytes:
+    return draw(case_figure(case, result, comparison, label), mode, label)
+
+
+_reused = threading.local()  # a figure is drawn by one thread at a time
+
+
+def _layouts() -> dict:
+    """(rows, columns, has_inputs) -> (figure, axes grid) of this thread."""
+    if not hasattr(_reused, "layouts"):
+        _reused.layouts = {}
+    return _reused.layouts
+
+
+def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
+    """The figure as PNG bytes. A layout (number of panels, zoom or not)
+    is built once per process (and thread) and then only cleared and
+    refilled: making the axes and their ticks is about 40 % of a
+    figure's cost, and the picture is a freshly built one's, pixel for
+    pixel (test_fmutrace_plot)."""
+    has_inputs = bool(figure.inputs)
+    rows = len(figure.signals) + 1 + has_inputs
+    columns = 2 if figure.zoom else 1
+    key, layouts = (rows, columns, has_inputs), _layouts()
+    if reuse and key in layouts:
+        fig, grid = layouts[key]
+        for ax in grid.ravel():
+            _clear(ax)
+    else:
+        fig, grid = _layout(*key)
+        if reuse:
+            layouts[key] = fig, grid
+    axes = list(grid[:, 0])
+    if has_inputs:
+        ax = axes.pop(0)
+        for name, times, values in figure.inputs:
+            ax.step(times, values, where="post", label=f"input {name}")
+        ax.legend(loc="best", fontsize=7)
+    deviation_axis = axes.pop()
+    many = max((len(r[0]) for _, _, r, _ in figure.signals), default=0) > COLUMNS
+    for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals, strict=False):
+        if band is not None and mode.fills_band:
+            ax.fill_between(band[0], band[1], band[2], color="0.85", label=mode.name)
+        ax.plot(ref_t, ref_v, **mode.reference_line, label=f"{name} reference")
+        ax.step(
+            res_t,
+            res_v,
+            where="post",
+            color="C1",
+            linewidth=1.2,
+            marker="" if many else ".",
+            markersize=3,
+            label=f"{name} {label}",
+        )
+        ax.legend(loc="best", fontsize=7)
+    for name, times, values in figure.deviations:
+        deviation_axis.plot(times, values, drawstyle="steps-post", label=name)
+    deviation_axis.set_ylabel(mode.deviation_label, fontsize=7)
+    deviation_axis.legend(loc="best", fontsize=7)
+    if figure.zoom:
+        at, lines = figure.zoom
+        zoom_axes = list(grid[has_inputs:, 1])
+        zoom_deviation = zoom_axes.pop()
+        for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines, strict=False):
+            ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
+            ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=name)
+            ax.axvline(at, color="C3", linewidth=0.8)
+            zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=name)
+        zoom_axes and zoom_axes[0].set_title(f"zoom: first deviation at t={at!r}", fontsize=8)
+        zoom_deviation.axvline(at, color="C3", linewidth=0.8)
+    title = figure.title
+    fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize=9)
+    stream = io.BytesIO()
+    fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
+    return stream.getvalue()
+
+
+def load_plotting():
+    """Imports what drawing a figure needs (matplotlib, its Agg canvas): a
+    second or more on a loaded machine, paid once by a process."""
+    for module in ("matplotlib.figure", "matplotlib.backends.backend_agg"):  # the Agg canvas: savefig's
+        importlib.import_module(module)
+
+
+def _layout(rows: int, columns: int, has_inputs: bool):
+    """A new empty figure of the layout and its axes grid (rows, columns)."""
+    from matplotlib.figure import Figure as MplFigure
+    from matplotlib.ticker import MaxNLocator
+
+    height = 1.6 * rows + 0.6
+    # no pyplot: a figure kept for reuse must not stay in pyplot's list of open figures
+    fig = MplFigure(figsize=(WIDTH_INCHES * (1 + 0.45 * (columns - 1)), height))
+    grid = fig.subplots(rows, columns, sharex="col", squeeze=False, width_ratios=[1, 0.45][:columns])
+    for ax in grid.ravel():
+        ax.tick_params(labelsize=7)
+        # few ticks: matplotlib makes every tick as artists of its own, most of a figure's cost
+        ax.xaxis.set_major_locator(MaxNLocator(6))
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+    for ax in grid[-1]:
+        ax.set_xlabel("time [s]")
+    if columns == 2 and has_inputs:
+        grid[0, 1].set_axis_off()
+    # fixed margins: tight_layout would cost more than the rest of the plot
+    fig.subplots_adjust(
+        left=0.1 / (1 + 0.45 * (columns - 1)),
+        right=0.98,
+        top=1 - 0.45 / height,
+        bottom=0.45 / height,
+        hspace=0.12,
+        wspace=0.18,
+    )
+    return fig, grid
+
+
+def _clear(ax):
+    """An axis of a reused layout back to how _layout left it, its ticks
+    kept: no line, band or legend, no data limits, the colour
+    cycle from its start."""
+    for artist in (*ax.lines, *ax.collections):
+        artist.remove()
+    if ax.get_legend():
+        ax.get_legend().remove()
+    ax.set_prop_cycle(None)
+    ax.relim()
+    # the limits of a new axis: an axis left empty shows 0..1, a drawn one autoscales when it is drawn
+    ax.set_xlim(0, 1, auto=True)
+    ax.set_ylim(0, 1, auto=True)

@@ -1,0 +1,144 @@
+"""Channels matched to an FMU's variables.
+
+A channel means the variable named by the last component of its name:
+MAIN.fbRamp.delayedValue, "DB_Ramp".delayedValue and
+Application.PLC_PRG.fbRamp.delayedValue all mean delayedValue (the same
+name in another case too, when that is the only such variable). --map
+VARIABLE=CHANNEL says it where the names differ. A channel of an input
+or a tunable parameter drives the FMU, one of an output is compared, any
+other is listed as ignored with the reason."""
+
+from dataclasses import dataclass, field
+
+from .._errors import InputError
+
+
+def components(name):
+    """The dot-separated parts of a name, dots inside double quotes kept."""
+    parts, current, quoted = [], "", False
+    for char in name.strip():
+        if char == '"':
+            quoted = not quoted
+        elif char == "." and not quoted:
+            parts.append(current)
+            current = ""
+            continue
+        current += char
+    parts.append(current)
+    return [p.strip().strip('"') for p in parts]
+
+
+def last_component(name):
+    return components(name)[-1]
+
+
+@dataclass
+class Plan:
+    drives: list = field(default_factory=list)  # (variable name, Channel): inputs and tunable parameters
+    compares: list = field(default_factory=list)  # (variable name, Channel): outputs
+    ignored: list = field(default_factory=list)  # (Channel, why)
+
+    def describe(self):
+        lines = []
+        if self.drives:
+            lines.append("drives: " + ", ".join(_pair(v, c) for v, c in self.drives))
+        if self.compares:
+            lines.append("compared: " + ", ".join(_pair(v, c) for v, c in self.compares))
+        for channel, why in self.ignored:
+            lines.append(f"ignored: {channel.name} ({why})")
+        return lines
+
+
+def _column(channel):
+    return f" (column {channel.column} of {channel.file})" if channel.column else f" (in {channel.file})"
+
+
+def _pair(variable, channel):
+    return variable if channel.name == variable else f"{variable} <- {channel.name}"
+
+
+def _role(variable):
+    if variable.causality == "input":
+        return "drive", None
+    if variable.causality == "parameter" and variable.variability == "tunable":
+        return "drive", None
+    if variable.causality == "output":
+        return "compare", None
+    return None, f"a {variable.variability} {variable.causality} of the FMU: it can neither drive nor be compared"
+
+
+def _find_channel(recording, wanted):
+    for channel in recording.channels:
+        if wanted in (channel.name, channel.symbol):
+            return channel
+    named = [c for c in recording.channels if wanted in (last_component(c.name), last_component(c.symbol or c.name))]
+    if len(named) == 1:
+        return named[0]
+    return None
+
+
+def plan(recording, variables, label, maps=()):
+    """The Plan of a recording for an FMU whose variables (name ->
+    fmpy ScalarVariable) are given; maps: (VARIABLE, CHANNEL) pairs."""
+    taken = {}  # variable -> channel
+    for variable, wanted in maps:
+        if variable not in variables:
+            raise InputError(f"--map {variable}={wanted}: {label} has no variable {variable!r}")
+        channel = _find_channel(recording, wanted)
+        if channel is None:
+            raise InputError(
+                f"--map {variable}={wanted}: {recording.label} has no channel {wanted!r} (its channels: "
+                f"{', '.join(c.name for c in recording.channels)})"
+            )
+        taken[variable] = channel
+    mapped = {id(c) for c in taken.values()}
+    folded: dict[str, list[str]] = {}
+    for name in variables:
+        folded.setdefault(name.lower(), []).append(name)
+    result = Plan()
+    for channel in recording.channels:
+        if id(channel) in mapped:
+            continue
+        if not len(channel.values):
+            result.ignored.append((channel, "no samples"))
+            continue
+        variable = None
+        for candidate in dict.fromkeys(
+            (last_component(channel.symbol) if channel.symbol else None, last_component(channel.name))
+        ):
+            if candidate is None:
+                continue
+            if candidate in variables:
+                variable = candidate
+            elif len(folded.get(candidate.lower(), [])) == 1:
+                variable = folded[candidate.lower()][0]
+            if variable:
+                break
+        if variable is None:
+            result.ignored.append(
+                (channel, f"no variable of {label} is named {last_component(channel.symbol or channel.name)!r}")
+            )
+            continue
+        if variable in taken:
+            other = taken[variable]
+            if any(v == variable for v, _ in maps):
+                result.ignored.append((channel, f"{variable} is mapped to {other.name!r}"))
+                continue
+            raise InputError(
+                f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
+                f"{_column(channel)} both mean {variable}: say which with --map {variable}=CHANNEL"
+            )
+        taken[variable] = channel
+    for variable, channel in taken.items():
+        role, why = _role(variables[variable])
+        if role == "drive":
+            result.drives.append((variable, channel))
+        elif role == "compare":
+            result.compares.append((variable, channel))
+        else:
+            result.ignored.append((channel, f"{variable} is {why}"))
+    order = {id(c): i for i, c in enumerate(recording.channels)}
+    result.drives.sort(key=lambda p: order[id(p[1])])
+    result.compares.sort(key=lambda p: order[id(p[1])])
+    result.ignored.sort(key=lambda p: order[id(p[0])])
+    return result

@@ -1,0 +1,64 @@
+"""How the recordings of a campaign are read: one RecordingOptions for all."""
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+from .._errors import InputError
+from ._align import TIMINGS
+
+TIME_UNITS = ("s", "ms", "us", "ns", "cycles", "filetime")
+
+
+def _pairs(value: Mapping | Iterable, what: str) -> tuple:
+    """{name: value} or (name, value) pairs as a tuple of pairs."""
+    try:
+        return tuple((str(name), value) for name, value in (dict(value) if value is not None else {}).items())
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be a dict or (name, value) pairs, not {value!r}") from None
+
+
+@dataclass(frozen=True)
+class RecordingOptions:
+    """How recordings (files as a recorder exports them) are read; case
+    folders carry their own settings (<Model>_ref.opt, <Model>_start.csv).
+
+    step_size     the PLC's cycle in seconds (None: the recording's sample
+                  time, else its finest interval between samples)
+    time_unit     s, ms, us, ns, cycles or filetime (None: the recording's own)
+    timing        'cycle': a row is the input a cycle read and the output it
+                  produced, as recorders write it; 'fmi': a row's output is
+                  the output at its time, as fmpy writes it
+    maps          {VARIABLE: CHANNEL} (or pairs): the channel that is the
+                  FMU's variable
+    start_values  {name: value} (or pairs): start values of the FMU
+    """
+
+    step_size: float | None = None
+    time_unit: str | None = None
+    timing: str = "cycle"
+    maps: tuple = ()
+    start_values: tuple = ()
+
+    def __post_init__(self):
+        object.__setattr__(self, "maps", _pairs(self.maps, "maps"))
+        object.__setattr__(self, "start_values", _pairs(self.start_values, "start_values"))
+        if self.time_unit is not None and self.time_unit not in TIME_UNITS:
+            raise InputError(f"time_unit must be one of {', '.join(TIME_UNITS)}, not {self.time_unit!r}")
+        if self.timing not in TIMINGS:
+            raise InputError(f"timing must be one of {', '.join(TIMINGS)}, not {self.timing!r}")
+        if self.step_size is not None and not self.step_size > 0:
+            raise InputError(f"step_size must be greater than 0, not {self.step_size!r}")
+
+    @property
+    def timebase_unit(self) -> str | None:
+        """time_unit as recordings._timebase names it."""
+        return "FILETIME" if self.time_unit == "filetime" else self.time_unit
+
+    def settings(self) -> dict:
+        return {
+            "step_size": self.step_size,
+            "time_unit": self.time_unit,
+            "timing": self.timing,
+            "maps": [list(m) for m in self.maps],
+            "start_values": [list(s) for s in self.start_values],
+        }

@@ -1,0 +1,308 @@
+"""Time as recorders stamp it, made seconds from the recording's first
+sample, and matched to the cycles of the FMU's step.
+
+Units: s, ms, us, ns (a number per sample), FILETIME (100 ns ticks since
+1601, TwinCAT's full time stamps), OLE days (WinCC's Time_ms: days since
+30 Dec 1899 times 1e6), date strings (ISO 8601, 24.03.2014 10:42:55.123,
+22-Sep-26 09:00:01.250 AM UTC, ...), and cycle counts (times the step).
+Integer stamps are subtracted as integers first, so FILETIME's 1.3e17
+ticks lose no resolution.
+
+A stamp belongs to the nearest cycle end; one further than OFF_CYCLE of a
+cycle from it is reported (recorders' clocks and printed decimals are
+not exact, a stamp that far off means another clock or another step).
+"""
+
+import re
+from datetime import datetime, timedelta, timezone
+
+import numpy as np
+
+from .._errors import InputError, TraceError
+from ._model import TIME_FACTORS
+
+OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
+MAX_STEPS = 200_000_000  # more steps than this (23 days of 10 ms cycles) is a misread unit
+MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless --time-unit says so)
+MAX_SPAN = 366 * 86400.0  # and so is a recording over a year long
+SNAP = 1e-3  # an interval between stamps this close to a shorter decimal is that decimal
+UNIT_WORDS = {
+    "s": "s",
+    "sec": "s",
+    "seconds": "s",
+    "ms": "ms",
+    "msec": "ms",
+    "us": "us",
+    "µs": "us",
+    "μs": "us",
+    "usec": "us",
+    "ns": "ns",
+    "cycle": "cycles",
+    "cycles": "cycles",
+}
+UNIT_NAMES = {
+    "s": "seconds",
+    "ms": "milliseconds",
+    "us": "microseconds",
+    "ns": "nanoseconds",
+    "cycles": "cycle counts",
+    "FILETIME": "FILETIME (100 ns ticks since 1601)",
+    "OLE days": "OLE days (days since 30 Dec 1899, times 1e6)",
+    "date": "dates and times",
+}
+_UNIT_IN_NAME = re.compile(r"(?:[\[(]\s*([^\])]+?)\s*[\])]|[_/ ](ms|us|µs|ns|s)\s*$)", re.IGNORECASE)
+
+
+def unit_in_name(name):
+    """The time unit a column's name states ('Time [ms]', 'Zeit (ms)',
+    'Time_ms', 'time/s'), or None."""
+    match = _UNIT_IN_NAME.search(name)
+    if not match:
+        return None
+    word = (match.group(1) or match.group(2)).strip()
+    return UNIT_WORDS.get(word) or UNIT_WORDS.get(word.lower())
+
+
+# stamps of a time column that names no unit, by their size: FILETIME of the years 1981 to 2108 (100 ns ticks
+# since 1601, as TwinCAT and Windows stamp), Unix time in ms of 2001 to 2096; anything else is seconds
+FILETIME_SIZED = (1.2e17, 1.6e17)
+UNIX_MS_SIZED = (1e12, 4e12)
+
+
+def unnamed_unit(stamps, name):
+    """(unit, why) of a time column that names no unit."""
+    first = stamps[0]
+    if stamps.dtype.kind == "i" and FILETIME_SIZED[0] <= first <= FILETIME_SIZED[1]:
+        return "FILETIME", f"column {name!r} names no unit; its stamps are FILETIME-sized"
+    if UNIX_MS_SIZED[0] <= first <= UNIX_MS_SIZED[1]:
+        return "ms", f"column {name!r} names no unit; its stamps are Unix time in ms"
+    return "s", f"assumed: column {name!r} names no unit"
+
+
+# -- date strings ---------------------------------------------------------------
+_MONTHS = {
+    m: i + 1 for i, m in enumerate(("jan", "feb", "mar", "apr", "may", "jun", "jul", "aug", "sep", "oct", "nov", "dec"))
+}
+_MONTHS.update({"mär": 3, "mrz": 3, "mai": 5, "okt": 10, "dez": 12})
+_DATE_FORMS = [
+    # 2026-11-20T14:03:11.125+01:00, 2026-11-20 14:03:11,125
+    re.compile(
+        r"^(?P<Y>\d{4})-(?P<m>\d{1,2})-(?P<d>\d{1,2})[T ](?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+        r"(?:[.,](?P<f>\d+))?\s*(?P<z>Z|[+-]\d{2}:?\d{2})?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"
+    ),
+    # 24.03.2014 10:42:55.123 (WinCC), 20/11/2026 14:03:11
+    re.compile(
+        r"^(?P<d>\d{1,2})[./](?P<m>\d{1,2})[./](?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+        r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"
+    ),
+    # 22-Sep-26 09:00:01.250 AM UTC (Niagara)
+    re.compile(
+        r"^(?P<d>\d{1,2})-(?P<b>[A-Za-zä]{3})-(?P<Y>\d{2,4})\s+(?P<H>\d{1,2}):(?P<M>\d{2}):(?P<S>\d{2})"
+        r"(?:[.,](?P<f>\d+))?(?:\s*(?P<ap>[AaPp][Mm]))?(?:\s*(?P<z>[+-]\d{2}:?\d{2}))?"
+        r"(?:\s*(?P<zn>[A-Za-z]{1,5}))?$"
+    ),
+]
+
+
+def looks_like_date(text):
+    return any(form.match(text.strip()) for form in _DATE_FORMS)
+
+
+def parse_date(text):
+    """A date string as integer nanoseconds since 1970 (local times and
+    named zones other than UTC/GMT/Z taken as they read: only differences
+    matter here); None if it is no date form known."""
+    text = text.strip()
+    for form in _DATE_FORMS:
+        match = form.match(text)
+        if match:
+            break
+    else:
+        return None
+    g = match.groupdict()
+    year = int(g["Y"])
+    if year < 100:
+        year += 2000
+    month = _MONTHS.get(g["b"].lower()) if g.get("b") else int(g["m"])
+    if month is None:
+        return None
+    hour = int(g["H"])
+    if g.get("ap"):
+        hour = hour % 12 + (12 if g["ap"].lower() == "pm" else 0)
+    try:
+        moment = datetime(year, month, int(g["d"]), hour, int(g["M"]), int(g["S"]), tzinfo=timezone.utc)
+    except ValueError:
+        return None
+    zone = g.get("z")
+    if zone and zone != "Z":
+        sign = -1 if zone[0] == "-" else 1
+        digits = zone[1:].replace(":", "")
+        moment -= sign * timedelta(hours=int(digits[:2]), minutes=int(digits[2:]))
+    fraction = g.get("f") or ""
+    nanoseconds = int((fraction + "000000000")[:9]) if fraction else 0
+    return int((moment - datetime(1970, 1, 1, tzinfo=timezone.utc)).total_seconds()) * 1_000_000_000 + nanoseconds
+
+
+def dates(cells, text, line_of, column, name):
+    """A column of date strings as int64 nanoseconds; the first that is no
+    date is a TraceError at its place."""
+    out = np.empty(len(cells), dtype=np.int64)
+    for i, cell in enumerate(cells):
+        value = parse_date(cell)
+        if value is None:
+            raise text.error(
+                line_of(i),
+                column,
+                f"{cell.strip()!r} in column {name!r} is not a date and time "
+                "(e.g. 2026-11-20 14:03:11.125 or 20.11.2026 14:03:11.125)",
+            )
+        out[i] = value
+    return out
+
+
+# -- seconds from the first sample -------------------------------------------------
+def normalise(recording, time_unit=None, step_size=None, default_step=None):
+    """Set every channel's times (seconds from the recording's first
+    sample, over all channels) and the recording's step_size: step_size if
+    given, else the sample time the file declares, else the finest interval
+    between its time stamps (the recorder sampled every cycle), else
+    default_step (the FMU's) for cycle counts. time_unit overrides the
+    recording's. Refuses a recording whose length in steps is absurd,
+    naming the unit it assumed."""
+    if time_unit:
+        if recording.time_unit in ("date", "OLE days") and time_unit != recording.time_unit:
+            raise InputError(
+                f"{recording.label}: its time stamps are {UNIT_NAMES[recording.time_unit]}: "
+                f"--time-unit {time_unit} does not apply"
+            )
+        recording.time_unit, recording.time_source = time_unit, "--time-unit"
+    unit = recording.time_unit
+    channels = [c for c in recording.channels if len(c.stamps)]
+    if not channels:
+        raise TraceError(recording.label, 0, 0, "no samples: the recording holds no channel with values")
+    if unit == "cycles":
+        step = step_size or recording.sample_time or default_step
+        if not step:
+            raise InputError(f"{recording.label}: its time is a cycle count: give the cycle time with --step-size")
+        recording.step_size = step
+        recording.step_source = (
+            "--step-size"
+            if step_size
+            else "the recording's sample time"
+            if recording.sample_time
+            else "the FMU's default step size"
+        )
+    origin = min(c.stamps[0] for c in channels)
+    factor = recording.step_size if unit == "cycles" else 1e-9 if unit == "date" else TIME_FACTORS[unit]
+    for channel in recording.channels:
+        channel.times = _minus(channel.stamps, origin) * factor
+    span = max(float(c.times[-1]) for c in channels)
+    assumed = f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit]
+    if too_long(span):
+        raise InputError(
+            f"{recording.label}: with its time read as {assumed}, the recording would span "
+            f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give --time-unit "
+            "(s, ms, us, ns, cycles, filetime)"
+        )
+    if unit != "cycles":
+        if step_size:
+            recording.step_size, recording.step_source = step_size, "--step-size"
+        elif recording.sample_time:
+            recording.step_size, recording.step_source = recording.sample_time, "the recording's sample time"
+        else:
+            step = finest_interval(channels)
+            if step is None:
+                if not default_step:
+                    raise InputError(f"{recording.label}: one sample per channel tells no cycle time: give --step-size")
+                step, source = default_step, "the FMU's default step size"
+            else:
+                source = "the finest interval between its time stamps"
+            recording.step_size, recording.step_source = step, source
+    steps = span / recording.step_size
+    samples = max(len(c.times) for c in channels)
+    if too_many_steps(steps, samples, recording.time_source):
+        raise InputError(
+            f"{recording.label}: with its time read as {assumed} and a step of "
+            f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
+            f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit "
+            "(s, ms, us, ns, cycles, filetime)"
+        )
+    return recording
+
+
+def _minus(stamps, origin):
+    """stamps - origin as float64, exactly for integer stamps."""
+    if stamps.dtype.kind in "iu":
+        return (stamps - np.int64(origin)).astype(np.float64)
+    if stamps.dtype.kind == "M":
+        return (stamps - origin).astype("timedelta64[ns]").astype(np.int64).astype(np.float64)
+    return stamps.astype(np.float64) - float(origin)
+
+
+def too_long(span):
+    """Whether a recording span seconds long is a misread unit."""
+    return span > MAX_SPAN
+
+
+def too_many_steps(steps, samples, time_source):
+    """Whether so many steps for so many samples is a misread unit (or
+    step), unless --time-unit (time_source) said the unit."""
+    return steps > MAX_STEPS or (steps > MAX_SPARSE * samples and time_source != "--time-unit")
+
+
+class Intervals:
+    """The positive intervals between consecutive times of a time column,
+    given whole or block by block, counted by value (a recorder's are a
+    handful of values): their exact median without keeping them all."""
+
+    def __init__(self, times=None):
+        self.values, self.counts, self.last = np.empty(0), np.empty(0, dtype=np.int64), None
+        if times is not None:
+            self.add(times)
+
+    def add(self, times):
+        if not len(times):
+            return
+        joined = times if self.last is None else np.concatenate([[self.last], times])
+        self.last = times[-1]
+        steps = np.diff(joined)
+        values, counts = np.unique(steps[steps > 0], return_counts=True)
+        self.values, at = np.unique(np.concatenate([self.values, values]), return_inverse=True)
+        merged = np.zeros(len(self.values), dtype=np.int64)
+        np.add.at(merged, at, np.concatenate([self.counts, counts]))
+        self.counts = merged
+
+    def median(self):
+        """np.median of all the intervals (None if there are none)."""
+        total = int(self.counts.sum())
+        if not total:
+            return None
+        middle = np.searchsorted(np.cumsum(self.counts), [(total - 1) // 2, total // 2], side="right")
+        return float(np.median(self.values[middle]))  # one value twice, or the two middle ones: their mean
+
+
+def finest_interval(channels):
+    """The smallest of the channels' typical (median) positive intervals
+    between samples, in seconds; None if no channel has two samples."""
+    medians = [m for m in (Intervals(channel.times).median() for channel in channels) if m is not None]
+    return snapped_interval(min(medians)) if medians else None
+
+
+def snapped_interval(best):
+    """A typical interval between stamps as the recorder's cycle."""
+    # clocks and printed stamps are not exact: a median of 0.2499985 s is a 250 ms cycle (the shortest
+    # decimal within SNAP of it)
+    for digits in range(1, 16):
+        rounded = float(f"{best:.{digits}g}")
+        if abs(rounded - best) <= SNAP * best:
+            return rounded
+    return best
+
+
+def cycles(times, step):
+    """(cycle index of each time, indices of those off their cycle end by
+    more than OFF_CYCLE of a cycle)."""
+    exact = times / step
+    index = np.rint(exact).astype(np.int64)
+    off = np.flatnonzero(np.abs(exact - index) > OFF_CYCLE)
+    return index, off

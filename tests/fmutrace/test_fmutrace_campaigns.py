@@ -1,0 +1,373 @@
+"""Campaigns that lose nothing: results journaled as each case finishes, a
+killed client resumed without recomputing, a second campaign into the same
+report folder refused, a Dask worker killed in the middle."""
+
+import contextlib
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+import fmutrace
+from support.fmu_driver import BUILD_DIR
+from support.scenarios import FMI_VERSIONS, SCENARIO_ROOT, discover, fmu_path
+from support.reports import without_timings
+
+FMUTRACE = Path(sys.executable).parent / "fmutrace"
+PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
+WAIT = 120
+
+
+def step_cases(root, model, values):
+    """A case per value k, worked by hand for PassThrough's equation
+    y(t + 0.1) = u(t): u = k from t = 0.2 on."""
+    for k in values:
+        folder = root / f"case_{k:02d}"
+        folder.mkdir(parents=True)
+        (folder / f"{model}_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
+        (folder / f"{model}_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
+        (folder / f"{model}_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    return root
+
+
+def pass_through_cases(root, count):
+    return step_cases(root, "PassThrough", range(count))
+
+
+def start(args):
+    return subprocess.Popen(
+        [str(FMUTRACE), *map(str, args)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+
+
+def finish(process):
+    try:
+        out, err = process.communicate(timeout=WAIT)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        raise AssertionError("fmutrace did not finish within the bound") from None
+    return process.returncode, out, err
+
+
+def wait_for(condition, what):
+    deadline = time.monotonic() + WAIT
+    while not condition():
+        assert time.monotonic() < deadline, f"{what} did not happen within {WAIT} s"
+        time.sleep(0.05)
+
+
+def journal_keys(report):
+    lines = (report / "results.jsonl").read_text().splitlines()
+    keys = []
+    for line in lines[1:]:
+        try:
+            keys.append(json.loads(line)["key"])
+        except ValueError:
+            pass  # the line the kill cut short
+    return keys
+
+
+def comparable(report):
+    results = json.loads((report / "results.json").read_text())
+    return [(c["case"], c["fmu"], c["status"], c["messages"], c.get("plot")) for c in results["cases"]]
+
+
+@pytest.mark.slow
+def test_a_killed_client_resumes_without_recomputing(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 40)
+    undisturbed = tmp_path / "undisturbed"
+    code, out, _ = finish(
+        start(["compare", PASS_THROUGH, cases, "--report", undisturbed, "--jobs", 1, "--plots", "all"])
+    )
+    assert code == 0, out
+
+    report = tmp_path / "report"
+    process = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all"])
+    wait_for(lambda: (report / "results.jsonl").exists() and len(journal_keys(report)) >= 5, "five journaled cases")
+    os.killpg(process.pid, signal.SIGKILL)
+    process.communicate(timeout=WAIT)
+    done = journal_keys(report)
+    assert 5 <= len(done) < 40 and len(set(done)) == len(done)
+
+    code, out, err = finish(
+        start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all", "--resume"])
+    )
+    assert code == 0, out + err
+    assert f"({len(done)} cases from the journal)" in out
+    keys = journal_keys(report)
+    assert len(keys) == 40 and len(set(keys)) == 40  # every case exactly once: nothing done twice
+    assert keys[: len(done)] == done
+    assert comparable(report) == comparable(undisturbed)
+    assert without_timings((report / "summary.md").read_text()) == without_timings(
+        (undisturbed / "summary.md").read_text()
+    )
+
+    code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume"]))
+    assert code == 0 and "on the journal" in out  # all done: nothing runs
+
+
+@pytest.mark.cluster  # 501 cases: the command starts a local cluster
+def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp_path):
+    """The command's default is the documented one: a plot and a result CSV
+    for every case up to 500 (test_fmutrace.py's report test: every case
+    plotted), the failing ones beyond. Two of 501 cases differ at t = 0.4."""
+    cases = pass_through_cases(tmp_path / "cases", 501)
+    for k in (7, 300):
+        reference = cases / f"case_{k:02d}" / "PassThrough_ref.csv"
+        reference.write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k + 1}\n")
+    report = tmp_path / "report"
+    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report]))
+    assert code == 1, out + err
+    assert "499 of 501 cases pass, 2 differ" in out
+    failing = ["PassThrough-fmi3/case_07", "PassThrough-fmi3/case_300"]
+    assert sorted(str(p.relative_to(report)) for p in report.rglob("*.png")) == [f"{c}.png" for c in failing]
+    assert sorted(str(p.relative_to(report)) for p in report.rglob("*_out.csv")) == [f"{c}_out.csv" for c in failing]
+    assert [c["case"] for c in json.loads((report / "results.json").read_text())["cases"] if "plot" in c] == [
+        "case_07",
+        "case_300",
+    ]
+
+
+def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 6)
+    report = tmp_path / "report"
+    assert fmutrace.compare(PASS_THROUGH, cases, report=report, run=fmutrace.RunOptions(jobs=1)).passed
+    journal = report / "results.jsonl"
+    lines = journal.read_bytes().splitlines(keepends=True)
+    journal.write_bytes(b"".join(lines[:4]) + lines[4][:25])  # three cases whole, the fourth cut by a kill
+    campaign = fmutrace.compare(PASS_THROUGH, cases, report=report, run=fmutrace.RunOptions(jobs=1), resume=True)
+    assert campaign.passed and campaign.where == "1 process (3 cases from the journal)"
+    assert [o.case for o in campaign.cases] == [f"case_{k:02d}" for k in range(6)]
+    keys = journal_keys(report)
+    assert len(keys) == 6 and len(set(keys)) == 6
+    assert [json.loads(c)["counts"] for c in [(report / "results.json").read_text()]] == [
+        {"pass": 6, "fail": 0, "error": 0, "invalid": 0}
+    ]
+
+
+def test_a_journaled_campaign_gives_its_outcomes_and_results_back(tmp_path):
+    """With a report, the outcomes are read back from the journal and the
+    results from their CSV files: the outcomes of a campaign kept in memory,
+    and the results worked by hand (y(t + 0.1) = u(t))."""
+    cases = step_cases(tmp_path / "cases", "PassThrough", [3, 4])
+    in_memory = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=1))
+    journaled = fmutrace.compare(
+        PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=1), plots="all", report=tmp_path / "report"
+    )
+    assert len(journaled.cases) == len(in_memory.cases) == 2
+    for k, kept, read in zip((3, 4), in_memory.cases, journaled.cases, strict=True):
+        assert (read.case, read.fmu, read.status, read.messages) == (kept.case, kept.fmu, kept.status, kept.messages)
+        assert list(read.result["time"]) == pytest.approx([0, 0.1, 0.2, 0.3, 0.4], abs=1e-15)
+        assert list(read.result["y"]) == [0, 0, 0, k, k]
+    assert journaled.cases[-1].case == "case_04" and journaled.cases[0:1][0].case == "case_03"
+    assert journaled.counts() == in_memory.counts() == {"pass": 2, "fail": 0, "error": 0, "invalid": 0}
+
+
+def test_the_failed_cases_of_a_journaled_campaign_with_or_without_their_results(tmp_path):
+    """The command prints the failing cases' messages only: failed(results=False) gives them without reading
+    each result back from its CSV file."""
+    cases = step_cases(tmp_path / "cases", "PassThrough", [3, 4, 5])
+    (cases / "case_04" / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,4\n0.4,9\n")
+    campaign = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=1), report=tmp_path / "report")
+    whole, light = campaign.failed(), campaign.failed(results=False)
+    assert [o.case for o in whole] == [o.case for o in light] == ["case_04"]
+    assert whole[0].messages == light[0].messages and whole[0].status == light[0].status == "fail"
+    assert list(whole[0].result["y"]) == [0, 0, 0, 4, 4] and light[0].result is None
+
+
+def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 3)
+    report = tmp_path / "report"
+    assert finish(start(["compare", PASS_THROUGH, cases, "--report", report]))[0] == 0
+    code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--resume", "--rel-tol", "1e-3"]))
+    assert code == 2 and "made by a campaign with other FMUs or options" in err
+    code, _, err = finish(start(["compare", PASS_THROUGH, cases, "--resume"]))
+    assert code == 2 and "give it with --report" in err
+
+
+@pytest.mark.slow
+def test_a_second_campaign_into_the_same_report_folder_is_refused(tmp_path):
+    cases = pass_through_cases(tmp_path / "cases", 30)
+    report = tmp_path / "report"
+    first = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all"])
+    wait_for(lambda: (report / "results.jsonl").exists() and journal_keys(report), "the first campaign's start")
+    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1]))
+    assert code == 2, out + err
+    assert f"another campaign is writing this report folder (pid {first.pid})" in err
+    code, out, _ = finish(first)
+    assert code == 0 and "30 of 30 cases pass" in out  # undisturbed
+    assert len(set(journal_keys(report))) == 30
+    assert json.loads((report / "results.json").read_text())["counts"]["pass"] == 30
+    code, out, _ = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1]))
+    assert code == 0  # the lock went with the first campaign
+
+
+@pytest.mark.cluster
+def test_a_worker_killed_in_the_middle_of_a_campaign(cluster, tmp_path):
+    """SIGKILL to a Dask worker process while it works: its batches run
+    again elsewhere, the campaign completes, each case once, the same
+    report as a run in one process."""
+    from dask.distributed import Client
+
+    fmus = [fmu_path(BUILD_DIR, model, version) for model in ("RateLimiter", "Ramp") for version in FMI_VERSIONS]
+    cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
+    report = tmp_path / "killed"
+    result = {}
+    campaign = threading.Thread(
+        target=lambda: result.setdefault(
+            "campaign",
+            fmutrace.compare(
+                fmus, cases, report=report, run=fmutrace.RunOptions(scheduler=cluster, cluster_timeout=600), plots="all"
+            ),
+        )
+    )
+    campaign.start()
+    wait_for(lambda: (report / "results.jsonl").exists() and len(journal_keys(report)) >= 3, "three finished cases")
+    with Client(cluster, timeout=WAIT) as client:
+        pids = client.run(os.getpid)
+        victim = sorted(pids.values())[0]
+        os.kill(victim, signal.SIGKILL)
+        campaign.join(timeout=600)
+        assert not campaign.is_alive()
+        assert victim not in client.run(os.getpid).values()  # it died (its nanny starts another)
+    killed = result["campaign"]
+    assert killed.passed, killed.summary()
+    total = 2 * len(discover(["RateLimiter", "Ramp"]))
+    keys = journal_keys(report)
+    assert len(killed.cases) == total and len(keys) == total and len(set(keys)) == total
+    fmutrace.compare(fmus, cases, report=tmp_path / "serial", run=fmutrace.RunOptions(jobs=1), plots="all")
+    assert comparable(report) == comparable(tmp_path / "serial")
+    for page in ("index.html", "summary.md"):
+        assert without_timings((report / page).read_text()) == without_timings((tmp_path / "serial" / page).read_text())
+
+
+FAULTY = {v: BUILD_DIR / "fixtures" / f"fmi{v}" / "Faulty.fmu" for v in (2, 3)}
+# in the sanitizer tree AddressSanitizer's handler takes the SIGSEGV: it reports and exits with status 1
+CRASH = "exited with status 1" if os.environ.get("RL_SANITIZED") == "1" else "killed by signal SIGSEGV"
+
+
+def faulty_cases(root, values):
+    """Cases of the Faulty fixture (PassThrough's equation): k = 13 crashes
+    its process, k = 17 hangs."""
+    return step_cases(root, "Faulty", values)
+
+
+@pytest.mark.parametrize(
+    "version,jobs",
+    [pytest.param(2, 2, marks=pytest.mark.cluster), pytest.param(3, 2, marks=pytest.mark.cluster), (3, 1)],
+)
+def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, jobs, tmp_path):
+    """On workers the batch that holds it kills its worker, is run again
+    case by case in child processes, and only the crashing case fails; in
+    one process (with --case-timeout, which runs the cases in a child) the
+    same."""
+    cases = faulty_cases(tmp_path / "cases", [1, 2, 13, 4, 5, 6])
+    args = ["compare", FAULTY[version], cases, "--report", tmp_path / "report", "--jobs", jobs]
+    code, out, err = finish(start(args + (["--case-timeout", 60] if jobs == 1 else [])))
+    assert code == 1, out + err
+    assert (
+        f"ERROR  case_13 on Faulty (FMI {version})\n      the simulation's process was {CRASH} while running "
+        "this case" in out
+    )
+    assert "5 of 6 cases pass, 0 differ, 1 failed to simulate" in out
+    assert len(set(journal_keys(tmp_path / "report"))) == 6
+
+
+@pytest.mark.parametrize("jobs", [1, pytest.param(2, marks=pytest.mark.cluster)])
+def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
+    """The hanging case is stopped once its timeout has passed (not before),
+    the campaign goes on to the cases after it, and the command ends (finish
+    bounds the wait)."""
+    cases = faulty_cases(tmp_path / "cases", [1, 17, 3, 13, 5])
+    report = tmp_path / "report"
+    code, out, err = finish(
+        start(["compare", FAULTY[3], cases, "--jobs", jobs, "--case-timeout", 3, "--report", report])
+    )
+    assert code == 1, out + err
+    assert "ERROR  case_17 on Faulty (FMI 3)\n      stopped after the per-case timeout of 3 s" in out
+    assert f"ERROR  case_13 on Faulty (FMI 3)\n      the simulation's process was {CRASH}" in out
+    assert "3 of 5 cases pass, 0 differ, 2 failed to simulate" in out
+    results = {c["case"]: c for c in json.loads((report / "results.json").read_text())["cases"]}
+    assert sorted(results) == [f"case_{k:02d}" for k in (1, 3, 5, 13, 17)]
+    assert results["case_17"]["status"] == "error" and results["case_17"]["seconds"] >= 3
+
+
+class _FailingStarts:
+    """dask.distributed.LocalCluster whose first `failures` starts fail as
+    one does when a worker is lost while the cluster starts."""
+
+    def __init__(self, real, failures):
+        self.real, self.failures, self.starts = real, failures, 0
+
+    def __call__(self, *args, **kwargs):
+        self.starts += 1
+        if self.starts <= self.failures:
+            raise RuntimeError("Nanny failed to start.")
+        return self.real(*args, **kwargs)
+
+
+@pytest.mark.cluster
+@pytest.mark.parametrize("failures", [1, 2])
+def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path, monkeypatch):
+    """Once: a new cluster runs the campaign; every time: the cases run in
+    child processes. Never a traceback, every case run."""
+    import dask.distributed
+
+    starts = _FailingStarts(dask.distributed.LocalCluster, failures)
+    monkeypatch.setattr(dask.distributed, "LocalCluster", starts)
+    cases = pass_through_cases(tmp_path / "cases", 24)
+    result = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=2), report=tmp_path / "report")
+    assert result.passed and len(result.cases) == 24, result.summary()
+    assert starts.starts == min(failures + 1, 2)
+    assert ("Dask, 2 workers" in result.where) == (failures == 1), result.where
+    assert (tmp_path / "report" / "index.html").exists()
+
+
+# evaluated in each worker: where its fmutrace comes from, and each Runner's loop and fast runs
+WORKER_LOOPS = (
+    "(__import__('fmutrace._runner')._runner.__file__, "
+    "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace._worker')._worker._fmus.values()])"
+)
+
+
+@pytest.mark.cluster
+def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch, recwarn):
+    """A local cluster's workers share this environment: they import the
+    installed fmutrace, with its compiled _steps, not an uploaded zip of
+    its Python sources (where the C loop cannot be imported). Its
+    scheduler starts no dashboard and leaves port 8787 alone (held here
+    while it runs): no warning that the port is in use."""
+    from fmutrace import _executors as executors
+
+    reports = {}
+    run = executors.Dask._run
+
+    def run_and_ask_the_workers(self, client, todo, work, finished):
+        workers = run(self, client, todo, work, finished)
+        reports.update(client.run(eval, WORKER_LOOPS))
+        return workers
+
+    monkeypatch.setattr(executors.Dask, "_run", run_and_ask_the_workers)
+    cases = pass_through_cases(tmp_path / "cases", 40)
+    with socket.socket() as dashboard_port:
+        with contextlib.suppress(OSError):  # (taken already: just as well)
+            dashboard_port.bind(("127.0.0.1", 8787))
+            dashboard_port.listen()
+        result = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=2), plots="none")
+    assert not [str(w.message) for w in recwarn if "8787" in str(w.message)]
+    assert result.passed and len(result.cases) == 40 and "Dask, 2 workers" in result.where, result.summary()
+    assert len(reports) == 2, reports
+    for source, runners in reports.values():
+        assert ".zip" not in source and all(c_loop for c_loop, _ in runners), reports
+    assert sum(fast for _, runners in reports.values() for _, fast in runners) == 40, reports

@@ -1,0 +1,133 @@
+"""The tube on chunks (fmutrace._longcase: each result sample against the
+reference within the tube's time around it, the reference kept from the
+row before that window to a row after it) gives the outcome Tube.bands
+gives on the whole: status, messages and every failing signal's
+deviation, on every reference scenario in chunks of one step and a few
+bytes (every window crosses chunk boundaries), and on references made
+to fail, with repeated times and with fewer samples than the result."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from fmutrace import Tube, read_trace, write_trace
+from fmutrace._longcase import Streaming, run_long_case
+from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
+from support.fmu_driver import BUILD_DIR
+from support.scenarios import SCENARIO_ROOT, fmu_path
+
+FOLDERS = sorted(p.parent for p in SCENARIO_ROOT.glob("*/*/*_ref.csv"))
+# a window within one step, across a few steps (the scenarios' steps are 0.1 to 1 s), across many
+TUBES = [Tube(0.05, 0.0), Tube(0.5, 1e-9), Tube(3.0, 0.25)]
+
+
+def outcomes(folder, model, mode, steps, chunk_bytes):
+    path = fmu_path(BUILD_DIR, model, 3)
+    runner, fmu = worker_fmu(path.read_bytes(), str(path))
+    target = Target(runner, fmu, {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"})
+    whole = run_case(folder, folder.name, None, target, CaseSettings(mode, "none"))
+    long = run_long_case(
+        folder,
+        folder.name,
+        target,
+        CaseSettings(mode, "none"),
+        Streaming(steps_per_chunk=steps, chunk_bytes=chunk_bytes),
+    )
+    return whole, long
+
+
+def same(whole, long):
+    assert (long.status, long.messages) == (whole.status, whole.messages)
+    assert [d.to_json() for d in long.deviations] == [d.to_json() for d in whole.deviations]
+
+
+@pytest.mark.parametrize("mode", TUBES, ids=["narrow", "few-steps", "wide"])
+def test_every_reference_scenario_in_a_tube_chunked_as_in_memory(mode):
+    taken, eligible = 0, 0
+    for folder in FOLDERS:
+        inputs = folder / f"{folder.parent.name}_in.csv"
+        # a long case has many input rows; a single row is held to the stop by fmpy (the in-memory path)
+        eligible += not inputs.exists() or len(read_trace(inputs)) > 1
+        whole, long = outcomes(folder, folder.parent.name, mode, 1, 8)
+        if long is not None:
+            same(whole, long)
+            taken += 1
+    assert eligible > len(FOLDERS) // 2
+    assert taken >= eligible - 2  # those take fmpy's loop: inputs between communication points
+
+
+def varied(tmp_path, how):
+    folder = tmp_path / "RateLimiter" / how
+    shutil.copytree(SCENARIO_ROOT / "RateLimiter" / "step_up", folder)
+    ref = read_trace(folder / "RateLimiter_ref.csv")
+    if how == "off":
+        ref["y"][9] = ref["y"][9] + 0.5
+        ref["y"][-1] = ref["y"][-1] - 7.0
+    elif how == "repeated":
+        ref = np.concatenate([ref[:4], ref[3:4], ref[4:]])
+        ref["y"][3] = 99.0  # an event: the polyline jumps there
+    elif how == "shorter":
+        ref = ref[2:-3]  # result samples before and after the reference: outside its time range
+    write_trace(folder / "RateLimiter_ref.csv", ref)
+    return folder
+
+
+@pytest.mark.parametrize("how", ["off", "repeated", "shorter"])
+@pytest.mark.parametrize("mode", TUBES, ids=["narrow", "few-steps", "wide"])
+def test_varied_references_in_a_tube_chunked_as_in_memory(how, mode, tmp_path):
+    folder = varied(tmp_path, how)
+    for steps, chunk_bytes in [(1, 8), (3, 30), (100, 1 << 20)]:
+        whole, long = outcomes(folder, "RateLimiter", mode, steps, chunk_bytes)
+        assert long is not None and long.streamed
+        same(whole, long)
+    # the result is the original reference: an added sample only widens the tube, fewer samples narrow its
+    # range; the ramp reaches 10 at t = 6, the last sample, there made 3: every window around t = 6 tops at
+    # 9 (t = 5.5) + 0.25 at the most
+    assert whole.passed == (how != "off")
+
+
+SAMPLES = SCENARIO_ROOT.parent / "recordings"
+TABLES = [
+    ("codesys_v3_ratelimiter.csv", "RateLimiter"),
+    ("plain_ratelimiter.tsv", "RateLimiter"),
+    ("tia_portal_siemens.csv", "LGF_LimRateOfChangeCI"),
+]
+
+
+@pytest.mark.parametrize("mode", TUBES, ids=["narrow", "few-steps", "wide"])
+@pytest.mark.parametrize(
+    "name, model", TABLES + [("perturbed", "LGF_LimRateOfChangeCI")], ids=[t[0] for t in TABLES] + ["perturbed"]
+)
+def test_table_exports_in_a_tube_streamed_as_in_memory(name, model, mode, monkeypatch, tmp_path):
+    """A one-file recording streamed in blocks of a few lines (its head 400
+    bytes), in a tube: the outcome run_case gives reading it whole; the
+    TIA Portal export with an output 0.25 off in one row fails the
+    narrow tube, and names the row."""
+    from fmutrace import _worker as worker
+    from fmutrace._longrecording import run_long_recording
+    from fmutrace.recordings import _stream as stream
+    from fmutrace.recordings._options import RecordingOptions
+
+    path = SAMPLES / name
+    if name == "perturbed":
+        lines = (SAMPLES / "tia_portal_siemens.csv").read_text(encoding="cp1252").splitlines()
+        assert ";0,5;" in lines[16]
+        lines[16] = lines[16].replace(";0,5;", ";0,75;")
+        path = tmp_path / "tia_portal_siemens.csv"
+        path.write_text("\r\n".join(lines) + "\r\n", encoding="cp1252")
+    fmu_file = fmu_path(BUILD_DIR, model, 3)
+    runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
+    target = Target(runner, fmu, {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"})
+    settings = CaseSettings(mode, "none", RecordingOptions())
+    monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
+    whole = run_case(str(path), path.name, None, target, settings)
+    monkeypatch.setattr(stream, "HEAD_BYTES", 400)
+    for block in (40, 120, 1 << 20):
+        streamed = run_long_recording(
+            str(path), path.name, target, settings, Streaming(block_bytes=block, steps_per_chunk=3)
+        )
+        assert streamed is not None and streamed.streamed
+        same(whole, streamed)
+    if name == "perturbed" and mode == TUBES[0]:
+        assert not whole.passed and any("line 17" in m for m in whole.messages), whole.messages
