@@ -317,3 +317,13 @@ def test_1_the_braking_to_a_lowered_limit_is_judged_without_a_far_targets_allowa
     per_cycle = [{}, {}, {"rateUpPar": 1000.0}] + [{"rateUpPar": 1000.0, "u": 10000.0}] * 3
     ys = [1000.0, 2500.0, 3800.0, 4900.0, 5900.0, 6900.0]
     assert check([trace(ys, values, per_cycle=per_cycle)], LREAL, 1.0) == []
+
+
+def test_5_the_bound_at_huge_values_does_not_overflow():
+    """D = 8 * 2^1000, V = 2 * 2^1000 per s, A = 2^1000 per s^2: V^2 overflows, D >= V^2 / A all the same (the
+    trapezoid: t_opt = 4 + 2 = 6 s); arriving at cycle 5 is within it, where the triangle's 2 sqrt(D/A) = 5.7 s
+    would wrongly allow it too but a slower arrival at cycle 8 must not be flagged."""
+    scale = 2.0 ** 1000
+    values = dict(BASE, u=8.0 * scale, rateUpPar=2.0 * scale, rateDownPar=2.0 * scale, accelMax=scale)
+    ys = [y * scale for y in [1.0, 2.5, 4.0, 5.5, 6.5, 7.25, 7.75, 8.0, 8.0, 8.0]]
+    assert "5" not in props(trace(ys, values, settle=True))

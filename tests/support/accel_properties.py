@@ -433,7 +433,7 @@ class Checker:
         if V == 0:
             return
         D = abs(float(Fraction(uc) - Fraction(y0)))
-        if V is None or D < V * V / A:
+        if V is None or D / V < V / A:  # D < V^2 / A, without V^2 overflowing at huge values
             t_opt = 2 * math.sqrt(D / A)
         else:
             t_opt = D / V + V / A
