@@ -356,11 +356,15 @@ def run_random(chooser, model, version, arithmetic, model_exchange=False, cycles
         tail = gen.tail()
         sc.settle_from = len(sc.cycles)
         sc.cycles.append(tail)
-        run.cycle(tail)
+        out = run.cycle(tail)
         seg = run.segments[-1]
+        first = len(seg.cycles) - 1
+        # the block's own remaining time sets the length when it is longer (property 7 checks that time)
+        if math.isfinite(out["remainingTime"]):
+            settle_cap = max(settle_cap, min(int(3 * out["remainingTime"] / sc.T) + 100, 300_000))
         for _ in range(settle_cap):
-            if len(seg.cycles) >= 4 and len({c.out["y"] for c in seg.cycles[-4:]}) == 1:
-                break  # still for 3 cycles
+            if len(seg.cycles) - first >= 4 and len({c.out["y"] for c in seg.cycles[-4:]}) == 1:
+                break  # still for 3 cycles of the tail
             sc.cycles.append({})
             run.cycle({})
         seg.settle = True
