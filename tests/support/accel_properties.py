@@ -403,8 +403,11 @@ class Checker:
                     self.flag("3", index, j, f"at rest on the target for a second cycle but d2ydt2 = "
                               f"{out['d2ydt2']!r}")
         if accel_limited and settle and not (ys[last] == uc and last >= 2 and ys[last - 1] == uc):
+            stall = ""
+            if ys[last] == ys[last - 1] and s.a() < ulp(ys[last], self.arithmetic):
+                stall = f"; a stall: accelMax T^2 = {float(s.a())!r} is below one ulp of y"
             self.flag("3", index, last, f"held constant for {last - first + 1} cycles, the output did not settle "
-                      f"on the target {uc!r} (y = {ys[last]!r}, before it {ys[last - 1]!r})")
+                      f"on the target {uc!r} (y = {ys[last]!r}, before it {ys[last - 1]!r}){stall}")
         if accel_limited:
             self.time_optimal(index, seg, s, first, last, ys, prev, arrival)
             self.remaining_time(index, seg, s, first, last, ys)
