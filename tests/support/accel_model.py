@@ -166,9 +166,10 @@ class ModelBlock:
         self.t = t0
         return self.outputs()
 
-    def cycle(self, T, changes):
-        out = self.model.do_step(self.t, T, changes)
-        self.t += T
+    def cycle(self, T, changes, end=None):
+        end = self.t + T if end is None else end
+        out = self.model.do_step(self.t, end - self.t, changes)
+        self.t = end
         return self.pick(out)
 
     def outputs(self):

@@ -104,8 +104,14 @@ class Block:
         result = self.update()
         self.next_event = result[5] if result[4] else None
 
-    def cycle(self, T, changes):
+    def cycle(self, T, changes, end=None):
+        """One cycle of length T; with the FMU's cycleTime, the step ends at the cycle's end (t0 + n T, as the FMU
+        counts them: a sum of steps drifts past the FMU's tolerance after some 10,000 cycles)."""
         self.fmu.set(**changes)
+        if end is not None and not self.me:
+            self.fmu.fmu.doStep(currentCommunicationPoint=self.fmu.t, communicationStepSize=end - self.fmu.t)
+            self.fmu.t = end
+            return self.outputs()
         if self.me:
             f = self.fmu.fmu
             f.enterContinuousTimeMode()
@@ -169,10 +175,10 @@ class Run:
             return self.begin(changes["_reinit"])
         changes = self.settable(self.sc.model, changes)
         self.values.update(changes)
-        out = self.block.cycle(self.sc.T, changes)
-        self.n += 1
         seg = self.segments[-1]
-        end = seg.start_time + self.n * self.sc.T
+        end = seg.start_time + (self.n + 1) * self.sc.T
+        out = self.block.cycle(self.sc.T, changes, end if self.sc.cycle_time > 0 else None)
+        self.n += 1
         self.t = end
         seg.cycles.append(Cycle(dict(self.values), end, out))
         self.v = out["y"] - self.y if math.isfinite(out["y"]) and math.isfinite(self.y) else 0.0
