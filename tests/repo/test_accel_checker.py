@@ -273,8 +273,8 @@ class FirstOrder(ModelBlock):
     def start(self, t0, values):
         return super().start(t0, {k: v for k, v in values.items() if k not in ("accelMax", "decelMax")})
 
-    def cycle(self, T, changes):
-        return super().cycle(T, {k: v for k, v in changes.items() if k not in ("accelMax", "decelMax")})
+    def cycle(self, T, changes, end=None):
+        return super().cycle(T, {k: v for k, v in changes.items() if k not in ("accelMax", "decelMax")}, end)
 
 
 @pytest.mark.parametrize("seed", range(4))

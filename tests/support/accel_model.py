@@ -139,9 +139,11 @@ class AccelModel(RateLimiterOracle):
         out = super().evaluate_outputs()
         if not hasattr(self, "v"):
             return out
-        dydt = out["dydt"]
-        ramped_before = getattr(self, "ramped_before", False)
         real = self.real
+        y, yp = self.y, self.yp
+        dydt = real(real(y - yp) / real(self.T)) if self.decided_by and finite(y) and finite(yp) else 0.0
+        out["dydt"] = dydt
+        ramped_before = getattr(self, "ramped_before", False)
         out["d2ydt2"] = real(real(dydt - self.dydt_before) / real(self.T)) if self.ramped and ramped_before else 0.0
         self.dydt_before = dydt
         accel, _ = self.accel()
@@ -167,9 +169,9 @@ class ModelBlock:
         return self.outputs()
 
     def cycle(self, T, changes, end=None):
-        end = self.t + T if end is None else end
-        out = self.model.do_step(self.t, end - self.t, changes)
-        self.t = end
+        h = T if end is None else end - self.t  # cycleTime 0: the step is the cycle, T exactly
+        out = self.model.do_step(self.t, h, changes)
+        self.t = self.t + T if end is None else end
         return self.pick(out)
 
     def outputs(self):
