@@ -33,6 +33,7 @@ distance to the input in the last second (the lag).
 
     acceleration.py --build-dir build [--smoke]
 """
+
 import argparse
 import math
 import os
@@ -82,6 +83,7 @@ INPUTS = {"sine": sine, "cosine": cosine, "square": square, "sawtooth": sawtooth
 class Limit3:
     """LinuxCNC limit3 as its component describes its steps, in double precision (its pins' type). State: the
     output of this and the last period and the last input, all 0 at the start (HAL's pins)."""
+
     EPSILON = 1e-9
 
     def __init__(self, low, high, maxv, maxa, period, smooth_steps=2):
@@ -151,9 +153,21 @@ class RateLimiterBlock:
 
     def __init__(self):
         from support.accel_scenarios import Block
+
         self.block = Block("RateLimiter", 2)
-        self.block.start(0.0, {"initMode": 1, "initValue": 0.0, "u": 0.0, "rateUpPar": MAXV, "rateDownPar": MAXV,
-                               "accelMax": MAXA, "yMaxPar": HIGH, "yMinPar": LOW})
+        self.block.start(
+            0.0,
+            {
+                "initMode": 1,
+                "initValue": 0.0,
+                "u": 0.0,
+                "rateUpPar": MAXV,
+                "rateDownPar": MAXV,
+                "accelMax": MAXA,
+                "yMaxPar": HIGH,
+                "yMinPar": LOW,
+            },
+        )
 
     def step(self, target):
         return self.block.cycle(T, {"u": target})["y"]
@@ -176,11 +190,22 @@ def run(block, name, cycles):
 
 def figures(rows):
     from support.accel_properties import Cycle, Segment, check
-    values = {"rateUpPar": MAXV, "rateDownPar": MAXV, "ratePeriod": 1.0, "accelMax": MAXA, "decelMax": 0.0,
-              "yMaxPar": HIGH, "yMinPar": LOW}
-    segment = Segment(values, 0.0, {"y": 0.0},
-                      [Cycle(dict(values, u=u), (k + 1) * T, {"y": y, "runningTime": 0.0})
-                       for k, (u, y) in enumerate(rows)])
+
+    values = {
+        "rateUpPar": MAXV,
+        "rateDownPar": MAXV,
+        "ratePeriod": 1.0,
+        "accelMax": MAXA,
+        "decelMax": 0.0,
+        "yMaxPar": HIGH,
+        "yMinPar": LOW,
+    }
+    segment = Segment(
+        values,
+        0.0,
+        {"y": 0.0},
+        [Cycle(dict(values, u=u), (k + 1) * T, {"y": y, "runningTime": 0.0}) for k, (u, y) in enumerate(rows)],
+    )
     found = check([segment], 1, T)
     count = {p: sum(1 for v in found if v.prop == p) for p in ("1", "2", "4", "6")}
     positions = sum(1 for _, y in rows if y > HIGH or y < LOW)
@@ -200,11 +225,12 @@ def figures(rows):
                 if j > k and abs(rows[j][0] - rows[j - 1][0]) > 10 * MAXV * T:
                     break  # the next jump came first
                 j += 1
-            times.append((j - k + 1) * T * 1000 if j < len(rows) and abs(rows[j][1] - rows[j][0]) <= 1e-6 *
-                         AMPLITUDE else None)
+            times.append(
+                (j - k + 1) * T * 1000 if j < len(rows) and abs(rows[j][1] - rows[j][0]) <= 1e-6 * AMPLITUDE else None
+            )
             k = j - 1
         k += 1
-    tail = sorted(abs(y - u) for u, y in rows[-min(len(rows), 1000):])
+    tail = sorted(abs(y - u) for u, y in rows[-min(len(rows), 1000) :])
     lag = tail[len(tail) // 2]  # the median distance to the input in the last second
     return count, positions, largest, times, lag
 
@@ -212,11 +238,11 @@ def figures(rows):
 def settle(rows, cycles):
     """The loopback: cycles from the switch until the output stands still for good, and its direction changes."""
     start = cycles // 2
-    ys = [y for _, y in rows[start - 1:]]
-    steps = [b - a for a, b in zip(ys, ys[1:])]
+    ys = [y for _, y in rows[start - 1 :]]
+    steps = [b - a for a, b in zip(ys, ys[1:], strict=False)]
     still = next((i for i in range(len(steps)) if all(s == 0 for s in steps[i:])), None)
     signs = [s > 0 for s in steps if s != 0]
-    turns = sum(1 for a, b in zip(signs, signs[1:]) if a != b)
+    turns = sum(1 for a, b in zip(signs, signs[1:], strict=False) if a != b)
     return still, turns
 
 
@@ -228,11 +254,15 @@ def main(argv=None):
     os.environ.setdefault("RL_BUILD_DIR", str(Path(args.build_dir).resolve()))
     sys.path.insert(0, str(REPO / "tests"))
     cycles = 200 if args.smoke else 2000
-    print(f"limit3's inputs (2 Hz, amplitude 100), maxv {MAXV:g}/s, maxa {MAXA:g}/s^2, limits +-{HIGH:g}, "
-          f"{T * 1000:g} ms cycles, {cycles} cycles an input\n")
-    print("| input | block | velocity violations | acceleration violations | position violations | avoidable "
-          "overshoots | largest overshoot past the target | time to target after a jump (ms, mean) | "
-          "median distance to the input, last second | loopback: still after (ms), direction changes |")
+    print(
+        f"limit3's inputs (2 Hz, amplitude 100), maxv {MAXV:g}/s, maxa {MAXA:g}/s^2, limits +-{HIGH:g}, "
+        f"{T * 1000:g} ms cycles, {cycles} cycles an input\n"
+    )
+    print(
+        "| input | block | velocity violations | acceleration violations | position violations | avoidable "
+        "overshoots | largest overshoot past the target | time to target after a jump (ms, mean) | "
+        "median distance to the input, last second | loopback: still after (ms), direction changes |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     total_rl = 0
     for name in list(INPUTS) + ["loopback"]:
@@ -256,8 +286,10 @@ def main(argv=None):
                 still, turns = settle(rows, cycles)
                 loop = f"{'never' if still is None else f'{still * T * 1000:.0f}'}, {turns}"
             smooth = f"{lag:.3g}" if name != "loopback" else "-"
-            print(f"| {name} | {label} | {count['1']} | {count['2']} | {positions} | {count['4'] + count['6']} | "
-                  f"{largest:.3g} | {arrival} | {smooth} | {loop} |")
+            print(
+                f"| {name} | {label} | {count['1']} | {count['2']} | {positions} | {count['4'] + count['6']} | "
+                f"{largest:.3g} | {arrival} | {smooth} | {loop} |"
+            )
     print(f"\nRateLimiter: {total_rl} violations and avoidable overshoots in all")
     return 0  # a benchmark: the figures are reported, not asserted (the tests assert the properties)
 

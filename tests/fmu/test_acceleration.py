@@ -17,6 +17,7 @@
 
 More scenarios than CI runs: `python -m support.accel_campaign` (from tests/).
 """
+
 import math
 
 import pytest
@@ -64,15 +65,16 @@ def test_every_property_holds_on_random_scenarios(model, version, arithmetic, da
 def test_model_exchange_gives_the_co_simulation_outputs_and_the_properties(model, version, arithmetic, data):
     """The scenario drawn in Co-Simulation with cycleTime = T, replayed as Model Exchange (a time event at
     each cycle end): the same bits after every cycle, and so the same properties."""
-    scenario, segments = run_random(HypothesisChooser(data), model, version, arithmetic, model_exchange=True,
-                                    cycles=CI_CYCLES)
+    scenario, segments = run_random(
+        HypothesisChooser(data), model, version, arithmetic, model_exchange=True, cycles=CI_CYCLES
+    )
     found = violations(scenario, segments)
     assert not found, report(scenario, found)
     me = replay(scenario, model_exchange=True)
     cs_cycles = [c for s in segments for c in s.cycles]
     me_cycles = [c for s in me for c in s.cycles]
     assert len(me_cycles) == len(cs_cycles)
-    for n, (a, b) in enumerate(zip(cs_cycles, me_cycles), start=1):
+    for n, (a, b) in enumerate(zip(cs_cycles, me_cycles, strict=True), start=1):
         for name in a.out:
             assert agree(a.out[name], b.out[name]), (n, name, a.out[name], b.out[name], scenario.dumps())
 
@@ -95,8 +97,9 @@ def run_against_oracle(scenario):
         for k, changes in enumerate(scenario.cycles, start=1):
             if "_reinit" in changes:
                 fmu.fmu.reset()
-                oracle = begin(dict(changes["_reinit"], cycleTime=scenario.cycle_time,
-                                    arithmetic=scenario.arithmetic), fmu.t)
+                oracle = begin(
+                    dict(changes["_reinit"], cycleTime=scenario.cycle_time, arithmetic=scenario.arithmetic), fmu.t
+                )
                 expected, where = oracle.outputs(), "initialisation"
             else:
                 changes = {n: v for n, v in changes.items() if n in fmu.variables}
@@ -105,8 +108,13 @@ def run_against_oracle(scenario):
                 fmu.step(T)
                 expected, where = oracle.do_step(t, T, changes), f"cycle {k}"
             for name in names:
-                assert agree(fmu.get(name), expected[name]), (where, name, fmu.get(name), expected[name],
-                                                              scenario.dumps())
+                assert agree(fmu.get(name), expected[name]), (
+                    where,
+                    name,
+                    fmu.get(name),
+                    expected[name],
+                    scenario.dumps(),
+                )
     finally:
         fmu.free()
 
@@ -119,8 +127,9 @@ def run_against_oracle(scenario):
 def test_accel_max_zero_is_the_block_without_the_acceleration_limit(model, version, arithmetic, data):
     """accelMax = 0 (decelMax 0 or not: it brakes only where accelMax limits): the oracle (rules.md) which
     has no acceleration limit, bit for bit after every cycle, every output it has."""
-    scenario, _ = run_random(HypothesisChooser(data), model, version, arithmetic, cycles=CI_CYCLES,
-                             accel_zero=True, settle_cap=50)
+    scenario, _ = run_random(
+        HypothesisChooser(data), model, version, arithmetic, cycles=CI_CYCLES, accel_zero=True, settle_cap=50
+    )
     assert scenario.start["accelMax"] == 0.0
     run_against_oracle(scenario)
 
@@ -143,8 +152,11 @@ def test_a_bad_acceleration_is_status_8205_naming_it_and_holds(model, version, a
         try:
             good = {"accelMax": 2.0, "decelMax": 0.0}
             fmu.start(u=0.0, arithmetic=arithmetic, rateUpPar=10.0, **dict(good, **{name: bad}))
-            assert (fmu.get("status"), fmu.get("error"), fmu.get("subFunctionStatus")) == (0x8205, True,
-                                                                                          fmu.vr(name)), bad
+            assert (fmu.get("status"), fmu.get("error"), fmu.get("subFunctionStatus")) == (
+                0x8205,
+                True,
+                fmu.vr(name),
+            ), bad
             fmu.set(u=100.0)
             for _ in range(3):
                 fmu.step(0.5)

@@ -1,6 +1,7 @@
 """The property checker of the acceleration limit (support/accel_properties.py)
 on hand-made traces: each breaks one property and must be flagged for it,
 and clean ones (worked by hand from the properties) must pass. No FMU."""
+
 import math
 import random
 
@@ -49,12 +50,15 @@ TRIANGLE = [1.0, 3.0, 4.0, 4.0, 4.0]
 TRAPEZOID = [1.0, 3.0, 5.0, 7.0, 8.0, 8.0, 8.0]
 
 
-@pytest.mark.parametrize("ys,values", [
-    (TRIANGLE, dict(BASE, u=4.0)),
-    (TRAPEZOID, dict(BASE, u=8.0, rateUpPar=2.0, rateDownPar=2.0)),
-    # braking at decelMax = 2 (steps 2 -> 0 in one cycle is allowed: b = 2)
-    ([1.0, 3.0, 4.0, 4.0], dict(BASE, u=4.0, decelMax=2.0)),
-])
+@pytest.mark.parametrize(
+    "ys,values",
+    [
+        (TRIANGLE, dict(BASE, u=4.0)),
+        (TRAPEZOID, dict(BASE, u=8.0, rateUpPar=2.0, rateDownPar=2.0)),
+        # braking at decelMax = 2 (steps 2 -> 0 in one cycle is allowed: b = 2)
+        ([1.0, 3.0, 4.0, 4.0], dict(BASE, u=4.0, decelMax=2.0)),
+    ],
+)
 def test_clean_steps_pass(ys, values):
     assert check([trace(ys, values, settle=True)], LREAL, 1.0) == []
 
@@ -91,7 +95,7 @@ def test_an_output_limit_approached_by_braking_passes():
     assert check([trace(TRIANGLE, values, settle=True)], LREAL, 1.0) == []
 
 
-@pytest.mark.parametrize("scale", [2.0 ** 900, 2.0 ** -1000, 3.0, 1e-7])
+@pytest.mark.parametrize("scale", [2.0**900, 2.0**-1000, 3.0, 1e-7])
 def test_huge_and_tiny_scales_pass(scale):
     """The trapezoid scaled: exactly by powers of 2 (down into the subnormals), rounded by 3 and 1e-7."""
     values = dict(BASE, u=8.0 * scale, rateUpPar=2.0 * scale, rateDownPar=2.0 * scale, accelMax=scale)
@@ -122,6 +126,7 @@ def test_real_arithmetic_with_rounded_values_passes():
 
 
 # -- each property broken ------------------------------------------------------
+
 
 def test_1_velocity_beyond_the_limit():
     values = dict(BASE, u=20.0, rateUpPar=2.0, rateDownPar=2.0, accelMax=10.0)
@@ -158,12 +163,13 @@ def test_2_the_first_step_from_rest_is_bounded_too():
 
 def test_3_no_arrival_in_a_settled_tail():
     ys = [1.0, 3.0, 4.0, 4.0, 4.0]
-    assert props(trace(ys, dict(BASE, u=4.5), outputs={k: {"remainingTime": math.inf} for k in range(1, 6)},
-                       settle=True)) == ["3"]
+    assert props(
+        trace(ys, dict(BASE, u=4.5), outputs={k: {"remainingTime": math.inf} for k in range(1, 6)}, settle=True)
+    ) == ["3"]
 
 
 def test_3_leaving_the_target_reached_at_rest():
-    ys = [1.0, 3.0, 4.0, 4.0, 4.0, 4.0 + 2.0 ** -30, 4.0]
+    ys = [1.0, 3.0, 4.0, 4.0, 4.0, 4.0 + 2.0**-30, 4.0]
     found = props(trace(ys, dict(BASE, u=4.0)))
     assert "3" in found
 
@@ -252,8 +258,9 @@ def test_status_of_a_negative_accel_max():
 
 def test_interface_d2ydt2_after_a_hold():
     per_cycle = [{}, {"hold": True}, {}]
-    assert "interface" in props(trace([1.0, 1.0, 2.0], dict(BASE, u=10.0), per_cycle=per_cycle,
-                                      outputs={2: {"d2ydt2": -1.0}}))
+    assert "interface" in props(
+        trace([1.0, 1.0, 2.0], dict(BASE, u=10.0), per_cycle=per_cycle, outputs={2: {"d2ydt2": -1.0}})
+    )
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -261,8 +268,9 @@ def test_a_second_order_limiter_that_keeps_the_properties_passes_random_scenario
     """support/accel_model.py (a plain time-optimal limiter, exact, that brakes a few ulp harder to absorb the
     rounding of its outputs) through the random scenarios the FMU gets: no violation, so that one found in the
     FMU is the FMU's and not the checker's."""
-    scenario, segments = run_random(RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60),
-                                    block=ModelBlock)
+    scenario, segments = run_random(
+        RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60), block=ModelBlock
+    )
     assert sum(len(s.cycles) for s in segments) > 20
     assert violations(scenario, segments) == [], scenario.dumps()
 
@@ -280,8 +288,9 @@ class FirstOrder(ModelBlock):
 @pytest.mark.parametrize("seed", range(4))
 def test_the_block_without_the_acceleration_limit_fails_the_same_scenarios(seed):
     """The control of the test above: the first-order block jumps to its velocity limit from rest."""
-    scenario, segments = run_random(RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60),
-                                    block=FirstOrder)
+    scenario, segments = run_random(
+        RandomChooser(random.Random(seed)), "RateLimiter", 2, LREAL, cycles=(20, 60), block=FirstOrder
+    )
     assert "2" in {v.prop for v in violations(scenario, segments)}
 
 
@@ -313,7 +322,7 @@ def test_1_crossing_0_after_decel_max_was_lowered_may_brake_down_to_the_limit():
 def test_1_the_braking_to_a_lowered_limit_is_judged_without_a_far_targets_allowance():
     """A rate lowered to 1000 per cycle at a speed of 1500 while the target is 2^60 away (8 ulp of it: 2048, more
     than the excess): braking at decelMax (200) down to the limit is allowed, also after the target came near."""
-    values = dict(BASE, u=2.0 ** 60, rateUpPar=10000.0, rateDownPar=10000.0, accelMax=1000.0, decelMax=200.0)
+    values = dict(BASE, u=2.0**60, rateUpPar=10000.0, rateDownPar=10000.0, accelMax=1000.0, decelMax=200.0)
     per_cycle = [{}, {}, {"rateUpPar": 1000.0}] + [{"rateUpPar": 1000.0, "u": 10000.0}] * 3
     ys = [1000.0, 2500.0, 3800.0, 4900.0, 5900.0, 6900.0]
     assert check([trace(ys, values, per_cycle=per_cycle)], LREAL, 1.0) == []
@@ -323,7 +332,7 @@ def test_5_the_bound_at_huge_values_does_not_overflow():
     """D = 8 * 2^1000, V = 2 * 2^1000 per s, A = 2^1000 per s^2: V^2 overflows, D >= V^2 / A all the same (the
     trapezoid: t_opt = 4 + 2 = 6 s); arriving at cycle 5 is within it, where the triangle's 2 sqrt(D/A) = 5.7 s
     would wrongly allow it too but a slower arrival at cycle 8 must not be flagged."""
-    scale = 2.0 ** 1000
+    scale = 2.0**1000
     values = dict(BASE, u=8.0 * scale, rateUpPar=2.0 * scale, rateDownPar=2.0 * scale, accelMax=scale)
     ys = [y * scale for y in [1.0, 2.5, 4.0, 5.5, 6.5, 7.25, 7.75, 8.0, 8.0, 8.0]]
     assert "5" not in props(trace(ys, values, settle=True))

@@ -12,6 +12,7 @@ every cycle end). Prints how many scenarios and cycles were checked and
 every violation with its scenario as JSON (a reproducer:
 `--replay FILE`); exits 1 on any violation.
 """
+
 import argparse
 import collections
 import random
@@ -28,7 +29,7 @@ def same_outputs(a, b):
     """Bit for bit (NaN equal to NaN), cycle by cycle: the first cycle that differs, or None."""
     flat_a = [c.out for s in a for c in s.cycles]
     flat_b = [c.out for s in b for c in s.cycles]
-    for n, (x, y) in enumerate(zip(flat_a, flat_b)):
+    for n, (x, y) in enumerate(zip(flat_a, flat_b, strict=False)):
         if any(repr(float(x[k])) != repr(float(y[k])) for k in x):
             return n + 1, x, y
     if len(flat_a) != len(flat_b):
@@ -54,8 +55,14 @@ def main(argv=None):
     parser.add_argument("--scenarios", type=int, default=1000)
     parser.add_argument("--arithmetic", choices=["lreal", "real", "both"], default="both")
     parser.add_argument("--seed", default="0")
-    parser.add_argument("--cycles", type=int, nargs=2, default=(40, 200), metavar=("MIN", "MAX"),
-                        help="cycles of a scenario before its settling tail")
+    parser.add_argument(
+        "--cycles",
+        type=int,
+        nargs=2,
+        default=(40, 200),
+        metavar=("MIN", "MAX"),
+        help="cycles of a scenario before its settling tail",
+    )
     parser.add_argument("--replay", help="a file with one scenario's JSON (as printed): run and check it")
     parser.add_argument("--show", type=int, default=20, help="violations printed per scenario")
     args = parser.parse_args(argv)
@@ -79,15 +86,18 @@ def main(argv=None):
             if found:
                 bad += 1
                 kinds.update(v.split(",")[0] for v in found)
-                print(f"--- {name} scenario {index} ({scenario.model}, FMI {scenario.version}): "
-                      f"{len(found)} violations")
-                for v in found[:args.show]:
+                print(
+                    f"--- {name} scenario {index} ({scenario.model}, FMI {scenario.version}): {len(found)} violations"
+                )
+                for v in found[: args.show]:
                     print("   ", v)
                 print("    scenario:", scenario.dumps())
                 sys.stdout.flush()
         failed += bad
-        print(f"{name}: {args.scenarios} scenarios, {cycles} cycles checked in {time.monotonic() - start:.0f} s; "
-              f"{bad} scenarios with violations" + (f" ({dict(kinds)})" if kinds else ""))
+        print(
+            f"{name}: {args.scenarios} scenarios, {cycles} cycles checked in {time.monotonic() - start:.0f} s; "
+            f"{bad} scenarios with violations" + (f" ({dict(kinds)})" if kinds else "")
+        )
     return 1 if failed else 0
 
 

@@ -13,6 +13,7 @@ brakes (and, once it can stop within the cycle, turns towards uc with what
 is left of a). Exact arithmetic, the output rounded once to the block's
 arithmetic (LREAL or REAL).
 """
+
 import collections
 import math
 from fractions import Fraction
@@ -30,10 +31,10 @@ def fastest(E, low, high, b):
     """The largest w in [low, high] with w + B(w) <= E, or low when none (exact: Fractions)."""
     if low + stopping(low, b) > E:
         return low
-    if high is None or E / b > 10 ** 30:
+    if high is None or E / b > 10**30:
         if high is None or high + stopping(high, b) <= E:  # braking is no bound at this scale
             return high if high is not None else E
-    ratio = float(E / b) if E / b < 10 ** 300 else 1e300
+    ratio = float(E / b) if E / b < 10**300 else 1e300
     n = max(0, math.floor((math.sqrt(1 + 8 * ratio) - 1) / 2) - 1)
     while b * (n + 1) * (n + 2) / 2 <= E:  # the largest n with b n (n + 1) / 2 <= E
         n += 1
@@ -79,14 +80,14 @@ class AccelModel(RateLimiterOracle):
         """The next output from yp after a step v (exact arithmetic, the output rounded once)."""
         accel, decel = self.accel()
         Th = Fraction(self.real(T))
-        a, b = Fraction(accel) * Th ** 2, Fraction(decel) * Th ** 2
+        a, b = Fraction(accel) * Th**2, Fraction(decel) * Th**2
         out = self.round
         Y, U = Fraction(yp), Fraction(uc)
         d = 1 if U > Y else -1 if U < Y else 0
         s, E = abs(v), abs(U - Y)
         if d == 0 and s == 0:
             return yp
-        if d == 0 or d * v < 0:       # at uc while moving, or moving away from it: brake
+        if d == 0 or d * v < 0:  # at uc while moving, or moving away from it: brake
             if s > b:
                 return out(Y + (s - b) * (1 if v > 0 else -1))
             if d == 0:
@@ -97,7 +98,7 @@ class AccelModel(RateLimiterOracle):
             low = max(Fraction(0), s - b)
             limit = self.limit(d > 0, yp, T)
             high = s + a if limit is None else min(s + a, limit)
-            high = max(low, high)     # a lowered limit: brake at b
+            high = max(low, high)  # a lowered limit: brake at b
         if low + stopping(low, b) > E:
             # short of the braking curve by the rounding of the outputs: brake up to 4 ulp harder (within the
             # allowance) to keep to it; else it cannot stop before uc: pass it

@@ -18,6 +18,7 @@ as before (`rules`), the status word (`status`), `dydt` and `d2ydt2`
 Nothing here knows how the block plans its motion: the checks read the
 outputs only, against bounds worked from the settings.
 """
+
 import math
 import struct
 import sys
@@ -25,14 +26,20 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 
 LREAL, REAL = 1, 2
-EPS = {LREAL: Fraction(1, 2 ** 53), REAL: Fraction(1, 2 ** 24)}
+EPS = {LREAL: Fraction(1, 2**53), REAL: Fraction(1, 2**24)}
 INF = math.inf
 TIME_TOL = 1e-9
 _F32 = struct.Struct("<f")
 
 # the parameters' start values (modelDescription/RateLimiter.toml), for a variable a run leaves out
-DEFAULTS = {"rateUpPar": 1.0, "rateDownPar": 1.0, "bypassValuePar": math.nan, "durationPar": 0.0,
-            "yMaxPar": sys.float_info.max, "yMinPar": -sys.float_info.max}
+DEFAULTS = {
+    "rateUpPar": 1.0,
+    "rateDownPar": 1.0,
+    "bypassValuePar": math.nan,
+    "durationPar": 0.0,
+    "yMaxPar": sys.float_info.max,
+    "yMinPar": -sys.float_info.max,
+}
 
 
 def f32(x):
@@ -53,33 +60,33 @@ def ulp(x, arithmetic):
         return Fraction(0)
     if arithmetic == LREAL:
         return Fraction(math.ulp(x))
-    if x < 2.0 ** -126:
-        return Fraction(1, 2 ** 149)
+    if x < 2.0**-126:
+        return Fraction(1, 2**149)
     exponent = math.frexp(x)[1]  # x in [2^(e-1), 2^e)
     return Fraction(2) ** (exponent - 24)
 
 
 @dataclass
 class Cycle:
-    values: dict          # every variable's value as set for this cycle
-    end: float            # the time at the cycle's end
-    out: dict             # the outputs after it (y, dydt, d2ydt2, remainingTime, runningTime, status)
+    values: dict  # every variable's value as set for this cycle
+    end: float  # the time at the cycle's end
+    out: dict  # the outputs after it (y, dydt, d2ydt2, remainingTime, runningTime, status)
 
 
 @dataclass
 class Segment:
-    start_values: dict    # the values at initialisation
+    start_values: dict  # the values at initialisation
     start_time: float
-    init_out: dict        # the outputs after initialisation
+    init_out: dict  # the outputs after initialisation
     cycles: list = field(default_factory=list)
     settle: bool = False  # the run's last stretch was held until the output settled (property 3's arrival)
 
 
 @dataclass
 class Violation:
-    prop: str             # "1" ... "7", "rules", "status", "interface", "finite"
+    prop: str  # "1" ... "7", "rules", "status", "interface", "finite"
     segment: int
-    cycle: int            # 1-based within the segment (0: initialisation)
+    cycle: int  # 1-based within the segment (0: initialisation)
     text: str
 
     def __str__(self):
@@ -89,6 +96,7 @@ class Violation:
 @dataclass
 class Settings:
     """One cycle's resolved settings, as the block holds them."""
+
     u: float
     up: float
     down: float
@@ -105,7 +113,7 @@ class Settings:
     accel: float
     decel: float
     status: int
-    T: float              # the cycle length as the signal path holds it
+    T: float  # the cycle length as the signal path holds it
 
     def uc(self):
         return self.y_min if self.u < self.y_min else self.y_max if self.u > self.y_max else self.u
@@ -140,9 +148,27 @@ class Settings:
 
     def key(self):
         """What a stretch of constant settings keeps (the time aside)."""
-        return tuple(float(v).hex() if isinstance(v, float) else v for v in (
-            self.u, self.up, self.down, self.up_neg, self.down_neg, self.period, self.zero_rate, self.y_max,
-            self.y_min, self.bypass, self.bypass_value, self.hold, self.duration, self.accel, self.decel, self.T))
+        return tuple(
+            float(v).hex() if isinstance(v, float) else v
+            for v in (
+                self.u,
+                self.up,
+                self.down,
+                self.up_neg,
+                self.down_neg,
+                self.period,
+                self.zero_rate,
+                self.y_max,
+                self.y_min,
+                self.bypass,
+                self.bypass_value,
+                self.hold,
+                self.duration,
+                self.accel,
+                self.decel,
+                self.T,
+            )
+        )
 
 
 def resolve(values, arithmetic, T):
@@ -182,10 +208,25 @@ def resolve(values, arithmetic, T):
         status = 0x8601
     else:
         status = 0
-    return Settings(real(values["u"]), up, down, up_neg, down_neg, period, int(values.get("zeroRate", 1)), y_max,
-                    y_min, bool(values.get("bypass", False)), real(or_par("bypassValue")),
-                    bool(values.get("hold", False)),
-                    duration, accel, decel, status, real(T))
+    return Settings(
+        real(values["u"]),
+        up,
+        down,
+        up_neg,
+        down_neg,
+        period,
+        int(values.get("zeroRate", 1)),
+        y_max,
+        y_min,
+        bool(values.get("bypass", False)),
+        real(or_par("bypassValue")),
+        bool(values.get("hold", False)),
+        duration,
+        accel,
+        decel,
+        status,
+        real(T),
+    )
 
 
 def braking_distance(speed, b):
@@ -232,7 +273,7 @@ class Checker:
         ramping = [False] * (n + 1)  # index by cycle number 1..n
         decided = [None] * (n + 1)
         t0 = seg.start_time
-        for k, (c, s) in enumerate(zip(cycles, settings), start=1):
+        for k, (c, s) in enumerate(zip(cycles, settings, strict=True), start=1):
             yp, y = ys[k - 1], ys[k]
             rule, expected = self.rule(c, s, yp, t0)
             decided[k] = rule
@@ -244,8 +285,10 @@ class Checker:
                     self.flag("finite", index, k, f"a ramping cycle from y = {yp!r} towards {s.uc()!r} gave y = {y!r}")
             elif not same(y, expected):
                 self.flag("rules", index, k, f"rule {rule} gives y = {expected!r}, the block gave {y!r}")
-        steps = [None] + [Fraction(ys[k]) - Fraction(ys[k - 1]) if finite(ys[k]) and finite(ys[k - 1]) else None
-                          for k in range(1, n + 1)]
+        steps = [None] + [
+            Fraction(ys[k]) - Fraction(ys[k - 1]) if finite(ys[k]) and finite(ys[k - 1]) else None
+            for k in range(1, n + 1)
+        ]
         prev = [Fraction(0)] * (n + 1)
         for k in range(2, n + 1):
             if ramping[k - 1] and steps[k - 1] is not None:
@@ -277,7 +320,7 @@ class Checker:
         decided, the duration's jump included (rules.md, Outputs derived from the last cycle; in REAL binary32,
         or binary64 with T rounded or not), else 0."""
         real, cycles = self.real, seg.cycles
-        for k, (c, s) in enumerate(zip(cycles, settings), start=1):
+        for k, (c, s) in enumerate(zip(cycles, settings, strict=True), start=1):
             out, before = c.out, seg.init_out if k == 1 else cycles[k - 2].out
             y, yp = out["y"], before["y"]
             if "dydt" in out:
@@ -289,8 +332,9 @@ class Checker:
             d2 = out["d2ydt2"]
             if decided[k] not in ("6", "jump"):
                 if d2 != 0:
-                    self.flag("interface", index, k, f"d2ydt2 = {d2!r} after a cycle decided by rule {decided[k]}, "
-                              "not 0")
+                    self.flag(
+                        "interface", index, k, f"d2ydt2 = {d2!r} after a cycle decided by rule {decided[k]}, not 0"
+                    )
                 continue
             if not finite(d2):
                 self.flag("interface", index, k, f"d2ydt2 = {d2!r} is not finite")
@@ -304,13 +348,18 @@ class Checker:
             else:
                 expected = {0.0}
             if d2 not in expected:
-                self.flag("interface", index, k, f"d2ydt2 = {d2!r}, (dydt - dydt_previous) / T = "
-                          f"({dydt!r} - {dydt_prev!r}) / T = {sorted(expected)!r}")
+                self.flag(
+                    "interface",
+                    index,
+                    k,
+                    f"d2ydt2 = {d2!r}, (dydt - dydt_previous) / T = "
+                    f"({dydt!r} - {dydt_prev!r}) / T = {sorted(expected)!r}",
+                )
 
     # -- properties 1 and 2, cycle by cycle --------------------------------
     def velocity_and_acceleration(self, index, cycles, settings, ys, steps, prev, ramping):
         braking_to = None  # property 1's exception: the limit a change lowered below the speed
-        changed_at = 0     # the last cycle whose rates, ratePeriod, zeroRate, accelMax or decelMax changed
+        changed_at = 0  # the last cycle whose rates, ratePeriod, zeroRate, accelMax or decelMax changed
         for k in range(1, len(cycles) + 1):
             s = settings[k - 1]
             if k >= 2 and settings[k - 2].key()[1:7] + settings[k - 2].key()[13:15] != s.key()[1:7] + s.key()[13:15]:
@@ -342,15 +391,25 @@ class Checker:
                 if limit is None or (step > 0) != rising or step == 0 or abs(step) <= limit:
                     braking_to = None
                 elif not self.holds(abs(step), max(limit, abs(p) - s.b()), *mags):
-                    self.flag("1", index, k, f"speed {float(abs(p))!r} -> {float(abs(step))!r} per cycle above the "
-                              f"lowered limit {float(limit)!r}: not braking at decelMax")
+                    self.flag(
+                        "1",
+                        index,
+                        k,
+                        f"speed {float(abs(p))!r} -> {float(abs(step))!r} per cycle above the "
+                        f"lowered limit {float(limit)!r}: not braking at decelMax",
+                    )
             if braking_to is None and step != 0:
                 limit = s.limit(step > 0, yp)
                 if not self.holds(abs(step), limit, *mags):
                     before = ys[k - 2] if k >= 2 else yp
                     where = " (the rates picked by the sign of y changed at 0)" if (before < 0) != (yp < 0) else ""
-                    self.flag("1", index, k, f"step {float(step)!r} from y = {yp!r} beyond the velocity limit "
-                              f"{float(limit)!r} per cycle{where}")
+                    self.flag(
+                        "1",
+                        index,
+                        k,
+                        f"step {float(step)!r} from y = {yp!r} beyond the velocity limit "
+                        f"{float(limit)!r} per cycle{where}",
+                    )
             # 2. acceleration (not in the cycle after one without the limit: no velocity to keep)
             if k >= 2 and ramping[k - 1] and settings[k - 2].accel <= 0:
                 continue
@@ -358,14 +417,29 @@ class Checker:
             if step == 0 or p == 0 or (step > 0) == (p > 0):
                 if abs(step) >= abs(p):
                     if not self.holds(abs(step) - abs(p), a, *mags):
-                        self.flag("2", index, k, f"speed per cycle {float(abs(p))!r} -> {float(abs(step))!r}: "
-                                  f"grows by more than accelMax T^2 = {float(a)!r}")
+                        self.flag(
+                            "2",
+                            index,
+                            k,
+                            f"speed per cycle {float(abs(p))!r} -> {float(abs(step))!r}: "
+                            f"grows by more than accelMax T^2 = {float(a)!r}",
+                        )
                 elif not self.holds(abs(p) - abs(step), b, *mags):
-                    self.flag("2", index, k, f"speed per cycle {float(abs(p))!r} -> {float(abs(step))!r}: "
-                              f"shrinks by more than decelMax T^2 = {float(b)!r}")
+                    self.flag(
+                        "2",
+                        index,
+                        k,
+                        f"speed per cycle {float(abs(p))!r} -> {float(abs(step))!r}: "
+                        f"shrinks by more than decelMax T^2 = {float(b)!r}",
+                    )
             elif not self.holds(abs(step) + abs(p) * a / b, a, *mags):
-                self.flag("2", index, k, f"reversal {float(p)!r} -> {float(step)!r} per cycle: |p|/b + |s|/a = "
-                          f"{float(abs(p) / b + abs(step) / a)!r} > 1 (a = {float(a)!r}, b = {float(b)!r})")
+                self.flag(
+                    "2",
+                    index,
+                    k,
+                    f"reversal {float(p)!r} -> {float(step)!r} per cycle: |p|/b + |s|/a = "
+                    f"{float(abs(p) / b + abs(step) / a)!r} > 1 (a = {float(a)!r}, b = {float(b)!r})",
+                )
 
     # -- properties 3 to 7, over stretches ---------------------------------
     def stretches(self, index, seg, settings, ys, steps, prev, ramping):
@@ -400,14 +474,18 @@ class Checker:
                 if out.get("dydt", 0.0) != 0:
                     self.flag("3", index, j, f"at rest on the target but dydt = {out['dydt']!r}")
                 if j > rest and out.get("d2ydt2", 0.0) != 0:
-                    self.flag("3", index, j, f"at rest on the target for a second cycle but d2ydt2 = "
-                              f"{out['d2ydt2']!r}")
+                    self.flag("3", index, j, f"at rest on the target for a second cycle but d2ydt2 = {out['d2ydt2']!r}")
         if accel_limited and settle and not (ys[last] == uc and last >= 2 and ys[last - 1] == uc):
             stall = ""
             if ys[last] == ys[last - 1] and s.a() < ulp(ys[last], self.arithmetic):
                 stall = f"; a stall: accelMax T^2 = {float(s.a())!r} is below one ulp of y"
-            self.flag("3", index, last, f"held constant for {last - first + 1} cycles, the output did not settle "
-                      f"on the target {uc!r} (y = {ys[last]!r}, before it {ys[last - 1]!r}){stall}")
+            self.flag(
+                "3",
+                index,
+                last,
+                f"held constant for {last - first + 1} cycles, the output did not settle "
+                f"on the target {uc!r} (y = {ys[last]!r}, before it {ys[last - 1]!r}){stall}",
+            )
         if accel_limited:
             self.time_optimal(index, seg, s, first, last, ys, prev, arrival)
             self.remaining_time(index, seg, s, first, last, ys)
@@ -444,11 +522,21 @@ class Checker:
         if arrival is not None:
             N = arrival - first + 1
             if N * self.T > bound:
-                self.flag("5", index, arrival, f"a step of {D!r} from rest (V = {V!r}, A = {A!r}) took {N} cycles "
-                          f"of {self.T!r} s, the bound t_opt + 2T is {t_opt + 2 * self.T!r} s")
+                self.flag(
+                    "5",
+                    index,
+                    arrival,
+                    f"a step of {D!r} from rest (V = {V!r}, A = {A!r}) took {N} cycles "
+                    f"of {self.T!r} s, the bound t_opt + 2T is {t_opt + 2 * self.T!r} s",
+                )
         elif (last - first + 1) * self.T > bound:
-            self.flag("5", index, last, f"a step of {D!r} from rest (V = {V!r}, A = {A!r}) has not arrived after "
-                      f"{last - first + 1} cycles; the bound t_opt + 2T is {t_opt + 2 * self.T!r} s")
+            self.flag(
+                "5",
+                index,
+                last,
+                f"a step of {D!r} from rest (V = {V!r}, A = {A!r}) has not arrived after "
+                f"{last - first + 1} cycles; the bound t_opt + 2T is {t_opt + 2 * self.T!r} s",
+            )
 
     def remaining_time(self, index, seg, s, first, last, ys):
         """7: after cycle k, the first j > k with y_j == uc is (j - k) T ahead."""
@@ -466,13 +554,22 @@ class Checker:
             elif next_arrival is not None:
                 want = (next_arrival - k) * self.T
                 if not abs(rt - want) <= TIME_TOL * want:
-                    self.flag("7", index, k, f"remainingTime = {rt!r}, the output arrived {next_arrival - k} cycles "
-                              f"later ({want!r} s)")
+                    self.flag(
+                        "7",
+                        index,
+                        k,
+                        f"remainingTime = {rt!r}, the output arrived {next_arrival - k} cycles later ({want!r} s)",
+                    )
             elif last > k:
                 want = (last + 1 - k) * self.T
                 if not rt >= want * (1 - TIME_TOL):
-                    self.flag("7", index, k, f"remainingTime = {rt!r}, the output had not arrived "
-                              f"{last - k} cycles later ({want!r} s at the least)")
+                    self.flag(
+                        "7",
+                        index,
+                        k,
+                        f"remainingTime = {rt!r}, the output had not arrived "
+                        f"{last - k} cycles later ({want!r} s at the least)",
+                    )
             if ys[k] == uc:
                 next_arrival = k
 
@@ -484,14 +581,28 @@ class Checker:
                 k += 1
                 continue
             end = k
-            while (end + 1 <= n and ramping[end + 1] and settings[end].accel == s.accel
-                   and settings[end].decel == s.decel and settings[end].T == s.T):
+            while (
+                end + 1 <= n
+                and ramping[end + 1]
+                and settings[end].accel == s.accel
+                and settings[end].decel == s.decel
+                and settings[end].T == s.T
+            ):
                 end += 1
             # within [k, end]: sub-stretches of constant uc (4) and of constant limits (6)
             self.no_passing(index, settings, ys, prev, k, end, lambda t: t.uc(), "4")
             for side in (0, 1):
-                self.no_passing(index, settings, ys, prev, k, end, lambda t, side=side: (t.y_min, t.y_max)[side], "6",
-                                limit_side=side)
+                self.no_passing(
+                    index,
+                    settings,
+                    ys,
+                    prev,
+                    k,
+                    end,
+                    lambda t, side=side: (t.y_min, t.y_max)[side],
+                    "6",
+                    limit_side=side,
+                )
             k = end + 1
 
     def no_passing(self, index, settings, ys, prev, first, last, target_of, prop, limit_side=None):
@@ -534,8 +645,13 @@ class Checker:
                     continue
                 past_hi, past_lo = Fraction(hi[k]) - tq, tq - Fraction(lo[k])
                 if max(past_hi, past_lo) > self.allowance(mag[k], target):
-                    self.flag(prop, index, k, f"at rest on {target!r}, the output left it in a stretch that kept it "
-                              f"(to {hi[k]!r} / {lo[k]!r})")
+                    self.flag(
+                        prop,
+                        index,
+                        k,
+                        f"at rest on {target!r}, the output left it in a stretch that kept it "
+                        f"(to {hi[k]!r} / {lo[k]!r})",
+                    )
                 break
             if d * p < 0 and limit_side is None:
                 continue  # moving away from uc: the target moved behind it, the sign rule below judges
@@ -547,9 +663,14 @@ class Checker:
             past = d * (Fraction(extreme) - tq)
             if past > self.allowance(mag[k], target):
                 what = "the target uc" if limit_side is None else ("yMax" if limit_side == 1 else "yMin")
-                self.flag(prop, index, k, f"could stop before {what} = {target!r} (distance {float(E)!r}, braking "
-                          f"needs {float(need)!r} at speed {float(d * p)!r} per cycle) but passed it to "
-                          f"{extreme!r}")
+                self.flag(
+                    prop,
+                    index,
+                    k,
+                    f"could stop before {what} = {target!r} (distance {float(E)!r}, braking "
+                    f"needs {float(need)!r} at speed {float(d * p)!r} per cycle) but passed it to "
+                    f"{extreme!r}",
+                )
                 break  # one report a stretch
         if limit_side is None:
             signs, allowance = [], self.allowance(mag[first], target, ys[first - 1])
@@ -560,8 +681,13 @@ class Checker:
                     if not signs or signs[-1] != sign:
                         signs.append(sign)
             if len(signs) > 2:
-                self.flag("4", index, last, f"y - uc changed sign {len(signs) - 1} times in a stretch of constant "
-                          f"uc = {target!r} (cycles {first} to {last})")
+                self.flag(
+                    "4",
+                    index,
+                    last,
+                    f"y - uc changed sign {len(signs) - 1} times in a stretch of constant "
+                    f"uc = {target!r} (cycles {first} to {last})",
+                )
 
 
 def check(segments, arithmetic, T):

@@ -9,6 +9,7 @@ cycle, what changes. What was set is recorded (`Scenario`, plain JSON), so
 that any run replays it exactly: through Model Exchange, another FMI
 version, or as a reproducer printed by the campaign.
 """
+
 import json
 import math
 import sys
@@ -22,9 +23,22 @@ nan, inf = math.nan, math.inf
 REAL_OUTPUTS = ("y", "dydt", "d2ydt2", "remainingTime", "runningTime")
 INT_OUTPUTS = ("status", "subFunctionStatus")
 # what a cycle may bring, by weight (most cycles bring nothing)
-EVENTS = (["none"] * 60 + ["far"] * 4 + ["inside"] * 4 + ["behind"] * 2 + ["moving"] * 2 + ["limit"] * 3
-          + ["release"] + ["rate"] * 2 + ["accel"] + ["hold"] + ["bypass"] + ["nonfinite"] + ["reinit"]
-          + ["period"])
+EVENTS = (
+    ["none"] * 60
+    + ["far"] * 4
+    + ["inside"] * 4
+    + ["behind"] * 2
+    + ["moving"] * 2
+    + ["limit"] * 3
+    + ["release"]
+    + ["rate"] * 2
+    + ["accel"]
+    + ["hold"]
+    + ["bypass"]
+    + ["nonfinite"]
+    + ["reinit"]
+    + ["period"]
+)
 
 
 @dataclass
@@ -33,10 +47,10 @@ class Scenario:
     version: int
     arithmetic: int
     T: float
-    cycle_time: float                 # 0: one cycle a doStep of T (Co-Simulation only); T: cycles of the FMU
-    start: dict                       # the values set before initialisation
-    cycles: list = field(default_factory=list)   # per cycle: the values set before it; "_reinit": a new start
-    settle_from: int = -1             # the last stretch, from this cycle, was held until the output settled
+    cycle_time: float  # 0: one cycle a doStep of T (Co-Simulation only); T: cycles of the FMU
+    start: dict  # the values set before initialisation
+    cycles: list = field(default_factory=list)  # per cycle: the values set before it; "_reinit": a new start
+    settle_from: int = -1  # the last stretch, from this cycle, was held until the output settled
 
     def dumps(self):
         return json.dumps(asdict(self))  # NaN and infinities as Python's json writes and reads them
@@ -63,6 +77,7 @@ class RandomChooser:
 class HypothesisChooser:
     def __init__(self, data):
         from hypothesis import strategies as st
+
         self.data, self.st = data, st
 
     def pick(self, options):
@@ -124,8 +139,8 @@ class Block:
         return self.outputs()
 
     def outputs(self):
-        out = dict(zip(self.real_names, self.get_real(self.real_vrs)))
-        out.update(zip(INT_OUTPUTS, self.get_int(self.int_vrs)))
+        out = dict(zip(self.real_names, self.get_real(self.real_vrs), strict=True))
+        out.update(zip(INT_OUTPUTS, self.get_int(self.int_vrs), strict=True))
         return out
 
     def reset(self):
@@ -151,7 +166,7 @@ class Run:
         self.settable = settable if block is None else (lambda model, values: dict(values))
         self.segments = []
         self.t = 0.0
-        self.n = 0            # cycles since the segment's start
+        self.n = 0  # cycles since the segment's start
         self.values = None
         self.y = self.v = 0.0
 
@@ -161,8 +176,9 @@ class Run:
         self.values["cycleTime"] = self.sc.cycle_time
         self.values["arithmetic"] = self.sc.arithmetic
         t0 = self.t
-        init_values = self.settable(self.sc.model, dict(start, cycleTime=self.sc.cycle_time,
-                                                   arithmetic=self.sc.arithmetic))
+        init_values = self.settable(
+            self.sc.model, dict(start, cycleTime=self.sc.cycle_time, arithmetic=self.sc.arithmetic)
+        )
         out = self.block.start(t0, init_values)
         self.segments.append(Segment(dict(self.values), t0, out))
         self.n = 0
@@ -194,7 +210,7 @@ def replay(scenario, model_exchange=False):
     run = Run(scenario, model_exchange)
     try:
         run.begin(scenario.start)
-        for k, changes in enumerate(scenario.cycles):
+        for changes in scenario.cycles:
             run.cycle(changes)
         if scenario.settle_from >= 0:
             run.segments[-1].settle = True
@@ -209,11 +225,11 @@ def violations(scenario, segments):
 
 # -- drawing a scenario ----------------------------------------------------------------------------------------
 
+
 class Generator:
     """Draws a scenario's settings and, cycle by cycle, its changes, from a Chooser."""
 
-    def __init__(self, chooser, model, version, arithmetic, model_exchange=False, cycles=(40, 200),
-                 accel_zero=False):
+    def __init__(self, chooser, model, version, arithmetic, model_exchange=False, cycles=(40, 200), accel_zero=False):
         c = self.c = chooser
         self.model, self.arithmetic, self.accel_zero = model, arithmetic, accel_zero
         self.T = c.pick([0.001, 0.01, 0.1, 0.25, 1.0, 0.3])
@@ -225,21 +241,26 @@ class Generator:
         self.offset = c.pick([0.0] * 6 + [1000.0 * self.scale, -30.0 * self.scale])
         self.length = c.integer(*cycles)
         self.scenario = Scenario(model, version, arithmetic, self.T, cycle_time, self.settings())
-        self.pending = []     # changes due at later cycles: (cycle, changes)
+        self.pending = []  # changes due at later cycles: (cycle, changes)
 
     def far(self):
         return self.offset + self.scale * self.c.uniform(-400.0, 400.0)
 
     def settings(self):
         c, s, T = self.c, self.scale, self.T
-        self.vmax = s * c.uniform(0.5, 20.0)                # per cycle
-        self.a = self.vmax / c.uniform(1.0, 30.0)           # per cycle squared
-        start = {"u": self.far(), "initMode": c.pick([2, 2, 2, 1, 3]), "initValue": self.far(),
-                 "initDelay": c.pick([0.0, 2 * T, 5 * T]), "zeroRate": c.pick([1, 1, 1, 2])}
+        self.vmax = s * c.uniform(0.5, 20.0)  # per cycle
+        self.a = self.vmax / c.uniform(1.0, 30.0)  # per cycle squared
+        start = {
+            "u": self.far(),
+            "initMode": c.pick([2, 2, 2, 1, 3]),
+            "initValue": self.far(),
+            "initDelay": c.pick([0.0, 2 * T, 5 * T]),
+            "zeroRate": c.pick([1, 1, 1, 2]),
+        }
         start.update(self.rates(self.vmax))
-        self.accel = 0.0 if self.accel_zero else self.a / T ** 2
+        self.accel = 0.0 if self.accel_zero else self.a / T**2
         start["accelMax"] = self.accel
-        start["decelMax"] = c.pick([0.0, 0.0, 0.25, 0.5, 2.0, 4.0]) * self.a / T ** 2
+        start["decelMax"] = c.pick([0.0, 0.0, 0.25, 0.5, 2.0, 4.0]) * self.a / T**2
         if c.pick([False] * 4 + [True]):
             start.update(self.limit_values(c.pick(["yMax", "yMin"]), self.far(), par=True))
         if c.pick([False] * 8 + [True]):
@@ -254,8 +275,13 @@ class Generator:
         per_period = (lambda v: v) if period == 0 else (lambda v: v / T * period)
         up = c.pick([vmax, vmax, vmax * c.uniform(0.3, 3.0), inf])
         down = c.pick([up, up, vmax * c.uniform(0.3, 3.0), inf])
-        values = {"ratePeriod": period, "rateUpPar": per_period(up) if up != inf else inf,
-                  "rateDownPar": per_period(down) if down != inf else inf, "rateUpNeg": nan, "rateDownNeg": nan}
+        values = {
+            "ratePeriod": period,
+            "rateUpPar": per_period(up) if up != inf else inf,
+            "rateDownPar": per_period(down) if down != inf else inf,
+            "rateUpNeg": nan,
+            "rateDownNeg": nan,
+        }
         if c.pick([False, False, False, True]):
             values["rateUpNeg"] = per_period(vmax * c.uniform(0.3, 3.0))
             values["rateDownNeg"] = c.pick([nan, per_period(vmax * c.uniform(0.3, 3.0))])
@@ -274,7 +300,7 @@ class Generator:
     def changes(self, k, y, v, values):
         """What changes before cycle k, given the last output y, its step v and the values in effect."""
         out = {}
-        for due, changes in [p for p in self.pending if p[0] == k]:
+        for _, changes in [p for p in self.pending if p[0] == k]:
             out.update(changes)
         self.pending = [p for p in self.pending if p[0] != k]
         c, s = self.c, self.scale
@@ -284,16 +310,16 @@ class Generator:
             y = self.offset
         if event == "far":
             out["u"] = self.far()
-        elif event == "inside":    # the target moved inside the braking distance, in the direction of motion
+        elif event == "inside":  # the target moved inside the braking distance, in the direction of motion
             out["u"] = y + direction * c.uniform(0.0, 1.0) * self.braking(abs(v))
         elif event == "behind":
             out["u"] = y - direction * c.uniform(0.0, 2.0) * self.braking(abs(v))
-        elif event == "moving":    # a target that moves every cycle for a while
+        elif event == "moving":  # a target that moves every cycle for a while
             centre, amplitude = y, s * c.uniform(1.0, 100.0)
             period = c.integer(5, 60)
             for j in range(c.integer(5, 60)):
                 self.pending.append((k + j, {"u": centre + amplitude * math.sin(2 * math.pi * j / period)}))
-        elif event == "limit":     # ahead (inside or beyond the braking distance) or behind the output
+        elif event == "limit":  # ahead (inside or beyond the braking distance) or behind the output
             where = c.uniform(-1.0, 2.0) * self.braking(abs(v))
             name = "yMax" if direction > 0 else "yMin"
             out.update(self.limit_values(name, y + direction * where))
@@ -302,7 +328,7 @@ class Generator:
             out[name + "Par"] = sys.float_info.max * (1 if name == "yMax" else -1)
             if self.model == "RateLimiter":
                 out[name] = nan
-        elif event == "rate":      # lowered (below the speed) or raised
+        elif event == "rate":  # lowered (below the speed) or raised
             vmax = c.pick([abs(v) * c.uniform(0.1, 0.9), self.vmax * c.uniform(0.3, 3.0)]) or self.vmax
             period = values["ratePeriod"]
             per_period = (lambda x: x) if period == 0 else (lambda x: x / self.T * period)
@@ -318,8 +344,9 @@ class Generator:
             self.pending.append((k + c.integer(1, 5), {"hold": False}))
         elif event == "bypass":
             out["bypass"] = True
-            out[c.pick(["bypassValuePar"] + (["bypassValue"] if self.model == "RateLimiter" else []))] = \
-                c.pick([nan, self.far()])
+            out[c.pick(["bypassValuePar"] + (["bypassValue"] if self.model == "RateLimiter" else []))] = c.pick(
+                [nan, self.far()]
+            )
             self.pending.append((k + c.integer(1, 3), {"bypass": False}))
         elif event == "nonfinite":
             out["u"] = c.pick([nan, inf, -inf])
@@ -330,8 +357,16 @@ class Generator:
         elif event == "period":
             out["zeroRate"] = c.pick([1, 2])
         # a value past the largest double is no scenario (a limit of +inf, a target of +inf by overflow)
-        return {n: x for n, x in out.items() if not (isinstance(x, float) and math.isinf(x) and event != "nonfinite"
-                                                     and n not in ("rateUpPar", "rateDownPar", "rateUp", "rateDown"))}
+        return {
+            n: x
+            for n, x in out.items()
+            if not (
+                isinstance(x, float)
+                and math.isinf(x)
+                and event != "nonfinite"
+                and n not in ("rateUpPar", "rateDownPar", "rateUp", "rateDown")
+            )
+        }
 
     def reinit_values(self):
         return self.settings()
@@ -345,8 +380,17 @@ class Generator:
         return out
 
 
-def run_random(chooser, model, version, arithmetic, model_exchange=False, cycles=(40, 200), accel_zero=False,
-               settle_cap=20000, block=None):
+def run_random(
+    chooser,
+    model,
+    version,
+    arithmetic,
+    model_exchange=False,
+    cycles=(40, 200),
+    accel_zero=False,
+    settle_cap=20000,
+    block=None,
+):
     """Draw and run one scenario in Co-Simulation (with the FMU's cycleTime for a later Model Exchange replay):
     (scenario, segments). The last stretch is held until the output has settled on its target for 3 cycles, or
     settle_cap cycles."""
