@@ -87,7 +87,6 @@ static inline RL_NUM RL_NAME(rl_triangle)(RL_NUM b, RL_NUM n) {
  * j = 1, 2, ..., while positive; n = floor(s / b) of them:
  * n * (s - b * (n + 1) / 2). */
 static inline RL_NUM RL_NAME(rl_braking_distance)(RL_NUM s, RL_NUM b) {
-    if (!isgreater(s, b)) return 0;
     if (isinf(s)) return s;
     const RL_NUM n = (RL_NUM)floor((double)RL_NAME(rl_quotient)(s, b));
     return RL_NAME(rl_product)(n, RL_NAME(rl_sum)(s, -(RL_NAME(rl_product)(b, n + 1) / 2)));
@@ -178,6 +177,25 @@ static inline RL_NUM RL_NAME(rl_advance)(RL_NUM y, RL_NUM delta) {
     return next;
 }
 
+/* a + b in the arithmetic, rounded towards 0 (towardsZero) or away from 0
+ * where rounding to nearest went the other way: a distance rounded up, or a
+ * speed rounded down, would plan on room the output does not have. */
+static inline RL_NUM RL_NAME(rl_directed_sum)(RL_NUM a, RL_NUM b, bool towardsZero) {
+    if (!(isless(fabs((double)a), 1e300) && isless(fabs((double)b), 1e300))) {
+        return RL_NAME(rl_sum)(a, b);
+    }
+    double error;
+    const double exact = rl_two_sum((double)a, (double)b, &error);        /* + error */
+    const RL_NUM sum = (RL_NUM)rl_binary32_or_not(exact, sizeof(RL_NUM)); /* a + b, rounded once */
+    const double beyond = ((double)sum - exact) - error;                  /* sum - (a + b) */
+    const bool away = isgreater(sum, 0) ? isgreater(beyond, 0) : isless(beyond, 0);
+    const bool shortOf = isgreater(sum, 0) ? isless(beyond, 0) : isgreater(beyond, 0);
+    if (towardsZero ? away : shortOf) {
+        return RL_NEXT_TOWARDS(sum, towardsZero ? 0 : (RL_NUM)copysign(INFINITY, (double)sum));
+    }
+    return sum;
+}
+
 /* One cycle of rule 6 with the acceleration limit: the output y (finite)
  * moves towards the target uc (finite); previous is the last cycle's step
  * scaled to this cycle's length (0 from rest). The step is the largest the
@@ -189,7 +207,7 @@ static inline RL_NUM RL_NAME(rl_advance)(RL_NUM y, RL_NUM delta) {
 static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_NUM uc, RL_NUM previous,
                                                                    const RlPrepared *p) {
     const RL_NUM a = (RL_NUM)p->accelStep, b = (RL_NUM)p->decelStep;
-    const RL_NUM e = RL_NAME(rl_sum)(uc, -y);
+    const RL_NUM e = RL_NAME(rl_directed_sum)(uc, -y, true);
     /* towards the target; at the target, the way the output moves */
     const bool up = isgreater(e, 0) || (e == 0 && isgreater(previous, 0));
     RL_NUM distance = up ? e : -e;
@@ -223,11 +241,13 @@ static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_
                  i++) {
                 stoppable = RL_NEXT_TOWARDS(stoppable, 0); /* the step's rounding, taken back */
             }
+            /* still too far (the formula's rounding beyond eight units): no step but braking's */
+            if (!RL_NAME(rl_stops_within)(stoppable, b, distance)) stoppable = 0;
             fastest = RL_NAME(rl_min)(fastest, stoppable);
         }
         /* braking harder than b is not allowed: a target too close is passed */
         if (isgreater(moving, b)) {
-            const RL_NUM braked = RL_NAME(rl_advance)(moving, -b);
+            const RL_NUM braked = RL_NAME(rl_directed_sum)(moving, -b, true); /* rounded down */
             step = isless(fastest, braked) ? braked : fastest;
         } else {
             step = fastest;
@@ -238,7 +258,13 @@ static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_
     if (islessequal(fabs((double)RL_NAME(rl_sum)(step, -distance)), (double)arrival)) {
         return uc;
     }
-    return RL_NAME(rl_advance)(y, up ? step : -step);
+    const RL_NUM next = RL_NAME(rl_advance)(y, up ? step : -step);
+    if (next == y && isgreater(step, 0)) {
+        /* a step below the output's resolution (REAL, or a large y): one
+         * unit in the last place towards uc, within the bounds' allowance */
+        return RL_NEXT_TOWARDS(y, uc);
+    }
+    return next;
 }
 
 /* The step of the last cycle, as the acceleration limit's velocity at this
@@ -248,7 +274,7 @@ static inline RL_NUM RL_NAME(rl_previous_step)(const RlState *s, const RlPrepare
         !isfinite(s->y) || !isfinite(s->yPrevious)) {
         return 0;
     }
-    const RL_NUM step = RL_NAME(rl_sum)((RL_NUM)s->y, -(RL_NUM)s->yPrevious);
+    const RL_NUM step = RL_NAME(rl_directed_sum)((RL_NUM)s->y, -(RL_NUM)s->yPrevious, false);
     if (s->periodLast == p->period || !isgreater(s->periodLast, 0)) {
         return step;
     }

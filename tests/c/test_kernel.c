@@ -1342,8 +1342,48 @@ static void test_quiet_arithmetic(void) {
     feclearexcept(FE_ALL_EXCEPT);
 }
 
+/* rules.md, Acceleration limit: the helpers its steps are written with,
+ * against values worked by hand (dyadic, so exact). */
+static void test_acceleration_helpers(void) {
+    /* one unit in the last place: 0's is the smallest subnormal */
+    CHECK_BITS(rl_ulp_lreal(0.0), ldexp(1.0, -1074));
+    CHECK_BITS(rl_ulp_lreal(1.0), ldexp(1.0, -52));
+    CHECK_BITS(rl_ulp_lreal(-3.0), ldexp(1.0, -51));
+    CHECK_BITS((double)rl_ulp_real(0.0f), ldexp(1.0, -149));
+    CHECK_BITS((double)rl_ulp_real(1.0f), ldexp(1.0, -23));
+    /* braking distance B(s) with b = 0.25: the steps s - 0.25, s - 0.5, ... while positive */
+    CHECK_EQ(rl_braking_distance_lreal(0.1, 0.25), 0.0); /* n = 0: 0 * (0.1 - 0.125) = -0 */
+    CHECK_BITS(rl_braking_distance_lreal(0.25, 0.25), 0.0);
+    CHECK_BITS(rl_braking_distance_lreal(0.5, 0.25), 0.25);
+    CHECK_BITS(rl_braking_distance_lreal(0.75, 0.25), 0.75);
+    CHECK_BITS(rl_braking_distance_lreal(1.0, 0.25), 1.5);
+    CHECK_BITS((double)rl_braking_distance_real(1.0f, 0.25f), 1.5);
+    /* S(E): the largest step that stops within E */
+    CHECK_BITS(rl_stoppable_step_lreal(0.0, 0.25), 0.0);
+    CHECK_BITS(rl_stoppable_step_lreal(0.25, 0.25), 0.25);
+    CHECK_BITS(rl_stoppable_step_lreal(0.75, 0.25), 0.5);
+    CHECK_BITS(rl_stoppable_step_lreal(1.5, 0.25), 0.75);
+    CHECK_BITS(rl_stoppable_step_lreal(2.5, 0.25), 1.0);
+    CHECK_BITS((double)rl_stoppable_step_real(1.5f, 0.25f), 0.75);
+    /* exact feasibility: 0.75 + B(0.75) = 1.5 stops within 1.5, one unit more does not */
+    CHECK_TRUE(rl_stops_within_lreal(0.75, 0.25, 1.5));
+    CHECK_TRUE(!rl_stops_within_lreal(nextafter(0.75, 1.0), 0.25, 1.5));
+    CHECK_TRUE(!rl_stops_within_lreal(0.75, 0.25, nextafter(1.5, 0.0)));
+    CHECK_TRUE(rl_stops_within_real(0.75f, 0.25f, 1.5f));
+    CHECK_TRUE(!rl_stops_within_real(nextafterf(0.75f, 1.0f), 0.25f, 1.5f));
+    /* directed sums: 1 + 2^-60 rounds to 1, below the exact sum; 1 - 2^-60 to 1, above it */
+    CHECK_BITS(rl_directed_sum_lreal(1.0, ldexp(1.0, -60), true), 1.0);
+    CHECK_BITS(rl_directed_sum_lreal(1.0, ldexp(1.0, -60), false), nextafter(1.0, 2.0));
+    CHECK_BITS(rl_directed_sum_lreal(1.0, -ldexp(1.0, -60), true), nextafter(1.0, 0.0));
+    CHECK_BITS(rl_directed_sum_lreal(1.0, -ldexp(1.0, -60), false), 1.0);
+    CHECK_BITS(rl_directed_sum_lreal(-1.0, -ldexp(1.0, -60), false), nextafter(-1.0, -2.0));
+    CHECK_BITS((double)rl_directed_sum_real(1.0f, (float)ldexp(1.0, -30), false), (double)nextafterf(1.0f, 2.0f));
+    CHECK_BITS(rl_directed_sum_lreal(0.5, 0.25, true), 0.75); /* exact: as it is */
+}
+
 int main(void) {
     test_quiet_arithmetic();
+    test_acceleration_helpers();
     test_rule0_resolve();
     test_rule0_limits();
     test_status_codes();

@@ -81,6 +81,7 @@ TESTS = (
     "repo/test_model_description.py",
     "fmu/test_random.py",
     "fmu/test_hostile.py",
+    "fmu/test_acceleration.py",
 )
 # outcomes a resumed run keeps: they depend on the sources and the build's flags alone, or (killed) stand
 # because tests are only added

@@ -289,7 +289,7 @@ class RateLimiterOracle:
         if not (finite(self.y) and finite(self.yp)):
             return 0.0
         A = Arithmetic(self.real)
-        step = A.add(self.y, -self.yp)
+        step = directed_sum(A, self.y, -self.yp, False)
         T_last = self.T
         if T_last == T or not T_last > 0:
             return step
@@ -925,11 +925,27 @@ def advance(A, y, delta):
     return nearest
 
 
+def directed_sum(A, a, b, towards_zero):
+    """a + b rounded to nearest, then towards 0 (or away from it) if that went
+    beyond (or fell short of) the exact sum"""
+    nearest = A.add(a, b)
+    if not (abs(a) < 1e300 and abs(b) < 1e300):
+        return nearest
+    beyond = Fraction(nearest) - (Fraction(a) + Fraction(b))
+    away = (nearest > 0 and beyond > 0) or (nearest < 0 and beyond < 0)
+    short = (nearest > 0 and beyond < 0) or (nearest < 0 and beyond > 0)
+    if towards_zero and away:
+        return A.towards(nearest, 0.0)
+    if not towards_zero and short:
+        return A.towards(nearest, math.copysign(math.inf, nearest))
+    return nearest
+
+
 def accel_step(A, yp, uc, v, a, b, limits):
     """One cycle of rules.md, Acceleration limit, steps 1 to 6. limits:
     (maxUp, maxDown, maxUpNeg, maxDownNeg) per cycle."""
     max_up, max_down, max_up_neg, max_down_neg = limits
-    e = A.add(uc, -yp)
+    e = directed_sum(A, uc, -yp, True)
     up = e > 0 or (e == 0 and v > 0)  # 1
     distance = e if up else -e
     if math.isinf(distance):
@@ -958,13 +974,18 @@ def accel_step(A, yp, uc, v, a, b, limits):
                 if not (stoppable > 0 and not stops_within(A, stoppable, b, distance)):
                     break
                 stoppable = A.towards(stoppable, 0.0)
+            if not stops_within(A, stoppable, b, distance):  # still too far: braking's step alone
+                stoppable = 0.0
             fastest = min(fastest, stoppable)
         if moving > b:
-            braked = advance(A, moving, -b)
+            braked = directed_sum(A, moving, -b, True)  # rounded down
             step = braked if fastest < braked else fastest
         else:
             step = fastest
     scale = uc if abs(uc) > abs(yp) else yp  # 6
     if abs(A.add(step, -distance)) <= 4 * A.ulp(scale):
         return uc
-    return advance(A, yp, step if up else -step)
+    following = advance(A, yp, step if up else -step)
+    if following == yp and step > 0:  # below the output's resolution: one unit in the last place
+        return A.towards(yp, uc)
+    return following
