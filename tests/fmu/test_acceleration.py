@@ -4,7 +4,7 @@
   with the Neg rates, zeroRate and ratePeriod 0 or not, accelMax and
   decelMax, targets moved mid-ramp and inside the braking distance, output
   limits tightened under way, hold, bypass, non-finite inputs and
-  re-initialisation between, huge and tiny values, both arithmetics)
+  re-initialisation between, huge and tiny values, LREAL and REAL)
   through RateLimiter and RateLimiterStatic, FMI 2 and 3, every cycle
   checked against the properties by support/accel_properties.py, which
   knows nothing of the block's algorithm. Model Exchange gives the

@@ -75,9 +75,9 @@ def main(argv=None):
             print(v)
         print(f"{len(found)} violations in {sum(len(s.cycles) for s in segments)} cycles")
         return 1 if found else 0
-    arithmetics = {"lreal": [LREAL], "real": [REAL], "both": [LREAL, REAL]}[args.arithmetic]
+    kinds = {"lreal": [LREAL], "real": [REAL], "both": [LREAL, REAL]}[args.arithmetic]
     failed = 0
-    for arithmetic in arithmetics:
+    for arithmetic in kinds:
         name = "LREAL" if arithmetic == LREAL else "REAL"
         start, cycles, bad, kinds = time.monotonic(), 0, 0, collections.Counter()
         for index in range(args.scenarios):
