@@ -35,6 +35,7 @@ SCENARIOS = [
     "Ramp/ttime_10s_both_ways",
     "RateLimiter/neg_rates_rising",
     "LGF_LimRateOfChangeAdvancedCI/quadrant_flags",
+    "RateLimiter/accel_reversal",  # the acceleration limit's exact sums and fma on the win64 binary
 ]
 CLIENT_SECONDS = 120  # a run takes under 1 s idle, a few on a busy machine
 
