@@ -15,12 +15,12 @@ import pytest
 from fmutrace import Exact, Tolerance
 from fmutrace import _worker as worker
 from fmutrace._fmu import Fmu
-from fmutrace._longcase import LONG_CASE_BYTES
+from fmutrace._longrecording import STREAMED_BYTES
 from fmutrace._longrecording import is_long_recording, run_long_recording
 from fmutrace.recordings import _stream as stream, _timebase as timebase
 from fmutrace.recordings._options import RecordingOptions
 from fmutrace._runner import Runner
-from fmutrace._longcase import Streaming
+from fmutrace._pipeline import Streaming
 from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
@@ -180,7 +180,8 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
     first = run_case(
         str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none", RecordingOptions())
     )
-    assert len(runs) == 1 and runs[0].gi_frame is None  # started, given up on, closed
+    # the stream's run started, given up on and closed; the in-memory path's own run (the same Runner) done
+    assert len(runs) == 2 and runs[0].gi_frame is None and runs[1].gi_frame is None
     assert (first.status, first.messages, first.streamed) == (whole.status, whole.messages, False)
     assert [d.to_json() for d in first.deviations] == [d.to_json() for d in whole.deviations]
 
@@ -259,6 +260,6 @@ def test_intervals_median_is_numpys():
         assert counted.median() == (float(np.median(steps)) if len(steps) else None)
 
 
-def test_a_recording_is_streamed_from_the_size_of_a_long_case(tmp_path):
+def test_a_recording_is_streamed_from_32_mib_on(tmp_path):
     assert not is_long_recording(SAMPLES / "plain_ratelimiter.tsv")
-    assert LONG_CASE_BYTES == 32 << 20
+    assert STREAMED_BYTES == 32 << 20

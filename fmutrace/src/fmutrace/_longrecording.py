@@ -8,18 +8,37 @@ import os
 import numpy as np
 
 from ._errors import InputError
-from ._longcase import ChunkedCase, Streaming, stream_case
+from ._pipeline import ChunkedCase, Streaming, run_chunked_case
 from ._recorded import first_differs
-from ._traces import LONG_CASE_BYTES, NotPlain
+from ._traces import NotPlain
 from .recordings import _stream as stream, _timebase as timebase
 from .recordings._align import off_cycle_note
 from .recordings._matching import plan
 
 
+STREAMED_BYTES = 32 << 20  # a one-file recording this large is read block by block
+
+
+def _once(chunks):
+    """The input table's function for ChunkedCase: the stream's blocks can
+    be read once; a second reading (fmpy's, for a trace the fast loop
+    cannot give) is NotPlain: the in-memory path reads the recording."""
+    given = False
+
+    def table():
+        nonlocal given
+        if given:
+            raise NotPlain("the recording is read once")
+        given = True
+        return chunks
+
+    return table
+
+
 def is_long_recording(path) -> bool:
     """Whether the recording at path is one file large enough to be streamed."""
     try:
-        return os.path.isfile(path) and os.path.getsize(path) >= LONG_CASE_BYTES
+        return os.path.isfile(path) and os.path.getsize(path) >= STREAMED_BYTES
     except OSError:
         return False
 
@@ -97,19 +116,25 @@ def run_long_recording(path, name, target, settings, streaming: Streaming = Stre
             return [description] + notes
         return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
 
+    inputs = queue("inputs") if drives else None
     case = ChunkedCase(
         name,
         f"{name} on {target.labels['fmu']}: {recording.format}",
         {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6},
         start_values,
         tuple(v for v, _ in drives),
-        queue("inputs") if drives else None,
+        _once(inputs) if inputs is not None else None,
         queue("refs"),
         [v for v, _ in compares],
         stop,
         more_messages,
     )
-    return stream_case(case, target, settings, streaming)
+    try:
+        outcome = run_chunked_case(case, target, settings, streaming)
+    except NotPlain:
+        return None
+    outcome.streamed = True
+    return outcome
 
 
 def _explain(table, deviations, channels, step, shift):

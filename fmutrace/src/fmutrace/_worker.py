@@ -8,12 +8,12 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 
-from ._cases import Case, load_case
+from ._cases import Case
 from ._comparison import Comparison, Mode
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
-from ._longcase import Streaming, is_long, run_long_case
+from ._pipeline import CaseFiles, Streaming, run_folder_case
 from ._longrecording import is_long_recording, run_long_recording
 from ._outcome import CaseOutcome, Status
 from ._plot import load_plotting, plot_case
@@ -60,31 +60,33 @@ class Target:
 def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> CaseOutcome:
     """The case in folder (its files' texts given, or None: read them), or
     the recording there (read with settings.recording), on target."""
+    plots = settings.plots
+    recorded = texts is None and is_recording(folder)  # (texts come with a case folder only)
+    if recorded and not is_long_recording(folder):
+        return _run_recording_in_memory(folder, name, target, settings)
+    result_file = _result_file() if plots != "none" else None
+    streaming = Streaming(result_file=result_file)
+    outcome = (
+        run_long_recording(folder, name, target, settings, streaming)
+        if recorded
+        else run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
+    )
+    if recorded and outcome is None:
+        outcome = _run_recording_in_memory(folder, name, target, settings)
+    if result_file and (outcome is None or not outcome.png):  # a result file only with a plot
+        os.unlink(result_file)
+    elif outcome is not None:
+        outcome.result_path = result_file
+    return outcome
+
+
+def _run_recording_in_memory(folder, name, target: Target, settings: CaseSettings) -> CaseOutcome:
     started = time.perf_counter()
     runner, fmu, labels, mode, plots = target.runner, target.fmu, target.labels, settings.mode, settings.plots
-    recorded = texts is None and is_recording(folder)  # (texts come with a case folder only)
-    streamed = is_long_recording(folder) if recorded else is_long(folder, fmu.model, texts)
-    if streamed:
-        result_file = _result_file() if plots != "none" else None
-        streaming = Streaming(result_file=result_file)
-        long = (
-            run_long_recording(folder, name, target, settings, streaming)
-            if recorded
-            else run_long_case(folder, name, target, settings, streaming)
-        )
-        if result_file and (long is None or not long.png):  # a result file only with the case's plot
-            os.unlink(result_file)
-        elif long is not None:
-            long.result_path = result_file
-        if long is not None:
-            return long
     outcome = CaseOutcome(name, **labels)
     case: Case
     try:
-        if recorded:
-            case = recorded_case(str(folder), fmu, name, settings.recording)
-        else:
-            case = load_case(folder, fmu, name, texts)
+        case = recorded_case(str(folder), fmu, name, settings.recording)
     except InputError as error:
         outcome.status, outcome.messages = Status.INVALID, [str(error)]
         outcome.seconds = time.perf_counter() - started

@@ -9,20 +9,20 @@ simulation, 2 bad input); compare's is its worst case's.
 
 import argparse
 import contextlib
+import os
 import sys
 
 from . import __version__
 from ._campaign import compare
 from ._executors import RunOptions
 from ._errors import ExitStatus, InputError, SimulationError
-from ._fmu import Fmu, is_fmu_file
-from ._longcase import simulate_long
-from ._simulation import SimulationOptions, simulate
+from ._fmu import is_fmu_file
+from ._simulation import SimulationOptions, simulate_chunks
 from ._outcome import Status
 from .recordings import is_recording
 from .recordings._align import TIMINGS
 from .recordings._options import TIME_UNITS, RecordingOptions
-from ._traces import write_trace
+from ._traces import TraceWriter
 from ._worker import PLOT_ALL_UP_TO, PLOTS
 
 EXAMPLES = """examples:
@@ -206,22 +206,24 @@ def run_command(args, out):
     options = SimulationOptions(
         dict(args.set), args.start_time, args.stop_time, args.step_size, args.output_interval, args.output
     )
-    if args.input and args.output_interval is None:  # a long input runs chunk by chunk, written as it goes
-        with open(args.out, "w", newline="\n") if args.out else contextlib.nullcontext(out) as stream:
-            written = simulate_long(args.fmu, args.input, stream, options)
-        if written is not None:
-            if args.out:
-                print(
-                    f"{written} samples of {len(args.output or Fmu(args.fmu).outputs)} signals written to {args.out}",
-                    file=out,
-                )
-            return ExitStatus.SUCCESS
-    result = simulate(args.fmu, args.input, **vars(options))
+    written, names = 0, ("time",)  # type: tuple[int, tuple[str, ...]]
+    with contextlib.ExitStack() as stack:
+        stream, writer = None, None
+        try:
+            for chunk in simulate_chunks(args.fmu, args.input, options, progress=True):
+                if writer is None:  # the file made once the run has begun: bad input leaves none
+                    stream = stack.enter_context(open(args.out, "w", newline="\n")) if args.out else out
+                    names = chunk.dtype.names or ("time",)
+                    writer = TraceWriter(stream, names)
+                writer.write(chunk)
+                written += len(chunk)
+        except (InputError, SimulationError):
+            if args.out and stream is not None:
+                stream.close()
+                os.unlink(args.out)  # no half-written result
+            raise
     if args.out:
-        write_trace(args.out, result)
-        print(f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {args.out}", file=out)
-    else:
-        write_trace(out, result)
+        print(f"{written} samples of {len(names) - 1} signals written to {args.out}", file=out)
     return ExitStatus.SUCCESS
 
 

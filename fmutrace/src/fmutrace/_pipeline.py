@@ -1,27 +1,23 @@
-"""A long case (a recorder's hours of cycles as a cross-check case) read,
-simulated, compared and plotted chunk by chunk, in memory that does not
-grow with its length.
+"""The one way a case is read, run and compared: chunk by chunk, in memory
+that does not grow with its length (a short case is one chunk).
 
-The reference and the inputs are read by pyarrow in chunks
-(traces.trace_chunks), the FMU runs chunk after chunk on one instance
-(Runner.run_chunks), each reference chunk is compared as soon as the
-result reaches it, and the figure's lines are envelopes filled as they
-go (plot.Envelope). The verdict is the in-memory path's (worker.run_case
-with comparison.compare_traces), bit for bit, from the comparison
-module's own rules (its samples matched by comparison.aligned, the
-verdict accumulated by comparison.Verdict): every signal's counts, its
-first deviation and its largest, and a reference time the result lacks
-(a test runs both on the same cases). A tube compares each result sample
-with the reference around it: the reference is kept from the row before
-that window to a row after it (Tube.band on that window gives the whole
-reference's bounds). A case this path cannot take (a file that is not
-the plain CSV dialect, an input the fast loop cannot replay, a failing
-FMU) goes to the in-memory path, which reads it or explains it:
-`run_long_case` returns None then, before anything is reported.
+The reference and the inputs are read in chunks (traces.trace_chunks, by
+pyarrow) where they are the plain CSV dialect, else whole by read_trace
+(which reads any dialect fmutrace reads, or explains what is wrong with
+file, line and column); the FMU runs chunk after chunk on one instance
+(Runner.run_chunks, which hands a trace the fast loop cannot give to fmpy
+itself); each reference chunk is compared as soon as the result reaches
+it, by the comparison module's rules (its samples matched by
+comparison.aligned, the verdict accumulated by comparison.Verdict), and
+the figure's lines are envelopes filled as they go (plot.Envelope). A
+tube compares each result sample with the reference around it: the
+reference is kept from the row before that window to a row after it
+(Tube.band on that window gives the whole reference's bounds). The
+verdict does not depend on where the chunks end (a test runs every
+reference scenario in chunks of one step and one row).
 """
 
 import contextlib
-import os
 import time
 from collections.abc import Callable, Iterator
 from typing import TextIO
@@ -30,47 +26,20 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cases import read_options, read_start_values
+from ._cases import load_case, read_options, read_start_values
 from ._comparison import Band, Mode, Pointwise, Tube, Verdict, aligned
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
-from ._fmu import Fmu
 from ._outcome import CaseOutcome, Status
 from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
 from ._progress import SampleProgress
-from ._runner import STEPS_PER_CHUNK, FastLoopFailed, Runner
-from ._simulation import SimulationOptions, resolved
-from ._traces import CHUNK_BYTES, LONG_CASE_BYTES, NotPlain, TraceWriter, read_text, trace_chunks
-
-
-def is_long(folder, model, texts) -> bool:
-    """Whether the case in folder is run chunk by chunk (its files are here and large)."""
-    if texts is not None:
-        return False
-    try:
-        return os.path.getsize(os.path.join(folder, f"{model}_ref.csv")) >= LONG_CASE_BYTES
-    except OSError:
-        return False
+from ._runner import STEPS_PER_CHUNK
+from ._traces import CHUNK_BYTES, NotPlain, TraceWriter, last_time, read_text, trace_chunks
 
 
 def _signal_names(trace: np.ndarray) -> tuple[str, ...]:
     """The names of a trace's columns after its time."""
     return tuple(trace.dtype.names or ())[1:]
-
-
-def _last_time(path):
-    """The time in the last data line of a plain CSV file (its first cell),
-    however long that line is."""
-    with open(path, "rb") as file:
-        end = file.seek(0, os.SEEK_END)
-        size = 4096
-        while True:
-            begin = max(0, end - size)
-            file.seek(begin)
-            lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
-            if len(lines) >= 2 or begin == 0:  # a line break before the last line: it is whole
-                return float(lines[-1].split(b",")[0])
-            size *= 4
 
 
 @dataclass(frozen=True)
@@ -87,15 +56,16 @@ class Streaming:
 
 @dataclass
 class ChunkedCase:
-    """A case given as chunks: input_chunks (None: no inputs) and
-    ref_chunks are consecutive structured arrays, time first."""
+    """A case given as chunks: inputs (None: no inputs) a function that
+    gives the input table's consecutive structured arrays, time first,
+    from its first row each time it is called; ref_chunks the reference's."""
 
     name: str
     title: str  # the figure's
     options: dict  # StartTime, StopTime, StepSize, RelTol
     start_values: dict
     input_names: tuple
-    input_chunks: Iterator | None
+    inputs: Callable[[], Iterator] | None
     ref_chunks: Iterator
     outputs: list
     t_end: float  # the figure's last time
@@ -104,77 +74,112 @@ class ChunkedCase:
     started: float = field(default_factory=time.perf_counter)
 
 
-def run_long_case(folder, name, target, settings, streaming: Streaming = Streaming()):
-    """The CaseOutcome of the case in folder on target (a _worker.Target),
-    chunk by chunk; None if this path cannot take it (the in-memory path
-    then runs it)."""
+@dataclass(frozen=True)
+class CaseFiles:
+    """A case folder as a campaign names it: its folder, its name, and its
+    files' texts (None: read from the folder)."""
+
+    folder: str | Path
+    name: str
+    texts: dict | None = None
+
+
+def run_folder_case(files: CaseFiles, target, settings, streaming: Streaming = Streaming()) -> CaseOutcome:
+    """The CaseOutcome of the case in files.folder on target (a _worker.Target)."""
     started = time.perf_counter()
-    folder = Path(folder)
-    fmu, labels = target.fmu, target.labels
+    whole = files.texts is not None  # texts travelled: read them whole
+    while True:
+        try:
+            case = _read_folder_case(files, target, streaming, whole)
+            case.started = started
+            return run_chunked_case(case, target, settings, streaming)
+        except (NotPlain, InputError) as error:
+            if isinstance(error, InputError) and whole:
+                outcome = CaseOutcome(files.name, **target.labels, status=Status.INVALID, messages=[str(error)])
+                outcome.seconds = time.perf_counter() - started
+                return outcome
+            whole = True  # a file the chunk reader does not take: read_trace reads or explains it
+
+
+def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: bool) -> ChunkedCase:
+    """The case's files as chunks (whole: each file one chunk, read by
+    read_trace); NotPlain where a file needs read_trace, InputError for
+    what is wrong in a file."""
+    fmu, folder, name = target.fmu, Path(files.folder), files.name
     model = fmu.model
-    ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
-    try:
+    if whole:
+        read = load_case(folder, fmu, name, files.texts)
+        inputs, reference = read.inputs, read.reference
+        options, start_values, description = read.options, read.start_values, read.description
+        input_names = _signal_names(inputs) if inputs is not None else ()
+        table = None if inputs is None else (lambda: iter([inputs]))
+        ref_chunks: Iterator = iter([reference])
+        outputs, last = read.outputs, float(reference["time"][-1])
+    else:
+        ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
         texts = {}  # the small files' texts (the reference and the inputs are read in chunks)
         for file_name in (f"{model}_ref.opt", f"{model}_start.csv", "README.md"):
             if (folder / file_name).exists():
                 texts[file_name] = read_text(folder / file_name)
-        first_ref = next(trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=1 << 16))
+        try:
+            first_ref = next(trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=1 << 16))
+            last = last_time(ref_path)
+        except (OSError, ValueError, StopIteration) as error:
+            raise NotPlain(str(error)) from None
         bounds = np.zeros(2, dtype=[("time", np.float64)])
-        bounds["time"] = [first_ref["time"][0], _last_time(ref_path)]
+        bounds["time"] = [first_ref["time"][0], last]
         options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
         start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
-        input_names: tuple[str, ...] = ()
+        input_names, table = (), None
         if in_path.exists():
-            first_in = next(trace_chunks(in_path, fmu.input_problem, chunk_bytes=1 << 16))
-            input_names = _signal_names(first_in)
-            if len(first_in) < 2:
-                return None
-    except (InputError, NotPlain, OSError, ValueError, StopIteration):
-        return None
-    outputs = list(_signal_names(first_ref))
-    stop = options["StopTime"]
-    readme = (texts.get("README.md") or "").strip().splitlines()
-    description = readme[0].lstrip("# ").strip() if readme else ""
+            input_names = _signal_names(next(trace_chunks(in_path, fmu.input_problem, chunk_bytes=1 << 16)))
 
-    def inputs():
-        yield from trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+            def table():
+                return trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
 
-    title = f"{name} on {labels['fmu']}" + (f": {description}" if description else "")
-    case = ChunkedCase(
+        ref_chunks = trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes)
+        outputs = list(_signal_names(first_ref))
+        readme = (texts.get("README.md") or "").strip().splitlines()
+        description = readme[0].lstrip("# ").strip() if readme else ""
+    title = f"{name} on {target.labels['fmu']}" + (f": {description}" if description else "")
+    return ChunkedCase(
         name,
         title,
         options,
         start_values,
         input_names,
-        inputs() if input_names else None,
-        trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes),
+        table,
+        ref_chunks,
         outputs,
-        max(stop, bounds["time"][1]),
-        started=started,
+        max(options["StopTime"], last),
     )
-    return stream_case(case, target, settings, streaming)
 
 
-def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Streaming()):
+def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming = Streaming()) -> CaseOutcome:
     """The CaseOutcome of a case given as chunks on target (a
-    _worker.Target); None if this path cannot take it (a chunk raises
-    NotPlain, the fast loop cannot replay it), before anything is
-    reported."""
+    _worker.Target): an FMU that fails makes it an error. NotPlain from a
+    chunk that needs read_trace (the caller reads the file whole)."""
     options, outputs, input_names = case.options, case.outputs, case.input_names
     start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
     n = round((stop - start) / step)
     bar = streaming.progress or SampleProgress(n + 1)
     state = _Comparer(case, settings.mode, bar)
+    seen = False  # the input envelopes are filled on the first reading of the table only
 
-    def inputs(chunks):
+    def inputs():
+        nonlocal seen
+        assert case.inputs is not None
+        chunks, first = case.inputs(), not seen
+        seen = True
         for chunk in chunks:
-            for s in input_names:
-                state.envelopes[("input", s)].add(chunk["time"], chunk[s])
+            if first:
+                for s in input_names:
+                    state.envelopes[("input", s)].add(chunk["time"], chunk[s])
             yield chunk
 
     results = target.runner.run_chunks(
         Experiment(start, stop, step, options["RelTol"]),
-        Signals(inputs(case.input_chunks) if case.input_chunks is not None else None, case.start_values, outputs),
+        Signals(inputs if case.inputs is not None else None, case.start_values, outputs),
         input_names,
         streaming.steps_per_chunk,
     )
@@ -198,11 +203,13 @@ def stream_case(case: ChunkedCase, target, settings, streaming: Streaming = Stre
                     state.compare_rows(chunk[:-1], chunk["time"][-1])
                 if held is not None:
                     state.compare_rows(held, np.nan)
-            state.result_until(n)  # the rest of the run: an FMU failing there fails the case as in memory
-            if state.reached != n + 1:
-                raise FastLoopFailed("the run ended early")
-        except (FastLoopFailed, NotPlain):
-            return None
+            state.result_until(n)  # the rest of the run: an FMU failing there fails the case
+        except SimulationError as error:
+            outcome = CaseOutcome(case.name, **target.labels, status=Status.ERROR, messages=[str(error)])
+            if case.more_messages is not None:
+                outcome.messages += case.more_messages(False, [])
+            outcome.seconds = time.perf_counter() - case.started
+            return outcome
     return state.outcome(case, target.labels, settings)
 
 
@@ -259,29 +266,34 @@ class _Comparer:
         whole: comparison.aligned on the result samples around the rows' times."""
         if not len(rows):
             return
-        start, step, n, window = self.start, self.step, self.n, self.window
+        step, window = self.step, self.window
         times = rows["time"]
         for s in self.outputs:
             self.envelopes[("ref", s)].add(times, rows[s])
-        # the communication points start + k * step from two before the first time to two after the last
-        first, last = np.clip([np.floor((times[0] - start) / step) - 2, np.ceil((times[-1] - start) / step) + 2], 0, n)
-        first, last = int(first), int(last)
-        self.result_until(last)
-        while len(window) > 1 and window[1][0] <= first:
+        # the result's samples from two steps before the first time to two after the last (by their times:
+        # fmpy's loop adds a sample at an input event between communication points)
+        low, high = times[0] - 2 * step, times[-1] + 2 * step
+        while not window or float(window[-1][1]["time"][-1]) < high:
+            before = self.reached
+            self.result_until(self.reached)
+            if self.reached == before:
+                break  # the run has no more samples
+        while len(window) > 1 and float(window[1][1]["time"][0]) <= low:
             window.pop(0)  # chunks before the first sample needed
-        base = window[0][0]
-        result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
-        result = result[first - base : last - base + 1]
-        if not len(result):
-            raise FastLoopFailed("the run ended early")
-        index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
+        result = (window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])) if window else None
+        if result is not None:
+            result = result[np.searchsorted(result["time"], low) : np.searchsorted(result["time"], high, "right")]
+        if result is None or not len(result):
+            result, index = None, np.full(len(times), -1)  # the run ended before these rows
+        else:
+            index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
         missing = np.flatnonzero(index == -1)
         if len(missing):
             if self.first_absent is None:
                 self.first_absent = float(times[missing[0]])
             self.absent += len(missing)
         use = index >= 0
-        if not use.any():
+        if result is None or not use.any():
             return
         assert isinstance(self.mode, Pointwise)  # (stream_case gives a tube's rows to tube_rows)
         picked, compared_times, bands = result[index[use]], times[use], {}
@@ -364,7 +376,7 @@ class _Comparer:
         """The case's CaseOutcome once every reference row was compared."""
         outputs, envelopes = self.outputs, self.envelopes
         deviations = [self.signals[s].deviation for s in outputs]
-        outcome = CaseOutcome(case.name, **labels, streamed=True)
+        outcome = CaseOutcome(case.name, **labels)
         problem = ""
         if self.absent:
             problem = f"the result has no sample at t={self.first_absent!r} ({self.absent} reference times without one)"
@@ -385,47 +397,3 @@ class _Comparer:
             outcome.png = draw(figure, settings.mode, labels["fmu"])
         outcome.seconds = time.perf_counter() - case.started
         return outcome
-
-
-def simulate_long(fmu_path, input_path, out, options: SimulationOptions, streaming: Streaming = Streaming()):
-    """fmutrace run on a long input file, chunk by chunk: the result (as
-    simulation.simulate gives it, the same bits) written to the text
-    stream out as it is made; its samples, or None if this path cannot
-    take it (an input it does not read, a trace the fast loop cannot
-    replay, a failing FMU): simulate then runs it and explains."""
-    try:
-        if os.path.getsize(input_path) < LONG_CASE_BYTES:
-            return None
-        fmu = Fmu(fmu_path)
-        first_in = next(trace_chunks(input_path, fmu.input_problem, chunk_bytes=1 << 16))
-        if len(first_in) < 2:
-            return None
-        span = (first_in["time"][0], _last_time(input_path))
-        experiment, signals = resolved(fmu, options, span)  # the defaults as simulate resolves them
-    except (InputError, NotPlain, OSError, ValueError, StopIteration):
-        return None  # simulate explains
-    runner = Runner(fmu.path.read_bytes())
-    start, step = experiment.start, experiment.step
-    bar = streaming.progress or SampleProgress(round((experiment.stop - start) / step) + 1)
-    written, writer = 0, None
-    try:
-        inputs = trace_chunks(input_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
-        for chunk in runner.run_chunks(
-            experiment,
-            Signals(inputs, signals.start_values, signals.outputs),
-            _signal_names(first_in),
-            streaming.steps_per_chunk,
-        ):
-            if writer is None:
-                writer = TraceWriter(out, chunk.dtype.names)
-            writer.write(chunk)
-            written += len(chunk)
-            bar.update(written)
-    except (FastLoopFailed, NotPlain) as error:
-        if written:  # too late to leave it to simulate: the result is half written
-            raise SimulationError(f"the simulation failed at t={start + (written - 1) * step!r}: {error}") from None
-        return None
-    finally:
-        bar.close()
-        runner.close()
-    return written
