@@ -131,7 +131,7 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = ()):
 def _coarse_note(coarse, plan, step, names):
     """What inputs sampled every N cycles mean, and a tolerance that is."""
     every = max(n for _, n in coarse)
-    names = ", ".join(f"{v} every {n} cycles" for v, n in coarse)
+    sampled = ", ".join(f"{v} every {n} cycles" for v, n in coarse)
     lag = (every - 1) * step
     spans = []
     for variable, channel in plan.compares:
@@ -144,7 +144,7 @@ def _coarse_note(coarse, plan, step, names):
             spans.append((variable, rate * (every - 1)))
     tolerance = max((s for _, s in spans), default=0.0)
     return (
-        f"the recording's inputs were sampled coarser than the step ({names}; step {step:g} s): between two "
+        f"the recording's inputs were sampled coarser than the step ({sampled}; step {step:g} s): between two "
         "samples the FMU holds the last recorded value while the controller saw values the recording does not "
         f"hold, so its output may lead or lag the recorded one by up to {every - 1} cycles and an exact "
         "comparison cannot hold. A meaningful comparison allows that lag: "

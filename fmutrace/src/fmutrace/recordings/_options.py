@@ -4,7 +4,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
 from .._errors import InputError
-from .._names import name_of
+from .._names import Names, name_of
 from ._align import TIMINGS
 
 TIME_UNITS = ("s", "ms", "us", "ns", "cycles", "filetime")
@@ -44,7 +44,7 @@ class RecordingOptions:
     timing: str = "cycle"
     maps: tuple = ()
     start_values: tuple = ()
-    names: tuple = field(default=(), compare=False)
+    names: Names = field(default=(), compare=False)  # stored as pairs
 
     def __post_init__(self):
         object.__setattr__(self, "maps", _pairs(self.maps, "maps"))
