@@ -51,7 +51,7 @@ def run_long_recording(path, name, target, settings, streaming: Streaming = Stre
     try:
         table = stream.Table(path, fmu, options)
         recording = table.recording
-        matched = plan(recording, fmu.variables, fmu.label, options.maps)
+        matched = plan(recording, fmu.variables, fmu.label, options.maps, options.names)
         if not matched.compares:
             return None
         step = recording.step_size
