@@ -182,7 +182,7 @@ def main():
     fmu = build / "fmi3" / f"{MODEL}.fmu"
     root = build / "benchmarks" / "long"
     cli = [sys.executable, "-m", "fmutrace"]
-    from fmutrace._longrecording import is_long_recording
+    from fmutrace._recording import streamable
     from fmutrace._runner import C_STEPS
 
     print(
@@ -217,7 +217,7 @@ def main():
         if status != 0 or f"{cycles} samples" not in output:
             raise SystemExit(f"compare of the {hours:g} h recording exited {status}:\n{output[-3000:]}")
         # a case is always read in chunks; a long one-file recording is streamed, a short one (--smoke) read whole
-        long = is_long_recording(one_file)
+        long = streamable(one_file)
         streamed = [
             c.get("streamed", False)
             for c in json.loads((case.parent / "report_recording" / "results.json").read_text())["cases"]

@@ -32,7 +32,7 @@ LAYERS = [
             "fmutrace._journal",
         },
     ),
-    ("one case", {"fmutrace._pipeline", "fmutrace._longrecording", "fmutrace._worker"}),
+    ("one case", {"fmutrace._pipeline", "fmutrace._recording", "fmutrace._worker"}),
     ("where cases run", {"fmutrace._isolated", "fmutrace._executors"}),
     ("campaign", {"fmutrace._campaign"}),
     ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__"}),

@@ -99,8 +99,8 @@ def test_table_exports_in_a_tube_streamed_as_in_memory(name, model, mode, monkey
     bytes), in a tube: the outcome run_case gives reading it whole; the
     TIA Portal export with an output 0.25 off in one row fails the
     narrow tube, and names the row."""
-    from fmutrace import _worker as worker
-    from fmutrace._longrecording import run_long_recording
+    from fmutrace import _recording as worker  # (where a recording is chosen to stream)
+    from fmutrace._recording import run_streamed_recording
     from fmutrace.recordings import _stream as stream
     from fmutrace.recordings._options import RecordingOptions
 
@@ -115,11 +115,11 @@ def test_table_exports_in_a_tube_streamed_as_in_memory(name, model, mode, monkey
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     target = Target(runner, fmu, {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"})
     settings = CaseSettings(mode, "none", RecordingOptions())
-    monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
+    monkeypatch.setattr(worker, "streamable", lambda path: False)
     whole = run_case(str(path), path.name, None, target, settings)
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
     for block in (40, 120, 1 << 20):
-        streamed = run_long_recording(
+        streamed = run_streamed_recording(
             str(path), path.name, target, settings, Streaming(block_bytes=block, steps_per_chunk=3)
         )
         assert streamed is not None and streamed.streamed

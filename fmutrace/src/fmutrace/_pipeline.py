@@ -58,7 +58,9 @@ class Streaming:
 class ChunkedCase:
     """A case given as chunks: inputs (None: no inputs) a function that
     gives the input table's consecutive structured arrays, time first,
-    from its first row each time it is called; ref_chunks the reference's."""
+    from its first row each time it is called; references: the reference
+    tables, each as consecutive structured arrays (one, or one per time
+    base of a recording's signals, each signal in one of them)."""
 
     name: str
     title: str  # the figure's
@@ -66,7 +68,7 @@ class ChunkedCase:
     start_values: dict
     input_names: tuple
     inputs: Callable[[], Iterator] | None
-    ref_chunks: Iterator
+    references: list[Iterator]
     outputs: list
     t_end: float  # the figure's last time
     # what the outcome's messages add after the comparison's: more_messages(passed, deviations)
@@ -113,7 +115,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         options, start_values, description = read.options, read.start_values, read.description
         input_names = _signal_names(inputs) if inputs is not None else ()
         table = None if inputs is None else (lambda: iter([inputs]))
-        ref_chunks: Iterator = iter([reference])
+        ref_chunks: Iterator = iter([reference])  # (one table)
         outputs, last = read.outputs, float(reference["time"][-1])
     else:
         ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
@@ -149,7 +151,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         start_values,
         input_names,
         table,
-        ref_chunks,
+        [ref_chunks],
         outputs,
         max(options["StopTime"], last),
     )
@@ -164,6 +166,7 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
     n = round((stop - start) / step)
     bar = streaming.progress or SampleProgress(n + 1)
     state = _Comparer(case, settings.mode, bar)
+    state.keep_all = len(case.references) > 1  # each table compared from the run's start: the run kept whole
     seen = False  # the input envelopes are filled on the first reading of the table only
 
     def inputs():
@@ -171,11 +174,16 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
         assert case.inputs is not None
         chunks, first = case.inputs(), not seen
         seen = True
+        last = None
         for chunk in chunks:
             if first:
                 for s in input_names:
                     state.envelopes[("input", s)].add(chunk["time"], chunk[s])
+                last = chunk[-1:] if len(chunk) else last
             yield chunk
+        if last is not None and last["time"][0] < case.t_end:  # a row holds to the end: drawn so
+            for s in input_names:
+                state.envelopes[("input", s)].add(np.array([case.t_end]), last[s])
 
     results = target.runner.run_chunks(
         Experiment(start, stop, step, options["RelTol"]),
@@ -190,19 +198,21 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
             state.out = stack.enter_context(open(streaming.result_file, "w", newline="\n"))
         state.results = results
         try:
-            if isinstance(settings.mode, Tube):
-                for chunk in case.ref_chunks:
-                    state.tube_rows(chunk)
-                state.tube_rows(None)
-            else:
-                held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-                for chunk in case.ref_chunks:
+            for reference in case.references:
+                if isinstance(settings.mode, Tube):
+                    for chunk in reference:
+                        state.tube_rows(chunk)
+                    state.tube_rows(None)
+                else:
+                    held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
+                    for chunk in reference:
+                        if held is not None:
+                            chunk = np.concatenate([held, chunk])
+                        held = chunk[-1:]
+                        state.compare_rows(chunk[:-1], chunk["time"][-1])
                     if held is not None:
-                        chunk = np.concatenate([held, chunk])
-                    held = chunk[-1:]
-                    state.compare_rows(chunk[:-1], chunk["time"][-1])
-                if held is not None:
-                    state.compare_rows(held, np.nan)
+                        state.compare_rows(held, np.nan)
+                state.next_reference()
             state.result_until(n)  # the rest of the run: an FMU failing there fails the case
         except SimulationError as error:
             outcome = CaseOutcome(case.name, **target.labels, status=Status.ERROR, messages=[str(error)])
@@ -227,14 +237,19 @@ class _Comparer:
             for key in [("ref", s) for s in outputs]
             + [("result", s) for s in outputs]
             + [("deviation", s) for s in outputs]
+            + ([(edge, s) for s in outputs for edge in ("lower", "upper")] if mode.fills_band else [])
             + [("input", s) for s in case.input_names]
         }
         self.zoom_at: float | None = None  # the first failing sample's time, the zoom's lines around it
         self.zoom_lines: list | None = None
         self.recent: dict[str, tuple] = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower,
         # upper, deviation)
-        self.absent = 0  # reference times without a result sample: their count, the first's time
+        # reference times without a result sample: their count and the first's time, of the first table with any
+        self.absent = 0
         self.first_absent: float | None = None
+        self.absent_here = 0  # of the table being compared
+        self.first_absent_here: float | None = None
+        self.keep_all = False  # the run's chunks kept from its start (several reference tables)
         self.window: list[tuple[int, np.ndarray]] = []  # result chunks not yet compared: (first index, chunk)
         self.reached = 0  # result samples made
         self.results: Iterator[np.ndarray] = iter(())  # the run's chunks
@@ -244,6 +259,13 @@ class _Comparer:
         self.reference: np.ndarray | None = None  # a tube's: the reference rows its next samples look around
         self.t_first: float | None = None  # the reference's first time
         self.compared = 0  # a tube's: the result samples compared
+
+    def next_reference(self):
+        """The table compared is done: the next one starts at the run's start."""
+        if self.absent_here and not self.absent:
+            self.absent, self.first_absent = self.absent_here, self.first_absent_here
+        self.absent_here, self.first_absent_here = 0, None
+        self.reference, self.t_first, self.compared = None, None, 0
 
     def result_until(self, k):
         """The result window through sample k (or the end)."""
@@ -266,9 +288,9 @@ class _Comparer:
         whole: comparison.aligned on the result samples around the rows' times."""
         if not len(rows):
             return
-        step, window = self.step, self.window
+        step, window, names = self.step, self.window, rows.dtype.names[1:]
         times = rows["time"]
-        for s in self.outputs:
+        for s in names:
             self.envelopes[("ref", s)].add(times, rows[s])
         # the result's samples from two steps before the first time to two after the last (by their times:
         # fmpy's loop adds a sample at an input event between communication points)
@@ -278,7 +300,7 @@ class _Comparer:
             self.result_until(self.reached)
             if self.reached == before:
                 break  # the run has no more samples
-        while len(window) > 1 and float(window[1][1]["time"][0]) <= low:
+        while not self.keep_all and len(window) > 1 and float(window[1][1]["time"][0]) <= low:
             window.pop(0)  # chunks before the first sample needed
         result = (window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])) if window else None
         if result is not None:
@@ -289,15 +311,15 @@ class _Comparer:
             index = aligned(result["time"], np.append(times, next_time))[:-1]  # (the next row tells a repeated time)
         missing = np.flatnonzero(index == -1)
         if len(missing):
-            if self.first_absent is None:
-                self.first_absent = float(times[missing[0]])
-            self.absent += len(missing)
+            if self.first_absent_here is None:
+                self.first_absent_here = float(times[missing[0]])
+            self.absent_here += len(missing)
         use = index >= 0
         if result is None or not use.any():
             return
         assert isinstance(self.mode, Pointwise)  # (stream_case gives a tube's rows to tube_rows)
         picked, compared_times, bands = result[index[use]], times[use], {}
-        for s in self.outputs:
+        for s in names:
             expected = rows[s][use].astype(np.float64)
             values = picked[s].astype(np.float64)
             lower, upper, ok = self.mode.bounds(values, expected)
@@ -314,7 +336,7 @@ class _Comparer:
         mode = self.mode
         assert isinstance(mode, Tube)
         if rows is not None and len(rows):
-            for s in self.outputs:
+            for s in rows.dtype.names[1:]:
                 self.envelopes[("ref", s)].add(rows["time"], rows[s])
             self.t_first = float(rows["time"][0]) if self.t_first is None else self.t_first
             self.reference = rows if self.reference is None else np.concatenate([self.reference, rows])
@@ -331,7 +353,7 @@ class _Comparer:
                 if self.reached == before:
                     return  # the run has no more samples
             window = self.window
-            while len(window) > 1 and window[1][0] <= self.compared:
+            while not self.keep_all and len(window) > 1 and window[1][0] <= self.compared:
                 window.pop(0)  # chunks compared already
             base = window[0][0]
             result = window[0][1] if len(window) == 1 else np.concatenate([c for _, c in window])
@@ -339,7 +361,9 @@ class _Comparer:
             take = int(np.searchsorted(result["time"], covered, side="left"))
             if take:
                 span = (self.t_first, last if rows is None else np.inf)
-                self._add({s: mode.band(result[:take], reference, s, span) for s in self.outputs})
+                self._add(
+                    {s: mode.band(result[:take], reference, s, span) for s in tuple(reference.dtype.names or ())[1:]}
+                )
                 self.compared += take
             if take < len(result):
                 break
@@ -350,14 +374,16 @@ class _Comparer:
     def _add(self, bands):
         """Each signal's band on the compared samples; the zoom at the first failing one."""
         failing_now = []
-        for s in self.outputs:
-            band = bands[s]
+        for s, band in bands.items():
             if not len(band.times):
                 continue
             verdict = self.signals[s].deviation
             before = verdict.failed
             self.signals[s].add(band)
             self.envelopes[("deviation", s)].add(band.times, band.deviation)
+            if self.mode.fills_band:  # (the same samples: both edges' envelopes have the same times)
+                self.envelopes[("lower", s)].add(band.times, band.lower)
+                self.envelopes[("upper", s)].add(band.times, band.upper)
             if self.zoom_lines is None and verdict.failed > before and verdict.time is not None:
                 failing_now.append(verdict.time)
             self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation)
@@ -371,6 +397,13 @@ class _Comparer:
                 k = int(np.searchsorted(t, at))
                 w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
                 self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w]))
+
+    def band(self, name):
+        """The band's edges to draw, (times, lower, upper), or None."""
+        if not self.mode.fills_band:
+            return None
+        (times, lower), (_, upper) = self.envelopes[("lower", name)].line(), self.envelopes[("upper", name)].line()
+        return (times, lower, upper) if len(times) else None
 
     def outcome(self, case: ChunkedCase, labels, settings):
         """The case's CaseOutcome once every reference row was compared."""
@@ -390,7 +423,7 @@ class _Comparer:
             figure = Figure(
                 case.title,
                 [(s, *envelopes[("input", s)].line()) for s in case.input_names],
-                [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), None) for s in outputs],
+                [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), self.band(s)) for s in outputs],
                 [(s, *envelopes[("deviation", s)].line()) for s in outputs],
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 
 from ._cases import Case
-from ._comparison import Comparison, compare_traces
 from ._errors import InputError
 from .recordings import read_recording
 from .recordings._align import align
@@ -28,22 +27,12 @@ class RecordedCase(Case):
     coarse: str = ""  # why an exact comparison cannot hold
     shift: int = 1  # steps from a row's time to its output's (timing)
 
-    def comparison(self, result, mode) -> Comparison:
-        """Every compared signal on its own samples."""
-        merged = Comparison()
-        for reference in self.references:
-            part = compare_traces(result, reference, mode)
-            merged.deviations += part.deviations
-            merged.bands.update(part.bands)
-            merged.problem = merged.problem or part.problem
-        return merged
-
-    def explain(self, comparison) -> list:
+    def explain(self, deviations) -> list:
         """What a failing comparison's reader needs beside the deviations:
         where in the recording the first ones are, and the notes."""
         messages = []
         step = self.options["StepSize"]
-        for deviation in comparison.deviations:
+        for deviation in deviations:
             channel = self.channels.get(deviation.name)
             if deviation.passed or channel is None or deviation.time is None:
                 continue

@@ -5,19 +5,14 @@ if asked."""
 import hashlib
 import os
 import tempfile
-import time
 from dataclasses import dataclass, field
 
-from ._cases import Case
-from ._comparison import Comparison, Mode
-from ._errors import InputError, SimulationError
-from ._fmpy import Experiment, Signals
+from ._comparison import Mode
 from ._fmu import Fmu
 from ._pipeline import CaseFiles, Streaming, run_folder_case
-from ._longrecording import is_long_recording, run_long_recording
-from ._outcome import CaseOutcome, Status
-from ._plot import load_plotting, plot_case
-from ._recorded import RecordedCase, recorded_case
+from ._recording import run_recording
+from ._outcome import CaseOutcome
+from ._plot import load_plotting
 from .recordings import is_recording
 from .recordings._options import RecordingOptions
 from ._runner import Runner
@@ -59,57 +54,18 @@ class Target:
 
 def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> CaseOutcome:
     """The case in folder (its files' texts given, or None: read them), or
-    the recording there (read with settings.recording), on target."""
-    plots = settings.plots
-    recorded = texts is None and is_recording(folder)  # (texts come with a case folder only)
-    if recorded and not is_long_recording(folder):
-        return _run_recording_in_memory(folder, name, target, settings)
-    result_file = _result_file() if plots != "none" else None
+    the recording there (read with settings.recording), on target: read,
+    run and compared by the pipeline, plotted if asked."""
+    result_file = _result_file() if settings.plots != "none" else None
     streaming = Streaming(result_file=result_file)
-    outcome = (
-        run_long_recording(folder, name, target, settings, streaming)
-        if recorded
-        else run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
-    )
-    if recorded and outcome is None:
-        outcome = _run_recording_in_memory(folder, name, target, settings)
-    if result_file and (outcome is None or not outcome.png):  # a result file only with a plot
+    if texts is None and is_recording(folder):  # (texts come with a case folder only)
+        outcome = run_recording(folder, name, target, settings, streaming)
+    else:
+        outcome = run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
+    if result_file and not outcome.png:  # a result file only with the case's plot
         os.unlink(result_file)
-    elif outcome is not None:
+    elif result_file:
         outcome.result_path = result_file
-    return outcome
-
-
-def _run_recording_in_memory(folder, name, target: Target, settings: CaseSettings) -> CaseOutcome:
-    started = time.perf_counter()
-    runner, fmu, labels, mode, plots = target.runner, target.fmu, target.labels, settings.mode, settings.plots
-    outcome = CaseOutcome(name, **labels)
-    case: Case
-    try:
-        case = recorded_case(str(folder), fmu, name, settings.recording)
-    except InputError as error:
-        outcome.status, outcome.messages = Status.INVALID, [str(error)]
-        outcome.seconds = time.perf_counter() - started
-        return outcome
-    try:
-        o = case.options
-        result = runner.run(
-            Experiment(o["StartTime"], o["StopTime"], o["StepSize"], o["RelTol"]),
-            Signals(case.inputs, case.start_values, case.outputs),
-        )
-        comparison = case.comparison(result, mode)
-        outcome.status = Status.PASS if comparison.passed else Status.FAIL
-    except SimulationError as error:
-        result, outcome.status = None, Status.ERROR
-        comparison = Comparison(problem=str(error))
-    outcome.deviations = [d for d in comparison.deviations if not d.passed]  # a passing signal says nothing more
-    outcome.messages = comparison.messages()
-    if isinstance(case, RecordedCase):  # what was read, matched and assumed, pass or fail
-        outcome.messages += [case.description] + (case.explain(comparison) if not comparison.passed else case.notes)
-    if result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
-        outcome.result = result
-        outcome.png = plot_case(case, result, comparison, mode, labels["fmu"])
-    outcome.seconds = time.perf_counter() - started
     return outcome
 
 

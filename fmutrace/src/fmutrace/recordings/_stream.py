@@ -1,5 +1,5 @@
 """A long one-file recording (a table export: CSV/TSV, TIA Portal, CODESYS
-V3) read in blocks of lines (_longrecording runs it through _longcase.stream_case),
+V3) read in blocks of lines (_recording runs it through _pipeline.run_chunked_case),
 in memory that does not grow with its length.
 
 The file's head (its first HEAD_BYTES) is read as the in-memory path reads
