@@ -12,6 +12,8 @@ import io
 import re
 import shutil
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -85,22 +87,33 @@ def test_failing_references_chunked_as_in_memory(how, mode, tmp_path):
     assert long.passed == (how == "repeated")
 
 
-def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
+@pytest.mark.parametrize("spill", [0, 1 << 22], ids=["in-a-file-as-made", "in-memory-until-kept"])
+def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(spill, tmp_path, monkeypatch):
+    import fmutrace._pipeline as pipeline
+
+    monkeypatch.setattr(pipeline, "SPILL_BYTES", spill)
+    monkeypatch.setattr(pipeline.tempfile, "tempdir", str(tmp_path / "temp"))
+    (tmp_path / "temp").mkdir()
     folder = failing_copy(tmp_path, "ulp")
     path = fmu_path(BUILD_DIR, "RateLimiter", 3)
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
-    out = tmp_path / "out.csv"
+    settings = {"keep_result": True, "steps_per_chunk": 2, "chunk_bytes": 16}
     long = run_folder_case(
-        CaseFiles(folder, "ulp"),
-        Target(runner, fmu, labels),
-        CaseSettings(Exact(), "failed"),
-        Streaming(result_file=out, steps_per_chunk=2, chunk_bytes=16),
+        CaseFiles(folder, "ulp"), Target(runner, fmu, labels), CaseSettings(Exact(), "failed"), Streaming(**settings)
     )
     assert not long.passed and long.png.startswith(b"\x89PNG")
     whole = on_the_whole(folder, runner, fmu, Exact())
     write_trace(tmp_path / "whole.csv", whole[3])
-    assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    out = Path(long.result_path)
+    assert out.parent == tmp_path / "temp" and out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    passing = run_folder_case(  # no plot: no result file, none left behind
+        CaseFiles(SCENARIO_ROOT / "RateLimiter" / "step_up", "step_up"),
+        Target(runner, fmu, labels),
+        CaseSettings(Exact(), "failed"),
+        Streaming(**settings),
+    )
+    assert passing.passed and not passing.result_path and sorted((tmp_path / "temp").iterdir()) == [out]
 
 
 def test_run_in_chunks_writes_what_simulate_gives(tmp_path):

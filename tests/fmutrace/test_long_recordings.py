@@ -7,6 +7,7 @@ here (perturbed, off-cycle stamps, the other timing, a tolerance, a
 printed 10 ms ramp), with a head and blocks of a few lines so that every
 boundary occurs; and what the streamed path leaves to the in-memory one."""
 
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -211,15 +212,18 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
         runner = Runner(fmu_file.read_bytes())  # its own: worker_fmu's are shared
         fmu = Fmu(str(fmu_file), runner.md)
         labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
-        written = tmp_path / "result.csv"
         streamed = run_streamed_recording(
             str(path),
             path.name,
             Target(runner, fmu, labels),
             CaseSettings(Exact(), "all", RecordingOptions()),
-            Streaming(result_file=str(written), block_bytes=120),
+            Streaming(keep_result=True, block_bytes=120),
         )
-        return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not written.exists()
+        return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not any(temp.iterdir())
+
+    temp = tmp_path / "temp"  # where a result file would be written
+    temp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))
 
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
     for edit in (skipped, backwards, not_a_number):

@@ -18,8 +18,12 @@ reference scenario in chunks of one step and one row).
 """
 
 import contextlib
+import itertools
+import math
 import time
 from collections.abc import Callable, Iterator
+import os
+import tempfile
 from typing import TextIO
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -47,7 +51,7 @@ class Streaming:
     """How a long case streams: where its result goes, the size of its
     pieces (tests make them small), its progress bar."""
 
-    result_file: str | None = None  # the result written here as it is made (for the report), or None
+    keep_result: bool = False  # the result of a case that gets its plot kept in a file (result_path)
     steps_per_chunk: int = STEPS_PER_CHUNK  # steps run between two result chunks
     chunk_bytes: int = CHUNK_BYTES  # CSV text per chunk of a case's files
     block_bytes: int | None = None  # text per block of a recording's lines (None: recordings._stream's)
@@ -123,23 +127,33 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         for file_name in (f"{model}_ref.opt", f"{model}_start.csv", "README.md"):
             if (folder / file_name).exists():
                 texts[file_name] = read_text(folder / file_name)
+        ref_chunks = trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes)
         try:
-            first_ref = next(trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=1 << 16))
+            first_ref = next(ref_chunks)
             last = last_time(ref_path)
         except (OSError, ValueError, StopIteration) as error:
             raise NotPlain(str(error)) from None
+        ref_chunks = itertools.chain([first_ref], ref_chunks)  # (each file read once)
         bounds = np.zeros(2, dtype=[("time", np.float64)])
         bounds["time"] = [first_ref["time"][0], last]
         options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
         start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
         input_names, table = (), None
         if in_path.exists():
-            input_names = _signal_names(next(trace_chunks(in_path, fmu.input_problem, chunk_bytes=1 << 16)))
+            in_chunks = trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+            first_in = next(in_chunks, None)
+            if first_in is None:
+                raise NotPlain("no samples")
+            input_names = _signal_names(first_in)
+            read_once = [itertools.chain([first_in], in_chunks)]  # the first reading goes on from there
 
             def table():
-                return trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+                return (
+                    read_once.pop()
+                    if read_once
+                    else trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
+                )
 
-        ref_chunks = trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes)
         outputs = list(_signal_names(first_ref))
         readme = (texts.get("README.md") or "").strip().splitlines()
         description = readme[0].lstrip("# ").strip() if readme else ""
@@ -194,8 +208,8 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
     with contextlib.ExitStack() as stack:
         stack.callback(bar.close)
         stack.callback(results.close)  # given up or done: the run's chunks and pointers go now, not with the frame
-        if streaming.result_file:
-            state.out = stack.enter_context(open(streaming.result_file, "w", newline="\n"))
+        state.result = _Result(streaming.keep_result)
+        stack.callback(state.result.close)  # (a result not kept by then is removed)
         state.results = results
         try:
             for reference in case.references:
@@ -213,14 +227,14 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
                     if held is not None:
                         state.compare_rows(held, np.nan)
                 state.next_reference()
-            state.result_until(n)  # the rest of the run: an FMU failing there fails the case
+            state.result_until(math.inf)  # the rest of the run: an FMU failing there fails the case
         except SimulationError as error:
             outcome = CaseOutcome(case.name, **target.labels, status=Status.ERROR, messages=[str(error)])
             if case.more_messages is not None:
                 outcome.messages += case.more_messages(False, [])
             outcome.seconds = time.perf_counter() - case.started
             return outcome
-    return state.outcome(case, target.labels, settings)
+        return state.outcome(case, target.labels, settings)  # (its result file kept before the stack closes)
 
 
 class _Comparer:
@@ -230,7 +244,6 @@ class _Comparer:
     def __init__(self, case: ChunkedCase, mode: Mode, bar: SampleProgress):
         options, outputs = case.options, case.outputs
         self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
-        self.n = round((options["StopTime"] - self.start) / self.step)
         self.signals = {name: Verdict(name) for name in outputs}
         self.envelopes = {
             key: Envelope(self.start, case.t_end)
@@ -253,8 +266,7 @@ class _Comparer:
         self.window: list[tuple[int, np.ndarray]] = []  # result chunks not yet compared: (first index, chunk)
         self.reached = 0  # result samples made
         self.results: Iterator[np.ndarray] = iter(())  # the run's chunks
-        self.out: TextIO | None = None  # the result file
-        self.writer: TraceWriter | None = None
+        self.result = _Result(False)  # the result kept for its file
         self.bar = bar
         self.reference: np.ndarray | None = None  # a tube's: the reference rows its next samples look around
         self.t_first: float | None = None  # the reference's first time
@@ -277,9 +289,7 @@ class _Comparer:
             self.reached += len(chunk)
             for s in self.outputs:
                 self.envelopes[("result", s)].add(chunk["time"], chunk[s])
-            if self.out is not None:
-                self.writer = self.writer or TraceWriter(self.out, chunk.dtype.names)
-                self.writer.write(chunk)
+            self.result.add(chunk)
             self.bar.update(self.reached)
 
     def compare_rows(self, rows, next_time):
@@ -428,5 +438,65 @@ class _Comparer:
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
             outcome.png = draw(figure, settings.mode, labels["fmu"])
+            outcome.result_path = self.result.keep() or ""
         outcome.seconds = time.perf_counter() - case.started
         return outcome
+
+
+SPILL_BYTES = 1 << 22  # a result kept for its file goes there as it is made once it is larger than this
+
+
+class _Result:
+    """A run's result kept for the case's result file (the report moves it
+    in): in memory while it is small, in a file of its own (made then)
+    once larger, so that memory stays flat; keep() gives the file, close()
+    removes one not kept."""
+
+    def __init__(self, wanted: bool):
+        self.wanted = wanted
+        self.chunks: list[np.ndarray] = []
+        self.size = 0
+        self.path: str | None = None
+        self.file: TextIO | None = None
+        self.writer: TraceWriter | None = None
+        self.kept = False
+
+    def add(self, chunk):
+        if not self.wanted:
+            return
+        if self.writer is None:
+            self.chunks.append(chunk)
+            self.size += chunk.nbytes
+            if self.size <= SPILL_BYTES:
+                return
+            self._open()
+        else:
+            self.writer.write(chunk)
+
+    def _open(self):
+        handle, self.path = tempfile.mkstemp(prefix="fmutrace-", suffix="_out.csv")
+        os.chmod(self.path, 0o644)  # as the report's other files (mkstemp makes it private)
+        self.file = file = os.fdopen(handle, "w", newline="\n")
+        names = self.chunks[0].dtype.names if self.chunks else ("time",)
+        self.writer = TraceWriter(file, names)
+        for chunk in self.chunks:
+            self.writer.write(chunk)
+        self.chunks = []
+
+    def keep(self) -> str | None:
+        """The result's file, written whole (None if no result was wanted or made)."""
+        if not self.wanted or (self.writer is None and not self.chunks):
+            return None
+        if self.writer is None:
+            self._open()
+        assert self.file is not None
+        self.file.close()
+        self.kept = True
+        return self.path
+
+    def close(self):
+        if self.file is not None and not self.file.closed:
+            self.file.close()
+        if self.path is not None and not self.kept:
+            os.unlink(self.path)
+        self.chunks = []

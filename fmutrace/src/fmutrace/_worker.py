@@ -3,8 +3,6 @@ process or a Dask worker): read and checked, simulated, compared, plotted
 if asked."""
 
 import hashlib
-import os
-import tempfile
 from dataclasses import dataclass, field
 
 from ._comparison import Mode
@@ -56,25 +54,12 @@ def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> Cas
     """The case in folder (its files' texts given, or None: read them), or
     the recording there (read with settings.recording), on target: read,
     run and compared by the pipeline, plotted if asked."""
-    result_file = _result_file() if settings.plots != "none" else None
-    streaming = Streaming(result_file=result_file)
+    streaming = Streaming(keep_result=settings.plots != "none")
     if texts is None and is_recording(folder):  # (texts come with a case folder only)
         outcome = run_recording(folder, name, target, settings, streaming)
     else:
         outcome = run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
-    if result_file and not outcome.png:  # a result file only with the case's plot
-        os.unlink(result_file)
-    elif result_file:
-        outcome.result_path = result_file
     return outcome
-
-
-def _result_file():
-    """A new file for a long case's result, written as it is made (the report takes it)."""
-    handle, path = tempfile.mkstemp(prefix="fmutrace-", suffix="_out.csv")
-    os.close(handle)
-    os.chmod(path, 0o644)  # as the report's other files (mkstemp makes it private)
-    return path
 
 
 # the FMU's content hash -> (Runner, Fmu), kept from task to task in a worker process
