@@ -176,6 +176,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 void fmi2FreeInstance(fmi2Component instance) {
     Fmi2Instance *g = (Fmi2Instance *)instance;
     if (!g) return;
+    fmu_free_instance(&g->base);
     const fmi2CallbackFreeMemory release = g->functions.freeMemory;
     release((void *)g->instanceName);
     release(g);

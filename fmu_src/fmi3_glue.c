@@ -192,6 +192,7 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
 }
 
 void fmi3FreeInstance(fmi3Instance instance) {
+    if (instance) fmu_free_instance((FmuInstance *)instance);
     free(instance);
 }
 

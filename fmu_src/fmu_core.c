@@ -37,7 +37,23 @@ void fmu_init_instance(FmuInstance *instance) {
     instance->model = &fmuModel;
     instance->inputVr = fmuModel.inputVr;
     instance->outputVr = fmuModel.outputVr;
+    instance->plan = NULL;
     fmu_reset(instance);
+}
+
+void fmu_free_instance(FmuInstance *instance) {
+    if (instance->plan) instance->release(instance, instance->plan);
+    instance->plan = NULL;
+}
+
+/* The instance's kept plan, made at its first use; NULL if no memory
+ * (remainingTime is then planned afresh at each read: the same value). */
+static RlPlan *kept_plan(FmuInstance *instance) {
+    if (!instance->plan) {
+        instance->plan = (RlPlan *)instance->allocate(instance, sizeof *instance->plan);
+        if (instance->plan) memset(instance->plan, 0, sizeof *instance->plan);
+    }
+    return instance->plan;
 }
 
 void fmu_reset(FmuInstance *instance) {
@@ -51,6 +67,7 @@ void fmu_reset(FmuInstance *instance) {
     fmu_leave_instant(instance); /* latched: values this FMU could have */
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
+    if (instance->plan) instance->plan->valid = false; /* (a plan is only ever a cost saved) */
     /* the start values are the outputs until Initialization Mode */
     instance->outputsStale = FMU_FRESH;
     fmu_invalidate(instance);
@@ -161,7 +178,8 @@ FmuStatus fmu_access_error(FmuInstance *instance, const char *function, int type
 static void publish(FmuInstance *instance, bool block) {
     instance->core.values[0] = instance->core.time; /* the independent variable */
     if (block) {
-        instance->model->publish(&instance->core.block, &instance->prepared, instance->modelMode,
+        RlPlan *plan = instance->prepared.accelLimited ? kept_plan(instance) : NULL;
+        instance->model->publish(&instance->core.block, &instance->prepared, instance->modelMode, plan,
                                  instance->core.values);
     }
     instance->outputsStale = FMU_FRESH;

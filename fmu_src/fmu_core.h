@@ -67,6 +67,8 @@ struct FmuInstance {
      * from the values at the next step (configure), prepared before a
      * cycle runs (prepareDue) */
     RlPrepared prepared;
+    RlPlan *plan;               /* remainingTime's with the acceleration limit, kept from read to read
+                                   (rl_outputs); made at its first use, NULL until then */
     int modelMode;              /* the model's own, from the same configure */
     bool configDirty;           /* a parameter or input other than u changed */
     unsigned char outputsStale; /* FMU_STALE_*: what changed since the outputs were published */
@@ -98,6 +100,8 @@ struct FmuInstance {
 
 /* modelExchange and errorMode set first */
 RL_LINKAGE void fmu_init_instance(FmuInstance *instance);
+/* What the instance holds beyond its own memory, released (before the glue frees it) */
+RL_LINKAGE void fmu_free_instance(FmuInstance *instance);
 RL_LINKAGE void fmu_reset(FmuInstance *instance);
 
 /* The values or the mode changed other than by a new u (a set, a reset, a

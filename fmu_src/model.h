@@ -51,8 +51,9 @@ typedef struct {
      * the configuration of the last cycle. */
     int (*configure)(const double *values, RlConfig *config);
     /* The outputs of the block's state and of the configuration of its
-     * last cycle (prepared, modelMode). */
-    void (*publish)(const RlState *block, const RlPrepared *prepared, int modelMode, double *values);
+     * last cycle (prepared, modelMode); plan: the block's kept plan
+     * (rl_outputs). */
+    void (*publish)(const RlState *block, const RlPrepared *prepared, int modelMode, RlPlan *plan, double *values);
     /* NULL: the block has no status outputs */
     const FmuStatusOutputs *statusOutputs;
 } ModelDefinition;

@@ -292,23 +292,76 @@ static double remaining_time(const RlState *s, const RlPrepared *p, double y, do
 /* With the acceleration limit the time to uc is the block's own plan: its
  * cycles run ahead on a copy at constant inputs, counted (rules.md). A
  * plan that does not arrive within RL_PLAN_CYCLES, or stalls (a step that
- * does not move the output from rest), gives +inf. */
+ * does not move the output from rest), gives +inf. A kept plan (RlPlan)
+ * is followed instead of made again while the state is one of its cycles:
+ * the same count, exactly, at the cost of the cycles run since. */
 #define RL_PLAN_CYCLES 67108864.0 /* 2^26 */
-static double planned_time(const RlState *s, const RlPrepared *p, double uc) {
-    RlState ahead = *s;
-    if (s->decided == RL_DECIDED_HOLD) ahead.decided = RL_DECIDED_OTHER; /* hold stops the output */
-    double cycles = 0;
-    while (ahead.y != uc && cycles < RL_PLAN_CYCLES) {
-        const double before = ahead.y;
-        const bool atRest = ahead.decided != RL_DECIDED_RAMP || ahead.y == ahead.yPrevious;
-        rl_ramp(&ahead, p, s->uPrevious);
-        cycles += 1;
-        if (atRest && ahead.y == before) return INFINITY;
-    }
-    return ahead.y == uc ? rl_product(cycles, p->period) : INFINITY;
+
+static bool same_double(double a, double b) {
+    return memcmp(&a, &b, sizeof a) == 0; /* bit for bit: -0.0 and NaN payloads too */
 }
 
-void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
+/* What rule 6's next cycles depend on: equal in a and b */
+static bool same_course(const RlState *a, const RlState *b, const RlPrepared *p) {
+    return same_double(a->y, b->y) && same_double(a->yPrevious, b->yPrevious) && same_double(a->yBefore, b->yBefore) &&
+           same_double(a->uPrevious, b->uPrevious) && a->decided == b->decided &&
+           same_double(a->periodLast, b->periodLast) && same_double(a->periodBefore, b->periodBefore) &&
+           (!p->durationLimited || (a->runCycles == b->runCycles && same_double(a->runPeriod, b->runPeriod) &&
+                                    same_double(a->runBase, b->runBase)));
+}
+
+/* plan->end one cycle on at most RL_PLAN_CYCLES from plan->at, until it
+ * reaches uc or stalls. */
+static void plan_ahead(RlPlan *plan, const RlPrepared *p) {
+    RlState *end = &plan->end;
+    while (end->y != plan->uc && !plan->stalled && plan->planned < RL_PLAN_CYCLES) {
+        const double before = end->y;
+        const bool atRest = end->decided != RL_DECIDED_RAMP || end->y == end->yPrevious;
+        rl_ramp(end, p, plan->at.uPrevious);
+        plan->planned += 1;
+        plan->work += 1;
+        plan->stalled = atRest && end->y == before;
+    }
+}
+
+/* Whether now is the plan's state after the cycles the block ran since
+ * plan->at (rule 6 counts them in runCycles): plan->at moves there. */
+static bool plan_followed(RlPlan *plan, const RlState *now, const RlPrepared *p) {
+    if (same_course(&plan->at, now, p)) return true;
+    if (now->runPeriod != plan->at.runPeriod || now->runCycles <= plan->at.runCycles ||
+        !same_double(now->uPrevious, plan->at.uPrevious)) {
+        return false;
+    }
+    const uint64_t ran = now->runCycles - plan->at.runCycles;
+    if ((double)ran > plan->planned) return false;
+    RlState course = plan->at;
+    for (uint64_t n = 0; n < ran; n++) rl_ramp(&course, p, plan->at.uPrevious);
+    plan->work += (double)ran;
+    if (!same_course(&course, now, p)) return false;
+    plan->at = *now;
+    plan->planned -= (double)ran;
+    return true;
+}
+
+static double planned_time(const RlState *s, const RlPrepared *p, RlPlan *kept, double uc) {
+    RlState now = *s;
+    if (now.decided == RL_DECIDED_HOLD) now.decided = RL_DECIDED_OTHER; /* hold stops the output */
+    RlPlan fresh;
+    RlPlan *plan = kept ? kept : &fresh;
+    if (!kept || !kept->valid || !same_double(kept->uc, uc) || memcmp(&kept->prepared, p, sizeof *p) != 0 ||
+        !plan_followed(kept, &now, p)) {
+        plan->valid = true;
+        plan->stalled = false;
+        plan->at = plan->end = now;
+        plan->planned = 0;
+        plan->uc = uc;
+        plan->prepared = *p;
+    }
+    plan_ahead(plan, p);
+    return plan->end.y == uc && !plan->stalled ? rl_product(plan->planned, p->period) : INFINITY;
+}
+
+void rl_outputs(const RlState *s, const RlPrepared *p, RlPlan *plan, RlOutputs *o) {
     const double y = s->y, yp = s->yPrevious;
     const double uc = rl_target(s->uPrevious, p);
     const bool ramped = s->decided == RL_DECIDED_RAMP;
@@ -334,7 +387,7 @@ void rl_outputs(const RlState *s, const RlPrepared *p, RlOutputs *o) {
                   ? (real ? rl_dydt_real(y, yp, p->period) : rl_dydt_lreal(y, yp, p->period))
                   : 0.0;
     const bool remains = (ramped || s->decided == RL_DECIDED_HOLD) && y != uc && isfinite(y) && isfinite(uc);
-    o->remainingTime = !remains ? 0.0 : p->accelLimited ? planned_time(s, p, uc) : remaining_time(s, p, y, uc);
+    o->remainingTime = !remains ? 0.0 : p->accelLimited ? planned_time(s, p, plan, uc) : remaining_time(s, p, y, uc);
     o->d2ydt2 = !ramped || !isfinite(o->dydt) ? 0.0
                 : real                        ? rl_d2ydt2_real(o->dydt, s, p->period)
                                               : rl_d2ydt2_lreal(o->dydt, s, p->period);

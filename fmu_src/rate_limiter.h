@@ -463,7 +463,24 @@ typedef struct {
     double d2ydt2;                 /* (dydt - dydt of the cycle before) / T */
 } RlOutputs;
 
-RL_LINKAGE void rl_outputs(const RlState *state, const RlPrepared *prepared, RlOutputs *outputs);
+/* remainingTime's plan with the acceleration limit, kept from read to read
+ * while the cycles follow it (rl_outputs): a ramp read every cycle then
+ * costs a few planned cycles per cycle, not the rest of the ramp. Not the
+ * block's memory: a plan the state does not follow is made again, so a
+ * zeroed one, or one of another block, only costs that. */
+typedef struct {
+    bool valid;
+    bool stalled;        /* end cannot move from rest: uc is never reached */
+    RlState at;          /* the state the plan starts from (a hold released) */
+    RlState end;         /* at after planned cycles of rule 6 */
+    double planned;      /* at most RL_PLAN_CYCLES */
+    double uc;           /* the target it runs to */
+    double work;         /* cycles of rule 6 run for it so far (its cost, never reset) */
+    RlPrepared prepared; /* the configuration it runs with */
+} RlPlan;
+
+/* plan: the block's kept plan, or NULL (remainingTime planned afresh). */
+RL_LINKAGE void rl_outputs(const RlState *state, const RlPrepared *prepared, RlPlan *plan, RlOutputs *outputs);
 
 /* Short meaning of a status word, for log messages. */
 RL_LINKAGE const char *rl_status_text(int status);

@@ -47,9 +47,9 @@ static int model_configure(const double *v, RlConfig *c) {
     return mode;
 }
 
-static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, RlPlan *plan, double *v) {
     RlOutputs o;
-    rl_outputs(block, prepared, &o);
+    rl_outputs(block, prepared, plan, &o);
     /* the quadrant of the output the rate was picked by */
     const bool negative = isless(block->yPrevious, 0);
     const bool reset = modelMode == MODE_RESET;

@@ -21,9 +21,10 @@ static int model_configure(const double *v, RlConfig *c) {
     return 0;
 }
 
-static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, RlPlan *plan, double *v) {
     (void)prepared;
     (void)modelMode;
+    (void)plan;
     v[VR_delayedValue] = block->y;
 }
 

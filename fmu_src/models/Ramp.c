@@ -27,11 +27,11 @@ static int model_configure(const double *v, RlConfig *c) {
     return 0;
 }
 
-static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) {
+static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, RlPlan *plan, double *v) {
     (void)modelMode;
     v[VR_rOut] = block->y;
     RlOutputs o;
-    rl_outputs(block, prepared, &o);
+    rl_outputs(block, prepared, plan, &o);
     v[VR_xRampActive] = o.rampActive;
 }
 

@@ -36,9 +36,9 @@ static inline void unified_configure(const UnifiedVariables *vr, const double *v
 }
 
 static inline void unified_publish(const UnifiedVariables *vr, const RlState *block, const RlPrepared *prepared,
-                                   double *v) {
+                                   RlPlan *plan, double *v) {
     RlOutputs o;
-    rl_outputs(block, prepared, &o);
+    rl_outputs(block, prepared, plan, &o);
     v[vr->y] = block->y;
     v[vr->rampActive] = o.rampActive;
     v[vr->runningTime] = rl_running_time(block);
@@ -72,9 +72,10 @@ static inline void unified_publish(const UnifiedVariables *vr, const RlState *bl
         unified_configure(&unifiedVariables, v, c); \
         return 0; \
     } \
-    static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, double *v) { \
+    static void model_publish(const RlState *block, const RlPrepared *prepared, int modelMode, RlPlan *plan, \
+                              double *v) { \
         (void)modelMode; \
-        unified_publish(&unifiedVariables, block, prepared, v); \
+        unified_publish(&unifiedVariables, block, prepared, plan, v); \
     } \
     static const FmuStatusOutputs statusOutputs = { VR_error, VR_status, VR_subFunctionStatus }; \
     FMU_MODEL(VR_u, VR_y, model_configure, model_publish, &statusOutputs)

@@ -118,7 +118,7 @@ static double cycle(Block *b, double u) {
 
 static RlOutputs outputs(const Block *b) {
     RlOutputs o;
-    rl_outputs(&b->state, &b->prepared, &o);
+    rl_outputs(&b->state, &b->prepared, NULL, &o);
     return o;
 }
 
@@ -586,8 +586,8 @@ static void check_same_state(const RlState *a, const RlState *b) {
 
 static void check_same_outputs(const RlState *a, const RlState *b, const RlPrepared *p) {
     RlOutputs x, y;
-    rl_outputs(a, p, &x);
-    rl_outputs(b, p, &y);
+    rl_outputs(a, p, NULL, &x);
+    rl_outputs(b, p, NULL, &y);
     CHECK_EQ(x.rampActive, y.rampActive);
     CHECK_EQ(x.limitingUp, y.limitingUp);
     CHECK_EQ(x.limitingDown, y.limitingDown);
@@ -1381,9 +1381,56 @@ static void test_acceleration_helpers(void) {
     CHECK_BITS(rl_directed_sum_lreal(0.5, 0.25, true), 0.75); /* exact: as it is */
 }
 
+/* remainingTime with a kept plan (RlPlan) is the fresh plan's, read after
+ * every cycle, after runs of cycles, through a hold, a target moved and a
+ * limit changed; and the output reaches uc after exactly that time. */
+static void test_kept_plan_equals_fresh_plan(void) {
+    for (int real = 0; real <= 1; real++) {
+        Block b;
+        RlConfig c = defaults();
+        c.rateUp.value = 3.0;
+        c.rateDown.value = 3.0;
+        c.accelMax.value = 0.7;
+        c.decelMax.value = 0.4;
+        c.real = real;
+        start(&b, &c, 0.0, 0.01);
+        RlPlan plan;
+        memset(&plan, 0, sizeof plan);
+        double u = 25.0, predictedEnd = -1;
+        int mismatches = 0, arrivals = 0;
+        for (int n = 1; n <= 9000; n++) {
+            if (n == 1500) u = 11.0; /* the target moved mid-ramp */
+            if (n == 3000) c.hold = true, reconfigure(&b, &c);
+            if (n == 3040) c.hold = false, reconfigure(&b, &c);
+            if (n == 3500) c.accelMax.value = 0.9, reconfigure(&b, &c);
+            if (n == 4000) u = -7.5; /* across 0 */
+            cycle(&b, u);
+            if (n % 7 == 3) continue; /* runs of cycles unread */
+            RlOutputs kept, fresh;
+            rl_outputs(&b.state, &b.prepared, &plan, &kept);
+            rl_outputs(&b.state, &b.prepared, NULL, &fresh);
+            rl_outputs(&b.state, &b.prepared, &plan, &kept); /* read twice: the same */
+            mismatches += memcmp(&kept.remainingTime, &fresh.remainingTime, sizeof(double)) != 0;
+            if (n > 4000 && predictedEnd < 0 && isfinite(kept.remainingTime) && kept.remainingTime > 0) {
+                predictedEnd = n + kept.remainingTime / 0.01;
+            }
+            if (n > 4000 && b.state.y == (real ? (double)(float)u : u) && predictedEnd > 0) {
+                CHECK_TRUE(fabs(n - predictedEnd) < 1e-6 * predictedEnd); /* arrived when it said */
+                predictedEnd = 0;
+                arrivals++;
+            }
+        }
+        CHECK_EQ(mismatches, 0);
+        CHECK_EQ(arrivals, 1);
+        /* a plan made afresh at every read would run about 10^7 cycles */
+        CHECK_TRUE(plan.work < 40000);
+    }
+}
+
 int main(void) {
     test_quiet_arithmetic();
     test_acceleration_helpers();
+    test_kept_plan_equals_fresh_plan();
     test_rule0_resolve();
     test_rule0_limits();
     test_status_codes();

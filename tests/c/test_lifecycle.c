@@ -124,6 +124,7 @@ static int failures;
 static int version;
 static char token[128];
 static unsigned uVr, yVr, cycleTimeVr;
+static int accelVr = -1; /* accelMax, where the model has it: its plan is made, kept and freed */
 
 #define F2(name) ((name##TYPE *)function(#name))
 #define F3(name) ((name##TYPE *)function(#name))
@@ -232,6 +233,7 @@ static void full_simulation(void) {
     /* debug logging: every category by name */
     static const char *const every[] = { "logStatusError", "logStatusWarning", "logEvents" };
     CHECK(set_debug_logging(c, 3, every) == 0);
+    if (accelVr >= 0) CHECK(set_real(c, (unsigned)accelVr, 40.0) == 0); /* remainingTime's plan in use */
     double t = 0.0;
     for (int k = 0; k < 200; k++, t += 0.01) {
         CHECK(set_u(c, input(k, 0)) == 0);
@@ -532,6 +534,9 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     /* every model has the parameter cycleTime */
     char number[32];
     cycleTimeVr = (unsigned)atoi(attribute(text, "name=\"cycleTime\"", "valueReference=\"", number, sizeof number));
+    if (strstr(text, "name=\"accelMax\"")) {
+        accelVr = atoi(attribute(text, "name=\"accelMax\"", "valueReference=\"", number, sizeof number));
+    }
 }
 
 int main(int argc, char **argv) {
