@@ -168,6 +168,16 @@ def test_3_no_arrival_in_a_settled_tail():
     ) == ["3"]
 
 
+def test_3_a_tail_too_short_for_the_velocity_limit_is_not_judged():
+    """A hold that ends more than two cycles at the fastest velocity limit
+    (V = 100 here) before the target cannot have settled: not flagged; one
+    that ends within them, short of the target, is."""
+    ys = [1.0, 3.0, 6.0, 10.0, 15.0]  # accelerating at A = 1, far from 1000
+    assert props(trace(ys, dict(BASE, u=1000.0), settle=True)) == []
+    ys = [1.0, 3.0, 4.0, 4.0, 4.0]  # stopped 150 short: within two cycles at V = 100
+    assert props(trace(ys, dict(BASE, u=154.0), settle=True)) == ["3"]
+
+
 def test_3_leaving_the_target_reached_at_rest():
     ys = [1.0, 3.0, 4.0, 4.0, 4.0, 4.0 + 2.0**-30, 4.0]
     found = props(trace(ys, dict(BASE, u=4.0)))

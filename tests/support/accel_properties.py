@@ -476,6 +476,8 @@ class Checker:
                 if j > rest and out.get("d2ydt2", 0.0) != 0:
                     self.flag("3", index, j, f"at rest on the target for a second cycle but d2ydt2 = {out['d2ydt2']!r}")
         if accel_limited and settle and not (ys[last] == uc and last >= 2 and ys[last - 1] == uc):
+            if self.still_on_its_way(s, ys[last], uc):
+                return  # the hold ended before even the velocity limit could have brought it there
             stall = ""
             if ys[last] == ys[last - 1] and s.a() < ulp(ys[last], self.arithmetic):
                 stall = f"; a stall: accelMax T^2 = {float(s.a())!r} is below one ulp of y"
@@ -489,6 +491,14 @@ class Checker:
         if accel_limited:
             self.time_optimal(index, seg, s, first, last, ys, prev, arrival)
             self.remaining_time(index, seg, s, first, last, ys)
+
+    def still_on_its_way(self, s, y, uc):
+        """Whether more than two cycles at the fastest velocity limit separate y from uc."""
+        speeds = [s.per_second(rate, self.T) for rate in (s.up, s.down, s.up_neg, s.down_neg)]
+        if any(v is None or not math.isfinite(v) for v in speeds):
+            return False
+        fastest = max(speeds) * self.T
+        return abs(Fraction(uc) - Fraction(y)) > 2 * Fraction(fastest)
 
     def time_optimal(self, index, seg, s, first, last, ys, prev, arrival):
         """5: from rest, a step to u with V and A, no limits cutting, no duration."""
