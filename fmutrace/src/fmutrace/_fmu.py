@@ -2,7 +2,9 @@
 columns and start values before anything runs) and its default
 experiment; and the FMU unpacked once per process for fmpy."""
 
+import atexit
 import hashlib
+import io
 import math
 import os
 import shutil
@@ -149,28 +151,33 @@ def _float(value):
     return float(value)
 
 
-_unpacked: dict[str, tuple] = {}
+_unpacked: dict[str, tuple] = {}  # content hash -> (folder, model description, pid of the process that made it)
 
 
 def unpacked(fmu_bytes):
     """(folder, model description) of an FMU given as bytes, unzipped once
-    per process into a folder named by its content."""
-    key = hashlib.sha256(fmu_bytes).hexdigest()[:20]
-    if key not in _unpacked:
-        folder = Path(tempfile.gettempdir()) / f"fmutrace-{key}"
-        if not (folder / "modelDescription.xml").exists():
-            archive = folder.with_name(f"{folder.name}.{os.getpid()}.fmu")
-            archive.write_bytes(fmu_bytes)
-            try:
-                partial = extract(str(archive), unzipdir=str(folder.with_name(f"{folder.name}.{os.getpid()}.part")))
-                try:
-                    os.replace(partial, folder)
-                except OSError:  # another process was first: theirs is the same
-                    shutil.rmtree(partial, ignore_errors=True)
-            finally:
-                archive.unlink()
-        _unpacked[key] = (str(folder), read_model_description(str(folder)))
-    return _unpacked[key]
+    per process into a folder of its own: made fresh (mkdtemp, mode 0700,
+    never found again by a name another user could plant) and removed at
+    the process's exit."""
+    key = hashlib.sha256(fmu_bytes).hexdigest()
+    known = _unpacked.get(key)
+    if known is None or known[2] != os.getpid():  # (a forked child makes its own: the parent removes its one)
+        folder = tempfile.mkdtemp(prefix="fmutrace-fmu-")
+        atexit.register(_remove, folder, os.getpid())
+        try:
+            extract(io.BytesIO(fmu_bytes), unzipdir=folder)
+            known = (folder, read_model_description(folder), os.getpid())
+        except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
+            _remove(folder, os.getpid())
+            raise InputError(f"the FMU cannot be unpacked ({error})") from None
+        _unpacked[key] = known
+    return known[:2]
+
+
+def _remove(folder, owner):
+    """An unpacked FMU's folder, at the exit of the process that made it."""
+    if os.getpid() == owner:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def is_fmu_file(path):
