@@ -50,6 +50,17 @@ def read_text(path):
         raise TraceError(path, 0, 0, error.strerror or str(error)) from None
 
 
+def shown(text) -> str:
+    """Text from users' files and names as it can be shown and written:
+    bytes of a file name that are not UTF-8 (Python's surrogate escapes)
+    as U+FFFD."""
+    text = str(text)
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    except UnicodeEncodeError:  # a surrogate that escapes no byte
+        return text.encode("utf-8", "replace").decode("utf-8")
+
+
 def data_lines(text):
     """(line number, text) of the lines that hold data or the header, split
     as str.splitlines() splits them, one at a time (a reader that needs only

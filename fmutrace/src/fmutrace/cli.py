@@ -19,6 +19,7 @@ from ._fmu import Fmu, is_fmu_file
 from ._longcase import simulate_long
 from ._simulation import SimulationOptions, simulate
 from ._outcome import Status
+from ._report import text
 from .recordings import is_recording
 from .recordings._align import TIMINGS
 from .recordings._options import TIME_UNITS, RecordingOptions
@@ -264,13 +265,13 @@ def compare_command(args, out):
     )
     for o in result.failed(results=False) if not recordings else result.cases.light():
         if o.status == Status.INVALID:
-            print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
+            print(f"fmutrace: error: {text(o.messages[0])}", file=sys.stderr)
             continue
         if o.passed and not o.messages:
             continue
-        print(f"{o.status.upper()}  {o.case} on {o.fmu}", file=out)
+        print(f"{o.status.upper()}  {text(o.case)} on {text(o.fmu)}", file=out)
         for message in o.messages[:10]:
-            print(f"      {message}", file=out)
+            print(f"      {text(message)}", file=out)
     print(result.headline(), file=out)
     if args.report:
         print(f"report: {args.report.rstrip('/')}/index.html", file=out)
