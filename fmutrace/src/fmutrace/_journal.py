@@ -56,9 +56,14 @@ class ReportLock:
 
     def __init__(self, folder):
         self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
         self.path = self.folder / LOCK
-        self.file = open(self.path, "a+")
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            self.file = open(self.path, "a+")
+        except OSError as error:  # a file of that name, a folder not writable
+            raise InputError(
+                f"{self.folder}: cannot write the report there ({error.strerror or error}); choose another folder"
+            ) from None
         try:
             _try_lock(self.file)
         except OSError:

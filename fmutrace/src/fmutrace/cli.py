@@ -4,7 +4,7 @@
   fmutrace compare FMU... CASE... [--report DIR] [--rel-tol R] ...
 
 Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
-simulation, 2 bad input); compare's is its worst case's.
+simulation, 2 bad input, 130 interrupted); compare's is its worst case's.
 """
 
 import argparse
@@ -291,6 +291,15 @@ def main(argv=None, out=None):
     except SimulationError as error:
         print(f"fmutrace: {error}", file=sys.stderr)
         return error.exit_code
+    except OSError as error:  # a file or folder given that cannot be read or written
+        where = f"{text(error.filename)}: " if error.filename else ""
+        print(f"fmutrace: error: {where}{error.strerror or error}", file=sys.stderr)
+        return ExitStatus.BAD_INPUT
+    except KeyboardInterrupt:
+        journal = getattr(args, "report", None)
+        hint = f"; the finished cases are in {journal}: --resume continues" if journal else ""
+        print(f"fmutrace: interrupted{hint}", file=sys.stderr)
+        return ExitStatus.INTERRUPTED
 
 
 if __name__ == "__main__":
