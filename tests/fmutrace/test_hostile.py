@@ -365,3 +365,27 @@ def test_no_copy_of_the_tests_fmus_is_left_in_the_temporary_folder(tmp_path):
     no_traceback(done)
     assert done.returncode == 0, output(done)
     assert not list(shared.iterdir())
+
+
+# 6. Numbers
+
+
+def test_an_underscore_is_no_digit_separator_in_a_case_file(tmp_path):
+    """'1_0' is Python's literal for 10, not a number of a CSV file: the case
+    is invalid, its message at the cell (a recording reads IEC's 1_000 on purpose)."""
+    case = write_case(tmp_path / "cases" / "underscore")
+    (case / "PassThrough_in.csv").write_text("time,u\n0,1\n0.2,1_0\n")
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases")
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "PassThrough_in.csv, line 3, column 2: '1_0' in column 'u' is not a number" in done.stderr, done.stderr
+
+
+def test_a_time_stamp_that_is_not_finite_is_refused_in_a_recording(tmp_path):
+    """A recording's time stamp nan (or inf): exit 2 and the cell, not a comparison at a garbage time."""
+    recording = tmp_path / "rec.csv"
+    recording.write_text("time,u,y\n0,1,0\nnan,1,1\n0.2,3,1\n0.3,3,3\n")
+    done = fmutrace("compare", PASS_THROUGH, recording)
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "rec.csv, line 3, column 1: time nan in column 'time' is not a finite number" in done.stderr, done.stderr

@@ -16,7 +16,7 @@ from pathlib import Path
 from fmpy import extract, read_model_description
 
 from ._errors import InputError
-from ._traces import BOOLEAN_WORDS
+from ._traces import BOOLEAN_WORDS, plain_float
 
 INTEGER_RANGES = {
     "Integer": (-(2**31), 2**31 - 1),
@@ -106,13 +106,13 @@ class Fmu:
             return str(value)
         if kind in REAL_TYPES:
             try:
-                number = float(text)
+                number = plain_float(text)
             except ValueError:
                 raise InputError(f"{name} is a {kind}: {text!r} is not a number") from None
             self._check_range(variable, number, text)
             return number
         try:
-            number = float(text)
+            number = plain_float(text)
         except ValueError:
             number = math.nan
         if not number.is_integer():

@@ -136,9 +136,18 @@ def parse_number(text, decimal_comma=False):
     if decimal_comma and "," in text and "." not in text:
         text = text.replace(",", ".")
     try:
-        return float(text)
+        return plain_float(text)
     except ValueError:
         return None
+
+
+def plain_float(text) -> float:
+    """float(text) without Python's own literal forms: '_' between digits
+    (1_0 is not 10 in a CSV file; recordings read IEC's 1_000 themselves);
+    ValueError if it is not a number."""
+    if "_" in text:
+        raise ValueError(f"{text!r} is not a number")
+    return float(text)
 
 
 def read_trace(
