@@ -227,6 +227,21 @@ def test_a_model_name_with_dot_dot_writes_nothing_outside_the_report(tmp_path):
     assert any(p.name.endswith("_out.csv") for p in new)
 
 
+def test_a_link_in_the_report_folder_does_not_lead_its_files_outside(tmp_path):
+    """The FMU's folder in the report is a link to a folder outside it: no
+    file is written through it; exit 2 and a line that says why."""
+    write_case(tmp_path / "cases" / "one")
+    report, outside = tmp_path / "report", tmp_path / "outside"
+    report.mkdir()
+    outside.mkdir()
+    (report / "PassThrough-fmi2").symlink_to(outside)
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", report)
+    no_traceback(done)
+    assert not list(outside.iterdir())
+    assert done.returncode == 2, output(done)
+    assert "outside the report folder" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
+
+
 # 4. Resumes wrongly
 
 
