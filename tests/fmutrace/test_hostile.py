@@ -242,6 +242,25 @@ def test_a_link_in_the_report_folder_does_not_lead_its_files_outside(tmp_path):
     assert "outside the report folder" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+def test_two_recordings_of_one_file_name_keep_their_own_results(tmp_path):
+    """a/rec.csv and b/rec.csv: two cases of two names, each with its own
+    result file (the second used to overwrite the first's)."""
+    for folder, (low, high) in (("a", (1, 3)), ("b", (5, 7))):
+        (tmp_path / folder).mkdir()
+        # a recorded cycle: the input it read and the output it wrote (PassThrough's y is its u)
+        rows = [(0, low), (0.1, low), (0.2, high), (0.3, high)]
+        (tmp_path / folder / "rec.csv").write_text("time,u,y\n" + "".join(f"{t},{u},{u}\n" for t, u in rows))
+    report = tmp_path / "report"
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "a" / "rec.csv", tmp_path / "b" / "rec.csv", "--report", report)
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    cases = json.loads((report / "results.json").read_text())["cases"]
+    assert [c["case"] for c in cases] == ["a/rec.csv", "b/rec.csv"]
+    for case, (low, high) in zip(cases, ((1, 3), (5, 7)), strict=True):
+        rows = (report / case["result_csv"]).read_text().splitlines()[1:]
+        assert [float(row.split(",")[1]) for row in rows] == [0, low, low, high, high]
+
+
 # 4. Resumes wrongly
 
 
