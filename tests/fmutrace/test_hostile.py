@@ -354,6 +354,21 @@ def test_a_report_folder_that_cannot_be_written_is_bad_input(tmp_path):
     assert done.stderr.startswith("fmutrace: error: ") and len(done.stderr.strip().splitlines()) == 1
 
 
+def test_an_fmu_without_a_binary_for_this_platform_is_bad_input(tmp_path):
+    """PassThrough without its Linux binary: run says so in one line, exit 2."""
+    fmu = tmp_path / "windows_only.fmu"
+    with zipfile.ZipFile(PASS_THROUGH) as source, zipfile.ZipFile(fmu, "w") as target:
+        for item in source.infolist():
+            if not item.filename.startswith("binaries/linux64/"):
+                target.writestr(item, source.read(item))
+    (tmp_path / "in.csv").write_text(INPUT)
+    done = fmutrace("run", fmu, "--input", tmp_path / "in.csv", "--stop-time", "0.5", "--step-size", "0.1")
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "no binaries/linux64/PassThrough.so in the FMU" in done.stderr, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+
+
 def test_ctrl_c_ends_the_command_with_130_and_one_line(tmp_path):
     """SIGINT (Ctrl-C) in the middle of a campaign: exit 130, one line, no traceback."""
     slow = "StartTime,0\nStopTime,20000\nStepSize,0.01\nRelTol,1e-6\n"  # 2 million steps a case

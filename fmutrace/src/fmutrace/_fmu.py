@@ -13,6 +13,7 @@ import tempfile
 import zipfile
 from pathlib import Path
 
+import fmpy
 from fmpy import extract, read_model_description
 
 from ._errors import InputError
@@ -57,6 +58,27 @@ class Fmu:
         self.default_start = _float(experiment and experiment.startTime)
         self.default_stop = _float(experiment and experiment.stopTime)
         self.default_step = _float(experiment and experiment.stepSize)
+
+    def binary_problem(self):
+        """Why the FMU cannot run on this machine (no Co-Simulation binary for
+        its platform), or None. Only where it runs: a cluster's workers may
+        be of another platform than the command's."""
+        fmi3 = self.fmi_version >= 3
+        platform = fmpy.platform_tuple if fmi3 else fmpy.platform
+        identifier = self.model_description.coSimulation.modelIdentifier
+        binary = f"binaries/{platform}/{identifier}{fmpy.sharedLibraryExtension}"
+        try:
+            with zipfile.ZipFile(self.path) as archive:
+                names = archive.namelist()
+        except (OSError, zipfile.BadZipFile) as error:
+            return f"{self.path}: not an FMU ({error})"
+        if binary in names:
+            return None
+        present = sorted({n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") > 1})
+        return (
+            f"{self.path}: {self.label} has no binary for this platform: no {binary} in the FMU "
+            f"(it has binaries for: {', '.join(present) or 'none'})"
+        )
 
     @property
     def outputs(self):

@@ -204,6 +204,9 @@ def parser():
 
 
 def run_command(args, out):
+    problem = Fmu(args.fmu).binary_problem()  # (compare reports it per case, as any failed simulation)
+    if problem:
+        raise InputError(problem)
     options = SimulationOptions(
         dict(args.set), args.start_time, args.stop_time, args.step_size, args.output_interval, args.output
     )
