@@ -416,6 +416,22 @@ def test_no_copy_of_the_tests_fmus_is_left_in_the_temporary_folder(tmp_path):
     assert not list(shared.iterdir())
 
 
+def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(tmp_path):
+    """An MDF 4.10 file marked not finalized, its blocks garbage: asammdf
+    copies it into the temporary folder to finalize it and fails. The case
+    is invalid (exit 2), the copy gone, no traceback of asammdf's clean-up."""
+    shared = tmp_path / "tmp"
+    shared.mkdir()
+    identification = b"MDF     4.10    fmutrace" + bytes(4) + (410).to_bytes(2, "little") + bytes(30)
+    identification += (1).to_bytes(2, "little") + bytes(2)  # unfinalized standard flags: 1
+    (tmp_path / "damaged.mf4").write_bytes(identification + b"##HD" + b"\xff" * 200)
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "damaged.mf4", env=dict(os.environ, TMPDIR=str(shared)))
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "damaged.mf4: not a readable MDF file" in done.stderr, done.stderr
+    assert not list(shared.iterdir())
+
+
 # 6. Numbers
 
 
