@@ -432,6 +432,17 @@ def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(tmp_path):
     assert not list(shared.iterdir())
 
 
+def test_recording_options_on_case_folders_are_not_left_unused_silently(tmp_path):
+    """--step-size and --set read recordings; given with case folders alone
+    they change nothing, and the command says so (the case passes as its
+    own settings make it)."""
+    write_case(tmp_path / "cases" / "one")
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--step-size", "0.2", "--set", "u=7")
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    assert "fmutrace: warning: --step-size, --set not used" in done.stderr, done.stderr
+
+
 # 6. Numbers
 
 

@@ -246,12 +246,30 @@ def compare_command(args, out):
         case_timeout=args.case_timeout,
         cluster_timeout=args.cluster_timeout,
     )
-    # the recordings group's flags read recordings; with case folders alone the command ignores them, as it did
+    # the recordings group's flags read recordings; with case folders alone the command leaves them unused, as
+    # it did, and says so
     recording = (
         RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set)
         if recordings
         else RecordingOptions()
     )
+    unused = [
+        flag
+        for flag, given in (
+            ("--step-size", args.step_size is not None),
+            ("--map", args.map),
+            ("--set", args.set),
+            ("--time-unit", args.time_unit is not None),
+            ("--timing", args.timing != "cycle"),
+        )
+        if given and not recordings
+    ]
+    if unused:
+        print(
+            f"fmutrace: warning: {', '.join(unused)} not used: they read recordings, and a case folder carries its "
+            "own settings (<Model>_ref.opt, <Model>_start.csv)",
+            file=sys.stderr,
+        )
     result = compare(
         fmus,
         cases,
