@@ -443,6 +443,29 @@ def test_recording_options_on_case_folders_are_not_left_unused_silently(tmp_path
     assert "fmutrace: warning: --step-size, --set not used" in done.stderr, done.stderr
 
 
+def bounded_memory():
+    """A child's address space bounded (2 GiB): a command that allocates without bound fails instead of
+    taking the machine."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+
+@pytest.mark.parametrize("times", [("--step-size", "1e-12", "--stop-time", "1"), ("--stop-time", "1e300")])
+def test_run_refuses_more_steps_than_the_bound_before_it_allocates(tmp_path, times):
+    """fmutrace run --step-size 1e-12 (10^12 steps) or a stop time of 1e300:
+    refused at once, exit 2, the value and the bound named."""
+    done = run_bounded(
+        [sys.executable, "-m", "fmutrace", "run", str(PASS_THROUGH), "--step-size", "0.1", *times],
+        timeout=60,
+        what="fmutrace run " + " ".join(times),
+        preexec_fn=bounded_memory,
+    )
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "more than the bound of 200,000,000 steps" in done.stderr, done.stderr
+
+
 # 6. Numbers
 
 
