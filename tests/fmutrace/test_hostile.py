@@ -106,6 +106,31 @@ def test_an_fmu_is_unpacked_into_a_private_folder_never_one_planted(tmp_path):
     assert not [p for p in shared.iterdir() if p != planted], "files left in the temporary folder"
 
 
+FAULTY = BUILD_DIR / "fixtures" / "fmi3" / "Faulty.fmu"  # PassThrough's equation; u = 13 crashes, u = 17 hangs
+
+
+def test_children_killed_leave_no_unpacked_fmu_behind(tmp_path):
+    """--case-timeout runs the cases in child processes: one killed at its
+    timeout (u = 17 hangs) and one crashed (u = 13) cannot remove what they
+    unpacked; the command removes it at its exit. The temporary folder is
+    left as it was found."""
+    shared = tmp_path / "tmp"
+    shared.mkdir()
+    for k in (1, 13, 17):
+        case = tmp_path / "cases" / f"case_{k}"
+        case.mkdir(parents=True)
+        (case / "Faulty_in.csv").write_text(f"time,u\n0,0\n0.2,{k}\n")
+        (case / "Faulty_ref.csv").write_text(f"time,y\n0,0\n0.1,0\n0.2,0\n0.3,{k}\n0.4,{k}\n")
+        (case / "Faulty_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    done = fmutrace(
+        "compare", FAULTY, tmp_path / "cases", "--case-timeout", "3", env=dict(os.environ, TMPDIR=str(shared))
+    )
+    no_traceback(done)
+    assert done.returncode == 1, output(done)
+    assert "ERROR  case_13" in done.stdout and "ERROR  case_17" in done.stdout, output(done)
+    assert not list(shared.rglob("*")), list(shared.rglob("*"))
+
+
 # 2. Text from users' files shown as text everywhere
 
 

@@ -174,6 +174,19 @@ def _float(value):
 
 
 _unpacked: dict[str, tuple] = {}  # content hash -> (folder, model description, pid of the process that made it)
+# a parent's private folder that its child processes unpack into: a child killed (a case over its timeout, a
+# crash) cannot remove its own, the parent removes them all at its exit
+CHILDREN_UNPACK = "FMUTRACE_CHILDREN_UNPACK"
+_children_folder: list[str] = []
+
+
+def children_folder() -> str:
+    """This process's folder for its children's unpacked FMUs (made once, mode 0700, removed at exit): the
+    value of CHILDREN_UNPACK in a child's environment."""
+    if not _children_folder:
+        _children_folder.append(tempfile.mkdtemp(prefix="fmutrace-children-"))
+        atexit.register(_remove, _children_folder[0], os.getpid())
+    return _children_folder[0]
 
 
 def unpacked(fmu_bytes):
@@ -184,7 +197,8 @@ def unpacked(fmu_bytes):
     key = hashlib.sha256(fmu_bytes).hexdigest()
     known = _unpacked.get(key)
     if known is None or known[2] != os.getpid():  # (a forked child makes its own: the parent removes its one)
-        folder = tempfile.mkdtemp(prefix="fmutrace-fmu-")
+        parent = os.environ.get(CHILDREN_UNPACK)  # (a child of a campaign: in the parent's own folder)
+        folder = tempfile.mkdtemp(prefix="fmutrace-fmu-", dir=parent if parent and os.path.isdir(parent) else None)
         atexit.register(_remove, folder, os.getpid())
         try:
             extract(io.BytesIO(fmu_bytes), unzipdir=folder)

@@ -25,6 +25,7 @@ import threading
 import time
 from pathlib import Path
 
+from ._fmu import CHILDREN_UNPACK, children_folder
 from ._outcome import CaseOutcome, Status
 from ._worker import CaseSettings, FmuFile, run_cases
 
@@ -76,6 +77,7 @@ def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outc
         PYTHONPATH=os.pathsep.join(
             [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
         ),
+        **{CHILDREN_UNPACK: children_folder()},  # a child killed leaves its unpacked FMU to this process
     )
     while remaining:
         said = tempfile.TemporaryFile()  # the child's last words, if it dies
