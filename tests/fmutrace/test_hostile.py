@@ -131,6 +131,58 @@ def test_children_killed_leave_no_unpacked_fmu_behind(tmp_path):
     assert not list(shared.rglob("*")), list(shared.rglob("*"))
 
 
+def children_of(pid):
+    """The pids of a process's children (Linux's /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if fields[1] == str(pid):
+            found.append(int(entry.name))
+    return found
+
+
+def alive(pid):
+    try:
+        return (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0] not in ("Z", "X")
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parent-death signal is Linux's")
+def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
+    """The command killed with SIGKILL while its child hangs in the FMU's
+    doStep (u = 17, --case-timeout far away): the child does not spin on."""
+    case = tmp_path / "cases" / "case_17"
+    case.mkdir(parents=True)
+    (case / "Faulty_in.csv").write_text("time,u\n0,0\n0.2,17\n")
+    (case / "Faulty_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,17\n0.4,17\n")
+    (case / "Faulty_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    command = subprocess.Popen(
+        [sys.executable, "-m", "fmutrace", "compare", str(FAULTY), str(tmp_path / "cases"), "--case-timeout", "600"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while not children_of(command.pid) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        children = children_of(command.pid)
+        assert children, "no child started"
+        time.sleep(2)  # in the hanging doStep by now
+        command.kill()
+        command.wait(timeout=30)
+        deadline = time.monotonic() + 30
+        while any(map(alive, children)) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(map(alive, children)), "the child outlived the command"
+    finally:
+        kill_session(command)
+
+
 # 2. Text from users' files shown as text everywhere
 
 
