@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 
+from fmutrace import _report, compare
 from support.fmu_driver import BUILD_DIR
 from support.process import kill_session
 from support.process import run as run_bounded
@@ -336,6 +337,33 @@ def test_two_recordings_of_one_file_name_keep_their_own_results(tmp_path):
     for case, (low, high) in zip(cases, ((1, 3), (5, 7)), strict=True):
         rows = (report / case["result_csv"]).read_text().splitlines()[1:]
         assert [float(row.split(",")[1]) for row in rows] == [0, low, low, high, high]
+
+
+def test_a_report_page_is_replaced_whole_or_not_at_all(tmp_path, monkeypatch):
+    """Writing the pages fails half way (here: the second case's verdict):
+    the pages of the campaign before stay as they were, no half page, no
+    file left beside them."""
+    write_case(tmp_path / "cases" / "one")
+    write_case(tmp_path / "cases" / "two")
+    report = tmp_path / "report"
+    result = compare(PASS_THROUGH, tmp_path / "cases", report=report)
+    assert result.passed
+    pages = {name: (report / name).read_bytes() for name in ("index.html", "summary.md", "results.json")}
+    verdicts = []
+
+    def failing(outcome):
+        verdicts.append(outcome)
+        if len(verdicts) == 2:
+            raise OSError(28, "No space left on device")
+        return "pass"
+
+    monkeypatch.setattr(_report, "_verdict", failing)
+    with pytest.raises(OSError):
+        _report.write_report(result, report)
+    assert {name: (report / name).read_bytes() for name in pages} == pages
+    assert sorted(p.name for p in report.iterdir() if p.is_file()) == sorted(
+        [*pages, "results.jsonl", ".fmutrace.lock"]
+    )
 
 
 # 4. Resumes wrongly

@@ -2,6 +2,7 @@
 case), summary.md, results.json and, when asked, JUnit XML; and each
 case's result as <case>_out.csv."""
 
+import contextlib
 import hashlib
 import html
 import json
@@ -99,6 +100,22 @@ def write_case_files(outcome: CaseOutcome, report_dir):
         outcome.plot = os.path.relpath(f"{stem}.png", report_dir)
 
 
+@contextlib.contextmanager
+def _replaced(path):
+    """A text file written whole or not at all: written as a new file
+    beside it, renamed over it when complete (a reader, or a campaign that
+    fails half way, never sees half a page)."""
+    path = Path(path)
+    new = path.with_name(f".{path.name}.{os.getpid()}.new")
+    try:
+        with open(new, "w", encoding="utf-8") as out:
+            yield out
+        os.replace(new, path)
+    finally:
+        if new.exists():
+            new.unlink()
+
+
 def write_results_json(campaign: CampaignResult, path):
     """results.json, a case at a time (a campaign's cases may not fit in memory at once)."""
     head = {
@@ -110,7 +127,7 @@ def write_results_json(campaign: CampaignResult, path):
         "where": campaign.where,
         "seconds": round(campaign.seconds, 3),
     }
-    with open(path, "w", encoding="utf-8") as out:
+    with _replaced(path) as out:
         out.write(json.dumps(head)[:-1] + ', "cases": [')
         for n, o in enumerate(campaign.cases.light()):
             out.write(("," if n else "") + "\n" + json.dumps(_shown_entry(o.to_json())))
@@ -137,7 +154,7 @@ def write_junit(campaign: CampaignResult, path):
         totals[1] += o.status == Status.FAIL
         totals[2] += o.status in (Status.ERROR, Status.INVALID)
         totals[3] += o.seconds
-    with open(path, "w", encoding="utf-8") as out:
+    with _replaced(path) as out:
         out.write("<?xml version='1.0' encoding='utf-8'?>\n")
         out.write(
             f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts[Status.FAIL]}" '
@@ -184,8 +201,8 @@ def write_report(campaign: CampaignResult, report_dir):
     report_dir.mkdir(parents=True, exist_ok=True)
     headline = campaign.headline()
     with (
-        open(report_dir / "summary.md", "w", encoding="utf-8") as summary,
-        open(report_dir / "index.html", "w", encoding="utf-8") as page,
+        _replaced(report_dir / "summary.md") as summary,
+        _replaced(report_dir / "index.html") as page,
     ):
         summary.write(
             "\n".join(
