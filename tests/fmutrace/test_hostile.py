@@ -571,6 +571,25 @@ def test_run_refuses_more_steps_than_the_bound_before_it_allocates(tmp_path, tim
     assert "more than the bound of 200,000,000 steps" in done.stderr, done.stderr
 
 
+def test_a_recording_of_millions_of_columns_is_refused_at_once(tmp_path):
+    """A CSV recording of 2.5 million columns (a 21 MB header line: 9 + 2.5e6
+    'c' + 16,388,890 digits + 2,499,999 commas; and one row): refused naming
+    the line and the bound, within a bounded memory, instead of minutes of
+    work towards a MemoryError."""
+    columns = 2_500_000
+    header = "time,u,y," + ",".join(f"c{i}" for i in range(columns))
+    (tmp_path / "wide.csv").write_text(header + "\n" + "0,1,1," + ",".join("0" * columns) + "\n")
+    done = run_bounded(
+        [sys.executable, "-m", "fmutrace", "compare", str(PASS_THROUGH), str(tmp_path / "wide.csv")],
+        timeout=120,
+        what="fmutrace compare wide.csv",
+        preexec_fn=bounded_memory,
+    )
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "wide.csv, line 1: a line of 21,388,898 characters: more than the 4,194,304" in done.stderr, done.stderr
+
+
 # 6. Numbers
 
 
