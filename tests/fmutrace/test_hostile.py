@@ -408,8 +408,10 @@ def test_a_journal_of_another_program_is_refused(tmp_path):
         lambda entry: {k: v for k, v in entry.items() if k != "case"},
         lambda entry: [entry],
         lambda entry: dict(entry, signals=[{"nonsense": 1}]),
+        lambda entry: dict(entry, messages=7),
+        lambda entry: dict(entry, result_csv="../../outside_out.csv"),
     ],
-    ids=["unknown status", "no case", "not an object", "bad signal"],
+    ids=["unknown status", "no case", "not an object", "bad signal", "messages a number", "a path outside"],
 )
 def test_a_bad_journal_line_is_skipped_with_a_message_and_its_case_runs_again(tmp_path, damage):
     """A journal line with an unknown status, without its case, or not a

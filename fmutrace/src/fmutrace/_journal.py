@@ -187,8 +187,8 @@ def _entry(line):
     if not (
         isinstance(key, str)
         and key.startswith(f"{outcome.fmu_file}|")
-        and all(isinstance(v, str) for v in (outcome.case, outcome.fmu, outcome.fmu_file, *outcome.messages))
         and isinstance(outcome.messages, list)
+        and all(isinstance(v, str) for v in (outcome.case, outcome.fmu, outcome.fmu_file, *outcome.messages))
         and isinstance(outcome.seconds, (int, float))
         and all(isinstance(p, str) and _in_report(p) for p in (outcome.csv, outcome.plot))
     ):
