@@ -244,6 +244,21 @@ def test_a_name_that_is_not_utf8_is_shown_with_replacement_characters(tmp_path):
     assert [c.get("name") for c in ET.parse(junit).getroot().iter("testcase")] == ["r\ufffdsum\ufffd"]
 
 
+def test_paths_given_that_are_not_utf8_are_printed_with_replacement_characters(tmp_path):
+    """--report and --junit named in Latin-1 bytes, printed to a strict UTF-8
+    standard output (a terminal's): the lines that name them show U+FFFD."""
+    write_case(tmp_path / "cases" / "one")
+    base = os.fsencode(tmp_path)
+    report, junit = os.path.join(base, b"r\xe9port"), os.path.join(base, b"j\xe9.xml")
+    env = dict(os.environ, PYTHONIOENCODING="utf-8:strict")
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", report, "--junit", junit, env=env)
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    assert f"report: {tmp_path}/r\ufffdport/index.html" in done.stdout, done.stdout
+    assert f"JUnit XML: {tmp_path}/j\ufffd.xml" in done.stdout, done.stdout
+    assert os.path.isfile(os.path.join(report, b"index.html")) and os.path.isfile(junit)
+
+
 def test_a_250_byte_name_becomes_a_file_name_shortened_with_a_hash(tmp_path):
     """A case folder of 250 bytes (the file system allows 255): its result
     file and plot get names that fit, distinct for two names that share

@@ -215,15 +215,16 @@ def run_command(args, out):
             written = simulate_long(args.fmu, args.input, stream, options)
         if written is not None:
             if args.out:
-                print(
-                    f"{written} samples of {len(args.output or Fmu(args.fmu).outputs)} signals written to {args.out}",
-                    file=out,
-                )
+                signals = len(args.output or Fmu(args.fmu).outputs)
+                print(f"{written} samples of {signals} signals written to {text(args.out)}", file=out)
             return ExitStatus.SUCCESS
     result = simulate(args.fmu, args.input, **vars(options))
     if args.out:
         write_trace(args.out, result)
-        print(f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {args.out}", file=out)
+        print(
+            f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {text(args.out)}",
+            file=out,
+        )
     else:
         write_trace(out, result)
     return ExitStatus.SUCCESS
@@ -295,9 +296,9 @@ def compare_command(args, out):
             print(f"      {text(message)}", file=out)
     print(result.headline(), file=out)
     if args.report:
-        print(f"report: {args.report.rstrip('/')}/index.html", file=out)
+        print(f"report: {text(args.report.rstrip('/'))}/index.html", file=out)
     if args.junit:
-        print(f"JUnit XML: {args.junit}", file=out)
+        print(f"JUnit XML: {text(args.junit)}", file=out)
     return result.exit_code
 
 
