@@ -33,6 +33,13 @@ INPUT = "time,u\n0,1\n0.2,3\n"
 REF = "time,y\n0,0\n0.1,1\n0.2,1\n0.3,3\n0.4,3\n0.5,3\n"
 
 
+@pytest.fixture(autouse=True)
+def own_unpack_root(monkeypatch):
+    """Each command here makes its own folder for unpacked FMUs: not the one
+    an in-process campaign of this test process made (its children inherit it)."""
+    monkeypatch.delenv("FMUTRACE_UNPACK_ROOT", raising=False)
+
+
 def fmutrace(*args, env=None, timeout=300):
     """The command, as users start it, in a process of its own."""
     return run_bounded(
@@ -102,7 +109,7 @@ def test_an_fmu_is_unpacked_into_a_private_folder_never_one_planted(tmp_path):
     assert model == "PassThrough", f"the planted folder {planted} was loaded"
     assert Path(folder) != planted
     assert reused == "True"
-    assert mode == "0o700"
+    assert mode == "0o700" and Path(folder).parent.parent == shared
     assert not Path(folder).exists(), "the unpacked FMU is left behind at exit"
     assert not [p for p in shared.iterdir() if p != planted], "files left in the temporary folder"
 
@@ -182,6 +189,23 @@ def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
         assert not any(map(alive, children)), "the child outlived the command"
     finally:
         kill_session(command)
+
+
+@pytest.mark.cluster
+def test_a_local_clusters_workers_leave_no_unpacked_fmu_behind(tmp_path):
+    """--jobs 2: the local Dask workers unpack into the command's folder,
+    removed when the command ends, however the workers are stopped."""
+    shared = tmp_path / "tmp"
+    shared.mkdir()
+    write_case(tmp_path / "cases" / "one")
+    write_case(tmp_path / "cases" / "two")
+    done = fmutrace(
+        "compare", PASS_THROUGH, tmp_path / "cases", "--jobs", "2", env=dict(os.environ, TMPDIR=str(shared))
+    )
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    assert "Dask, 2 workers" in done.stdout, done.stdout
+    assert not [p for p in shared.rglob("*") if "fmutrace" in p.name or p.name.startswith("fmu-")]
 
 
 # 2. Text from users' files shown as text everywhere

@@ -174,19 +174,22 @@ def _float(value):
 
 
 _unpacked: dict[str, tuple] = {}  # content hash -> (folder, model description, pid of the process that made it)
-# a parent's private folder that its child processes unpack into: a child killed (a case over its timeout, a
-# crash) cannot remove its own, the parent removes them all at its exit
-CHILDREN_UNPACK = "FMUTRACE_CHILDREN_UNPACK"
-_children_folder: list[str] = []
+# the folder every unpacked FMU of a campaign goes into, its child processes' and local workers' too (they
+# inherit it in their environment): made by the first process that unpacks, removed at that process's exit, so
+# a child killed (a case over its timeout, a crash, a Dask worker stopped) leaves nothing behind
+UNPACK_ROOT = "FMUTRACE_UNPACK_ROOT"
 
 
-def children_folder() -> str:
-    """This process's folder for its children's unpacked FMUs (made once, mode 0700, removed at exit): the
-    value of CHILDREN_UNPACK in a child's environment."""
-    if not _children_folder:
-        _children_folder.append(tempfile.mkdtemp(prefix="fmutrace-children-"))
-        atexit.register(_remove, _children_folder[0], os.getpid())
-    return _children_folder[0]
+def unpack_root() -> str:
+    """The folder this process and the processes it starts unpack FMUs into:
+    its parent's (UNPACK_ROOT in its environment), else one of its own
+    (mkdtemp, mode 0700, removed at exit), then set for its children."""
+    root = os.environ.get(UNPACK_ROOT)
+    if not (root and os.path.isdir(root)):
+        root = tempfile.mkdtemp(prefix="fmutrace-")
+        atexit.register(_remove, root, os.getpid())
+        os.environ[UNPACK_ROOT] = root
+    return root
 
 
 def unpacked(fmu_bytes):
@@ -197,8 +200,7 @@ def unpacked(fmu_bytes):
     key = hashlib.sha256(fmu_bytes).hexdigest()
     known = _unpacked.get(key)
     if known is None or known[2] != os.getpid():  # (a forked child makes its own: the parent removes its one)
-        parent = os.environ.get(CHILDREN_UNPACK)  # (a child of a campaign: in the parent's own folder)
-        folder = tempfile.mkdtemp(prefix="fmutrace-fmu-", dir=parent if parent and os.path.isdir(parent) else None)
+        folder = tempfile.mkdtemp(prefix="fmu-", dir=unpack_root())
         atexit.register(_remove, folder, os.getpid())
         try:
             extract(io.BytesIO(fmu_bytes), unzipdir=folder)
@@ -211,7 +213,7 @@ def unpacked(fmu_bytes):
 
 
 def _remove(folder, owner):
-    """An unpacked FMU's folder, at the exit of the process that made it."""
+    """An unpacked FMU's folder (or the root of them), at the exit of the process that made it."""
     if os.getpid() == owner:
         shutil.rmtree(folder, ignore_errors=True)
 

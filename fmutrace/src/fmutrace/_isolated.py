@@ -26,7 +26,7 @@ import threading
 import time
 from pathlib import Path
 
-from ._fmu import CHILDREN_UNPACK, children_folder
+from ._fmu import UNPACK_ROOT, unpack_root
 from ._outcome import CaseOutcome, Status
 from ._worker import CaseSettings, FmuFile, run_cases
 
@@ -80,7 +80,7 @@ def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outc
         PYTHONPATH=os.pathsep.join(
             [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
         ),
-        **{CHILDREN_UNPACK: children_folder()},  # a child killed leaves its unpacked FMU to this process
+        **{UNPACK_ROOT: unpack_root()},  # a child killed leaves its unpacked FMU to this process
         **{PARENT: str(os.getpid())},
     )
     while remaining:
