@@ -139,15 +139,16 @@ def test_children_killed_leave_no_unpacked_fmu_behind(tmp_path):
     assert not list(shared.rglob("*")), list(shared.rglob("*"))
 
 
-def children_of(pid):
-    """The pids of a process's children (Linux's /proc)."""
+def children_of(pid, running):
+    """The pids of a process's children whose command line holds running (Linux's /proc)."""
     found = []
     for entry in Path("/proc").iterdir():
         try:
             fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            command = (entry / "cmdline").read_bytes()
         except (OSError, IndexError):
             continue
-        if fields[1] == str(pid):
+        if fields[1] == str(pid) and running.encode() in command:
             found.append(int(entry.name))
     return found
 
@@ -176,9 +177,10 @@ def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
     )
     try:
         deadline = time.monotonic() + 120
-        while not children_of(command.pid) and time.monotonic() < deadline:
+        while not children_of(command.pid, "fmutrace._isolated") and time.monotonic() < deadline:
+            assert command.poll() is None, "the command ended before its child started"
             time.sleep(0.1)
-        children = children_of(command.pid)
+        children = children_of(command.pid, "fmutrace._isolated")
         assert children, "no child started"
         time.sleep(2)  # in the hanging doStep by now
         command.kill()
