@@ -182,8 +182,7 @@ def main():
     fmu = build / "fmi3" / f"{MODEL}.fmu"
     root = build / "benchmarks" / "long"
     cli = [sys.executable, "-m", "fmutrace"]
-    from fmutrace._longcase import is_long
-    from fmutrace._longrecording import is_long_recording
+    from fmutrace._recording import streamable
     from fmutrace._runner import C_STEPS
 
     print(
@@ -217,15 +216,14 @@ def main():
         )
         if status != 0 or f"{cycles} samples" not in output:
             raise SystemExit(f"compare of the {hours:g} h recording exited {status}:\n{output[-3000:]}")
-        for what, report_folder, long in (
-            ("case", report, is_long(case, MODEL, None)),
-            ("recording", case.parent / "report_recording", is_long_recording(one_file)),
-        ):
-            streamed = [
-                c.get("streamed", False) for c in json.loads((report_folder / "results.json").read_text())["cases"]
-            ]
-            if streamed != [long]:  # a long one in chunks (flat memory), a short one (--smoke) in memory
-                raise SystemExit(f"the {hours:g} h {what} was {'not ' * long}streamed")
+        # a case is always read in chunks; a long one-file recording is streamed, a short one (--smoke) read whole
+        long = streamable(one_file)
+        streamed = [
+            c.get("streamed", False)
+            for c in json.loads((case.parent / "report_recording" / "results.json").read_text())["cases"]
+        ]
+        if streamed != [long]:
+            raise SystemExit(f"the {hours:g} h recording was {'not ' * long}streamed")
         run_out = root / f"{hours:g}h" / "run_out.csv"
         run_seconds, run_megabytes, status, output, run_user = measured(
             cli

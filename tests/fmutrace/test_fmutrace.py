@@ -246,6 +246,7 @@ def test_the_tube_needs_both_widths_and_no_tolerance_beside_it(tmp_path):
     for args, message in [
         (("--tube-time", 0.1), "needs both"),
         (("--tube-time", 0.1, "--tube-value", 0.1, "--rel-tol", 1e-3), "not both"),
+        (("--tube-time", "inf", "--tube-value", 0), "tube-time must be a finite number >= 0"),
     ]:
         done = fmutrace_cli("compare", LAG[3], tmp_path, *args)
         assert done.returncode == 2 and message in done.stderr
@@ -500,7 +501,8 @@ def test_api_comparison_modes_as_objects(tmp_path):
     assert fmutrace.comparison_mode(abs_tol=1e-5) == fmutrace.Tolerance(abs_tol=1e-5)
     assert fmutrace.comparison_mode() == fmutrace.Exact()
     assert fmutrace.comparison_mode(tube_time=0.1, tube_value=1e-3) == fmutrace.Tube(0.1, 1e-3)
-    with pytest.raises(fmutrace.InputError, match="tube-time must be a finite number >= 0") as refused:
+    # the command's words (tube-time) at the command's level: test_the_tube_needs_both_widths_and_no_tolerance_beside_it
+    with pytest.raises(fmutrace.InputError, match=r"Tube\(time=\.\.\.\) must be a finite number >= 0") as refused:
         fmutrace.Tube(-1.0, 0.0)
     assert refused.value.exit_code == 2
 

@@ -17,7 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "fmutrace" / "src" / "fmutrace"
 
 # lowest first; a module imports from its own layer or the ones before it
 LAYERS = [
-    ("base", {"fmutrace._errors", "fmutrace._progress"}),
+    ("base", {"fmutrace._errors", "fmutrace._names", "fmutrace._progress"}),
     ("readers", {"fmutrace._traces", "fmutrace.recordings", "fmutrace.recordings.*"}),
     ("model", {"fmutrace._fmu", "fmutrace._comparison", "fmutrace._fmpy", "fmutrace._outcome"}),
     (
@@ -32,7 +32,7 @@ LAYERS = [
             "fmutrace._journal",
         },
     ),
-    ("one case", {"fmutrace._longcase", "fmutrace._longrecording", "fmutrace._worker"}),
+    ("one case", {"fmutrace._pipeline", "fmutrace._recording", "fmutrace._worker"}),
     ("where cases run", {"fmutrace._isolated", "fmutrace._executors"}),
     ("campaign", {"fmutrace._campaign"}),
     ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__"}),

@@ -1,26 +1,31 @@
-"""A long case run chunk by chunk (fmutrace._longcase) gives the in-memory
-path's outcome (worker.run_case), bit for bit: status, messages and every
-failing signal's deviation, on every reference scenario (in chunks of a
-few steps and a few rows, so every boundary case occurs) and on
-references made to fail (one ulp off, a sample the result lacks, a
-repeated time), exact and with a tolerance. `fmutrace run` on a long
-input writes what it writes on a short one. Its progress shows on a
-terminal only."""
+"""The one pipeline (fmutrace._pipeline) reads, runs and compares a case
+chunk by chunk; its outcome is the whole trace's (the result of
+Runner.run compared by comparison.compare_traces on the whole arrays),
+bit for bit: status, messages and every failing signal's deviation, on
+every reference scenario (in chunks of a few steps and a few rows, so
+every boundary case occurs, and in one chunk) and on references made to
+fail (one ulp off, a sample the result lacks, a repeated time), exact and
+with a tolerance. `fmutrace run` in chunks writes what simulate gives.
+Its progress shows on a terminal only."""
 
 import io
 import re
 import shutil
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance, read_trace, write_trace
-from fmutrace._longcase import Streaming, run_long_case, simulate_long
+from fmutrace._pipeline import CaseFiles, Streaming, run_folder_case
 from fmutrace._progress import SampleProgress
-from fmutrace._simulation import SimulationOptions, simulate
-from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
+from fmutrace._simulation import SimulationOptions, simulate, simulate_chunks
+from fmutrace._traces import TraceWriter, last_time
+from fmutrace._worker import CaseSettings, Target, worker_fmu
 from support.scenarios import SCENARIO_ROOT, fmu_path
 from support.fmu_driver import BUILD_DIR
+from support.whole_case import on_the_whole
 
 FOLDERS = sorted(p.parent for p in SCENARIO_ROOT.glob("*/*/*_ref.csv"))
 MODES = [Exact(), Tolerance(rel_tol=1e-12, abs_tol=0.0)]
@@ -30,10 +35,9 @@ def outcomes(folder, version, mode, steps, chunk_bytes):
     path = fmu_path(BUILD_DIR, folder.parent.name, version)
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
-    whole = run_case(folder, folder.name, None, Target(runner, fmu, labels), CaseSettings(mode, "none"))
-    long = run_long_case(
-        folder,
-        folder.name,
+    whole = on_the_whole(folder, runner, fmu, mode)
+    long = run_folder_case(
+        CaseFiles(folder, folder.name),
         Target(runner, fmu, labels),
         CaseSettings(mode, "none"),
         Streaming(steps_per_chunk=steps, chunk_bytes=chunk_bytes),
@@ -42,25 +46,18 @@ def outcomes(folder, version, mode, steps, chunk_bytes):
 
 
 def same(whole, long):
-    assert long.status == whole.status
-    assert long.messages == whole.messages
-    assert [d.to_json() for d in long.deviations] == [d.to_json() for d in whole.deviations]
+    status, messages, deviations, _ = whole
+    assert long.status == status
+    assert long.messages == messages
+    assert [d.to_json() for d in long.deviations] == [d.to_json() for d in deviations]
 
 
 @pytest.mark.parametrize("version", [2, 3])
 @pytest.mark.parametrize("steps,chunk_bytes", [(1, 8), (4, 40), (1000, 1 << 20)])
 def test_every_reference_scenario_chunked_as_in_memory(version, steps, chunk_bytes):
-    taken, eligible = 0, 0
-    for folder in FOLDERS:
-        inputs = folder / f"{folder.parent.name}_in.csv"
-        # a long case has many input rows; a single row is held to the stop by fmpy (the in-memory path)
-        eligible += not inputs.exists() or len(read_trace(inputs)) > 1
+    for folder in FOLDERS:  # single input rows and inputs between communication points (fmpy's loop) too
         whole, long = outcomes(folder, version, MODES[0], steps, chunk_bytes)
-        if long is not None:
-            same(whole, long)
-            taken += 1
-    assert eligible > len(FOLDERS) // 2
-    assert taken >= eligible - 2  # those take the in-memory path: inputs between communication points
+        same(whole, long)
 
 
 def failing_copy(tmp_path, how):
@@ -86,45 +83,56 @@ def test_failing_references_chunked_as_in_memory(how, mode, tmp_path):
     folder = failing_copy(tmp_path, how)
     for steps, chunk_bytes in [(1, 8), (3, 30), (100, 1 << 20)]:
         whole, long = outcomes(folder, 3, mode, steps, chunk_bytes)
-        assert long is not None
         same(whole, long)
-    assert whole.passed == (how == "repeated")
+    assert long.passed == (how == "repeated")
 
 
-def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(tmp_path):
+@pytest.mark.parametrize("spill", [0, 1 << 22], ids=["in-a-file-as-made", "in-memory-until-kept"])
+def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(spill, tmp_path, monkeypatch):
+    import fmutrace._pipeline as pipeline
+
+    monkeypatch.setattr(pipeline, "SPILL_BYTES", spill)
+    monkeypatch.setattr(pipeline.tempfile, "tempdir", str(tmp_path / "temp"))
+    (tmp_path / "temp").mkdir()
     folder = failing_copy(tmp_path, "ulp")
     path = fmu_path(BUILD_DIR, "RateLimiter", 3)
     runner, fmu = worker_fmu(path.read_bytes(), str(path))
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
-    out = tmp_path / "out.csv"
-    long = run_long_case(
-        folder,
-        "ulp",
-        Target(runner, fmu, labels),
-        CaseSettings(Exact(), "failed"),
-        Streaming(result_file=out, steps_per_chunk=2, chunk_bytes=16),
+    settings = {"keep_result": True, "steps_per_chunk": 2, "chunk_bytes": 16}
+    long = run_folder_case(
+        CaseFiles(folder, "ulp"), Target(runner, fmu, labels), CaseSettings(Exact(), "failed"), Streaming(**settings)
     )
     assert not long.passed and long.png.startswith(b"\x89PNG")
-    whole = run_case(folder, "ulp", None, Target(runner, fmu, labels), CaseSettings(Exact(), "failed"))
-    write_trace(tmp_path / "whole.csv", whole.result)
-    assert out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    whole = on_the_whole(folder, runner, fmu, Exact())
+    write_trace(tmp_path / "whole.csv", whole[3])
+    out = Path(long.result_path)
+    assert out.parent == tmp_path / "temp" and out.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    passing = run_folder_case(  # no plot: no result file, none left behind
+        CaseFiles(SCENARIO_ROOT / "RateLimiter" / "step_up", "step_up"),
+        Target(runner, fmu, labels),
+        CaseSettings(Exact(), "failed"),
+        Streaming(**settings),
+    )
+    assert passing.passed and not passing.result_path and sorted((tmp_path / "temp").iterdir()) == [out]
 
 
-def test_run_on_a_long_input_writes_what_simulate_gives(tmp_path, monkeypatch):
-    import fmutrace._longcase as longcase
-
-    monkeypatch.setattr(longcase, "LONG_CASE_BYTES", 0)
+def test_run_in_chunks_writes_what_simulate_gives(tmp_path):
     scenario = SCENARIO_ROOT / "RateLimiter" / "asymmetric"
     path = fmu_path(BUILD_DIR, "RateLimiter", 3)
     start = {"rateUpPar": "2.0", "rateDownPar": "0.5"}
-    with open(tmp_path / "long.csv", "w") as out:
-        written = simulate_long(
+    written = 0
+    with open(tmp_path / "long.csv", "w", newline="\n") as out:
+        writer = None
+        for chunk in simulate_chunks(
             path,
             scenario / "RateLimiter_in.csv",
-            out,
             SimulationOptions(start, 0.0, 8.0, 0.5),
-            Streaming(steps_per_chunk=3, chunk_bytes=8),
-        )
+            chunk_bytes=8,
+            steps_per_chunk=3,
+        ):
+            writer = writer or TraceWriter(out, chunk.dtype.names)
+            writer.write(chunk)
+            written += len(chunk)
     whole = simulate(
         path, scenario / "RateLimiter_in.csv", start_values=start, start_time=0.0, stop_time=8.0, step_size=0.5
     )
@@ -161,8 +169,6 @@ def test_a_long_case_shows_its_progress_on_a_terminal_only(terminal, monkeypatch
 
 @pytest.mark.parametrize("width", [10, 5000, 100_000])
 def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
-    from fmutrace._longcase import _last_time
-
     names = ["time"] + [f"s{i}" for i in range(width // 10)]
     lines = [
         ",".join(names),
@@ -171,7 +177,7 @@ def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
     ]
     path = tmp_path / "wide.csv"
     path.write_text("\n".join(lines) + "\n\n")
-    assert _last_time(path) == 7.75
+    assert last_time(path) == 7.75
 
 
 @pytest.mark.parametrize("parts", [1, 2, 7])

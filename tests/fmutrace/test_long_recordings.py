@@ -7,20 +7,20 @@ here (perturbed, off-cycle stamps, the other timing, a tolerance, a
 printed 10 ms ramp), with a head and blocks of a few lines so that every
 boundary occurs; and what the streamed path leaves to the in-memory one."""
 
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from fmutrace import Exact, Tolerance
-from fmutrace import _worker as worker
+from fmutrace import _recording as worker  # (where a recording is chosen to stream)
 from fmutrace._fmu import Fmu
-from fmutrace._longcase import LONG_CASE_BYTES
-from fmutrace._longrecording import is_long_recording, run_long_recording
+from fmutrace._recording import streamable, run_streamed_recording
 from fmutrace.recordings import _stream as stream, _timebase as timebase
 from fmutrace.recordings._options import RecordingOptions
 from fmutrace._runner import Runner
-from fmutrace._longcase import Streaming
+from fmutrace._pipeline import Streaming
 from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
@@ -36,10 +36,10 @@ def outcomes(path, model, mode=None, options=None, head=400, block=120, version=
     fmu_file = fmu_path(BUILD_DIR, model, version)
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
-    monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
+    monkeypatch.setattr(worker, "streamable", lambda path: False)
     whole = run_case(str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(mode, "none", options))
     monkeypatch.setattr(stream, "HEAD_BYTES", head)
-    streamed = run_long_recording(
+    streamed = run_streamed_recording(
         str(path),
         path.name,
         Target(runner, fmu, labels),
@@ -163,7 +163,7 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
     fmu_file = fmu_path(BUILD_DIR, "LGF_LimRateOfChangeCI", 3)
     runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
     labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
-    monkeypatch.setattr(worker, "is_long_recording", lambda path: False)
+    monkeypatch.setattr(worker, "streamable", lambda path: False)
     whole = run_case(
         str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none", RecordingOptions())
     )
@@ -175,12 +175,13 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
         return runs[-1]
 
     monkeypatch.setattr(runner, "run_chunks", kept_run_chunks)
-    monkeypatch.setattr(worker, "is_long_recording", lambda path: True)
+    monkeypatch.setattr(worker, "streamable", lambda path: True)
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
     first = run_case(
         str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none", RecordingOptions())
     )
-    assert len(runs) == 1 and runs[0].gi_frame is None  # started, given up on, closed
+    # the stream's run started, given up on and closed; the in-memory path's own run (the same Runner) done
+    assert len(runs) == 2 and runs[0].gi_frame is None and runs[1].gi_frame is None
     assert (first.status, first.messages, first.streamed) == (whole.status, whole.messages, False)
     assert [d.to_json() for d in first.deviations] == [d.to_json() for d in whole.deviations]
 
@@ -211,22 +212,25 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
         runner = Runner(fmu_file.read_bytes())  # its own: worker_fmu's are shared
         fmu = Fmu(str(fmu_file), runner.md)
         labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
-        written = tmp_path / "result.csv"
-        streamed = run_long_recording(
+        streamed = run_streamed_recording(
             str(path),
             path.name,
             Target(runner, fmu, labels),
             CaseSettings(Exact(), "all", RecordingOptions()),
-            Streaming(result_file=str(written), block_bytes=120),
+            Streaming(keep_result=True, block_bytes=120),
         )
-        return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not written.exists()
+        return streamed is None and runner.fmu is None and runner.fast_runs == 0 and not any(temp.iterdir())
+
+    temp = tmp_path / "temp"  # where a result file would be written
+    temp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(temp))
 
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
     for edit in (skipped, backwards, not_a_number):
         path = copy(tmp_path, "tia_portal_siemens.csv", edit, encoding="cp1252")
         assert len(b"".join(path.read_bytes().splitlines(keepends=True)[:16])) > 400  # the row is past the head
         assert refused(path, "LGF_LimRateOfChangeCI"), edit.__name__
-    monkeypatch.setattr(worker, "is_long_recording", lambda path: True)
+    monkeypatch.setattr(worker, "streamable", lambda path: True)
     fmu_file = fmu_path(BUILD_DIR, "LGF_LimRateOfChangeCI", 3)
     runner = Runner(fmu_file.read_bytes())
     fmu = Fmu(str(fmu_file), runner.md)
@@ -259,6 +263,21 @@ def test_intervals_median_is_numpys():
         assert counted.median() == (float(np.median(steps)) if len(steps) else None)
 
 
-def test_a_recording_is_streamed_from_the_size_of_a_long_case(tmp_path):
-    assert not is_long_recording(SAMPLES / "plain_ratelimiter.tsv")
-    assert LONG_CASE_BYTES == 32 << 20
+def test_a_short_one_file_export_is_streamed_too_and_other_recordings_read_whole():
+    """No size decides the path: a one-file table export of a few lines is
+    read in blocks as a 48 h one is; several files (a recording given as
+    its parts) are read whole."""
+    fmu_file = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    runner, fmu = worker_fmu(fmu_file.read_bytes(), str(fmu_file))
+    labels = {"fmu": fmu.label, "fmu_file": str(fmu_file), "fmu_folder": "f"}
+    path = SAMPLES / "plain_ratelimiter.tsv"
+    assert path.stat().st_size < 4096 and streamable(path)
+    outcome = run_case(str(path), path.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none"))
+    assert outcome.streamed and outcome.passed, outcome.messages
+    siemens = fmu_path(BUILD_DIR, "LGF_LimRateOfChangeCI", 3)
+    runner, fmu = worker_fmu(siemens.read_bytes(), str(siemens))
+    labels = {"fmu": fmu.label, "fmu_file": str(siemens), "fmu_folder": "f"}
+    folder = SAMPLES / "niagara_siemens"  # a Niagara history export: one file per point
+    assert not streamable(folder)
+    outcome = run_case(str(folder), folder.name, None, Target(runner, fmu, labels), CaseSettings(Exact(), "none"))
+    assert not outcome.streamed and outcome.passed, outcome.messages

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from fmutrace import InputError, TraceError
+from fmutrace.cli import FLAGS
 from fmutrace.recordings import FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file, read_recording
 from fmutrace.recordings._align import align
 from fmutrace.recordings._text import decode, numbers
@@ -207,7 +208,9 @@ def test_a_unit_that_would_mean_an_absurd_number_of_steps_is_refused_naming_it(t
     path = tmp_path / "counter.csv"
     path.write_text("time;u;y\n" + "".join(f"{5000000000 + k * 10000};1;1\n" for k in range(4)))
     with pytest.raises(InputError, match=r"read as seconds \(assumed: column 'time' names no unit\).*--time-unit"):
-        normalise(read_recording(path)[0], step_size=0.01)
+        normalise(read_recording(path)[0], step_size=0.01, names=FLAGS)  # the command's words
+    with pytest.raises(InputError, match=r"names no unit\).*give RecordingOptions\(time_unit=\.\.\.\) \(s, ms"):
+        normalise(read_recording(path)[0], step_size=0.01)  # a Python caller's
     recording = normalise(read_recording(path)[0], time_unit="us")
     assert recording.step_size == 0.01
 
@@ -354,7 +357,11 @@ def test_two_channels_meaning_one_variable_are_refused(tmp_path):
         match=r"'MAIN.a.value' \(column 2 of .*twice.csv\) and 'MAIN.b.value' "
         r"\(column 3 of .* both mean value: .*--map",
     ):
-        plan(recording, SIEMENS_VARIABLES, "M")
+        plan(recording, SIEMENS_VARIABLES, "M", names=FLAGS)  # the command's words
+    with pytest.raises(
+        InputError, match=r"both mean value: say which with RecordingOptions\(maps=\{'value': 'CHANNEL'\}\)"
+    ):
+        plan(recording, SIEMENS_VARIABLES, "M")  # a Python caller's
 
 
 # -- the recorder's timing on fmpy's steps --------------------------------------------------------
@@ -379,10 +386,12 @@ def test_inputs_sampled_coarser_than_the_step_are_explained_with_a_tolerance(tmp
         "time [ms];value;setChangeRate;delayedValue\n" + "".join(f"{k * 250};{v};4;{y}\n" for k, v, y in rows)
     )
     recording = normalise(read_recording(path)[0], step_size=CYCLE)
-    aligned = align(recording, plan(recording, SIEMENS_VARIABLES, "M"))
+    aligned = align(recording, plan(recording, SIEMENS_VARIABLES, "M"), names=FLAGS)  # the command's words
     assert "value every 3 cycles" in aligned.coarse and "by up to 2 cycles" in aligned.coarse
     # delayedValue moves by 1 a cycle at most between its samples (1.5 -> -1.5 in 3 cycles): 2 in 2 cycles
     assert "--tube-time 0.5 --tube-value 0" in aligned.coarse and "--abs-tol 2 " in aligned.coarse
+    in_python = align(recording, plan(recording, SIEMENS_VARIABLES, "M")).coarse  # a Python caller's
+    assert "allows that lag: Tube(time=0.5, value=0), or Tolerance(abs_tol=2) (the largest change" in in_python
     assert aligned.inputs["time"].tolist() == [k * CYCLE for k in range(0, 14, 3)]
 
 

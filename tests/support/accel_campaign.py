@@ -65,6 +65,9 @@ def main(argv=None):
     )
     parser.add_argument("--replay", help="a file with one scenario's JSON (as printed): run and check it")
     parser.add_argument("--show", type=int, default=20, help="violations printed per scenario")
+    parser.add_argument(
+        "--progress", type=int, default=500, metavar="N", help="a progress line on stderr every N scenarios (0: none)"
+    )
     args = parser.parse_args(argv)
     if args.replay:
         with open(args.replay) as f:
@@ -93,6 +96,13 @@ def main(argv=None):
                     print("   ", v)
                 print("    scenario:", scenario.dumps())
                 sys.stdout.flush()
+            if args.progress and (index + 1) % args.progress == 0:
+                print(
+                    f"{name}: {index + 1} of {args.scenarios} scenarios, {cycles} cycles, "
+                    f"{bad} with violations, {time.monotonic() - start:.0f} s",
+                    file=sys.stderr,
+                    flush=True,
+                )
         failed += bad
         print(
             f"{name}: {args.scenarios} scenarios, {cycles} cycles checked in {time.monotonic() - start:.0f} s; "

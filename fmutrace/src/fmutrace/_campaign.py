@@ -147,7 +147,7 @@ def _run(cases_of, work, executor, journal_of, progress):
     report, key, resume = journal_of
     outcomes: MutableSequence = array("q", bytes(8 * len(cases_of))) if report else [None] * len(cases_of)
     counts = dict.fromkeys(Status, 0)
-    journal = Journal(report, key, resume) if report else None
+    journal = Journal(report, key, resume, work.settings.recording.names) if report else None
     try:
         indices: Sequence[int]
         if journal and journal.done:

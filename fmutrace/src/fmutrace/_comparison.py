@@ -30,6 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ._errors import InputError
+from ._names import Names, name_of
 
 TIME_MATCH = 1e-9  # seconds below |t| = 1 s, relative above
 
@@ -183,7 +184,7 @@ class Tolerance(Pointwise):
     name: ClassVar[str] = "tolerance"
 
     def __post_init__(self):
-        _check_widths(self, rel_tol="rel-tol", abs_tol="abs-tol")
+        _check_widths({"rel_tol": self.rel_tol, "abs_tol": self.abs_tol})
 
     def describe(self):
         return f"relative tolerance {self.rel_tol:g}, absolute tolerance {self.abs_tol:g}"
@@ -209,7 +210,7 @@ class Tube(Mode):
     deviation_label = "outside the tube"
 
     def __post_init__(self):
-        _check_widths(self, time="tube-time", value="tube-value")
+        _check_widths({"tube_time": self.time, "tube_value": self.value})
 
     def settings(self):
         return {"tube_time": self.time, "tube_value": self.value}
@@ -235,29 +236,40 @@ class Tube(Mode):
         return Band(result["time"][inside], values, lower, upper, ok, outside)
 
 
-def _check_widths(mode, **options):
-    """Every width a finite number >= 0; options: field -> the command's option."""
-    for name, option in options.items():
-        value = getattr(mode, name)
+def _check_widths(widths, names: Names = ()):
+    """Every width a finite number >= 0; widths: setting -> value; names:
+    the caller's words for the settings."""
+    for setting, value in widths.items():
         if not (value >= 0 and math.isfinite(value)):
-            raise InputError(f"{option} must be a finite number >= 0, not {value!r}")
+            raise InputError(f"{name_of(names, setting)} must be a finite number >= 0, not {value!r}")
 
 
 EXACT = Exact()
 
 
 def comparison_mode(
-    rel_tol: float = 0.0, abs_tol: float = 0.0, tube_time: float | None = None, tube_value: float | None = None
+    rel_tol: float = 0.0,
+    abs_tol: float = 0.0,
+    tube_time: float | None = None,
+    tube_value: float | None = None,
+    *,
+    names: Names = (),
 ) -> Mode:
     """The mode the command's options (and compare's arguments of the same
     names) choose: a tube, a tolerance, else exact. InputError if they do
-    not make one."""
+    not make one, naming the settings in names (the caller's words, as
+    RecordingOptions.names; default the API's)."""
     if (tube_time is None) != (tube_value is None):
-        raise InputError("a tube needs both its time and its value tolerance (--tube-time and --tube-value)")
+        raise InputError(
+            "a tube needs both its time and its value tolerance "
+            f"({name_of(names, 'tube_time')} and {name_of(names, 'tube_value')})"
+        )
     if tube_time is not None and tube_value is not None:
         if rel_tol or abs_tol:
             raise InputError("choose a tube or a relative/absolute tolerance, not both")
+        _check_widths({"tube_time": tube_time, "tube_value": tube_value}, names)
         return Tube(tube_time, tube_value)
+    _check_widths({"rel_tol": rel_tol, "abs_tol": abs_tol}, names)
     return Tolerance(rel_tol, abs_tol) if (rel_tol or abs_tol) else EXACT
 
 

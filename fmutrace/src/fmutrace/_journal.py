@@ -1,7 +1,7 @@
 """A campaign's journal: results.jsonl in the report folder, one line per
 finished case, appended and flushed as each case finishes, so that a
-campaign whose client is killed loses nothing it finished; `--resume`
-reads it back and runs only the rest. The folder is locked while a
+campaign whose client is killed loses nothing it finished; a resumed
+campaign reads it back and runs only the rest. The folder is locked while a
 campaign writes it: a second campaign into the same folder is refused.
 
 The first line describes the campaign (comparison, plots, the FMUs by
@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ._comparison import Mode
 from ._errors import InputError
+from ._names import Names, name_of
 from ._outcome import CaseOutcome, Outcomes
 from ._traces import read_trace
 
@@ -110,7 +111,8 @@ class Journal:
     A case's entry is found again by where its line starts (done, record):
     the campaign keeps that offset, not the outcome."""
 
-    def __init__(self, folder, key, resume):
+    def __init__(self, folder, key, resume, names: Names = ()):
+        """names: the caller's words for the settings (RecordingOptions.names)."""
         self.path = Path(folder) / JOURNAL
         self.done: dict[str, int] | None = {}  # key -> offset of the case's line, of a campaign resumed
         if resume and self.path.exists():
@@ -120,12 +122,12 @@ class Journal:
                 if first.strip() and not (isinstance(header, dict) and isinstance(header.get("campaign"), dict)):
                     raise InputError(
                         f"{self.path}: its first line is damaged or not a fmutrace journal's, so which options "
-                        "made its verdicts is unknown; start afresh without --resume"
+                        f"made its verdicts is unknown; start afresh without {name_of(names, 'resume')}"
                     )
                 if header is not None and header["campaign"] != key:
                     raise InputError(
                         f"{self.path}: made by a campaign with other FMUs or options; resume it with "
-                        "the same ones, or start afresh without --resume"
+                        f"the same ones, or start afresh without {name_of(names, 'resume')}"
                     )
                 offset, number = journal.tell(), 1
                 for line in journal:

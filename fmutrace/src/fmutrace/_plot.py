@@ -14,7 +14,7 @@ import threading
 
 import numpy as np
 
-from ._comparison import Comparison, Mode
+from ._comparison import Mode
 from ._traces import shown
 
 WIDTH_INCHES, DPI = 8.0, 80
@@ -62,16 +62,6 @@ class Envelope:
         return times, values
 
 
-def decimated(times, values, t0=None, t1=None):
-    """(times, values) of a whole line, decimated when it has more samples
-    than its pixel columns can show."""
-    if len(times) <= 4 * COLUMNS:
-        return times, values
-    envelope = Envelope(times[0] if t0 is None else t0, times[-1] if t1 is None else t1)
-    envelope.add(times, values)
-    return envelope.line()
-
-
 class Figure:
     """What a case's figure shows, each line already decimated:
     inputs [(name, times, values)], signals [(name, (ref times, values),
@@ -81,66 +71,6 @@ class Figure:
 
     def __init__(self, title, inputs, signals, deviations, zoom=None):
         self.title, self.inputs, self.signals, self.deviations, self.zoom = title, inputs, signals, deviations, zoom
-
-
-def case_figure(case, result, comparison: Comparison, label: str) -> Figure:
-    """The Figure of a case run in memory."""
-    title = f"{case.name} on {label}" + (f": {case.description}" if case.description else "")
-    stop = case.options["StopTime"]
-    inputs = []
-    if case.inputs is not None:
-        for name in case.inputs.dtype.names[1:]:
-            inputs.append(
-                (
-                    name,
-                    *decimated(
-                        np.append(case.inputs["time"], stop), np.append(case.inputs[name], case.inputs[name][-1])
-                    ),
-                )
-            )
-    ref = case.reference
-    signals, deviations = [], []
-    for name in case.outputs:
-        band = comparison.bands.get(name)
-        shown_band = None
-        if band is not None and len(band.times) > 4 * COLUMNS:
-            lower, upper = decimated(band.times, band.lower), decimated(band.times, band.upper)
-            shown_band = (lower[0], lower[1], upper[1])
-        elif band is not None:
-            shown_band = (band.times, band.lower, band.upper)
-        signals.append((name, decimated(ref["time"], ref[name]), decimated(result["time"], result[name]), shown_band))
-        if band is not None:
-            deviations.append((name, *decimated(band.times, band.deviation)))
-    return Figure(title, inputs, signals, deviations, zoom_of(comparison))
-
-
-def zoom_of(comparison: Comparison):
-    """The zoom on the first deviation of a failing comparison (None if it
-    passes): (its time, [(name, times, result, lower, upper, deviation)] of
-    every signal's compared samples around it)."""
-    failing = [d for d in comparison.deviations if not d.passed and d.time is not None]
-    if not failing:
-        return None
-    first = min(failing, key=lambda d: d.time)
-    lines = []
-    for name, band in comparison.bands.items():
-        k = int(np.searchsorted(band.times, first.time))
-        window = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
-        lines.append(
-            (
-                name,
-                band.times[window],
-                band.values[window],
-                band.lower[window],
-                band.upper[window],
-                band.deviation[window],
-            )
-        )
-    return first.time, lines
-
-
-def plot_case(case, result, comparison: Comparison, mode: Mode, label: str) -> bytes:
-    return draw(case_figure(case, result, comparison, label), mode, label)
 
 
 _reused = threading.local()  # a figure is drawn by one thread at a time

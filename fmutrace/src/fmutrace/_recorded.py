@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 
 from ._cases import Case
-from ._comparison import Comparison, compare_traces
 from ._errors import InputError
 from .recordings import read_recording
 from .recordings._align import align
@@ -28,22 +27,12 @@ class RecordedCase(Case):
     coarse: str = ""  # why an exact comparison cannot hold
     shift: int = 1  # steps from a row's time to its output's (timing)
 
-    def comparison(self, result, mode) -> Comparison:
-        """Every compared signal on its own samples."""
-        merged = Comparison()
-        for reference in self.references:
-            part = compare_traces(result, reference, mode)
-            merged.deviations += part.deviations
-            merged.bands.update(part.bands)
-            merged.problem = merged.problem or part.problem
-        return merged
-
-    def explain(self, comparison) -> list:
+    def explain(self, deviations) -> list:
         """What a failing comparison's reader needs beside the deviations:
         where in the recording the first ones are, and the notes."""
         messages = []
         step = self.options["StepSize"]
-        for deviation in comparison.deviations:
+        for deviation in deviations:
             channel = self.channels.get(deviation.name)
             if deviation.passed or channel is None or deviation.time is None:
                 continue
@@ -74,9 +63,9 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     if len(found) != 1:
         raise InputError(f"{path}: holds {len(found)} recordings: give them one by one (or their files)")
     recording = found[0]
-    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step)
-    matched = plan(recording, fmu.variables, fmu.label, options.maps)
-    aligned = align(recording, matched, options.timing, fmu.label)
+    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names)
+    matched = plan(recording, fmu.variables, fmu.label, options.maps, options.names)
+    aligned = align(recording, matched, options.timing, fmu.label, options.names)
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     names = [v for reference in aligned.references for v in reference.dtype.names[1:]]
     unit = UNIT_NAMES.get(recording.time_unit, recording.time_unit)

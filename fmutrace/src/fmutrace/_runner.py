@@ -40,7 +40,7 @@ import io
 import itertools
 import math
 from ctypes import c_void_p
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import cffi
 import numpy as np
@@ -168,6 +168,23 @@ def _row_pointers(values):
     """A char pointer to each row of a 2-D array."""
     base = FFI.cast("char *", values.ctypes.data)
     return [base + k * values.strides[0] for k in range(len(values))]
+
+
+def _held_to(chunks, stop_time):
+    """The chunks of an input table, a table of a single row held until
+    stop_time as held_to holds it for fmpy."""
+    first = next(chunks, None)
+    if first is None:
+        return
+    if len(first) == 1:
+        second = next(chunks, None)
+        if second is None:
+            yield held_to(first, stop_time)
+            return
+        yield first
+        first = second
+    yield first
+    yield from chunks
 
 
 def _value_references(variables):
@@ -493,45 +510,52 @@ class Runner:
 
     def run(self, experiment: Experiment, signals: Signals):
         """The trace's result, as fmpy.simulate_fmu(..., output_interval=step)
-        returns it (a structured array). SimulationError if the FMU fails."""
-        inputs = held_to(signals.inputs, experiment.stop)  # as run_fmpy gives them to fmpy
+        returns it (a structured array): run_chunks' chunks joined, the
+        input table given whole. SimulationError if the FMU fails."""
+        inputs: Any = signals.inputs  # a structured array, or None
         names = inputs.dtype.names[1:] if inputs is not None else ()
-        if self.static_problem(experiment, names, signals.outputs) is None:
-            try:  # the input events are checked as the table is read, before the FMU is called
-                chunks = list(
-                    self._fast(
-                        experiment,
-                        Signals(None if inputs is None else iter([inputs]), signals.start_values, signals.outputs),
-                        STEPS_PER_CHUNK,
-                    )
-                )
+        table = None if inputs is None else (lambda: iter([inputs]))
+        chunks = list(self.run_chunks(experiment, Signals(table, signals.start_values, signals.outputs), names))
+        return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+
+    def run_chunks(self, experiment: Experiment, signals: Signals, input_names, steps_per_chunk=STEPS_PER_CHUNK):
+        """The trace's result as fmpy.simulate_fmu(..., output_interval=step)
+        gives it, in consecutive structured arrays (the first holds the
+        start time's row too), in memory that does not grow with the length
+        on the fast loop. signals.inputs: None, or a function that gives the
+        input table as consecutive structured arrays from its first row
+        each time it is called (an iterator of them is read once and kept);
+        input_names: their columns. Where the fast loop cannot give fmpy's
+        result (the names or the grid say so before it starts; an input
+        event between communication points or a failing call as it runs),
+        fmpy runs the trace on an instance of its own, the table read whole,
+        and its rows after those given already follow (the fast loop's are
+        fmpy's bits: a test checks it). SimulationError if the FMU fails."""
+        inputs: Any = signals.inputs
+        if inputs is not None and not callable(inputs):
+            kept = list(inputs)
+            inputs = lambda: iter(kept)  # noqa: E731 (a table given as an iterator: read once)
+        given = -math.inf  # the time of the last row given
+        if self.static_problem(experiment, input_names, signals.outputs) is None:
+            table = None if inputs is None else _held_to(inputs(), experiment.stop)
+            try:
+                for chunk in self._fast(
+                    experiment, Signals(table, signals.start_values, signals.outputs), steps_per_chunk
+                ):
+                    given = float(chunk["time"][-1])
+                    yield chunk
                 self.fast_runs += 1
-                return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+                return
             except InputsNeedFmpy:
                 pass
             except FastLoopFailed:
                 self._drop_instance()  # a call failed: fmpy tells the story on an instance of its own
         self.fmpy_runs += 1
-        return run_fmpy(self.folder, self.md, experiment, Signals(inputs, signals.start_values, signals.outputs))
-
-    def run_chunks(self, experiment: Experiment, signals: Signals, input_names, steps_per_chunk=STEPS_PER_CHUNK):
-        """The result of run() in consecutive structured arrays (the first
-        holds the start time's row too), the instance kept from chunk to
-        chunk: the same bits as run() gives (a test checks it), in memory
-        that does not grow with the length. signals.inputs: consecutive
-        structured arrays of the input table (two rows at least in all),
-        or None; input_names: their columns. FastLoopFailed where run()
-        would go through fmpy (before the first chunk when the names or the
-        grid say so)."""
-        problem = self.static_problem(experiment, input_names, signals.outputs)
-        if problem:
-            raise FastLoopFailed(problem)
-        self.fast_runs += 1
-        try:
-            yield from self._fast(experiment, signals, steps_per_chunk)
-        except FastLoopFailed:
-            self._drop_instance()
-            raise
+        table = None if inputs is None else np.concatenate(list(inputs()))
+        result = run_fmpy(self.folder, self.md, experiment, Signals(table, signals.start_values, signals.outputs))
+        result = result[result["time"] > given]
+        for k in range(0, len(result), steps_per_chunk):
+            yield result[k : k + steps_per_chunk]
 
     def _grid(self, start, step, k, m):
         """fmpy's communication points from step k on for m steps,

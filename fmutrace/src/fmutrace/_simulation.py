@@ -8,17 +8,18 @@ the outputs at t + h.
 """
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 from os import PathLike
-from pathlib import Path
 
 import numpy as np
 
 from ._errors import InputError
 from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
-from ._runner import Runner
-from ._traces import read_trace
+from ._progress import SampleProgress
+from ._runner import STEPS_PER_CHUNK, Runner
+from ._traces import CHUNK_BYTES, NotPlain, last_time, read_trace, trace_chunks
 from .recordings._timebase import MAX_STEPS
 
 
@@ -76,28 +77,80 @@ def simulate(
     Returns a NumPy structured array, 'time' first. Raises InputError for
     bad input (nothing is run) and SimulationError if the FMU fails.
     """
-    fmu = fmu if isinstance(fmu, Fmu) else Fmu(fmu)
-    if isinstance(input, (str, Path)):
-        inputs = read_trace(input, fmu.input_problem)
-    elif input is not None:
-        inputs = np.asarray(input)
-        if inputs.dtype.names is None or "time" not in inputs.dtype.names:
-            raise InputError("the input must be a structured array with a 'time' field")
-        for name in inputs.dtype.names:
-            problem = name != "time" and fmu.input_problem(name)
-            if problem:
-                raise InputError(problem)
-    else:
-        inputs = None
     options = SimulationOptions(start_values, start_time, stop_time, step_size, output_interval, outputs)
-    times = inputs["time"] if inputs is not None and len(inputs) else None
-    experiment, signals = resolved(fmu, options, (times[0], times[-1]) if times is not None else None)
+    chunks = list(simulate_chunks(fmu, input, options))
+    return chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
+
+
+def simulate_chunks(
+    fmu: str | PathLike | Fmu,
+    input: str | PathLike | np.ndarray | None = None,
+    options: SimulationOptions = SimulationOptions(),
+    chunk_bytes: int = CHUNK_BYTES,
+    steps_per_chunk: int = STEPS_PER_CHUNK,
+    progress: bool = False,
+) -> Iterator[np.ndarray]:
+    """simulate's result as consecutive structured arrays, made as they are
+    asked for: an input file of the plain dialect is read chunk by chunk
+    (chunk_bytes of text each), so memory does not grow with its length;
+    any other is read whole by read_trace. InputError for bad input before
+    the FMU runs (a value further into a long file than the first chunk
+    as the run reaches it), SimulationError if the FMU fails. progress: a
+    progress bar on standard error (on a terminal only)."""
+    fmu = fmu if isinstance(fmu, Fmu) else Fmu(fmu)
+    table, names, span = _input_table(fmu, input, chunk_bytes)
+    experiment, signals = resolved(fmu, options, span)
+    interval = options.output_interval
+    every_nth(np.empty(0, dtype=[("time", np.float64)]), experiment.start, experiment.step, interval)  # checked now
     runner = Runner(fmu.path.read_bytes())  # its own loop where it gives fmpy's result, else fmpy's
+    bar = SampleProgress(round((experiment.stop - experiment.start) / experiment.step) + 1) if progress else None
+    made = 0
     try:
-        result = runner.run(experiment, Signals(inputs, signals.start_values, signals.outputs))
+        results = runner.run_chunks(
+            experiment, Signals(table, signals.start_values, signals.outputs), names, steps_per_chunk
+        )
+        try:
+            for chunk in results:
+                made += len(chunk)
+                if bar is not None:
+                    bar.update(made)
+                yield every_nth(chunk, experiment.start, experiment.step, interval)
+        except NotPlain as error:  # a later chunk of an input file: read_trace says where
+            if isinstance(input, (str, PathLike)):
+                read_trace(input, fmu.input_problem)
+            raise InputError(f"{input}: {error}") from None
     finally:
+        if bar is not None:
+            bar.close()
         runner.close()
-    return every_nth(result, experiment.start, experiment.step, output_interval)
+
+
+def _input_table(fmu: Fmu, input, chunk_bytes) -> tuple:
+    """(a function that gives the input table's chunks from its first row,
+    or None; its columns; its first and last time, or None)."""
+    if input is None:
+        return None, (), None
+    if isinstance(input, (str, PathLike)):
+        try:
+            first = next(trace_chunks(input, fmu.input_problem, chunk_bytes=1 << 16))
+            span = (float(first["time"][0]), last_time(input))
+        except (NotPlain, OSError, ValueError, StopIteration):
+            whole = read_trace(input, fmu.input_problem)  # it reads the file, or says what is wrong where
+            return (lambda: iter([whole])), tuple(whole.dtype.names or ())[1:], _span(whole)
+        names = tuple(first.dtype.names or ())[1:]
+        return (lambda: trace_chunks(input, fmu.input_problem, chunk_bytes=chunk_bytes)), names, span
+    inputs = np.asarray(input)
+    if inputs.dtype.names is None or "time" not in inputs.dtype.names:
+        raise InputError("the input must be a structured array with a 'time' field")
+    for name in inputs.dtype.names:
+        problem = name != "time" and fmu.input_problem(name)
+        if problem:
+            raise InputError(problem)
+    return (lambda: iter([inputs])), inputs.dtype.names[1:], _span(inputs)
+
+
+def _span(inputs):
+    return (float(inputs["time"][0]), float(inputs["time"][-1])) if len(inputs) else None
 
 
 def resolved(fmu: Fmu, options: SimulationOptions, input_span: tuple | None) -> tuple[Experiment, Signals]:

@@ -20,6 +20,7 @@ the column.
 """
 
 import io
+import os
 import math
 import re
 import warnings
@@ -284,7 +285,6 @@ def _read_rows(path, lines, header: _Header, separator):
 
 
 CHUNK_BYTES = 1 << 22  # of CSV text per chunk of trace_chunks
-LONG_CASE_BYTES = 32 << 20  # a case or recording whose file is larger runs chunk by chunk
 
 
 def trace_chunks(
@@ -346,6 +346,21 @@ def trace_chunks(
         yield chunk
     if not rows:
         raise NotPlain("no samples")
+
+
+def last_time(path):
+    """The time in the last data line of a plain CSV file (its first cell),
+    however long that line is."""
+    with open(path, "rb") as file:
+        end = file.seek(0, os.SEEK_END)
+        size = 4096
+        while True:
+            begin = max(0, end - size)
+            file.seek(begin)
+            lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
+            if len(lines) >= 2 or begin == 0:  # a line break before the last line: it is whole
+                return float(lines[-1].split(b",")[0])
+            size *= 4
 
 
 def _line_blocks(path, size):

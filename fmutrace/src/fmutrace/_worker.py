@@ -3,21 +3,14 @@ process or a Dask worker): read and checked, simulated, compared, plotted
 if asked."""
 
 import hashlib
-import os
-import tempfile
-import time
 from dataclasses import dataclass, field
 
-from ._cases import Case, load_case
-from ._comparison import Comparison, Mode
-from ._errors import InputError, SimulationError
-from ._fmpy import Experiment, Signals
+from ._comparison import Mode
 from ._fmu import Fmu
-from ._longcase import Streaming, is_long, run_long_case
-from ._longrecording import is_long_recording, run_long_recording
-from ._outcome import CaseOutcome, Status
-from ._plot import load_plotting, plot_case
-from ._recorded import RecordedCase, recorded_case
+from ._pipeline import CaseFiles, Streaming, run_folder_case
+from ._recording import run_recording
+from ._outcome import CaseOutcome
+from ._plot import load_plotting
 from .recordings import is_recording
 from .recordings._options import RecordingOptions
 from ._runner import Runner
@@ -59,64 +52,14 @@ class Target:
 
 def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> CaseOutcome:
     """The case in folder (its files' texts given, or None: read them), or
-    the recording there (read with settings.recording), on target."""
-    started = time.perf_counter()
-    runner, fmu, labels, mode, plots = target.runner, target.fmu, target.labels, settings.mode, settings.plots
-    recorded = texts is None and is_recording(folder)  # (texts come with a case folder only)
-    streamed = is_long_recording(folder) if recorded else is_long(folder, fmu.model, texts)
-    if streamed:
-        result_file = _result_file() if plots != "none" else None
-        streaming = Streaming(result_file=result_file)
-        long = (
-            run_long_recording(folder, name, target, settings, streaming)
-            if recorded
-            else run_long_case(folder, name, target, settings, streaming)
-        )
-        if result_file and (long is None or not long.png):  # a result file only with the case's plot
-            os.unlink(result_file)
-        elif long is not None:
-            long.result_path = result_file
-        if long is not None:
-            return long
-    outcome = CaseOutcome(name, **labels)
-    case: Case
-    try:
-        if recorded:
-            case = recorded_case(str(folder), fmu, name, settings.recording)
-        else:
-            case = load_case(folder, fmu, name, texts)
-    except InputError as error:
-        outcome.status, outcome.messages = Status.INVALID, [str(error)]
-        outcome.seconds = time.perf_counter() - started
-        return outcome
-    try:
-        o = case.options
-        result = runner.run(
-            Experiment(o["StartTime"], o["StopTime"], o["StepSize"], o["RelTol"]),
-            Signals(case.inputs, case.start_values, case.outputs),
-        )
-        comparison = case.comparison(result, mode)
-        outcome.status = Status.PASS if comparison.passed else Status.FAIL
-    except SimulationError as error:
-        result, outcome.status = None, Status.ERROR
-        comparison = Comparison(problem=str(error))
-    outcome.deviations = [d for d in comparison.deviations if not d.passed]  # a passing signal says nothing more
-    outcome.messages = comparison.messages()
-    if isinstance(case, RecordedCase):  # what was read, matched and assumed, pass or fail
-        outcome.messages += [case.description] + (case.explain(comparison) if not comparison.passed else case.notes)
-    if result is not None and (plots == "all" or (plots == "failed" and not outcome.passed)):
-        outcome.result = result
-        outcome.png = plot_case(case, result, comparison, mode, labels["fmu"])
-    outcome.seconds = time.perf_counter() - started
+    the recording there (read with settings.recording), on target: read,
+    run and compared by the pipeline, plotted if asked."""
+    streaming = Streaming(keep_result=settings.plots != "none")
+    if texts is None and is_recording(folder):  # (texts come with a case folder only)
+        outcome = run_recording(folder, name, target, settings, streaming)
+    else:
+        outcome = run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
     return outcome
-
-
-def _result_file():
-    """A new file for a long case's result, written as it is made (the report takes it)."""
-    handle, path = tempfile.mkstemp(prefix="fmutrace-", suffix="_out.csv")
-    os.close(handle)
-    os.chmod(path, 0o644)  # as the report's other files (mkstemp makes it private)
-    return path
 
 
 # the FMU's content hash -> (Runner, Fmu), kept from task to task in a worker process

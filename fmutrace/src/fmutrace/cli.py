@@ -9,21 +9,22 @@ simulation, 2 bad input, 130 interrupted); compare's is its worst case's.
 
 import argparse
 import contextlib
+import os
 import sys
 
 from . import __version__
 from ._campaign import compare
+from ._comparison import comparison_mode
 from ._executors import RunOptions
 from ._errors import ExitStatus, InputError, SimulationError
 from ._fmu import Fmu, is_fmu_file
-from ._longcase import simulate_long
-from ._simulation import SimulationOptions, simulate
+from ._simulation import SimulationOptions, simulate_chunks
 from ._outcome import Status
 from ._report import text
 from .recordings import is_recording
 from .recordings._align import TIMINGS
 from .recordings._options import TIME_UNITS, RecordingOptions
-from ._traces import write_trace
+from ._traces import TraceWriter
 from ._worker import PLOT_ALL_UP_TO, PLOTS
 
 EXAMPLES = """examples:
@@ -32,6 +33,21 @@ EXAMPLES = """examples:
   fmutrace compare build/fmi3/LGF_LimRateOfChangeCI.fmu LGF_Ramp.csv     (a TwinCAT Scope export, say)
   fmutrace compare build/fmi2/*.fmu build/fmi3/*.fmu tests/scenarios --jobs 2 --junit junit.xml
 """
+
+
+# setting -> its flag: the command's words for the settings, in its messages too (RecordingOptions.names)
+FLAGS = {
+    "step_size": "--step-size",
+    "time_unit": "--time-unit",
+    "timing": "--timing",
+    "maps": "--map",
+    "start_values": "--set",
+    "rel_tol": "--rel-tol",
+    "abs_tol": "--abs-tol",
+    "tube_time": "--tube-time",
+    "tube_value": "--tube-value",
+    "resume": "--resume",
+}
 
 
 def _assignment(text):
@@ -119,15 +135,15 @@ def parser():
     cmp.add_argument(
         "--report", metavar="DIR", help="write index.html, summary.md, results.json, the results and plots here"
     )
-    cmp.add_argument("--rel-tol", type=_non_negative, default=0.0, metavar="R")
-    cmp.add_argument("--abs-tol", type=_non_negative, default=0.0, metavar="A")
+    cmp.add_argument(FLAGS["rel_tol"], type=_non_negative, default=0.0, metavar="R")
+    cmp.add_argument(FLAGS["abs_tol"], type=_non_negative, default=0.0, metavar="A")
     cmp.add_argument(
-        "--tube-time",
+        FLAGS["tube_time"],
         type=_non_negative,
         metavar="S",
         help="tube half-width in time (with --tube-value), for traces sampled at other instants",
     )
-    cmp.add_argument("--tube-value", type=_non_negative, metavar="V", help="tube half-width in value")
+    cmp.add_argument(FLAGS["tube_value"], type=_non_negative, metavar="V", help="tube half-width in value")
     cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
     cmp.add_argument(
         "--jobs",
@@ -156,21 +172,21 @@ def parser():
     cmp.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
     cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
     cmp.add_argument(
-        "--resume",
+        FLAGS["resume"],
         action="store_true",
         help="take the cases the report's journal holds from it and "
         "run the others (after a stopped campaign; needs --report)",
     )
     rec = cmp.add_argument_group("recordings", "how recordings are read (docs/recordings.md)")
     rec.add_argument(
-        "--step-size",
+        FLAGS["step_size"],
         type=_positive,
         metavar="H",
         help="the PLC's cycle in seconds (default: the "
         "recording's sample time, else its finest interval between samples)",
     )
     rec.add_argument(
-        "--map",
+        FLAGS["maps"],
         metavar="VARIABLE=CHANNEL",
         action="append",
         type=_assignment,
@@ -179,7 +195,7 @@ def parser():
         "last component is the variable's name)",
     )
     rec.add_argument(
-        "--set",
+        FLAGS["start_values"],
         metavar="NAME=VALUE",
         action="append",
         type=_assignment,
@@ -187,13 +203,13 @@ def parser():
         help="a start value of the FMU (repeatable)",
     )
     rec.add_argument(
-        "--time-unit",
+        FLAGS["time_unit"],
         choices=TIME_UNITS,
         help="the unit of the recording's time stamps (default: "
         "what the export says, else what their size says: FILETIME, Unix ms, else seconds)",
     )
     rec.add_argument(
-        "--timing",
+        FLAGS["timing"],
         choices=TIMINGS,
         default="cycle",
         help="cycle (default): a row is the input a "
@@ -210,23 +226,24 @@ def run_command(args, out):
     options = SimulationOptions(
         dict(args.set), args.start_time, args.stop_time, args.step_size, args.output_interval, args.output
     )
-    if args.input and args.output_interval is None:  # a long input runs chunk by chunk, written as it goes
-        with open(args.out, "w", newline="\n") if args.out else contextlib.nullcontext(out) as stream:
-            written = simulate_long(args.fmu, args.input, stream, options)
-        if written is not None:
-            if args.out:
-                signals = len(args.output or Fmu(args.fmu).outputs)
-                print(f"{written} samples of {signals} signals written to {text(args.out)}", file=out)
-            return ExitStatus.SUCCESS
-    result = simulate(args.fmu, args.input, **vars(options))
+    written, names = 0, ("time",)  # type: tuple[int, tuple[str, ...]]
+    with contextlib.ExitStack() as stack:
+        stream, writer = None, None
+        try:
+            for chunk in simulate_chunks(args.fmu, args.input, options, progress=True):
+                if writer is None:  # the file made once the run has begun: bad input leaves none
+                    stream = stack.enter_context(open(args.out, "w", newline="\n")) if args.out else out
+                    names = chunk.dtype.names or ("time",)
+                    writer = TraceWriter(stream, names)
+                writer.write(chunk)
+                written += len(chunk)
+        except (InputError, SimulationError):
+            if args.out and stream is not None:
+                stream.close()
+                os.unlink(args.out)  # no half-written result
+            raise
     if args.out:
-        write_trace(args.out, result)
-        print(
-            f"{len(result)} samples of {len(result.dtype.names or ()) - 1} signals written to {text(args.out)}",
-            file=out,
-        )
-    else:
-        write_trace(out, result)
+        print(f"{written} samples of {len(names) - 1} signals written to {text(args.out)}", file=out)
     return ExitStatus.SUCCESS
 
 
@@ -250,9 +267,9 @@ def compare_command(args, out):
     # the recordings group's flags read recordings; with case folders alone the command leaves them unused, as
     # it did, and says so
     recording = (
-        RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set)
+        RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set, names=FLAGS)
         if recordings
-        else RecordingOptions()
+        else RecordingOptions(names=FLAGS)
     )
     unused = [
         flag
@@ -274,10 +291,7 @@ def compare_command(args, out):
     result = compare(
         fmus,
         cases,
-        rel_tol=args.rel_tol,
-        abs_tol=args.abs_tol,
-        tube_time=args.tube_time,
-        tube_value=args.tube_value,
+        mode=comparison_mode(args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, names=FLAGS),
         report=args.report,
         junit=args.junit,
         plots=args.plots,

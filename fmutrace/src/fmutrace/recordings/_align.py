@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._errors import InputError
+from .._names import Names, name_of
 from ._timebase import OFF_CYCLE, cycles
 
 TIMINGS = ("cycle", "fmi")
@@ -42,7 +43,7 @@ class Aligned:
     coarse: str = ""  # why an exact comparison cannot hold (inputs sampled coarser than the step)
 
 
-def _cycles_of(channel, step, notes):
+def _cycles_of(channel, step, notes, names):
     index, off = cycles(channel.times, step)
     if len(off):
         i = int(off[0])
@@ -55,7 +56,7 @@ def _cycles_of(channel, step, notes):
         raise InputError(
             f"{channel.where(i + 1)}: samples of {channel.name} at t={float(channel.times[i]):.9g} s and "
             f"t={float(channel.times[i + 1]):.9g} s fall on the same cycle of {step:g} s: the step is "
-            "coarser than the recording (give the recorder's cycle with --step-size)"
+            f"coarser than the recording (give the recorder's cycle with {name_of(names, 'step_size')})"
         )
     return index
 
@@ -77,14 +78,16 @@ def _interval(index):
     return int(np.median(np.diff(index)))
 
 
-def align(recording, plan, timing="cycle", label="the FMU"):
-    """The Aligned of a normalised recording and its Plan."""
+def align(recording, plan, timing="cycle", label="the FMU", names: Names = ()):
+    """The Aligned of a normalised recording and its Plan; names: the
+    caller's words for the settings (RecordingOptions.names)."""
     if timing not in TIMINGS:
         raise InputError(f"timing must be one of {', '.join(TIMINGS)}, not {timing!r}")
     if not plan.compares:
         raise InputError(
             f"{recording.label}: no channel is an output of {label}: nothing to compare (channels: "
-            f"{', '.join(c.name for c in recording.channels)}; map one with --map VARIABLE=CHANNEL)"
+            f"{', '.join(c.name for c in recording.channels)}; map one with "
+            f"{name_of(names, maps=('VARIABLE', 'CHANNEL'))})"
         )
     step = recording.step_size
     notes = list(recording.notes)
@@ -93,7 +96,7 @@ def align(recording, plan, timing="cycle", label="the FMU"):
     inputs = None
     coarse = []
     if plan.drives:
-        indices = [_cycles_of(channel, step, notes) for _, channel in plan.drives]
+        indices = [_cycles_of(channel, step, notes, names) for _, channel in plan.drives]
         grid = np.unique(np.concatenate(indices))
         inputs = np.empty(len(grid), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in plan.drives])
         inputs["time"] = grid * step
@@ -107,7 +110,7 @@ def align(recording, plan, timing="cycle", label="the FMU"):
     last = 0
     groups: dict[bytes, tuple[np.ndarray, list]] = {}  # the cycles' bytes -> (cycles, [(variable, channel)])
     for variable, channel in plan.compares:
-        index = _cycles_of(channel, step, notes)
+        index = _cycles_of(channel, step, notes, names)
         last = max(last, int(index[-1]) if len(index) else 0)
         groups.setdefault(index.tobytes(), (index, []))[1].append((variable, channel))
     for index, members in groups.values():
@@ -121,14 +124,14 @@ def align(recording, plan, timing="cycle", label="the FMU"):
     stop = max(last + shift, 1) * step
     aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step, notes=notes)
     if coarse:
-        aligned.coarse = _coarse_note(coarse, plan, step)
+        aligned.coarse = _coarse_note(coarse, plan, step, names)
     return aligned
 
 
-def _coarse_note(coarse, plan, step):
+def _coarse_note(coarse, plan, step, names):
     """What inputs sampled every N cycles mean, and a tolerance that is."""
     every = max(n for _, n in coarse)
-    names = ", ".join(f"{v} every {n} cycles" for v, n in coarse)
+    sampled = ", ".join(f"{v} every {n} cycles" for v, n in coarse)
     lag = (every - 1) * step
     spans = []
     for variable, channel in plan.compares:
@@ -141,10 +144,11 @@ def _coarse_note(coarse, plan, step):
             spans.append((variable, rate * (every - 1)))
     tolerance = max((s for _, s in spans), default=0.0)
     return (
-        f"the recording's inputs were sampled coarser than the step ({names}; step {step:g} s): between two "
+        f"the recording's inputs were sampled coarser than the step ({sampled}; step {step:g} s): between two "
         "samples the FMU holds the last recorded value while the controller saw values the recording does not "
         f"hold, so its output may lead or lag the recorded one by up to {every - 1} cycles and an exact "
-        f"comparison cannot hold. A meaningful comparison allows that lag: --tube-time {lag:.6g} --tube-value 0, "
-        f"or --abs-tol {tolerance:.6g} (the largest change of "
+        "comparison cannot hold. A meaningful comparison allows that lag: "
+        f"{name_of(names, tube_time=lag, tube_value=0.0)}, or {name_of(names, abs_tol=tolerance)} "
+        "(the largest change of "
         f"{', '.join(v for v, _ in spans) or 'the outputs'} over {every - 1} cycles, as recorded)"
     )

@@ -3,14 +3,16 @@
 A channel means the variable named by the last component of its name:
 MAIN.fbRamp.delayedValue, "DB_Ramp".delayedValue and
 Application.PLC_PRG.fbRamp.delayedValue all mean delayedValue (the same
-name in another case too, when that is the only such variable). --map
-VARIABLE=CHANNEL says it where the names differ. A channel of an input
-or a tunable parameter drives the FMU, one of an output is compared, any
-other is listed as ignored with the reason."""
+name in another case too, when that is the only such variable). A map
+(RecordingOptions.maps; the command's --map VARIABLE=CHANNEL) says it
+where the names differ. A channel of an input or a tunable parameter
+drives the FMU, one of an output is compared, any other is listed as
+ignored with the reason."""
 
 from dataclasses import dataclass, field
 
 from .._errors import InputError
+from .._names import Names, name_of
 
 
 def components(name):
@@ -77,18 +79,19 @@ def _find_channel(recording, wanted):
     return None
 
 
-def plan(recording, variables, label, maps=()):
+def plan(recording, variables, label, maps=(), names: Names = ()):
     """The Plan of a recording for an FMU whose variables (name ->
-    fmpy ScalarVariable) are given; maps: (VARIABLE, CHANNEL) pairs."""
+    fmpy ScalarVariable) are given; maps: (VARIABLE, CHANNEL) pairs;
+    names: the caller's words for the settings (RecordingOptions.names)."""
     taken = {}  # variable -> channel
     for variable, wanted in maps:
         if variable not in variables:
-            raise InputError(f"--map {variable}={wanted}: {label} has no variable {variable!r}")
+            raise InputError(f"{name_of(names, maps=(variable, wanted))}: {label} has no variable {variable!r}")
         channel = _find_channel(recording, wanted)
         if channel is None:
             raise InputError(
-                f"--map {variable}={wanted}: {recording.label} has no channel {wanted!r} (its channels: "
-                f"{', '.join(c.name for c in recording.channels)})"
+                f"{name_of(names, maps=(variable, wanted))}: {recording.label} has no channel {wanted!r} "
+                f"(its channels: {', '.join(c.name for c in recording.channels)})"
             )
         taken[variable] = channel
     mapped = {id(c) for c in taken.values()}
@@ -126,7 +129,7 @@ def plan(recording, variables, label, maps=()):
                 continue
             raise InputError(
                 f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
-                f"{_column(channel)} both mean {variable}: say which with --map {variable}=CHANNEL"
+                f"{_column(channel)} both mean {variable}: say which with {name_of(names, maps=(variable, 'CHANNEL'))}"
             )
         taken[variable] = channel
     for variable, channel in taken.items():

@@ -37,6 +37,7 @@ class Recording:
     notes: list = field(default_factory=list)
     step_size: float | None = None  # set by normalise()
     step_source: str = ""
+    unit_given: bool = False  # the caller gave the time unit (set by normalise())
 
     @property
     def label(self):

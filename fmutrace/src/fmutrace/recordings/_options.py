@@ -1,9 +1,10 @@
 """How the recordings of a campaign are read: one RecordingOptions for all."""
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from .._errors import InputError
+from .._names import Names, name_of
 from ._align import TIMINGS
 
 TIME_UNITS = ("s", "ms", "us", "ns", "cycles", "filetime")
@@ -31,6 +32,11 @@ class RecordingOptions:
     maps          {VARIABLE: CHANNEL} (or pairs): the channel that is the
                   FMU's variable
     start_values  {name: value} (or pairs): start values of the FMU
+    names         {setting: how the caller writes it} (or pairs): the
+                  words messages name the settings in (default: the
+                  API's, RecordingOptions(step_size=...); the command
+                  gives its flags, --step-size). Not a setting: equal
+                  options with other names are equal
     """
 
     step_size: float | None = None
@@ -38,16 +44,22 @@ class RecordingOptions:
     timing: str = "cycle"
     maps: tuple = ()
     start_values: tuple = ()
+    names: Names = field(default=(), compare=False)  # stored as pairs
 
     def __post_init__(self):
         object.__setattr__(self, "maps", _pairs(self.maps, "maps"))
         object.__setattr__(self, "start_values", _pairs(self.start_values, "start_values"))
+        object.__setattr__(self, "names", _pairs(self.names, "names"))
         if self.time_unit is not None and self.time_unit not in TIME_UNITS:
-            raise InputError(f"time_unit must be one of {', '.join(TIME_UNITS)}, not {self.time_unit!r}")
+            raise InputError(
+                f"{name_of(self.names, 'time_unit')} must be one of {', '.join(TIME_UNITS)}, not {self.time_unit!r}"
+            )
         if self.timing not in TIMINGS:
-            raise InputError(f"timing must be one of {', '.join(TIMINGS)}, not {self.timing!r}")
+            raise InputError(
+                f"{name_of(self.names, 'timing')} must be one of {', '.join(TIMINGS)}, not {self.timing!r}"
+            )
         if self.step_size is not None and not self.step_size > 0:
-            raise InputError(f"step_size must be greater than 0, not {self.step_size!r}")
+            raise InputError(f"{name_of(self.names, 'step_size')} must be greater than 0, not {self.step_size!r}")
 
     @property
     def timebase_unit(self) -> str | None:

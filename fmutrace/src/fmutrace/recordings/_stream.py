@@ -1,5 +1,5 @@
 """A long one-file recording (a table export: CSV/TSV, TIA Portal, CODESYS
-V3) read in blocks of lines (_longrecording runs it through _longcase.stream_case),
+V3) read in blocks of lines (_recording runs it through _pipeline.run_chunked_case),
 in memory that does not grow with its length.
 
 The file's head (its first HEAD_BYTES) is read as the in-memory path reads
@@ -75,7 +75,7 @@ class Table:
         rows = len(text.lines) - index - 1
         if any(c.stamps.dtype != np.float64 or len(c.values) != rows for c in recording.channels) or rows < 2:
             raise NotPlain("integer stamps, an empty cell or too few rows in the head")
-        timebase.normalise(recording, options.timebase_unit, options.step_size, fmu.default_step)
+        timebase.normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names)
         self.recording = recording
         self.origin = float(recording.channels[0].stamps[0])
         self.factor = (
@@ -241,6 +241,6 @@ def time_column_pass(table, step, block_bytes=None):
                 raise NotPlain("too many distinct intervals between stamps")
     if not table.step_given and timebase.snapped_interval(intervals.median() or step) != step:
         raise NotPlain("the whole file's interval is another step than its head's")
-    if timebase.too_long(span) or timebase.too_many_steps(span / step, rows, recording.time_source):
+    if timebase.too_long(span) or timebase.too_many_steps(span / step, rows, recording.unit_given):
         raise NotPlain("the in-memory path refuses the length")
     return Cycles(rows, expected - 1, off, first_off)

@@ -19,11 +19,12 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 
 from .._errors import InputError, TraceError
+from .._names import Names, name_of
 from ._model import TIME_FACTORS
 
 OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
 MAX_STEPS = 200_000_000  # more steps than this (23 days of 10 ms cycles) is a misread unit
-MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless --time-unit says so)
+MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless the caller gave the unit)
 MAX_SPAN = 366 * 86400.0  # and so is a recording over a year long
 SNAP = 1e-3  # an interval between stamps this close to a shorter decimal is that decimal
 UNIT_WORDS = {
@@ -161,21 +162,23 @@ def dates(cells, text, line_of, column, name):
 
 
 # -- seconds from the first sample -------------------------------------------------
-def normalise(recording, time_unit=None, step_size=None, default_step=None):
+def normalise(recording, time_unit=None, step_size=None, default_step=None, names: Names = ()):
     """Set every channel's times (seconds from the recording's first
     sample, over all channels) and the recording's step_size: step_size if
     given, else the sample time the file declares, else the finest interval
     between its time stamps (the recorder sampled every cycle), else
     default_step (the FMU's) for cycle counts. time_unit overrides the
     recording's. Refuses a recording whose length in steps is absurd,
-    naming the unit it assumed."""
+    naming the unit it assumed. names: the caller's words for the
+    settings (RecordingOptions.names)."""
     if time_unit:
         if recording.time_unit in ("date", "OLE days") and time_unit != recording.time_unit:
             raise InputError(
                 f"{recording.label}: its time stamps are {UNIT_NAMES[recording.time_unit]}: "
-                f"--time-unit {time_unit} does not apply"
+                f"{name_of(names, time_unit=time_unit)} does not apply"
             )
-        recording.time_unit, recording.time_source = time_unit, "--time-unit"
+        recording.time_unit, recording.time_source = time_unit, name_of(names, "time_unit")
+        recording.unit_given = True
     unit = recording.time_unit
     channels = [c for c in recording.channels if len(c.stamps)]
     if not channels:
@@ -183,10 +186,12 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
     if unit == "cycles":
         step = step_size or recording.sample_time or default_step
         if not step:
-            raise InputError(f"{recording.label}: its time is a cycle count: give the cycle time with --step-size")
+            raise InputError(
+                f"{recording.label}: its time is a cycle count: give the cycle time with {name_of(names, 'step_size')}"
+            )
         recording.step_size = step
         recording.step_source = (
-            "--step-size"
+            name_of(names, "step_size")
             if step_size
             else "the recording's sample time"
             if recording.sample_time
@@ -201,30 +206,33 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None):
     if too_long(span):
         raise InputError(
             f"{recording.label}: with its time read as {assumed}, the recording would span "
-            f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give --time-unit "
+            f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give {name_of(names, 'time_unit')} "
             "(s, ms, us, ns, cycles, filetime)"
         )
     if unit != "cycles":
         if step_size:
-            recording.step_size, recording.step_source = step_size, "--step-size"
+            recording.step_size, recording.step_source = step_size, name_of(names, "step_size")
         elif recording.sample_time:
             recording.step_size, recording.step_source = recording.sample_time, "the recording's sample time"
         else:
             step = finest_interval(channels)
             if step is None:
                 if not default_step:
-                    raise InputError(f"{recording.label}: one sample per channel tells no cycle time: give --step-size")
+                    raise InputError(
+                        f"{recording.label}: one sample per channel tells no cycle time: give "
+                        f"{name_of(names, 'step_size')}"
+                    )
                 step, source = default_step, "the FMU's default step size"
             else:
                 source = "the finest interval between its time stamps"
             recording.step_size, recording.step_source = step, source
     steps = span / recording.step_size
     samples = max(len(c.times) for c in channels)
-    if too_many_steps(steps, samples, recording.time_source):
+    if too_many_steps(steps, samples, recording.unit_given):
         raise InputError(
             f"{recording.label}: with its time read as {assumed} and a step of "
             f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
-            f"{steps:.3g} steps for {samples} samples: if that is not its unit, give --time-unit "
+            f"{steps:.3g} steps for {samples} samples: if that is not its unit, give {name_of(names, 'time_unit')} "
             "(s, ms, us, ns, cycles, filetime)"
         )
     return recording
@@ -244,10 +252,10 @@ def too_long(span):
     return span > MAX_SPAN
 
 
-def too_many_steps(steps, samples, time_source):
+def too_many_steps(steps, samples, unit_given):
     """Whether so many steps for so many samples is a misread unit (or
-    step), unless --time-unit (time_source) said the unit."""
-    return steps > MAX_STEPS or (steps > MAX_SPARSE * samples and time_source != "--time-unit")
+    step); sparse samples are not, when the caller gave the unit."""
+    return steps > MAX_STEPS or (steps > MAX_SPARSE * samples and not unit_given)
 
 
 class Intervals:

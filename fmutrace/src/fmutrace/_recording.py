@@ -1,30 +1,85 @@
-"""A long one-file recording (a table export) run and compared as it is
-read block by block (recordings._stream reads it) through the long-case
-path (_longcase.stream_case), in memory that does not grow with its
-length; its notes and messages are the in-memory path's, word for word."""
+"""A recording as a case of the pipeline (_pipeline.run_chunked_case): a
+one-file table export read in blocks of lines as it is compared
+(recordings._stream reads it), in memory that does not grow with its
+length; any other recording, or one the blocks cannot follow, read whole
+(_recorded.recorded_case). Its notes and messages are the same either
+way, word for word."""
 
 import os
+import time
 
 import numpy as np
 
 from ._errors import InputError
-from ._longcase import ChunkedCase, Streaming, stream_case
-from ._recorded import first_differs
-from ._traces import LONG_CASE_BYTES, NotPlain
+from ._pipeline import ChunkedCase, Streaming, run_chunked_case
+from ._outcome import CaseOutcome, Status
+from ._recorded import first_differs, recorded_case
+from ._traces import NotPlain
 from .recordings import _stream as stream, _timebase as timebase
 from .recordings._align import off_cycle_note
 from .recordings._matching import plan
 
 
-def is_long_recording(path) -> bool:
-    """Whether the recording at path is one file large enough to be streamed."""
+def _once(chunks):
+    """The input table's function for ChunkedCase: the stream's blocks can
+    be read once; a second reading (fmpy's, for a trace the fast loop
+    cannot give) is NotPlain: the in-memory path reads the recording."""
+    given = False
+
+    def table():
+        nonlocal given
+        if given:
+            raise NotPlain("the recording is read once")
+        given = True
+        return chunks
+
+    return table
+
+
+def streamable(path) -> bool:
+    """Whether the recording at path is one file (the blocks may follow it)."""
+    return os.path.isfile(path)
+
+
+def run_recording(path, name, target, settings, streaming: Streaming = Streaming()) -> CaseOutcome:
+    """The CaseOutcome of the recording at path (recording_paths' form) on
+    target (a _worker.Target), read with settings.recording: a one-file
+    table export read in blocks of lines as it is compared, any
+    other recording (or one the blocks cannot follow) read whole; either
+    way run and compared by the pipeline."""
+    if streamable(path):
+        outcome = run_streamed_recording(path, name, target, settings, streaming)
+        if outcome is not None:
+            return outcome
+    started = time.perf_counter()
     try:
-        return os.path.isfile(path) and os.path.getsize(path) >= LONG_CASE_BYTES
-    except OSError:
-        return False
+        recorded = recorded_case(str(path), target.fmu, name, settings.recording)
+    except InputError as error:
+        outcome = CaseOutcome(name, **target.labels, status=Status.INVALID, messages=[str(error)])
+        outcome.seconds = time.perf_counter() - started
+        return outcome
+    inputs = recorded.inputs
+
+    def more_messages(passed, deviations):
+        return [recorded.description] + (recorded.notes if passed else recorded.explain(deviations))
+
+    case = ChunkedCase(
+        name,
+        f"{name} on {target.labels['fmu']}: {recorded.description}",
+        recorded.options,
+        recorded.start_values,
+        tuple(inputs.dtype.names or ())[1:] if inputs is not None else (),
+        (lambda: iter([inputs])) if inputs is not None else None,
+        [iter([reference]) for reference in recorded.references],
+        recorded.outputs,
+        max(recorded.options["StopTime"], float(recorded.reference["time"][-1])),
+        more_messages,
+        started,
+    )
+    return run_chunked_case(case, target, settings, streaming)
 
 
-def run_long_recording(path, name, target, settings, streaming: Streaming = Streaming()):
+def run_streamed_recording(path, name, target, settings, streaming: Streaming = Streaming()):
     """The CaseOutcome of the one-file recording at path on target (a
     _worker.Target), read with settings.recording, streamed; None if this
     path cannot take it (the in-memory path then reads it)."""
@@ -32,7 +87,7 @@ def run_long_recording(path, name, target, settings, streaming: Streaming = Stre
     try:
         table = stream.Table(path, fmu, options)
         recording = table.recording
-        matched = plan(recording, fmu.variables, fmu.label, options.maps)
+        matched = plan(recording, fmu.variables, fmu.label, options.maps, options.names)
         if not matched.compares:
             return None
         step = recording.step_size
@@ -97,19 +152,25 @@ def run_long_recording(path, name, target, settings, streaming: Streaming = Stre
             return [description] + notes
         return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
 
+    inputs = queue("inputs") if drives else None
     case = ChunkedCase(
         name,
         f"{name} on {target.labels['fmu']}: {recording.format}",
         {"StartTime": 0.0, "StopTime": stop, "StepSize": step, "RelTol": 1e-6},
         start_values,
         tuple(v for v, _ in drives),
-        queue("inputs") if drives else None,
-        queue("refs"),
+        _once(inputs) if inputs is not None else None,
+        [queue("refs")],
         [v for v, _ in compares],
         stop,
         more_messages,
     )
-    return stream_case(case, target, settings, streaming)
+    try:
+        outcome = run_chunked_case(case, target, settings, streaming)
+    except NotPlain:
+        return None
+    outcome.streamed = True
+    return outcome
 
 
 def _explain(table, deviations, channels, step, shift):

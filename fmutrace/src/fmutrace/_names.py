@@ -1,0 +1,61 @@
+"""How a message names a setting: in the words of whoever gave it. A
+Python caller sets RecordingOptions(step_size=...) or Tube(time=...), the
+command sets --step-size or --tube-time; a message says what its reader
+wrote. The caller's words travel with the settings that reach the places
+where messages are made (RecordingOptions.names, down to the readers in
+worker processes); the command gives its flags (cli.FLAGS)."""
+
+from collections.abc import Iterable, Mapping
+
+# setting -> how a Python caller writes it: the object it is set on and its field there
+API_NAMES = {
+    "step_size": "RecordingOptions.step_size",
+    "time_unit": "RecordingOptions.time_unit",
+    "timing": "RecordingOptions.timing",
+    "maps": "RecordingOptions.maps",
+    "start_values": "RecordingOptions.start_values",
+    "rel_tol": "Tolerance.rel_tol",
+    "abs_tol": "Tolerance.abs_tol",
+    "tube_time": "Tube.time",
+    "tube_value": "Tube.value",
+    "resume": "compare.resume",
+}
+
+Names = Mapping[str, str] | Iterable[tuple[str, str]]  # setting -> the caller's word; pairs too
+
+
+def name_of(names: Names, *settings: str, **values: object) -> str:
+    """How the caller writes the settings named, or given with a value:
+    a flag of the command ('--tube-time 0.5 --tube-value 0', '--map
+    y=Y'), or the object a setting is set on ('Tube(time=0.5, value=0)',
+    'RecordingOptions(maps={'y': 'Y'})'; one object's settings together).
+    names: setting -> the caller's word (a flag starts with '-'); a
+    setting it lacks has its API name. A value: a float (written %.6g),
+    a str, or a (name, value) pair of a mapping setting."""
+    words = dict(names)
+    given = [(s, ...) for s in settings] + list(values.items())
+    parts: list[str] = []
+    owner = ""
+    for setting, value in given:
+        word = words.get(setting) or API_NAMES[setting]
+        if word.startswith("-"):
+            parts.append(word if value is ... else f"{word} {_text(value, flag=True)}")
+            owner = ""
+            continue
+        of, field = word.rsplit(".", 1)
+        item = f"{field}={'...' if value is ... else _text(value, flag=False)}"
+        if of == owner:
+            parts[-1] = f"{parts[-1][:-1]}, {item})"
+        else:
+            parts.append(f"{of}({item})")
+        owner = of
+    return " ".join(parts)
+
+
+def _text(value, flag):
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, tuple):
+        name, setting = value
+        return f"{name}={setting}" if flag else f"{{{name!r}: {setting!r}}}"
+    return str(value) if flag else repr(value)
