@@ -193,6 +193,40 @@ def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
         kill_session(command)
 
 
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX: the owner's lock tells a live campaign's folder")
+def test_a_killed_commands_unpack_folder_is_removed_by_the_next_one(tmp_path):
+    """A command killed with SIGKILL cannot remove its folder of unpacked
+    FMUs; the next command does, and leaves a live command's folder, and any
+    folder not made this way, alone."""
+    import fcntl
+
+    shared = tmp_path / "tmp"
+    shared.mkdir()
+    write_case(tmp_path / "cases" / "one")
+    env = dict(os.environ, TMPDIR=str(shared))
+    killed = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            UNPACK + "import os, signal; sys.stdout.flush(); os.kill(os.getpid(), signal.SIGKILL)",
+            str(PASS_THROUGH),
+        ],
+        env=env,
+        stdout=subprocess.PIPE,
+    )
+    abandoned = Path(killed.communicate(timeout=120)[0].decode().split()[0]).parent
+    assert killed.returncode == -signal.SIGKILL and abandoned.is_dir()
+    live, other = shared / "fmutrace-live", shared / "fmutrace-0123456789abcdef0123"
+    live.mkdir()
+    other.mkdir()
+    with open(live / ".owner", "w") as owner:
+        fcntl.flock(owner, fcntl.LOCK_EX | fcntl.LOCK_NB)  # a campaign running
+        done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--plots", "none", env=env)
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    assert sorted(shared.iterdir()) == [other, live]
+
+
 @pytest.mark.cluster
 def test_a_local_clusters_workers_leave_no_unpacked_fmu_behind(tmp_path):
     """--jobs 2: the local Dask workers unpack into the command's folder,

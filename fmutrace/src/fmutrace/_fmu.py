@@ -8,6 +8,8 @@ import io
 import math
 import os
 import shutil
+import stat
+import sys
 from os import PathLike
 import tempfile
 import zipfile
@@ -180,16 +182,60 @@ _unpacked: dict[str, tuple] = {}  # content hash -> (folder, model description, 
 UNPACK_ROOT = "FMUTRACE_UNPACK_ROOT"
 
 
+OWNER = ".owner"  # in a root: locked by the process that made it, as long as it lives
+_owned: list = []  # this process's root's OWNER, open (and locked) until it ends
+
+
 def unpack_root() -> str:
     """The folder this process and the processes it starts unpack FMUs into:
     its parent's (UNPACK_ROOT in its environment), else one of its own
-    (mkdtemp, mode 0700, removed at exit), then set for its children."""
+    (mkdtemp, mode 0700, removed at exit), then set for its children. A new
+    one first removes the roots whose makers died without removing theirs
+    (killed: no exit to do it at)."""
     root = os.environ.get(UNPACK_ROOT)
     if not (root and os.path.isdir(root)):
+        _remove_abandoned()
         root = tempfile.mkdtemp(prefix="fmutrace-")
         atexit.register(_remove, root, os.getpid())
+        if _lock is not None:
+            _owned.append(open(os.path.join(root, OWNER), "w"))
+            _lock(_owned[-1])
         os.environ[UNPACK_ROOT] = root
     return root
+
+
+if sys.platform == "win32":
+    _lock = None  # (a Windows root is removed at its maker's exit only)
+else:
+    import fcntl
+
+    def _lock(file):
+        """Locks the file without waiting; OSError if a live process holds it (the lock dies with it)."""
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
+def _remove_abandoned():
+    """Removes this user's roots in the temporary folder whose OWNER no live
+    process holds. Only roots: a folder without OWNER (another version's,
+    anyone else's) is left alone."""
+    if _lock is None:
+        return
+    temporary = tempfile.gettempdir()
+    try:
+        names = [n for n in os.listdir(temporary) if n.startswith("fmutrace-")]
+    except OSError:
+        return
+    for name in names:
+        folder = os.path.join(temporary, name)
+        try:
+            status = os.lstat(folder)
+            if not stat.S_ISDIR(status.st_mode) or status.st_uid != os.getuid():
+                continue
+            with open(os.path.join(folder, OWNER)) as owner:
+                _lock(owner)  # OSError while its maker lives
+        except OSError:
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def unpacked(fmu_bytes):
