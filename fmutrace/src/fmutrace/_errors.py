@@ -9,6 +9,7 @@ class ExitStatus(IntEnum):
     SUCCESS = 0  # compare: every case passes
     FAILURE = 1  # a result differs from its reference, or the FMU failed
     BAD_INPUT = 2  # usage, a file, an option: nothing a simulation can mend
+    INTERRUPTED = 130  # Ctrl-C (SIGINT), as shells report a command it ends
 
 
 class InputError(ValueError):

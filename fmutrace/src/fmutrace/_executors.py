@@ -28,6 +28,7 @@ from pathlib import Path
 
 from ._cases import case_texts
 from ._errors import InputError
+from ._fmu import unpack_root
 from ._isolated import run_isolated
 from ._outcome import CaseOutcome, Status
 from ._runner import Runner
@@ -197,6 +198,7 @@ class Dask(Executor):
         if self.scheduler:
             return None, Client(self.scheduler, timeout=self.cluster_timeout or 60)
         cluster = None
+        unpack_root()  # the local workers unpack into this process's folder (inherited): removed however they end
         try:
             # a task whose worker dies is not tried on others: the batch is run isolated instead (_run)
             # (silent: a worker's death is reported by the campaign)

@@ -2,19 +2,24 @@
 columns and start values before anything runs) and its default
 experiment; and the FMU unpacked once per process for fmpy."""
 
+import atexit
 import hashlib
+import io
 import math
 import os
 import shutil
+import stat
+import sys
 from os import PathLike
 import tempfile
 import zipfile
 from pathlib import Path
 
+import fmpy
 from fmpy import extract, read_model_description
 
 from ._errors import InputError
-from ._traces import BOOLEAN_WORDS
+from ._traces import BOOLEAN_WORDS, plain_float
 
 INTEGER_RANGES = {
     "Integer": (-(2**31), 2**31 - 1),
@@ -55,6 +60,27 @@ class Fmu:
         self.default_start = _float(experiment and experiment.startTime)
         self.default_stop = _float(experiment and experiment.stopTime)
         self.default_step = _float(experiment and experiment.stepSize)
+
+    def binary_problem(self):
+        """Why the FMU cannot run on this machine (no Co-Simulation binary for
+        its platform), or None. Only where it runs: a cluster's workers may
+        be of another platform than the command's."""
+        fmi3 = self.fmi_version >= 3
+        platform = fmpy.platform_tuple if fmi3 else fmpy.platform
+        identifier = self.model_description.coSimulation.modelIdentifier
+        binary = f"binaries/{platform}/{identifier}{fmpy.sharedLibraryExtension}"
+        try:
+            with zipfile.ZipFile(self.path) as archive:
+                names = archive.namelist()
+        except (OSError, zipfile.BadZipFile) as error:
+            return f"{self.path}: not an FMU ({error})"
+        if binary in names:
+            return None
+        present = sorted({n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") > 1})
+        return (
+            f"{self.path}: {self.label} has no binary for this platform: no {binary} in the FMU "
+            f"(it has binaries for: {', '.join(present) or 'none'})"
+        )
 
     @property
     def outputs(self):
@@ -104,13 +130,13 @@ class Fmu:
             return str(value)
         if kind in REAL_TYPES:
             try:
-                number = float(text)
+                number = plain_float(text)
             except ValueError:
                 raise InputError(f"{name} is a {kind}: {text!r} is not a number") from None
             self._check_range(variable, number, text)
             return number
         try:
-            number = float(text)
+            number = plain_float(text)
         except ValueError:
             number = math.nan
         if not number.is_integer():
@@ -149,28 +175,93 @@ def _float(value):
     return float(value)
 
 
-_unpacked: dict[str, tuple] = {}
+_unpacked: dict[str, tuple] = {}  # content hash -> (folder, model description, pid of the process that made it)
+# the folder every unpacked FMU of a campaign goes into, its child processes' and local workers' too (they
+# inherit it in their environment): made by the first process that unpacks, removed at that process's exit, so
+# a child killed (a case over its timeout, a crash, a Dask worker stopped) leaves nothing behind
+UNPACK_ROOT = "FMUTRACE_UNPACK_ROOT"
+
+
+OWNER = ".owner"  # in a root: locked by the process that made it, as long as it lives
+_owned: list = []  # this process's root's OWNER, open (and locked) until it ends
+
+
+def unpack_root() -> str:
+    """The folder this process and the processes it starts unpack FMUs into:
+    its parent's (UNPACK_ROOT in its environment), else one of its own
+    (mkdtemp, mode 0700, removed at exit), then set for its children. A new
+    one first removes the roots whose makers died without removing theirs
+    (killed: no exit to do it at)."""
+    root = os.environ.get(UNPACK_ROOT)
+    if not (root and os.path.isdir(root)):
+        _remove_abandoned()
+        root = tempfile.mkdtemp(prefix="fmutrace-")
+        atexit.register(_remove, root, os.getpid())
+        if _lock is not None:
+            _owned.append(open(os.path.join(root, OWNER), "w"))
+            _lock(_owned[-1])
+        os.environ[UNPACK_ROOT] = root
+    return root
+
+
+if sys.platform == "win32":
+    _lock = None  # (a Windows root is removed at its maker's exit only)
+else:
+    import fcntl
+
+    def _lock(file):
+        """Locks the file without waiting; OSError if a live process holds it (the lock dies with it)."""
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
+def _remove_abandoned():
+    """Removes this user's roots in the temporary folder whose OWNER no live
+    process holds. Only roots: a folder without OWNER (another version's,
+    anyone else's) is left alone."""
+    if _lock is None:
+        return
+    temporary = tempfile.gettempdir()
+    try:
+        names = [n for n in os.listdir(temporary) if n.startswith("fmutrace-")]
+    except OSError:
+        return
+    for name in names:
+        folder = os.path.join(temporary, name)
+        try:
+            status = os.lstat(folder)
+            if not stat.S_ISDIR(status.st_mode) or status.st_uid != os.getuid():
+                continue
+            with open(os.path.join(folder, OWNER)) as owner:
+                _lock(owner)  # OSError while its maker lives
+        except OSError:
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def unpacked(fmu_bytes):
     """(folder, model description) of an FMU given as bytes, unzipped once
-    per process into a folder named by its content."""
-    key = hashlib.sha256(fmu_bytes).hexdigest()[:20]
-    if key not in _unpacked:
-        folder = Path(tempfile.gettempdir()) / f"fmutrace-{key}"
-        if not (folder / "modelDescription.xml").exists():
-            archive = folder.with_name(f"{folder.name}.{os.getpid()}.fmu")
-            archive.write_bytes(fmu_bytes)
-            try:
-                partial = extract(str(archive), unzipdir=str(folder.with_name(f"{folder.name}.{os.getpid()}.part")))
-                try:
-                    os.replace(partial, folder)
-                except OSError:  # another process was first: theirs is the same
-                    shutil.rmtree(partial, ignore_errors=True)
-            finally:
-                archive.unlink()
-        _unpacked[key] = (str(folder), read_model_description(str(folder)))
-    return _unpacked[key]
+    per process into a folder of its own: made fresh (mkdtemp, mode 0700,
+    never found again by a name another user could plant) and removed at
+    the process's exit."""
+    key = hashlib.sha256(fmu_bytes).hexdigest()
+    known = _unpacked.get(key)
+    if known is None or known[2] != os.getpid():  # (a forked child makes its own: the parent removes its one)
+        folder = tempfile.mkdtemp(prefix="fmu-", dir=unpack_root())
+        atexit.register(_remove, folder, os.getpid())
+        try:
+            extract(io.BytesIO(fmu_bytes), unzipdir=folder)
+            known = (folder, read_model_description(folder), os.getpid())
+        except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
+            _remove(folder, os.getpid())
+            raise InputError(f"the FMU cannot be unpacked ({error})") from None
+        _unpacked[key] = known
+    return known[:2]
+
+
+def _remove(folder, owner):
+    """An unpacked FMU's folder (or the root of them), at the exit of the process that made it."""
+    if os.getpid() == owner:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def is_fmu_file(path):

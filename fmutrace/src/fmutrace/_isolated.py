@@ -13,6 +13,7 @@ so a child's start-up (imports, the FMU unpacked), slow on a loaded
 machine, is never charged to a case.
 """
 
+import ctypes
 import os
 import pickle
 import queue
@@ -25,10 +26,13 @@ import threading
 import time
 from pathlib import Path
 
+from ._fmu import UNPACK_ROOT, unpack_root
 from ._outcome import CaseOutcome, Status
 from ._worker import CaseSettings, FmuFile, run_cases
 
 HEADER = struct.Struct("!Q")
+PR_SET_PDEATHSIG = 1  # prctl(2)
+PARENT = "FMUTRACE_PARENT_PID"  # in a child's environment: the process whose child it is (it dies with it)
 CHILD = "import sys, fmutrace._isolated; sys.exit(fmutrace._isolated.main())"
 
 
@@ -76,6 +80,8 @@ def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outc
         PYTHONPATH=os.pathsep.join(
             [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
         ),
+        **{UNPACK_ROOT: unpack_root()},  # a child killed leaves its unpacked FMU to this process
+        **{PARENT: str(os.getpid())},
     )
     while remaining:
         said = tempfile.TemporaryFile()  # the child's last words, if it dies
@@ -127,8 +133,22 @@ def run_isolated(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, on_outc
     return outcomes
 
 
+def _die_with_parent():
+    """On Linux the kernel kills this child when the thread that started it
+    ends, however it ends (a command killed with SIGKILL included): a case
+    that hangs in the FMU does not spin on alone. (That thread waits for the
+    child: run_isolated.)"""
+    if not sys.platform.startswith("linux"):
+        return
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    if str(os.getppid()) != os.environ.get(PARENT):  # the parent was gone before the line above
+        os._exit(1)
+
+
 def main():
     """The child: the cases from standard input, the outcomes out as they finish."""
+    _die_with_parent()
     out = os.fdopen(os.dup(1), "wb")
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes

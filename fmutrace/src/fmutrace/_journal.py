@@ -5,8 +5,10 @@ campaign reads it back and runs only the rest. The folder is locked while a
 campaign writes it: a second campaign into the same folder is refused.
 
 The first line describes the campaign (comparison, plots, the FMUs by
-content hash); a resumed campaign must be the same campaign. A line cut
-short by a kill is ignored (its case runs again).
+content hash); a resumed campaign must be the same campaign, and a
+journal whose first line is damaged or not this one's is refused. A line
+cut short by a kill is ignored, a damaged one skipped with a warning (its
+case runs again).
 """
 
 import hashlib
@@ -55,9 +57,14 @@ class ReportLock:
 
     def __init__(self, folder):
         self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
         self.path = self.folder / LOCK
-        self.file = open(self.path, "a+")
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            self.file = open(self.path, "a+")
+        except OSError as error:  # a file of that name, a folder not writable
+            raise InputError(
+                f"{self.folder}: cannot write the report there ({error.strerror or error}); choose another folder"
+            ) from None
         try:
             _try_lock(self.file)
         except OSError:
@@ -110,17 +117,27 @@ class Journal:
         self.done: dict[str, int] | None = {}  # key -> offset of the case's line, of a campaign resumed
         if resume and self.path.exists():
             with open(self.path, "rb") as journal:
-                header = _parse(journal.readline())
-                if header is not None and header.get("campaign") != key:
+                first = journal.readline()
+                header = _parse(first) if first.strip() else None  # (empty: killed before its first line)
+                if first.strip() and not (isinstance(header, dict) and isinstance(header.get("campaign"), dict)):
+                    raise InputError(
+                        f"{self.path}: its first line is damaged or not a fmutrace journal's, so which options "
+                        f"made its verdicts is unknown; start afresh without {name_of(names, 'resume')}"
+                    )
+                if header is not None and header["campaign"] != key:
                     raise InputError(
                         f"{self.path}: made by a campaign with other FMUs or options; resume it with "
                         f"the same ones, or start afresh without {name_of(names, 'resume')}"
                     )
-                offset = journal.tell()
+                offset, number = journal.tell(), 1
                 for line in journal:
-                    entry = _parse(line)
-                    if entry is not None and "key" in entry:
+                    number += 1
+                    entry, problem = _entry(line)
+                    if problem is None:
                         self.done[entry["key"]] = offset
+                    elif line.endswith(b"\n"):  # (a last line without its end was cut short by a kill: no news)
+                        warning = f"{self.path}, line {number}: {problem}; its case runs again"
+                        print(f"fmutrace: warning: {warning}", file=sys.stderr)
                     offset += len(line)
             self.file = open(self.path, "ab")
             if self.file.tell() and not _ends_a_line(self.path):
@@ -155,6 +172,35 @@ def _ends_a_line(path):
     with open(path, "rb") as journal:
         journal.seek(-1, os.SEEK_END)
         return journal.read(1) == b"\n"
+
+
+def _entry(line):
+    """(entry, None) of a journal line that is a case's entry, else (None, what is wrong)."""
+    entry = _parse(line)
+    if not isinstance(entry, dict):
+        return None, "not a case's entry" if entry is not None else "not JSON"
+    try:
+        key = entry["key"]
+        outcome = CaseOutcome.from_json(entry, "")
+    except KeyError as missing:
+        return None, f"a case's entry without its {missing}"
+    except (TypeError, ValueError, AttributeError) as error:
+        return None, f"a case's entry with a bad value ({error})"
+    if not (
+        isinstance(key, str)
+        and key.startswith(f"{outcome.fmu_file}|")
+        and isinstance(outcome.messages, list)
+        and all(isinstance(v, str) for v in (outcome.case, outcome.fmu, outcome.fmu_file, *outcome.messages))
+        and isinstance(outcome.seconds, (int, float))
+        and all(isinstance(p, str) and _in_report(p) for p in (outcome.csv, outcome.plot))
+    ):
+        return None, "a case's entry with a bad value"
+    return entry, None
+
+
+def _in_report(path):
+    """Whether a path an entry names is a file of the report folder (or none)."""
+    return not path or not (os.path.isabs(path) or ".." in Path(path).parts)
 
 
 def _parse(line):

@@ -15,6 +15,7 @@ import threading
 import numpy as np
 
 from ._comparison import Mode
+from ._traces import shown
 
 WIDTH_INCHES, DPI = 8.0, 80
 COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
@@ -104,14 +105,14 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
     if has_inputs:
         ax = axes.pop(0)
         for name, times, values in figure.inputs:
-            ax.step(times, values, where="post", label=f"input {name}")
+            ax.step(times, values, where="post", label=_plain(f"input {name}"))
         ax.legend(loc="best", fontsize=7)
     deviation_axis = axes.pop()
     many = max((len(r[0]) for _, _, r, _ in figure.signals), default=0) > COLUMNS
     for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals, strict=False):
         if band is not None and mode.fills_band:
-            ax.fill_between(band[0], band[1], band[2], color="0.85", label=mode.name)
-        ax.plot(ref_t, ref_v, **mode.reference_line, label=f"{name} reference")
+            ax.fill_between(band[0], band[1], band[2], color="0.85", label=_plain(mode.name))
+        ax.plot(ref_t, ref_v, **mode.reference_line, label=_plain(f"{name} reference"))
         ax.step(
             res_t,
             res_v,
@@ -120,11 +121,11 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
             linewidth=1.2,
             marker="" if many else ".",
             markersize=3,
-            label=f"{name} {label}",
+            label=_plain(f"{name} {label}"),
         )
         ax.legend(loc="best", fontsize=7)
     for name, times, values in figure.deviations:
-        deviation_axis.plot(times, values, drawstyle="steps-post", label=name)
+        deviation_axis.plot(times, values, drawstyle="steps-post", label=_plain(name))
     deviation_axis.set_ylabel(mode.deviation_label, fontsize=7)
     deviation_axis.legend(loc="best", fontsize=7)
     if figure.zoom:
@@ -133,16 +134,23 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         zoom_deviation = zoom_axes.pop()
         for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines, strict=False):
             ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
-            ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=name)
+            ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=_plain(name))
             ax.axvline(at, color="C3", linewidth=0.8)
-            zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=name)
+            zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=_plain(name))
         zoom_axes and zoom_axes[0].set_title(f"zoom: first deviation at t={at!r}", fontsize=8)
         zoom_deviation.axvline(at, color="C3", linewidth=0.8)
-    title = figure.title
-    fig.suptitle(title if len(title) < 110 else title[:107] + "...", fontsize=9)
+    title = shown(figure.title)
+    fig.suptitle(_plain(title if len(title) < 110 else title[:107] + "..."), fontsize=9)
     stream = io.BytesIO()
     fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
     return stream.getvalue()
+
+
+def _plain(text):
+    """Text from users' files drawn as it is written: every $ escaped, so
+    that matplotlib finds no mathtext in it (a broken formula would abort
+    the figure), and bytes that are not UTF-8 as U+FFFD."""
+    return shown(text).replace("$", r"\$")
 
 
 def load_plotting():

@@ -51,6 +51,17 @@ def read_text(path):
         raise TraceError(path, 0, 0, error.strerror or str(error)) from None
 
 
+def shown(text) -> str:
+    """Text from users' files and names as it can be shown and written:
+    bytes of a file name that are not UTF-8 (Python's surrogate escapes)
+    as U+FFFD."""
+    text = str(text)
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    except UnicodeEncodeError:  # a surrogate that escapes no byte
+        return text.encode("utf-8", "replace").decode("utf-8")
+
+
 def data_lines(text):
     """(line number, text) of the lines that hold data or the header, split
     as str.splitlines() splits them, one at a time (a reader that needs only
@@ -126,9 +137,18 @@ def parse_number(text, decimal_comma=False):
     if decimal_comma and "," in text and "." not in text:
         text = text.replace(",", ".")
     try:
-        return float(text)
+        return plain_float(text)
     except ValueError:
         return None
+
+
+def plain_float(text) -> float:
+    """float(text) without Python's own literal forms: '_' between digits
+    (1_0 is not 10 in a CSV file; recordings read IEC's 1_000 themselves);
+    ValueError if it is not a number."""
+    if "_" in text:
+        raise ValueError(f"{text!r} is not a number")
+    return float(text)
 
 
 def read_trace(

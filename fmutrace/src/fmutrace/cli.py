@@ -4,7 +4,7 @@
   fmutrace compare FMU... CASE... [--report DIR] [--rel-tol R] ...
 
 Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
-simulation, 2 bad input); compare's is its worst case's.
+simulation, 2 bad input, 130 interrupted); compare's is its worst case's.
 """
 
 import argparse
@@ -17,9 +17,10 @@ from ._campaign import compare
 from ._comparison import comparison_mode
 from ._executors import RunOptions
 from ._errors import ExitStatus, InputError, SimulationError
-from ._fmu import is_fmu_file
+from ._fmu import Fmu, is_fmu_file
 from ._simulation import SimulationOptions, simulate_chunks
 from ._outcome import Status
+from ._report import text
 from .recordings import is_recording
 from .recordings._align import TIMINGS
 from .recordings._options import TIME_UNITS, RecordingOptions
@@ -219,6 +220,9 @@ def parser():
 
 
 def run_command(args, out):
+    problem = Fmu(args.fmu).binary_problem()  # (compare reports it per case, as any failed simulation)
+    if problem:
+        raise InputError(problem)
     options = SimulationOptions(
         dict(args.set), args.start_time, args.stop_time, args.step_size, args.output_interval, args.output
     )
@@ -239,7 +243,7 @@ def run_command(args, out):
                 os.unlink(args.out)  # no half-written result
             raise
     if args.out:
-        print(f"{written} samples of {len(names) - 1} signals written to {args.out}", file=out)
+        print(f"{written} samples of {len(names) - 1} signals written to {text(args.out)}", file=out)
     return ExitStatus.SUCCESS
 
 
@@ -260,12 +264,30 @@ def compare_command(args, out):
         case_timeout=args.case_timeout,
         cluster_timeout=args.cluster_timeout,
     )
-    # the recordings group's flags read recordings; with case folders alone the command ignores them, as it did
+    # the recordings group's flags read recordings; with case folders alone the command leaves them unused, as
+    # it did, and says so
     recording = (
         RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set, names=FLAGS)
         if recordings
         else RecordingOptions(names=FLAGS)
     )
+    unused = [
+        flag
+        for flag, given in (
+            ("--step-size", args.step_size is not None),
+            ("--map", args.map),
+            ("--set", args.set),
+            ("--time-unit", args.time_unit is not None),
+            ("--timing", args.timing != "cycle"),
+        )
+        if given and not recordings
+    ]
+    if unused:
+        print(
+            f"fmutrace: warning: {', '.join(unused)} not used: they read recordings, and a case folder carries its "
+            "own settings (<Model>_ref.opt, <Model>_start.csv)",
+            file=sys.stderr,
+        )
     result = compare(
         fmus,
         cases,
@@ -279,18 +301,18 @@ def compare_command(args, out):
     )
     for o in result.failed(results=False) if not recordings else result.cases.light():
         if o.status == Status.INVALID:
-            print(f"fmutrace: error: {o.messages[0]}", file=sys.stderr)
+            print(f"fmutrace: error: {text(o.messages[0])}", file=sys.stderr)
             continue
         if o.passed and not o.messages:
             continue
-        print(f"{o.status.upper()}  {o.case} on {o.fmu}", file=out)
+        print(f"{o.status.upper()}  {text(o.case)} on {text(o.fmu)}", file=out)
         for message in o.messages[:10]:
-            print(f"      {message}", file=out)
+            print(f"      {text(message)}", file=out)
     print(result.headline(), file=out)
     if args.report:
-        print(f"report: {args.report.rstrip('/')}/index.html", file=out)
+        print(f"report: {text(args.report.rstrip('/'))}/index.html", file=out)
     if args.junit:
-        print(f"JUnit XML: {args.junit}", file=out)
+        print(f"JUnit XML: {text(args.junit)}", file=out)
     return result.exit_code
 
 
@@ -305,6 +327,15 @@ def main(argv=None, out=None):
     except SimulationError as error:
         print(f"fmutrace: {error}", file=sys.stderr)
         return error.exit_code
+    except OSError as error:  # a file or folder given that cannot be read or written
+        where = f"{text(error.filename)}: " if error.filename else ""
+        print(f"fmutrace: error: {where}{error.strerror or error}", file=sys.stderr)
+        return ExitStatus.BAD_INPUT
+    except KeyboardInterrupt:
+        journal = getattr(args, "report", None)
+        hint = f"; the finished cases are in {journal}: --resume continues" if journal else ""
+        print(f"fmutrace: interrupted{hint}", file=sys.stderr)
+        return ExitStatus.INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ A file none of them fits is a TraceError that says, for each, why not.
 """
 
 import os
+from collections import Counter
 from pathlib import Path
 
 from .._errors import InputError, TraceError
@@ -136,7 +137,25 @@ def recording_paths(paths):
     if points:
         name = Path(points[0]).parent.name if len(points) > 1 else Path(points[0]).name
         items.append((os.pathsep.join(points), name))
-    return items
+    return _unique(items)
+
+
+def _unique(items):
+    """[(path, name)] with each name once (a case's name names its result
+    files): a name given twice gets its folder's name before it, as
+    find_cases names cases, then a number."""
+    given = Counter(name for _, name in items)
+    taken: set[str] = set()
+    unique_items = []
+    for path, name in items:
+        if given[name] > 1:
+            name = f"{Path(os.path.abspath(path.split(os.pathsep)[0])).parent.name}/{name}"
+        unique, n = name, 2
+        while unique in taken:
+            unique, n = f"{name} ({n})", n + 1
+        taken.add(unique)
+        unique_items.append((path, unique))
+    return unique_items
 
 
 def _is_single_point(path):

@@ -81,14 +81,24 @@ def numeric_stamps(text, column_cells, lines, column, name, decimal_comma):
 
 
 def check_increasing(text, stamps, lines, column, name):
-    """Time must not go backwards within a channel's time column."""
+    """Time must be finite and not go backwards within a channel's time column."""
+    if stamps.dtype.kind == "f" and not np.isfinite(stamps).all():
+        i = int(np.flatnonzero(~np.isfinite(stamps))[0])
+        raise text.error(int(lines[i]), column, f"time {float(stamps[i])!r} in column {name!r} is not a finite number")
     if len(stamps) > 1:
         back = np.flatnonzero(stamps[1:] < stamps[:-1])
         if len(back):
             i = int(back[0]) + 1
             raise text.error(
-                int(lines[i]), column, f"time goes backwards in column {name!r}: {stamps[i]!r} after {stamps[i - 1]!r}"
+                int(lines[i]),
+                column,
+                f"time goes backwards in column {name!r}: {_stamp(stamps[i])} after {_stamp(stamps[i - 1])}",
             )
+
+
+def _stamp(stamp):
+    """A time stamp as a message shows it (NumPy's repr names its type)."""
+    return str(stamp) if stamp.dtype.kind == "M" else repr(stamp.item())
 
 
 class Rows(NamedTuple):

@@ -27,13 +27,26 @@ _IEC_BASED = re.compile(r"^(?:[A-Za-z_]+#)?([+-]?)(2|8|16)#([0-9A-Fa-f_]+)$")
 _TYPED = re.compile(r"^[A-Za-z_]+#(.+)$")
 
 
+MAX_LINE = 1 << 22  # characters in a line of a recorder's export (100,000 channels of 40); a longer one is refused
+
+
 class Text:
     """A file's text, how it was decoded, and its lines (without their
-    ends) numbered from 1."""
+    ends) numbered from 1. A line longer than MAX_LINE is a TraceError:
+    millions of columns (or a file without line ends) would take minutes
+    and all the memory before anything could be said about them."""
 
     def __init__(self, path, text, encoding):
         self.path, self.text, self.encoding = str(path), text, encoding
         self.lines = text.splitlines()
+        if max(map(len, self.lines), default=0) > MAX_LINE:
+            number = next(n for n, line in enumerate(self.lines, 1) if len(line) > MAX_LINE)
+            raise self.error(
+                number,
+                0,
+                f"a line of {len(self.lines[number - 1]):,} characters: more than the {MAX_LINE:,} a recorder's "
+                "export is read with (so many columns, or no line ends?)",
+            )
 
     def error(self, line, column, message):
         return TraceError(self.path, line, column, message)
