@@ -681,6 +681,51 @@ def test_an_underscore_is_no_digit_separator_in_a_case_file(tmp_path):
     assert "PassThrough_in.csv, line 3, column 2: '1_0' in column 'u' is not a number" in done.stderr, done.stderr
 
 
+@pytest.mark.parametrize("line", ["StepSize,inf", "StopTime,inf", "StartTime,-inf"])
+def test_a_case_time_that_is_not_finite_is_refused(line, tmp_path):
+    case = write_case(tmp_path / "cases" / "infinite")
+    key = line.split(",")[0]
+    opt = "".join(o + "\n" for o in OPT.splitlines() if not o.startswith(key + ",")) + line + "\n"
+    (case / "PassThrough_ref.opt").write_text(opt)
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases")
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert f"PassThrough_ref.opt, line 4, column 2: {key} '{line.split(',')[1]}' is not a finite number" in (
+        done.stderr
+    ), done.stderr
+
+
+def test_a_case_of_more_steps_than_the_bound_is_refused_before_it_runs(tmp_path):
+    """StopTime 1e300 at 0.1 s: the case is invalid at once (the run's bound: one bound for every way to ask)."""
+    case = write_case(tmp_path / "cases" / "endless")
+    (case / "PassThrough_ref.opt").write_text(OPT.replace("StopTime,0.5", "StopTime,1e300"))
+    started = time.monotonic()
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", timeout=120)
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "PassThrough_ref.opt: 1e+301 steps of 0.1 s from 0.0 to 1e+300 s: more than the bound of 200,000,000" in (
+        done.stderr
+    ), done.stderr
+    assert time.monotonic() - started < 60
+
+
+def test_a_plot_that_cannot_be_drawn_costs_the_figure_not_the_verdict(tmp_path, monkeypatch):
+    from fmutrace import _pipeline
+
+    def broken(*args, **kwargs):
+        raise OverflowError("Exceeded cell block limit")  # as Agg says of a path too complex to draw
+
+    monkeypatch.setattr(_pipeline, "draw", broken)
+    write_case(tmp_path / "cases" / "differs", ref=REF.replace("0.3,3", "0.3,2"))
+    write_case(tmp_path / "cases" / "same")
+    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report")
+    by_name = {c.case: c for c in campaign.cases}
+    assert (by_name["differs"].status, by_name["same"].status) == ("fail", "pass")
+    for c in by_name.values():
+        assert c.messages[-1] == "no plot: drawing it failed (OverflowError: Exceeded cell block limit)"
+    assert (tmp_path / "report" / "index.html").exists()
+
+
 def test_a_time_stamp_that_is_not_finite_is_refused_in_a_recording(tmp_path):
     """A recording's time stamp nan (or inf): exit 2 and the cell, not a comparison at a garbage time."""
     recording = tmp_path / "rec.csv"

@@ -25,7 +25,7 @@ from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
 from .recordings import is_recording, recording_paths
 from .recordings._options import RecordingOptions
-from ._report import write_case_files, write_junit, write_report
+from ._report import file_name, write_case_files, write_junit, write_report
 from ._worker import PLOTS, CaseSettings, FmuFile, default_plots
 
 Paths = str | PathLike | Iterable[str | PathLike]  # one path, or several
@@ -194,10 +194,10 @@ def _report_folders(fmus):
     """Each FMU's folder in the report: <model>-fmi<version>, numbered if two are alike."""
     folders: dict[Path, str] = {}
     for fmu in fmus:
-        folder = f"{fmu.model}-fmi{fmu.fmi_version}"
+        folder = file_name(f"{fmu.model}-fmi{fmu.fmi_version}")
         n = 2
         while folder in folders.values():
-            folder, n = f"{fmu.model}-fmi{fmu.fmi_version}-{n}", n + 1
+            folder, n = file_name(f"{fmu.model}-fmi{fmu.fmi_version}-{n}"), n + 1
         folders[fmu.path] = folder
     return folders
 

@@ -12,6 +12,7 @@ Every file is checked against the FMU before anything runs: a problem is
 an InputError naming the file, line and column.
 """
 
+import math
 import os
 from array import array
 from os import PathLike
@@ -24,7 +25,7 @@ import numpy as np
 from ._comparison import Comparison, Mode, compare_traces
 from ._errors import InputError, TraceError
 from ._fmu import Fmu
-from ._traces import data_lines, parse_number, read_text, read_trace, split_cells
+from ._traces import data_lines, parse_number, read_text, read_trace, split_cells, steps_problem
 
 OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
 FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
@@ -62,8 +63,8 @@ def read_options(path, text, reference, fmu):
         if key not in OPTIONS:
             raise TraceError(path, number, 1, f"unknown option {key!r} (known: {', '.join(OPTIONS)})")
         value = parse_number(literal)
-        if value is None or value != value:
-            raise TraceError(path, number, 2, f"{key} {literal!r} is not a number")
+        if value is None or not math.isfinite(value):
+            raise TraceError(path, number, 2, f"{key} {literal!r} is not a finite number")
         options[key] = value
     options.setdefault("StartTime", float(reference["time"][0]))
     options.setdefault("StopTime", float(reference["time"][-1]))
@@ -80,6 +81,9 @@ def read_options(path, text, reference, fmu):
         raise TraceError(
             where, 0, 0, f"StopTime {options['StopTime']!r} must be after StartTime {options['StartTime']!r}"
         )
+    problem = steps_problem(options["StartTime"], options["StopTime"], options["StepSize"])
+    if problem:
+        raise TraceError(where, 0, 0, problem)
     return options
 
 

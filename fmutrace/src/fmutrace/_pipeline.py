@@ -437,8 +437,11 @@ class _Comparer:
                 [(s, *envelopes[("deviation", s)].line()) for s in outputs],
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
-            outcome.png = draw(figure, settings.mode, labels["fmu"])
-            outcome.result_path = self.result.keep() or ""
+            try:
+                outcome.png = draw(figure, settings.mode, labels["fmu"])
+                outcome.result_path = self.result.keep() or ""
+            except Exception as error:  # (matplotlib's errors are many) a figure lost, not the verdict
+                outcome.messages.append(f"no plot: drawing it failed ({type(error).__name__}: {error})")
         outcome.seconds = time.perf_counter() - case.started
         return outcome
 

@@ -19,8 +19,7 @@ from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK, Runner
-from ._traces import CHUNK_BYTES, NotPlain, last_time, read_trace, trace_chunks
-from .recordings._timebase import MAX_STEPS
+from ._traces import CHUNK_BYTES, NotPlain, last_time, read_trace, steps_problem, trace_chunks
 
 
 def every_nth(result, start_time, step_size, output_interval):
@@ -179,10 +178,7 @@ def resolved(fmu: Fmu, options: SimulationOptions, input_span: tuple | None) -> 
         raise InputError(f"the step size must be a finite number greater than 0, not {step!r}")
     if stop is None or not stop > start or not math.isfinite(stop - start):
         raise InputError(f"the stop time ({stop!r}) must be after the start time ({start!r}), both finite")
-    steps = (stop - start) / step
-    if steps > MAX_STEPS:  # refused before anything is allocated: the result would not fit in memory
-        raise InputError(
-            f"{steps:.3g} steps of {step!r} s from {start!r} to {stop!r} s: more than the bound of "
-            f"{MAX_STEPS:,} steps (a step size or time in another unit?)"
-        )
+    problem = steps_problem(start, stop, step)
+    if problem:
+        raise InputError(problem)
     return Experiment(start, stop, step), Signals(None, values, names)

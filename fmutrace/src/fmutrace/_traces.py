@@ -285,6 +285,19 @@ def _read_rows(path, lines, header: _Header, separator):
 
 
 CHUNK_BYTES = 1 << 22  # of CSV text per chunk of trace_chunks
+MAX_STEPS = 200_000_000  # more steps than this (23 days of 10 ms cycles) is a misread unit: refused
+
+
+def steps_problem(start, stop, step) -> str | None:
+    """Why a run from start to stop in steps of step is refused (None if it is not): the one bound on
+    the work a case, a recording or a run may ask for, checked before anything runs."""
+    steps = (stop - start) / step
+    if steps > MAX_STEPS:
+        return (
+            f"{steps:.3g} steps of {step!r} s from {start!r} to {stop!r} s: more than the bound of "
+            f"{MAX_STEPS:,} steps (a step size or time in another unit?)"
+        )
+    return None
 
 
 def trace_chunks(

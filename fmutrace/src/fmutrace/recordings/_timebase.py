@@ -18,12 +18,12 @@ from datetime import datetime, timedelta, timezone
 
 import numpy as np
 
+from .._traces import MAX_STEPS
 from .._errors import InputError, TraceError
 from .._names import Names, name_of
 from ._model import TIME_FACTORS
 
 OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
-MAX_STEPS = 200_000_000  # more steps than this (23 days of 10 ms cycles) is a misread unit
 MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless the caller gave the unit)
 MAX_SPAN = 366 * 86400.0  # and so is a recording over a year long
 SNAP = 1e-3  # an interval between stamps this close to a shorter decimal is that decimal
