@@ -553,10 +553,10 @@ def test_an_fmu_without_a_binary_for_this_platform_is_bad_input(tmp_path):
 
 def test_ctrl_c_ends_the_command_with_130_and_one_line(tmp_path):
     """SIGINT (Ctrl-C) in the middle of a campaign: exit 130, one line, no traceback."""
-    slow = "StartTime,0\nStopTime,20000\nStepSize,0.01\nRelTol,1e-6\n"  # 2 million steps a case
+    slow = "StartTime,0\nStopTime,1000000\nStepSize,0.01\nRelTol,1e-6\n"  # 10^8 steps a case: seconds
     for n in range(3):
         os.makedirs(tmp_path / "cases" / f"c{n}")
-        (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.csv").write_text("time,y\n0,0\n20000,1\n")
+        (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.csv").write_text("time,y\n0,0\n1000000,1\n")
         (tmp_path / "cases" / f"c{n}" / "PassThrough_in.csv").write_text("time,u\n0,1\n")
         (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.opt").write_text(slow)
     report = tmp_path / "report"
