@@ -258,6 +258,10 @@ static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_
     if (islessequal(fabs((double)RL_NAME(rl_sum)(step, -distance)), (double)arrival)) {
         return uc;
     }
+    /* at uc already, with the speed the rounding of the landing step left above b: at rest */
+    if (distance == 0 && isgreater(step, 0) && islessequal((double)step, 4.0 * (double)RL_NAME(rl_ulp)(moving))) {
+        return uc;
+    }
     const RL_NUM next = RL_NAME(rl_advance)(y, up ? step : -step);
     if (next == y && isgreater(step, 0)) {
         /* a step below the output's resolution (REAL, or a large y): one

@@ -1427,10 +1427,27 @@ static void test_kept_plan_equals_fresh_plan(void) {
     }
 }
 
+/* REAL: a step from rest onto a tiny target 7.3e11 away lands on it with
+ * a speed a unit in the last place (65536) above b after rounding; the
+ * output then rests on the target instead of passing it by that unit. */
+static void test_landing_leaves_no_speed(void) {
+    Block b;
+    RlConfig c = defaults();
+    c.rateUp.value = c.rateDown.value = 117771771536283.81;
+    c.ratePeriod.value = 1.0;
+    c.accelMax.value = 7285355228600680.0;
+    c.real = true;
+    start(&b, &c, -728535465984.0, 0.01);
+    const double uc = (double)(float)1.175494351e-26;
+    CHECK_BITS(cycle(&b, 1.175494351e-26), uc); /* one step from rest: the landing */
+    for (int n = 0; n < 3; n++) CHECK_BITS(cycle(&b, 1.175494351e-26), uc);
+}
+
 int main(void) {
     test_quiet_arithmetic();
     test_acceleration_helpers();
     test_kept_plan_equals_fresh_plan();
+    test_landing_leaves_no_speed();
     test_rule0_resolve();
     test_rule0_limits();
     test_status_codes();

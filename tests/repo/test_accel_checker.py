@@ -148,6 +148,32 @@ def test_1_a_rate_lowered_below_the_speed_may_be_braked_down_to():
     assert props(trace(ys, values, per_cycle=per_cycle)) == ["1"]
 
 
+# from -30 at rest towards 100, accelMax 1: steps 1 .. 6, the rates below 0 unlimited, rateUp 0.5 above
+ZONES = dict(BASE, u=100.0, rateUpPar=0.5, rateUpNeg=100.0, rateDownNeg=100.0)
+ACCELERATING = [-29.0, -27.0, -24.0, -20.0, -15.0, -9.0]
+
+
+def test_1_braking_into_the_other_zone_after_the_target_moved_inside_the_braking_distance():
+    """u moved behind the output at cycle 7, with 0 inside its braking distance: the output brakes at
+    decelMax (steps 5, 4, 3, 2, 1, 0) across 0 into rateUp's 0.5 a cycle: the documented exception."""
+    ys = ACCELERATING + [-4.0, 0.0, 3.0, 5.0, 6.0, 6.0]
+    per_cycle = [{}] * 6 + [{"u": -100.0}] * 6
+    assert "1" not in props(trace(ys, ZONES, y0=-30.0, per_cycle=per_cycle))
+
+
+def test_1_a_target_moved_far_from_0_leaves_no_excuse_for_crossing_it_too_fast():
+    """The target moved at cycle 2, 29 before 0 at a speed of 1: room enough to slow to 0.5 before 0."""
+    ys = ACCELERATING + [-4.0, 0.0, 3.0, 5.0, 6.0, 6.0]
+    per_cycle = [{}] + [{"u": -100.0}] * 11
+    assert "1" in props(trace(ys, ZONES, y0=-30.0, per_cycle=per_cycle))
+
+
+def test_1_crossing_into_the_other_zone_too_fast_for_a_constant_target():
+    """The same course towards a target that never moved: the output had to slow to 0.5 a cycle before 0."""
+    ys = ACCELERATING + [-4.0, 0.0, 3.0, 5.0, 6.0, 6.0]
+    assert "1" in props(trace(ys, dict(ZONES, u=6.0), y0=-30.0))
+
+
 def test_2_acceleration_beyond_accel_max():
     assert props(trace([1.0, 4.0], dict(BASE, u=20.0))) == ["2"]
 

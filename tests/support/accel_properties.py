@@ -360,10 +360,13 @@ class Checker:
     def velocity_and_acceleration(self, index, cycles, settings, ys, steps, prev, ramping):
         braking_to = None  # property 1's exception: the limit a change lowered below the speed
         changed_at = 0  # the last cycle whose rates, ratePeriod, zeroRate, accelMax or decelMax changed
+        moved_at = 0  # the last cycle whose target uc moved
         for k in range(1, len(cycles) + 1):
             s = settings[k - 1]
             if k >= 2 and settings[k - 2].key()[1:7] + settings[k - 2].key()[13:15] != s.key()[1:7] + s.key()[13:15]:
                 changed_at = k
+            if k >= 2 and settings[k - 2].uc() != s.uc():
+                moved_at = k
             if not ramping[k] or steps[k] is None:
                 braking_to = None
                 continue
@@ -376,11 +379,15 @@ class Checker:
             if p != 0 and ramping[k - 1] and k >= 2:
                 limit = s.limit(p > 0, yp)
                 # the exception: an input or parameter change lowered the limit at this y below the speed; or
-                # the output crossed 0 into the other rates' lower limit, and a change of the settings within
-                # the braking time before (a lowered decelMax) may have left no way to slow down to it in time
+                # the output crossed 0 into the other rates' lower limit, and a change of the settings (a
+                # lowered decelMax) or a target moved inside the braking distance, within the braking time
+                # before, may have left no way to slow down to it in time (docs/rules.md)
                 changed = settings[k - 2].limit(p > 0, yp) != limit
                 crossed = k >= 3 and (ys[k - 2] < 0) != (yp < 0)
-                if crossed and changed_at and k - changed_at <= abs(p) / s.b() + 2:
+                recent = [at for at in (changed_at, moved_at) if at and k - at <= abs(p) / s.b() + 2]
+                if moved_at in recent and changed_at not in recent and not self.unavoidable(s, ys, steps, moved_at):
+                    recent = []
+                if crossed and recent:
                     changed = True
                 if limit is not None and changed and abs(p) > limit:
                     braking_to = (p > 0, limit)
@@ -491,6 +498,18 @@ class Checker:
         if accel_limited:
             self.time_optimal(index, seg, s, first, last, ys, prev, arrival)
             self.remaining_time(index, seg, s, first, last, ys)
+
+    def unavoidable(self, s, ys, steps, moved_at):
+        """Whether, when the target moved (cycle moved_at), 0 lay inside the distance the output needed to
+        brake from its speed down to the other side's velocity limit (then crossing 0 faster is allowed)."""
+        if not all(math.isfinite(x) for x in (ys[moved_at - 1], steps[moved_at - 1] or 0)):
+            return False
+        y, v = Fraction(ys[moved_at - 1]), abs(Fraction(steps[moved_at - 1] or 0))
+        limit = s.limit((steps[moved_at - 1] or 0) > 0, -ys[moved_at - 1] or 0.0)  # the other side's
+        low = Fraction(limit) if limit is not None else Fraction(0)
+        b = Fraction(s.b())
+        needed = (v * v - low * low) / (2 * b) + v + b if v > low else Fraction(0)
+        return abs(y) < needed
 
     def still_on_its_way(self, s, y, uc):
         """Whether more than two cycles at the fastest velocity limit separate y from uc."""

@@ -985,6 +985,8 @@ def accel_step(A, yp, uc, v, a, b, limits):
     scale = uc if abs(uc) > abs(yp) else yp  # 6
     if abs(A.add(step, -distance)) <= 4 * A.ulp(scale):
         return uc
+    if distance == 0 and 0 < step <= 4 * A.ulp(moving):  # at uc: the landing's rounding left this speed
+        return uc
     following = advance(A, yp, step if up else -step)
     if following == yp and step > 0:  # below the output's resolution: one unit in the last place
         return A.towards(yp, uc)
