@@ -466,6 +466,23 @@ def test_a_journal_with_a_damaged_header_is_refused(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+def test_the_same_fmu_named_by_another_path_resumes_from_the_journal(tmp_path):
+    """A journal knows an FMU by its bytes: the campaign resumed with a copy
+    of the FMU elsewhere takes every case from the journal, runs none again,
+    and names the FMU by the path given now."""
+    report, lines = campaign_with_journal(tmp_path)
+    copy = tmp_path / "elsewhere" / PASS_THROUGH.name
+    copy.parent.mkdir()
+    copy.write_bytes(PASS_THROUGH.read_bytes())
+    done = fmutrace("compare", copy, tmp_path / "cases", "--report", report, "--resume")
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    assert "on the journal" in done.stdout, done.stdout  # all done: nothing ran
+    assert (report / "results.jsonl").read_text().splitlines(keepends=True) == lines  # nothing appended
+    cases = json.loads((report / "results.json").read_text())["cases"]
+    assert cases and all(c["fmu_file"] == str(copy) for c in cases), cases
+
+
 def test_a_journal_of_another_program_is_refused(tmp_path):
     """A JSON first line that is not a campaign's header (a list): exit 2, one line."""
     report, lines = campaign_with_journal(tmp_path)

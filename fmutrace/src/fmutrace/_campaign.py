@@ -20,7 +20,7 @@ from ._comparison import Mode, comparison_mode
 from ._errors import InputError
 from ._executors import RunOptions, Work, executor_for
 from ._fmu import Fmu
-from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key
+from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key, fmu_digest
 from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
 from .recordings import is_recording, recording_paths
@@ -122,7 +122,12 @@ def compare(
     try:  # the report folder stays locked until its last file is written
         outcomes, counts, where = _run(cases_of, work, executor, (report, key, resume), progress)
         kept = (
-            JournaledOutcomes(report, Path(report) / JOURNAL, outcomes, {str(f.path): folders[f.path] for f in loaded})
+            JournaledOutcomes(
+                report,
+                Path(report) / JOURNAL,
+                outcomes,
+                {fmu_digest(work.fmu_bytes[path]): fmu.labels for path, fmu in work.fmus.items()},
+            )
             if report
             else KeptOutcomes(outcomes)
         )
@@ -148,12 +153,13 @@ def _run(cases_of, work, executor, journal_of, progress):
     outcomes: MutableSequence = array("q", bytes(8 * len(cases_of))) if report else [None] * len(cases_of)
     counts = dict.fromkeys(Status, 0)
     journal = Journal(report, key, resume, work.settings.recording.names) if report else None
+    digests = {path: fmu_digest(data) for path, data in work.fmu_bytes.items()}  # a journal knows FMUs by content
     try:
         indices: Sequence[int]
         if journal and journal.done:
             indices = array("q")
             for i, (fmu, folder, _) in enumerate(cases_of):
-                offset = journal.done.get(case_key(fmu.path, folder))
+                offset = journal.done.get(case_key(digests[fmu.path], folder))
                 if offset is not None:  # finished by the campaign resumed
                     outcomes[i] = offset
                     counts[journal.entry(offset)["status"]] += 1
@@ -170,7 +176,7 @@ def _run(cases_of, work, executor, journal_of, progress):
             if journal:
                 write_case_files(outcome, report)
                 fmu, folder, _ = cases_of[i]
-                outcomes[i] = journal.record(case_key(fmu.path, folder), outcome.to_json())
+                outcomes[i] = journal.record(case_key(digests[fmu.path], folder), outcome.to_json())
             else:
                 outcomes[i] = outcome
             bar.update(sum(counts.values()), sum(counts.values()) - counts[Status.PASS])

@@ -14,6 +14,7 @@ case runs again).
 import hashlib
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -102,8 +103,14 @@ def campaign_key(fmu_bytes: dict, mode: Mode, plots: str, recordings: dict | Non
     return key
 
 
-def case_key(fmu_file, folder):
-    return f"{fmu_file}|{os.path.realpath(folder)}"
+def fmu_digest(fmu_bytes: bytes) -> str:
+    """An FMU as a journal knows it: by its content, whatever path names it."""
+    return hashlib.sha256(fmu_bytes).hexdigest()
+
+
+def case_key(digest, folder):
+    """A case in the journal: its FMU's fmu_digest and its folder's real path."""
+    return f"{digest}|{os.path.realpath(folder)}"
 
 
 class Journal:
@@ -188,7 +195,7 @@ def _entry(line):
         return None, f"a case's entry with a bad value ({error})"
     if not (
         isinstance(key, str)
-        and key.startswith(f"{outcome.fmu_file}|")
+        and re.fullmatch(r"[0-9a-f]{64}\|.+", key, re.DOTALL) is not None
         and isinstance(outcome.messages, list)
         and all(isinstance(v, str) for v in (outcome.case, outcome.fmu, outcome.fmu_file, *outcome.messages))
         and isinstance(outcome.seconds, (int, float))
@@ -217,9 +224,10 @@ class JournaledOutcomes(Outcomes):
     with a result CSV in the report gets its result read from it (bit for
     bit the one written); light() leaves the results out."""
 
-    def __init__(self, report_dir, journal_path, offsets, fmu_folders):
+    def __init__(self, report_dir, journal_path, offsets, fmus):
+        """fmus: fmu_digest -> the labels of the FMU of those bytes in this campaign (the path named now)."""
         self.report_dir, self.path = Path(report_dir), Path(journal_path)
-        self.offsets, self.fmu_folders = offsets, fmu_folders
+        self.offsets, self.fmus = offsets, fmus
 
     def __len__(self):
         return len(self.offsets)
@@ -227,7 +235,8 @@ class JournaledOutcomes(Outcomes):
     def _outcome(self, journal, offset, results=True):
         journal.seek(offset)
         entry = json.loads(journal.readline())
-        outcome = CaseOutcome.from_json(entry, self.fmu_folders[entry["fmu_file"]])
+        labels = self.fmus[entry["key"].partition("|")[0]]
+        outcome = CaseOutcome.from_json(dict(entry, **labels), labels["fmu_folder"])
         if results and outcome.csv:
             outcome.result = read_trace(self.report_dir / outcome.csv)
         return outcome
