@@ -93,18 +93,18 @@ class CaseFiles:
 def run_folder_case(files: CaseFiles, target, settings, streaming: Streaming = Streaming()) -> CaseOutcome:
     """The CaseOutcome of the case in files.folder on target (a _worker.Target)."""
     started = time.perf_counter()
-    whole = files.texts is not None  # texts travelled: read them whole
-    while True:
+    for whole in [True] if files.texts is not None else [False, True]:  # texts travelled: read them whole
         try:
             case = _read_folder_case(files, target, streaming, whole)
             case.started = started
             return run_chunked_case(case, target, settings, streaming)
         except (NotPlain, InputError) as error:
-            if isinstance(error, InputError) and whole:
+            if whole:  # (read whole, a file is read or explained: NotPlain does not come from there)
                 outcome = CaseOutcome(files.name, **target.labels, status=Status.INVALID, messages=[str(error)])
                 outcome.seconds = time.perf_counter() - started
                 return outcome
-            whole = True  # a file the chunk reader does not take: read_trace reads or explains it
+            # else a file the chunk reader does not take: read_trace reads or explains it, whole
+    raise AssertionError("unreachable")
 
 
 def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: bool) -> ChunkedCase:
