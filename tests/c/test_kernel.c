@@ -1443,11 +1443,37 @@ static void test_landing_leaves_no_speed(void) {
     for (int n = 0; n < 3; n++) CHECK_BITS(cycle(&b, 1.175494351e-26), uc);
 }
 
+/* The zone step against its definition, counted: the largest s whose K =
+ * ceil((s - v) / b) steps above v all start before the boundary z away,
+ * (K - 1) * s - b * (K - 1) * (K - 2) / 2 <= z (values whose sums are exact). */
+static double zone_step_counted(double z, double v, double b) {
+    double best = v + b; /* K = 1 */
+    for (int k = 2; k < 100000; k++) {
+        const double low = v + (k - 1) * b, cap = z / (k - 1) + b * (k - 2) / 2;
+        const double s = v + k * b < cap ? v + k * b : cap;
+        if (s > low && s > best) best = s;
+        if (cap <= low) break;
+    }
+    return best;
+}
+
+static void test_zone_step_counted(void) {
+    const double zs[] = { 0, 0.75, 1, 2.5, 7, 40, 1000, 123456.5 }, vs[] = { 0, 0.5, 2, 3.25 }, bs[] = { 0.25, 1, 2 };
+    for (int i = 0; i < 8; i++) {
+        for (int j = 0; j < 4; j++) {
+            for (int k = 0; k < 3; k++) {
+                CHECK_BITS(rl_zone_step_lreal(zs[i], vs[j], bs[k]), zone_step_counted(zs[i], vs[j], bs[k]));
+            }
+        }
+    }
+}
+
 int main(void) {
     test_quiet_arithmetic();
     test_acceleration_helpers();
     test_kept_plan_equals_fresh_plan();
     test_landing_leaves_no_speed();
+    test_zone_step_counted();
     test_rule0_resolve();
     test_rule0_limits();
     test_status_codes();
