@@ -56,6 +56,9 @@ def main(argv=None):
     parser.add_argument("--arithmetic", choices=["lreal", "real", "both"], default="both")
     parser.add_argument("--seed", default="0")
     parser.add_argument(
+        "--first", type=int, default=0, metavar="N", help="start at scenario N (a campaign split between processes)"
+    )
+    parser.add_argument(
         "--cycles",
         type=int,
         nargs=2,
@@ -83,7 +86,7 @@ def main(argv=None):
     for arithmetic in kinds:
         name = "LREAL" if arithmetic == LREAL else "REAL"
         start, cycles, bad, kinds = time.monotonic(), 0, 0, collections.Counter()
-        for index in range(args.scenarios):
+        for index in range(args.first, args.scenarios):
             scenario, n, found = one(index, arithmetic, args.seed, tuple(args.cycles))
             cycles += n
             if found:
@@ -98,14 +101,15 @@ def main(argv=None):
                 sys.stdout.flush()
             if args.progress and (index + 1) % args.progress == 0:
                 print(
-                    f"{name}: {index + 1} of {args.scenarios} scenarios, {cycles} cycles, "
+                    f"{name}: {index + 1} of {args.scenarios} scenarios (from {args.first}), {cycles} cycles, "
                     f"{bad} with violations, {time.monotonic() - start:.0f} s",
                     file=sys.stderr,
                     flush=True,
                 )
         failed += bad
         print(
-            f"{name}: {args.scenarios} scenarios, {cycles} cycles checked in {time.monotonic() - start:.0f} s; "
+            f"{name}: scenarios {args.first} to {args.scenarios - 1}, {cycles} cycles checked in "
+            f"{time.monotonic() - start:.0f} s; "
             f"{bad} scenarios with violations" + (f" ({dict(kinds)})" if kinds else "")
         )
     return 1 if failed else 0
