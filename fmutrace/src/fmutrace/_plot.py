@@ -22,24 +22,47 @@ COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
 ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
 
 
+FOLD_SAMPLES = 1 << 16  # samples an envelope holds before it folds them into its columns
+
+
 class Envelope:
     """A line over [t0, t1] decimated to COLUMNS pixel columns: per column
     the first and the last sample and the smallest and the largest value
-    (NaN ignored), filled from consecutive chunks of (times, values)."""
+    (NaN ignored), filled from consecutive chunks of (times, values).
+    Chunks are held as given (not to be changed after) and folded into
+    the columns once FOLD_SAMPLES of them wait, or when the line is drawn:
+    a short case that gets no figure never pays for its envelopes."""
 
     def __init__(self, t0: float, t1: float, columns: int = COLUMNS):
         self.t0, self.span, self.columns = float(t0), max(float(t1) - float(t0), 1e-300), columns
-        self.first_t = np.full(columns, np.nan)
-        self.first_v = np.full(columns, np.nan)
-        self.last_t = np.full(columns, np.nan)
-        self.last_v = np.full(columns, np.nan)
-        self.low = np.full(columns, np.nan)
-        self.high = np.full(columns, np.nan)
+        self.waiting: list[tuple[np.ndarray, np.ndarray]] = []
+        self.waiting_samples = 0
+        self.folded = False  # the columns below hold samples (they are made then)
+        self.first_t = self.first_v = self.last_t = self.last_v = self.low = self.high = np.full(0, np.nan)
 
     def add(self, times, values):
         """Samples in time order, after those added before."""
         if not len(times):
             return
+        self.waiting.append((times, values))
+        self.waiting_samples += len(times)
+        if self.waiting_samples >= FOLD_SAMPLES:
+            self._fold()
+
+    def _fold(self):
+        if not self.waiting:
+            return
+        if len(self.waiting) == 1:
+            times, values = self.waiting[0]
+        else:
+            times = np.concatenate([t for t, _ in self.waiting])
+            values = np.concatenate([np.asarray(v, dtype=np.float64) for _, v in self.waiting])
+        self.waiting, self.waiting_samples = [], 0
+        if not self.folded:
+            self.folded = True
+            self.first_t, self.first_v, self.last_t, self.last_v, self.low, self.high = (
+                np.full(self.columns, np.nan) for _ in range(6)
+            )
         values = np.asarray(values, dtype=np.float64)
         column = np.clip(((times - self.t0) / self.span * self.columns).astype(np.int64), 0, self.columns - 1)
         starts = np.flatnonzero(np.concatenate(([True], column[1:] != column[:-1])))
@@ -55,6 +78,9 @@ class Envelope:
     def line(self):
         """(times, values) to draw: per filled column its first sample, its
         range at its middle, its last sample."""
+        self._fold()
+        if not self.folded:
+            return np.empty(0), np.empty(0)
         filled = ~np.isnan(self.first_t)
         middle = (self.first_t + self.last_t) / 2
         times = np.stack([self.first_t, middle, middle, self.last_t], axis=1)[filled].ravel()
