@@ -6,13 +6,12 @@ over a campaign of many short cases, at a tenth of them and at all.
 
 Generates the cases as campaign.py does (kept under
 build/benchmarks/campaign/<cases>x<steps>/), then runs each campaign in a
-fresh process: a local Dask cluster of one worker per core, started there
-with the settings fmutrace gives its own, and fmutrace.compare with a
-report folder (the command's way). That
-process (the client, with the cluster's scheduler) and every worker
-report their peak resident memory (VmHWM). Memory is flat when the peaks
-at all the cases are within 10 % (+ 10 MB) of those at a tenth; exit 1 if
-not (not with --smoke).
+fresh process: fmutrace.compare with a report folder and its default
+local worker processes (the command's way). That process (the client)
+reports its peak resident memory (VmHWM), and the largest of its
+workers' peaks. Memory is flat when the peaks at all the cases are
+within 10 % (+ 10 MB) of those at a tenth; exit 1 if not (not with
+--smoke).
 """
 
 import argparse
@@ -30,34 +29,25 @@ FLAT_FACTOR, FLAT_MEGABYTES = 1.1, 10.0
 
 
 def child(fmu, cases, report, jobs):
-    """One campaign in this process; prints its figures as JSON."""
-    import dask
-    from dask.distributed import Client, LocalCluster
+    """One campaign in this process, on fmutrace's default local workers
+    (jobs of them at most); prints its figures as JSON."""
+    import resource
+
     import fmutrace
-    from fmutrace._executors import LOCAL_CLUSTER, SHORT_LOGS
 
     started = time.perf_counter()
-    with (
-        dask.config.set({**SHORT_LOGS, **LOCAL_CLUSTER}),
-        LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
-        Client(cluster) as client,
-    ):
-        campaign = fmutrace.compare(
-            fmu,
-            cases,
-            report=report,
-            plots="failed",
-            run=fmutrace.RunOptions(scheduler=cluster.scheduler_address, shared_files=True, cluster_timeout=7200),
-        )
-        workers = sorted(client.run(peak_megabytes).values())
-        counts = campaign.counts()
+    campaign = fmutrace.compare(fmu, cases, report=report, plots="failed")
+    counts = campaign.counts()
+    # the largest of the workers' peaks (the kernel keeps the largest of the children waited for)
+    largest_worker = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     print(
         json.dumps(
             {
                 "cases": sum(counts.values()),
                 "passed": counts["pass"],
                 "client": peak_megabytes(),
-                "workers": workers,
+                "workers": [largest_worker],
+                "where": campaign.where,
                 "seconds": time.perf_counter() - started,
             }
         )
@@ -105,15 +95,15 @@ def main():
         for name, folder in (("tenth", tenth), ("all", root / "cases"))
     }
     lines = [
-        f"Campaign memory: {args.cases} cases of {args.steps} steps, {MODEL} FMI 3, {jobs} workers "
+        f"Campaign memory: {args.cases} cases of {args.steps} steps, {MODEL} FMI 3, {jobs} cores "
         f"({platform.machine()}, Python {platform.python_version()})"
         f"{' (SMOKE: figures meaningless)' if args.smoke else ''}",
         f"  cases generated in {generated:.0f} s" if generated else "  cases from an earlier run",
     ]
     for f in figures.values():
         lines.append(
-            f"  {f['cases']} cases ({f['passed']} pass) in {f['seconds']:.0f} s: client (with the scheduler) "
-            f"{f['client']:.0f} MB, workers {', '.join(f'{w:.0f}' for w in f['workers'])} MB"
+            f"  {f['cases']} cases ({f['passed']} pass) in {f['seconds']:.0f} s on {f['where']}: client "
+            f"{f['client']:.0f} MB, the largest worker {max(f['workers']):.0f} MB"
         )
     print("\n".join(lines))
     if args.smoke:

@@ -555,7 +555,6 @@ def readme_example():
     return block.group(1)
 
 
-@pytest.mark.cluster  # its 32 scenarios run on a local cluster, as compare does from 20 cases on
 def test_the_readme_pytest_example_runs(tmp_path):
     """The example as a user copies it into a test file; 'build/' is this
     run's build folder."""

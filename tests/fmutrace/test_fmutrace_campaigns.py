@@ -2,11 +2,9 @@
 killed client resumed without recomputing, a second campaign into the same
 report folder refused, a Dask worker killed in the middle."""
 
-import contextlib
 import json
 import os
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -117,7 +115,6 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
     assert code == 0 and "on the journal" in out  # all done: nothing runs
 
 
-@pytest.mark.cluster  # 501 cases: the command starts a local cluster
 def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp_path):
     """The command's default is the documented one: a plot and a result CSV
     for every case up to 500 (test_fmutrace.py's report test: every case
@@ -263,28 +260,27 @@ def faulty_cases(root, values):
     return step_cases(root, "Faulty", values)
 
 
-@pytest.mark.parametrize(
-    "version,jobs",
-    [pytest.param(2, 2, marks=pytest.mark.cluster), pytest.param(3, 2, marks=pytest.mark.cluster), (3, 1)],
-)
+@pytest.mark.parametrize("version,jobs", [(2, 2), (3, 2), (3, 1), (2, None), (3, None)])
 def test_a_case_that_crashes_its_process_fails_alone_naming_the_signal(version, jobs, tmp_path):
-    """On workers the batch that holds it kills its worker, is run again
-    case by case in child processes, and only the crashing case fails; in
-    one process (with --case-timeout, which runs the cases in a child) the
-    same."""
+    """The worker it kills is replaced and only the crashing case fails:
+    with two workers, with the default (no --jobs), and with --jobs 1 and
+    --case-timeout (one worker process)."""
     cases = faulty_cases(tmp_path / "cases", [1, 2, 13, 4, 5, 6])
-    args = ["compare", FAULTY[version], cases, "--report", tmp_path / "report", "--jobs", jobs]
-    code, out, err = finish(start(args + (["--case-timeout", 60] if jobs == 1 else [])))
+    args = ["compare", FAULTY[version], cases, "--report", tmp_path / "report"]
+    args += [] if jobs is None else ["--jobs", jobs] + (["--case-timeout", 60] if jobs == 1 else [])
+    code, out, err = finish(start(args))
     assert code == 1, out + err
     assert (
         f"ERROR  case_13 on Faulty (FMI {version})\n      the simulation's process was {CRASH} while running "
         "this case" in out
     )
     assert "5 of 6 cases pass, 0 differ, 1 failed to simulate" in out
+    assert "1 lost with a case" in out  # (the headline's where)
     assert len(set(journal_keys(tmp_path / "report"))) == 6
+    assert (tmp_path / "report" / "index.html").exists()
 
 
-@pytest.mark.parametrize("jobs", [1, pytest.param(2, marks=pytest.mark.cluster)])
+@pytest.mark.parametrize("jobs", [1, 2])
 def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     """The hanging case is stopped once its timeout has passed (not before),
     the campaign goes on to the cases after it, and the command ends (finish
@@ -303,71 +299,37 @@ def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     assert results["case_17"]["status"] == "error" and results["case_17"]["seconds"] >= 3
 
 
-class _FailingStarts:
-    """dask.distributed.LocalCluster whose first `failures` starts fail as
-    one does when a worker is lost while the cluster starts."""
+def test_spawned_workers_give_what_this_process_gives(tmp_path, monkeypatch):
+    """Where a worker cannot be forked (another thread runs, or not Linux) it
+    is a new Python: the same outcomes as in this process, the crashing case
+    failing alone."""
+    from fmutrace import _workers
 
-    def __init__(self, real, failures):
-        self.real, self.failures, self.starts = real, failures, 0
-
-    def __call__(self, *args, **kwargs):
-        self.starts += 1
-        if self.starts <= self.failures:
-            raise RuntimeError("Nanny failed to start.")
-        return self.real(*args, **kwargs)
-
-
-@pytest.mark.cluster
-@pytest.mark.parametrize("failures", [1, 2])
-def test_a_worker_lost_while_the_cluster_starts_costs_a_retry(failures, tmp_path, monkeypatch):
-    """Once: a new cluster runs the campaign; every time: the cases run in
-    child processes. Never a traceback, every case run."""
-    import dask.distributed
-
-    starts = _FailingStarts(dask.distributed.LocalCluster, failures)
-    monkeypatch.setattr(dask.distributed, "LocalCluster", starts)
-    cases = pass_through_cases(tmp_path / "cases", 24)
-    result = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=2), report=tmp_path / "report")
-    assert result.passed and len(result.cases) == 24, result.summary()
-    assert starts.starts == min(failures + 1, 2)
-    assert ("Dask, 2 workers" in result.where) == (failures == 1), result.where
-    assert (tmp_path / "report" / "index.html").exists()
+    monkeypatch.setattr(_workers, "can_fork", lambda: False)
+    cases = faulty_cases(tmp_path / "cases", [1, 2, 13, 4])
+    spawned = fmutrace.compare(FAULTY[3], cases, run=fmutrace.RunOptions(jobs=2), plots="none")
+    assert spawned.where.startswith("2 local processes"), spawned.where
+    statuses = {o.case: o.status.value for o in spawned.cases}
+    assert statuses == {"case_01": "pass", "case_02": "pass", "case_04": "pass", "case_13": "error"}, statuses
+    [crashed] = [o for o in spawned.cases if o.case == "case_13"]
+    assert crashed.messages[0].startswith(f"the simulation's process was {CRASH}"), crashed.messages
+    good = faulty_cases(tmp_path / "good", [1, 2, 4])
+    in_process = fmutrace.compare(FAULTY[3], good, run=fmutrace.RunOptions(jobs=1), plots="none")
+    again = fmutrace.compare(FAULTY[3], good, run=fmutrace.RunOptions(jobs=2), plots="none")
+    assert [(o.case, o.status, o.messages) for o in again.cases] == [
+        (o.case, o.status, o.messages) for o in in_process.cases
+    ]
 
 
-# evaluated in each worker: where its fmutrace comes from, and each Runner's loop and fast runs
-WORKER_LOOPS = (
-    "(__import__('fmutrace._runner')._runner.__file__, "
-    "[(r.c_loop, r.fast_runs) for r, _ in __import__('fmutrace._worker')._worker._fmus.values()])"
-)
-
-
-@pytest.mark.cluster
-def test_the_workers_of_a_local_cluster_run_the_step_loop_in_c(tmp_path, monkeypatch, recwarn):
-    """A local cluster's workers share this environment: they import the
-    installed fmutrace, with its compiled _steps, not an uploaded zip of
-    its Python sources (where the C loop cannot be imported). Its
-    scheduler starts no dashboard and leaves port 8787 alone (held here
-    while it runs): no warning that the port is in use."""
-    from fmutrace import _executors as executors
-
-    reports = {}
-    run = executors.Dask._run
-
-    def run_and_ask_the_workers(self, client, todo, work, finished):
-        workers = run(self, client, todo, work, finished)
-        reports.update(client.run(eval, WORKER_LOOPS))
-        return workers
-
-    monkeypatch.setattr(executors.Dask, "_run", run_and_ask_the_workers)
-    cases = pass_through_cases(tmp_path / "cases", 40)
-    with socket.socket() as dashboard_port:
-        with contextlib.suppress(OSError):  # (taken already: just as well)
-            dashboard_port.bind(("127.0.0.1", 8787))
-            dashboard_port.listen()
-        result = fmutrace.compare(PASS_THROUGH, cases, run=fmutrace.RunOptions(jobs=2), plots="none")
-    assert not [str(w.message) for w in recwarn if "8787" in str(w.message)]
-    assert result.passed and len(result.cases) == 40 and "Dask, 2 workers" in result.where, result.summary()
-    assert len(reports) == 2, reports
-    for source, runners in reports.values():
-        assert ".zip" not in source and all(c_loop for c_loop, _ in runners), reports
-    assert sum(fast for _, runners in reports.values() for _, fast in runners) == 40, reports
+@pytest.mark.parametrize("plots,count,workers", [("none", 6, 1), ("all", 24, 2)])
+def test_the_default_starts_the_workers_the_work_pays_for(plots, count, workers, tmp_path):
+    """By default a second worker starts only when the work left pays for
+    its start-up, measured: 6 cases of a millisecond or so run in one (a
+    start-up loads the FMU: tens of milliseconds), 24 cases drawn (a tenth
+    of a second each) in two, where there are two cores. (The command:
+    its workers are forked, as users get them on Linux.)"""
+    cases = pass_through_cases(tmp_path / "cases", count)
+    code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", tmp_path / "report", "--plots", plots]))
+    assert code == 0 and f"{count} of {count} cases pass" in out, out + err
+    expected = min(workers, len(os.sched_getaffinity(0)))
+    assert f" on {expected} local process{'es' if expected > 1 else ''})." in out, out

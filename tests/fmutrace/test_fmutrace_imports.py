@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from support.fmu_driver import BUILD_DIR
+
 PACKAGE = Path(__file__).resolve().parents[2] / "fmutrace" / "src" / "fmutrace"
 
 # lowest first; a module imports from its own layer or the ones before it
@@ -33,7 +35,7 @@ LAYERS = [
         },
     ),
     ("one case", {"fmutrace._pipeline", "fmutrace._recording", "fmutrace._worker"}),
-    ("where cases run", {"fmutrace._isolated", "fmutrace._executors"}),
+    ("where cases run", {"fmutrace._workers", "fmutrace._executors"}),
     ("campaign", {"fmutrace._campaign"}),
     ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__"}),
 ]
@@ -200,6 +202,25 @@ def test_import_fmutrace_loads_no_heavy_package_and_no_posix_module():
     loaded = run_python("import sys, fmutrace, fmutrace.cli; print(' '.join(sorted(sys.modules)))").split()
     assert not [m for m in loaded if m.split(".")[0] in LOADED_ON_USE], loaded
     assert not [m for m in loaded if m.split(".")[0] in POSIX_ONLY and m.startswith("fmutrace")]
+
+
+def test_a_campaign_of_plain_cases_without_plots_loads_no_heavy_package(tmp_path):
+    """pandas (which pyarrow's to_numpy imports where it is installed) costs a
+    short campaign a third of a second; matplotlib is loaded for a figure."""
+    case = tmp_path / "cases" / "step"
+    case.mkdir(parents=True)
+    (case / "PassThrough_in.csv").write_text("time,u\n0,0\n0.2,1\n")
+    (case / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,1\n0.4,1\n")
+    (case / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    fmu = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
+    loaded = run_python(
+        "import sys, fmutrace\n"
+        f"c = fmutrace.compare({str(fmu)!r}, {str(tmp_path / 'cases')!r}, plots='failed', "
+        "run=fmutrace.RunOptions(jobs=1))\n"
+        "assert c.passed, c.summary()\n"
+        "print(' '.join(sorted(sys.modules)))"
+    ).split()
+    assert not [m for m in loaded if m.split(".")[0] in LOADED_ON_USE], loaded
 
 
 AS_ON_WINDOWS = """

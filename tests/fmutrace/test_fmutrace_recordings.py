@@ -242,7 +242,6 @@ def test_set_gives_the_fmus_start_values(tmp_path):
     assert "rateUpPar is a Float64: 'fast' is not a number" in said
 
 
-@pytest.mark.cluster  # --jobs 2: a local cluster
 def test_recordings_on_every_executor_and_niagara_histories_given_as_files(tmp_path):
     histories = sorted((SAMPLES / "niagara_siemens").iterdir())
     for options in (["--jobs", "2", "--report", tmp_path / "report"], ["--case-timeout", "120"]):

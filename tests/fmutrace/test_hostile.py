@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from fmutrace import _report, compare
+from fmutrace import RunOptions, _report, compare
 from support.fmu_driver import BUILD_DIR
 from support.process import kill_session
 from support.process import run as run_bounded
@@ -177,10 +177,10 @@ def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
     )
     try:
         deadline = time.monotonic() + 120
-        while not children_of(command.pid, "fmutrace._isolated") and time.monotonic() < deadline:
+        while not children_of(command.pid, "fmutrace") and time.monotonic() < deadline:
             assert command.poll() is None, "the command ended before its child started"
             time.sleep(0.1)
-        children = children_of(command.pid, "fmutrace._isolated")
+        children = children_of(command.pid, "fmutrace")
         assert children, "no child started"
         time.sleep(2)  # in the hanging doStep by now
         command.kill()
@@ -227,9 +227,8 @@ def test_a_killed_commands_unpack_folder_is_removed_by_the_next_one(tmp_path):
     assert sorted(shared.iterdir()) == [other, live]
 
 
-@pytest.mark.cluster
-def test_a_local_clusters_workers_leave_no_unpacked_fmu_behind(tmp_path):
-    """--jobs 2: the local Dask workers unpack into the command's folder,
+def test_local_workers_leave_no_unpacked_fmu_behind(tmp_path):
+    """--jobs 2: the local worker processes unpack into the command's folder,
     removed when the command ends, however the workers are stopped."""
     shared = tmp_path / "tmp"
     shared.mkdir()
@@ -240,7 +239,7 @@ def test_a_local_clusters_workers_leave_no_unpacked_fmu_behind(tmp_path):
     )
     no_traceback(done)
     assert done.returncode == 0, output(done)
-    assert "Dask, 2 workers" in done.stdout, done.stdout
+    assert "2 local processes" in done.stdout, done.stdout
     assert not [p for p in shared.rglob("*") if "fmutrace" in p.name or p.name.startswith("fmu-")]
 
 
@@ -439,6 +438,36 @@ def test_a_report_page_is_replaced_whole_or_not_at_all(tmp_path, monkeypatch):
     assert sorted(p.name for p in report.iterdir() if p.is_file()) == sorted(
         [*pages, "results.jsonl", ".fmutrace.lock"]
     )
+
+
+def test_a_campaign_started_while_another_writes_its_report_is_refused(tmp_path, monkeypatch):
+    """The race that lost a campaign's results: a second campaign started
+    in the moment the first writes its pages (made certain here: the first
+    starts it from inside its report writing) is refused, and the first
+    one's journal and pages hold all its cases."""
+    from fmutrace import _campaign
+
+    for name in ("one", "two", "three"):
+        write_case(tmp_path / "cases" / name)
+    report = tmp_path / "report"
+    raced = []
+    write_report = _campaign.write_report
+
+    def race_then_write(*args, **kwargs):
+        raced.append(fmutrace("compare", PASS_THROUGH, tmp_path / "cases" / "one", "--report", report))
+        return write_report(*args, **kwargs)
+
+    monkeypatch.setattr(_campaign, "write_report", race_then_write)
+    first = compare([PASS_THROUGH], [tmp_path / "cases"], report=report, run=RunOptions(jobs=1))
+    [second] = raced
+    no_traceback(second)
+    assert second.returncode == 2 and "another campaign is writing this report folder" in second.stderr, output(second)
+    assert first.passed and len(first.cases) == 3, first.summary()
+    journal = (report / "results.jsonl").read_text().splitlines()
+    assert len(journal) == 4, journal  # its header and the three cases
+    assert json.loads((report / "results.json").read_text())["counts"]["pass"] == 3
+    page = (report / "index.html").read_text()
+    assert all(name in page for name in ("one", "two", "three"))
 
 
 # 4. Resumes wrongly
@@ -735,7 +764,7 @@ def test_a_plot_that_cannot_be_drawn_costs_the_figure_not_the_verdict(tmp_path, 
     monkeypatch.setattr(_pipeline, "draw", broken)
     write_case(tmp_path / "cases" / "differs", ref=REF.replace("0.3,3", "0.3,2"))
     write_case(tmp_path / "cases" / "same")
-    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report")
+    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report", run=RunOptions(jobs=1))
     by_name = {c.case: c for c in campaign.cases}
     assert (by_name["differs"].status, by_name["same"].status) == ("fail", "pass")
     for c in by_name.values():

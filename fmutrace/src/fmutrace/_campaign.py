@@ -70,9 +70,10 @@ def compare(
                 from it, run the others (after a campaign was stopped)
     progress    the stream of the progress bar (default: standard error;
                 drawn on a terminal only)
-    run         where and how long the cases run: RunOptions(jobs=1,
+    run         where and how long the cases run: RunOptions(jobs=None,
                 scheduler=None, shared_files=False, case_timeout=None,
-                cluster_timeout=None); by default in this process
+                cluster_timeout=None); by default in local worker
+                processes, as many as the work pays for
     recording   how recordings are read: RecordingOptions(step_size,
                 time_unit, timing, maps, start_values); case folders carry
                 their own settings, so recording options are refused for
@@ -115,7 +116,7 @@ def compare(
         },
         settings=CaseSettings(mode, plots, recording, run.case_timeout),
     )
-    executor = executor_for(len(cases_of), run)
+    executor = executor_for(run)
     key = campaign_key(work.fmu_bytes, mode, plots, recording.settings() if has_recordings else None)
     started = time.perf_counter()
     lock = ReportLock(report) if report else None

@@ -1,11 +1,11 @@
 """Where a campaign's cases run, behind one interface: an Executor takes
 the cases to do and calls finished(i, outcome) as each one ends.
 
-InProcess       one after the other in this process
-ChildProcesses  one after the other in child processes (a per-case
-                timeout: a case that hangs is stopped by killing its process)
-Dask            in batches on Dask workers: a local cluster of worker
-                processes, or a distributed scheduler's
+InProcess       one after the other in this process (jobs=1)
+LocalProcesses  in local worker processes, as many as pay for themselves
+                or as asked (workers.Pool): a case that crashes its process
+                or hangs (the per-case timeout) fails alone
+Dask            in batches on a Dask scheduler's workers
 
 A Dask task carries a batch of cases and the FMU's bytes (sent once to
 every worker) and returns the outcomes with their results and plots, so
@@ -14,11 +14,8 @@ them) but no shared file system; the report is written by the caller.
 """
 
 import atexit
-import contextlib
 import functools
 import hashlib
-import logging
-import os
 import shutil
 import tempfile
 import time
@@ -28,48 +25,41 @@ from pathlib import Path
 
 from ._cases import case_texts
 from ._errors import InputError
-from ._fmu import unpack_root
-from ._isolated import run_isolated
 from ._outcome import CaseOutcome, Status
 from ._runner import Runner
 from ._worker import CaseSettings, FmuFile, Target, run_case, run_cases
+from ._workers import Pool
 from .recordings import is_recording
 
 BATCH_CASES = 256  # cases per Dask task at most
 BATCH_TEXT_BYTES = 2_000_000  # of case files' text per task at most, when they are sent
-CLUSTER_ATTEMPTS = 2  # a local cluster whose start fails (a worker lost) is started again, once
 BATCH_ATTEMPTS = 3  # a batch lost with its worker is sent again, so many times in all
 # Dask keeps its last messages for its developers (distributed.admin.low-level-log-length, 1000): a
-# message that sends a batch keeps the batch's cases, so a campaign's client (and a local cluster's
-# scheduler, in its process) would grow with the first 1000 batches. A few are enough here.
+# message that sends a batch keeps the batch's cases, so a campaign's client would grow with the first
+# 1000 batches. A few are enough here.
 SHORT_LOGS = {"distributed.admin.low-level-log-length": 16}
-# no statistical profiler in the workers (its history grows with the campaign's length)
-LOCAL_CLUSTER = {"distributed.worker.profile.enabled": False, "distributed.scheduler.allowed-failures": 0}
-
-
-AUTO_JOBS_FROM = 20  # RunOptions(jobs=None): a local cluster of one process per core from so many cases on
 
 
 @dataclass(frozen=True)
 class RunOptions:
     """Where and how long a campaign's cases run.
 
-    jobs             1: in this process (the default); N: a local Dask
-                     cluster of N processes; None: one per core for
-                     AUTO_JOBS_FROM cases or more, else 1 (the command's
-                     default)
+    jobs             None (the default): local worker processes, as
+                     many as the work pays for, up to one per core; N:
+                     N local worker processes; 1: in this process (an
+                     FMU that crashes takes the caller with it)
     scheduler        address of a Dask scheduler to run on (instead of
-                     this process or a local cluster)
+                     this process or local workers)
     shared_files     the scheduler's workers see the case folders at the
                      same paths (they read the files; else they are sent
                      the texts)
     case_timeout     seconds a case may run (None: no bound): a case over
-                     it is stopped and reported (cases then run in child
-                     processes)
+                     it is stopped and reported (jobs=1 then runs them
+                     in one worker process)
     cluster_timeout  seconds to wait for a cluster's results (None: no bound)
     """
 
-    jobs: int | None = 1
+    jobs: int | None = None
     scheduler: str | None = None
     shared_files: bool = False
     case_timeout: float | None = None
@@ -117,43 +107,46 @@ class InProcess(Executor):
                 runner.close()
 
 
-class ChildProcesses(Executor):
-    where = "1 process at a time (isolated)"
+class LocalProcesses(Executor):
+    """Local worker processes (workers.Pool): jobs of them, or None: as
+    many as pay for themselves."""
+
+    def __init__(self, jobs: int | None):
+        self.jobs = jobs
 
     def run(self, todo, work, finished):
-        by_fmu: dict = {}  # Fmu -> [(i, folder, name)]
-        for i, fmu, folder, name in todo:
-            by_fmu.setdefault(fmu, []).append((i, folder, name))
-        for fmu, cases in by_fmu.items():
-            arrived = iter(cases)
-            run_isolated(
-                [(str(folder), name, None) for _, folder, name in cases],
-                work.fmu_bytes[fmu.path],
-                work.fmus[fmu.path],
-                work.settings,
-                on_outcome=lambda outcome, arrived=arrived: finished(next(arrived)[0], outcome),
-            )
+        fmus = {path: (work.fmu_bytes[path], work.fmus[path]) for path in work.fmus}
+        pool = Pool(fmus, work.settings, self.jobs)
+        try:
+            pool.run([(i, fmu.path, (str(folder), name, None)) for i, fmu, folder, name in todo], finished)
+        finally:
+            self.where = f"{pool.peak} local process{'es' if pool.peak != 1 else ''}"
+            if pool.lost:
+                self.where += f", {pool.lost} lost with a case"
 
 
 def run_batch(items, fmu_bytes, fmu: FmuFile, settings: CaseSettings, isolate: bool):
     """A Dask task: the outcomes of the cases [(folder, name, texts or
-    None)] of one FMU, run in this worker, or (isolate) in child processes
-    of it."""
-    if isolate:
-        return run_isolated(items, fmu_bytes, fmu, settings)
-    return list(run_cases(items, fmu_bytes, fmu, settings))
+    None)] of one FMU, run in this worker, or (isolate) in a worker
+    process of its own."""
+    if not isolate:
+        return list(run_cases(items, fmu_bytes, fmu, settings))
+    outcomes: dict = {}
+    Pool({fmu.path: (fmu_bytes, fmu)}, settings, 1).run(
+        [(i, fmu.path, item) for i, item in enumerate(items)], outcomes.__setitem__
+    )
+    return [outcomes[i] for i in range(len(items))]
 
 
 class Dask(Executor):
-    """The cases in batches on Dask workers, at most a few batches per
-    worker in flight (the client's memory stays flat). Workers of a local
-    cluster (scheduler None: jobs processes), or of a scheduler's that see
-    the same files (shared_files), read the cases themselves; others get
-    the files' texts. cluster_timeout bounds the wait for the cluster."""
+    """The cases in batches on a Dask scheduler's workers, at most a few
+    batches per worker in flight (the client's memory stays flat). Workers
+    that see the same files (shared_files) read the cases themselves;
+    others get the files' texts. cluster_timeout bounds the wait."""
 
-    def __init__(self, jobs: int, options: RunOptions):
-        self.jobs, self.scheduler, self.shared_files, self.cluster_timeout = (
-            jobs,
+    def __init__(self, options: RunOptions):
+        assert options.scheduler is not None
+        self.scheduler, self.shared_files, self.cluster_timeout = (
             options.scheduler,
             options.shared_files,
             options.cluster_timeout,
@@ -161,75 +154,21 @@ class Dask(Executor):
 
     def run(self, todo, work, finished):
         import dask
+        from dask.distributed import Client
 
-        with dask.config.set(SHORT_LOGS):
-            for attempt in range(1, CLUSTER_ATTEMPTS + 1):
-                self.submitted = False
-                try:
-                    cluster, client = self._connect()
-                except Exception:  # a local worker lost while the cluster starts ("Nanny failed to start")
-                    if self.scheduler:
-                        raise
-                    continue
-                try:
-                    workers = self._run(client, todo, work, finished)
-                    break
-                except Exception:
-                    # lost before any batch was sent (the upload to a worker that died): once more, on a new
-                    # cluster; once batches run, a lost worker costs its batch a retry (in _run)
-                    if self.submitted or self.scheduler or attempt == CLUSTER_ATTEMPTS:
-                        raise
-                finally:
-                    client.close()
-                    if cluster is not None:
-                        cluster.close()
-            else:  # no local cluster would start: the cases in child processes of this one
-                fallback = ChildProcesses()
-                fallback.run(todo, work, finished)
-                self.where = f"{fallback.where}, the local Dask cluster failed to start {CLUSTER_ATTEMPTS} times"
-                return
-        self.where = f"Dask, {workers} workers" + (f" at {self.scheduler}" if self.scheduler else " (local processes)")
-
-    def _connect(self):
-        """(cluster or None, client): the scheduler's, or a local cluster of jobs processes."""
-        import dask
-        from dask.distributed import Client, LocalCluster
-
-        if self.scheduler:
-            return None, Client(self.scheduler, timeout=self.cluster_timeout or 60)
-        cluster = None
-        unpack_root()  # the local workers unpack into this process's folder (inherited): removed however they end
-        try:
-            # a task whose worker dies is not tried on others: the batch is run isolated instead (_run)
-            # (silent: a worker's death is reported by the campaign)
-            with dask.config.set(LOCAL_CLUSTER):
-                # no dashboard, and the scheduler's HTTP server (health, metrics) on a free loopback port:
-                # dashboard_address=None alone still takes port 8787 (and warns where that is in use)
-                cluster = LocalCluster(
-                    n_workers=self.jobs,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address=None,
-                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                    silence_logs=logging.CRITICAL,
-                )
-            return cluster, Client(cluster)
-        except Exception:
-            if cluster is not None:
-                with contextlib.suppress(Exception):
-                    cluster.close()
-            raise
+        with dask.config.set(SHORT_LOGS), Client(self.scheduler, timeout=self.cluster_timeout or 60) as client:
+            workers = self._run(client, todo, work, finished)
+        self.where = f"Dask, {workers} workers at {self.scheduler}"
 
     def _run(self, client, todo, work, finished):
         from dask.distributed import as_completed
 
-        if self.scheduler:  # fmutrace to every worker: nothing to install there but packages. A local cluster's
-            client.upload_file(str(package_zip()))  # workers share this venv: from a zip they would miss _steps
+        client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
         workers = len(client.scheduler_info()["workers"])
         shared = {path: client.scatter(data, broadcast=True) for path, data in work.fmu_bytes.items()}
         # about 8 batches per worker; at most BATCH_CASES cases each (a task's cost is a few milliseconds)
         size = max(1, min(BATCH_CASES, -(-len(todo) // (8 * workers))))
-        batches = _batches(todo, size, ship_texts=bool(self.scheduler) and not self.shared_files)
+        batches = _batches(todo, size, ship_texts=not self.shared_files)
         in_flight = as_completed()
         submitted = {}  # future -> (fmu, batch, isolated, attempt)
 
@@ -279,14 +218,13 @@ class Dask(Executor):
         return workers
 
 
-def executor_for(cases: int, options: RunOptions) -> Executor:
-    """The executor the run options choose for so many cases."""
-    jobs = options.jobs
-    if jobs is None:  # a local cluster takes seconds to start: worth it for many cases only
-        jobs = (os.cpu_count() or 1) if cases >= AUTO_JOBS_FROM else 1
-    if options.scheduler is None and jobs <= 1:
-        return InProcess() if options.case_timeout is None else ChildProcesses()
-    return Dask(jobs, options)
+def executor_for(options: RunOptions) -> Executor:
+    """The executor the run options choose."""
+    if options.scheduler is not None:
+        return Dask(options)
+    if options.jobs == 1 and options.case_timeout is None:
+        return InProcess()
+    return LocalProcesses(options.jobs)
 
 
 @functools.cache

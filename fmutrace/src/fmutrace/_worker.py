@@ -76,12 +76,19 @@ def worker_fmu(fmu_bytes: bytes, path: str) -> tuple[Runner, Fmu]:
     return _fmus[key]
 
 
+def plotting_first(settings: CaseSettings) -> bool:
+    """Load the plotting packages before the first case: every case is
+    drawn, or a case's timeout counts from its start and must not pay for
+    the import (else the first figure loads them, if any is drawn)."""
+    return settings.plots == "all" or (settings.plots == "failed" and settings.case_timeout is not None)
+
+
 def run_cases(items, fmu_bytes: bytes, fmu: FmuFile, settings: CaseSettings, on_start=None):
     """The outcomes of the cases [(folder, name, texts or None)] of one FMU
     in this process, as they finish; on_start() before each case starts."""
     target = Target(*worker_fmu(fmu_bytes, fmu.path), fmu.labels)
-    if settings.plots != "none":
-        load_plotting()  # start-up, not the first case's time: a case's timeout counts from on_start
+    if plotting_first(settings):
+        load_plotting()
     for folder, name, texts in items:
         if on_start:
             on_start()

@@ -149,7 +149,7 @@ def parser():
         "--jobs",
         type=_positive_int,
         metavar="N",
-        help="local worker processes (default: one per core for 20 cases or more, else this process)",
+        help="local worker processes (1: this process; default: as many as the work pays for, up to one per core)",
     )
     cmp.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
     cmp.add_argument(
@@ -167,7 +167,7 @@ def parser():
         "--case-timeout",
         type=_non_negative,
         metavar="S",
-        help="seconds a case may run: one over it is stopped and reported (the cases then run in child processes)",
+        help="seconds a case may run: one over it is stopped and reported (--jobs 1 then runs in one worker process)",
     )
     cmp.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
     cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")

@@ -1,0 +1,423 @@
+"""Cases in local worker processes: as many as pay for themselves, never
+more than cores, and a case whose FMU crashes its process or hangs is
+reported by itself while the others go on.
+
+A worker is a child process: forked from this one where that is safe
+(Linux, no other Python thread: it starts in milliseconds with fmutrace
+already imported), else a new Python running `main` below. It reads
+batches of cases on a pipe and writes back, per case, an empty record
+when it starts it and then its outcome (length-prefixed pickles; what the
+FMU prints goes nowhere). This process, one thread, waits on every
+worker's pipe with a deadline: a worker whose pipe closes died, and the
+case it ran gets an error naming the signal; a case over the per-case
+timeout gets its worker killed. Either way the rest of the batch goes
+back to the queue and a new worker takes over. The timeout counts from
+the case's start, so a worker's start-up (slow on a loaded machine) is
+never charged to a case.
+
+How many: `jobs` workers if asked, else one, and more once the first
+outcomes show that the work left pays for their start-up (measured: the
+first worker's, to its first case). Batches hold about BATCH_SECONDS of
+measured work, fewer cases near the end so that the workers finish
+together.
+"""
+
+import collections
+import ctypes
+import os
+import pickle
+import selectors
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ._fmu import UNPACK_ROOT, unpack_root
+from ._outcome import CaseOutcome, Status
+from ._plot import load_plotting
+from ._worker import CaseSettings, plotting_first, run_cases
+
+HEADER = struct.Struct("!Q")
+STARTED = b""  # a worker's record that it starts its next case (an empty record)
+PR_SET_PDEATHSIG = 1  # prctl(2)
+PARENT = "FMUTRACE_PARENT_PID"  # in a spawned worker's environment: the process whose child it is
+CHILD = "import sys, fmutrace._workers; sys.exit(fmutrace._workers.main())"
+# the most a worker may take to start a case (a new Python's imports, the FMU unpacked) on a loaded machine
+START_SECONDS = 300.0
+BATCH_SECONDS = 0.25  # of measured work per batch: the round trip to the worker is a fraction of a millisecond
+START_PAYS = 2.0  # another worker starts once the work left per worker exceeds so many times a start-up
+
+
+def cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # (not on every platform)
+        return os.cpu_count() or 1
+
+
+def can_fork() -> bool:
+    """A forked worker is safe here: Linux (macOS's frameworks are not
+    fork-safe, Windows has no fork) and no other Python thread, whose
+    locks the child would inherit held."""
+    return sys.platform.startswith("linux") and threading.active_count() == 1
+
+
+@dataclass
+class _Worker:
+    pid: int
+    to_worker: int  # pipe ends, this side's
+    from_worker: int
+    said: object  # a file with what the worker wrote to stderr (its last words, if it dies)
+    process: subprocess.Popen | None = None  # a spawned worker's
+    started: float = field(default_factory=time.monotonic)
+    received: bytearray = field(default_factory=bytearray)
+    fmus: set = field(default_factory=set)  # the FMUs whose bytes it has
+    batch: collections.deque = field(default_factory=collections.deque)  # its cases not finished (as in todo)
+    running_since: float | None = None  # the case at batch[0] started then
+    sent_at: float = 0.0
+    last_words: str = ""  # what it wrote last to stderr, once it ended
+    first_case: bool = True  # its next outcome is its first
+
+    def kill(self):
+        try:
+            os.kill(self.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+    def wait(self) -> int:
+        """Its exit status as subprocess gives it (negative: the signal)."""
+        if self.process is not None:
+            return self.process.wait()
+        _, status = os.waitpid(self.pid, 0)
+        return -os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status)
+
+    def close(self):
+        for fd in (self.to_worker, self.from_worker):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        self.said.close()  # type: ignore[attr-defined]
+
+
+def _start_worker(settings: CaseSettings, others: list[_Worker]) -> _Worker:
+    """A new worker, forked where can_fork() says it is safe, else spawned."""
+    said = tempfile.TemporaryFile()
+    if can_fork():
+        down_read, down_write = os.pipe()
+        up_read, up_write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the worker: nothing of this process's but the pipes, never back into its code
+            code = 1
+            try:
+                for worker in others:
+                    worker.close()
+                os.close(down_write)
+                os.close(up_read)
+                os.dup2(said.fileno(), 2)
+                _serve(down_read, up_write, settings)
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(down_read)
+        os.close(up_write)
+        return _Worker(pid, down_write, up_read, said)
+    environment = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(
+            [_package_root()] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
+        ),
+        **{UNPACK_ROOT: unpack_root(), PARENT: str(os.getpid())},
+    )
+    process = subprocess.Popen(
+        [sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=said, env=environment
+    )
+    assert process.stdin is not None and process.stdout is not None
+    worker = _Worker(process.pid, os.dup(process.stdin.fileno()), os.dup(process.stdout.fileno()), said, process)
+    process.stdin.close()
+    process.stdout.close()
+    _send(worker.to_worker, settings)
+    return worker
+
+
+def _package_root():
+    """The folder (or zip) fmutrace is imported from: a spawned worker's PYTHONPATH."""
+    return str(Path(__file__).resolve().parent.parent)
+
+
+def _send(fd, message):
+    data = pickle.dumps(message)
+    view = memoryview(HEADER.pack(len(data)) + data)
+    while view:
+        view = view[os.write(fd, view) :]
+
+
+def _read_exactly(fd, size) -> bytes | None:
+    parts, left = [], size
+    while left:
+        part = os.read(fd, left)
+        if not part:
+            return None
+        parts.append(part)
+        left -= len(part)
+    return b"".join(parts)
+
+
+def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
+    """A worker's loop: batches in, a STARTED record and an outcome per case out, until None."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the campaign's to handle (it stops its workers)
+    _die_with_parent()
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes (or the command's output)
+    fmus: dict[str, bytes] = {}
+
+    def write(data: bytes):
+        view = memoryview(HEADER.pack(len(data)) + data)
+        while view:
+            view = view[os.write(to_parent, view) :]
+
+    while True:
+        header = _read_exactly(from_parent, HEADER.size)
+        if header is None:
+            return
+        body = _read_exactly(from_parent, HEADER.unpack(header)[0])
+        if body is None:
+            return
+        message = pickle.loads(body)
+        if message is None:
+            return
+        path, data, fmu, items = message
+        if data is not None:
+            fmus[path] = data
+        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=lambda: write(STARTED)):
+            write(pickle.dumps(outcome))
+
+
+def _die_with_parent():
+    """On Linux the kernel kills a worker when the campaign's process ends,
+    however it ends (SIGKILL included): a case that hangs in the FMU does
+    not spin on alone."""
+    if not sys.platform.startswith("linux"):
+        return
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    parent = os.environ.get(PARENT)
+    if parent is not None and str(os.getppid()) != parent:  # the parent was gone before the line above
+        os._exit(1)
+
+
+def main():
+    """A spawned worker: its settings, then batches, on standard input."""
+    os.environ.pop(PARENT, None)  # (its own children are not its parent's)
+    from_parent, to_parent = os.dup(0), os.dup(1)
+    header = _read_exactly(from_parent, HEADER.size)
+    body = header and _read_exactly(from_parent, HEADER.unpack(header)[0])
+    if not body:
+        return 1
+    _serve(from_parent, to_parent, pickle.loads(body))
+    return 0
+
+
+def _last_words(file):
+    """'; it said: <its last line>' of what a dead worker wrote to stderr."""
+    file.seek(0)
+    lines = [line.strip() for line in file.read()[-4000:].decode(errors="replace").splitlines() if line.strip()]
+    return f"; it said: {lines[-1][:200]}" if lines else ""
+
+
+class Pool:
+    """Runs a campaign's cases in workers (see the module's text).
+
+    fmus      FMU path -> (its bytes, its FmuFile)
+    jobs      workers to run (None: chosen by the work, up to cores())
+    """
+
+    def __init__(self, fmus: dict, settings: CaseSettings, jobs: int | None):
+        self.fmus, self.settings = fmus, settings
+        self.most = jobs if jobs is not None else cores()
+        self.chosen = jobs is None
+        self.started = 0  # workers started in all (a lost one's replacement included)
+        self.peak = 0  # workers at once
+        self.lost = 0  # workers that died or were stopped with a case (a crash, a timeout)
+        self.start_up: float | None = None  # seconds from the first worker's start to its first case
+        # the work's measure: seconds and count of the cases finished, each worker's first apart (it carries
+        # the worker's warm-up: the FMU's first instance, lazy imports)
+        self.measured = {True: [0.0, 0], False: [0.0, 0]}  # first? -> [seconds, cases]
+        self.queue: collections.deque = collections.deque()
+        self.workers: dict[int, _Worker] = {}  # by its pipe from the worker
+        self.selector = selectors.DefaultSelector()
+        self.finished: Callable = lambda i, outcome: None
+
+    def run(self, todo, finished):
+        """Runs todo, [(i, FMU path, (folder, name, texts or None))];
+        finished(i, outcome) as each case ends."""
+        self.queue.extend(todo)
+        self.finished = finished
+        unpack_root()  # made here: the workers unpack into it, and this process removes it however they end
+        if plotting_first(self.settings) and can_fork():
+            load_plotting()  # once, here: every worker forked has it (else each imports it as it starts)
+        try:
+            for _ in range(min(len(self.queue), 1 if self.chosen else self.most)):
+                self._give(self._start())
+            while self.workers:
+                deadlines = [(self._deadline(w), w) for w in self.workers.values()]
+                soonest = min((d for d, _ in deadlines if d is not None), default=None)
+                timeout = None if soonest is None else max(0.0, soonest - time.monotonic())
+                for key, _ in self.selector.select(timeout):
+                    worker: _Worker = key.data
+                    if self.workers.get(key.fd) is worker:  # (not one stopped meanwhile)
+                        self._read(worker)
+                now = time.monotonic()
+                for deadline, worker in deadlines:
+                    if self.workers.get(worker.from_worker) is worker and deadline is not None and now > deadline:
+                        why = self._overdue(worker.running_since is not None)
+                        self._stop(worker, kill=True)
+                        self._lost(worker, why)
+                while self.chosen and self.queue and len(self.workers) < self.most and self._pays():
+                    self._give(self._start())
+        finally:
+            for worker in list(self.workers.values()):
+                self._stop(worker, kill=True)
+            self.selector.close()
+
+    def _start(self) -> _Worker:
+        worker = _start_worker(self.settings, list(self.workers.values()))
+        self.workers[worker.from_worker] = worker
+        os.set_blocking(worker.from_worker, False)
+        self.selector.register(worker.from_worker, selectors.EVENT_READ, worker)
+        self.started += 1
+        self.peak = max(self.peak, len(self.workers))
+        return worker
+
+    def _stop(self, worker: _Worker, kill=False) -> int:
+        """Ends the worker (kill: at once, else after its last batch); its exit status."""
+        self.selector.unregister(worker.from_worker)
+        del self.workers[worker.from_worker]
+        if not kill:
+            try:
+                _send(worker.to_worker, None)
+            except OSError:
+                kill = True
+        if kill:
+            worker.kill()
+        code = worker.wait()
+        worker.last_words = _last_words(worker.said)
+        worker.close()
+        return code
+
+    def _batch_size(self) -> int:
+        """Cases for a worker's next batch: about BATCH_SECONDS of the work
+        measured so far (one case before any is measured), and no more
+        than a share of what is left, so that the workers end together."""
+        per_case = self._per_case()
+        if per_case is None:
+            return 1
+        share = -(-len(self.queue) // (2 * max(1, len(self.workers))))
+        return max(1, min(round(BATCH_SECONDS / per_case), share))
+
+    def _give(self, worker: _Worker):
+        """Its next batch of one FMU's cases, or its end when none is left."""
+        if not self.queue:
+            self._stop(worker)
+            return
+        size, path = self._batch_size(), self.queue[0][1]
+        while self.queue and len(worker.batch) < size and self.queue[0][1] == path:
+            worker.batch.append(self.queue.popleft())
+        data, file = self.fmus[path]
+        first = path not in worker.fmus
+        worker.fmus.add(path)
+        worker.sent_at, worker.running_since = time.monotonic(), None
+        try:
+            _send(worker.to_worker, (path, data if first else None, file, [item for _, _, item in worker.batch]))
+        except OSError:  # it died before it read the batch: its end shows on its pipe
+            pass
+
+    def _deadline(self, worker: _Worker) -> float | None:
+        """When the worker's case is overdue: its start plus the per-case
+        timeout, or its batch's sending plus START_SECONDS until it starts."""
+        if worker.running_since is None:
+            return worker.sent_at + START_SECONDS if worker.batch else None
+        timeout = self.settings.case_timeout
+        return None if timeout is None else worker.running_since + timeout
+
+    def _pays(self) -> bool:
+        """Another worker pays for its start-up: the work left, spread over
+        one more worker, is START_PAYS times a start-up or more."""
+        per_case = self._per_case()
+        if self.start_up is None or per_case is None:
+            return False
+        # on a first case alone (its warm-up included): only when it pays ten times over
+        margin = START_PAYS * (1 if self.measured[False][1] else 10)
+        return len(self.queue) * per_case / (len(self.workers) + 1) > margin * self.start_up
+
+    def _per_case(self) -> float | None:
+        """Seconds a case takes, measured: on the cases after each worker's
+        first where there are any, else on the first ones."""
+        for seconds, cases in (self.measured[False], self.measured[True]):
+            if cases:
+                return max(seconds / cases, 1e-6)
+        return None
+
+    def _read(self, worker: _Worker):
+        """What the worker wrote: its records handled; its end if its pipe closed."""
+        try:
+            data = os.read(worker.from_worker, 1 << 20)
+        except BlockingIOError:
+            return
+        except OSError:
+            data = b""
+        if not data:  # it died: a worker ends only when stopped, and is forgotten then
+            code = self._stop(worker, kill=True)
+            cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
+            self._lost(worker, f"the simulation's process was {cause} while running this case" + worker.last_words)
+            return
+        worker.received += data
+        while len(worker.received) >= HEADER.size:
+            size = HEADER.unpack_from(worker.received)[0]
+            if len(worker.received) < HEADER.size + size:
+                return
+            record = bytes(worker.received[HEADER.size : HEADER.size + size])
+            del worker.received[: HEADER.size + size]
+            if not record:  # STARTED
+                worker.running_since = time.monotonic()
+                if self.start_up is None:
+                    self.start_up = worker.running_since - worker.started
+                continue
+            outcome = pickle.loads(record)
+            i = worker.batch.popleft()[0]
+            worker.running_since = None
+            measure = self.measured[worker.first_case]
+            measure[0] += outcome.seconds
+            measure[1] += 1
+            worker.first_case = False
+            self.finished(i, outcome)
+            if not worker.batch:
+                self._give(worker)
+                return
+
+    def _lost(self, worker: _Worker, why: str):
+        """The worker is gone: its running case (the first of its batch)
+        fails saying why, the rest of the batch goes back to the queue,
+        and a new worker takes over if cases are left."""
+        self.lost += 1
+        i, path, (_, name, _) = worker.batch.popleft()
+        started = worker.running_since if worker.running_since is not None else worker.sent_at
+        self.queue.extendleft(reversed(worker.batch))
+        worker.batch.clear()
+        labels = self.fmus[path][1].labels
+        outcome = CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=time.monotonic() - started)
+        self.finished(i, outcome)
+        if self.queue and (len(self.workers) < self.most):
+            self._give(self._start())
+
+    def _overdue(self, running: bool) -> str:
+        if running:
+            return f"stopped after the per-case timeout of {self.settings.case_timeout:g} s"
+        return f"the simulation's process did not start the case within {START_SECONDS:g} s"
