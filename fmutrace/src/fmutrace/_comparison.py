@@ -273,6 +273,12 @@ def comparison_mode(
     return Tolerance(rel_tol, abs_tol) if (rel_tol or abs_tol) else EXACT
 
 
+def time_slack(t):
+    """How far apart two times may be and still be the same instant (the
+    rule aligned uses): communication points are sums of steps."""
+    return TIME_MATCH * np.maximum(1.0, np.abs(t))
+
+
 def aligned(result_time, reference_time):
     """For each reference time, the index of the result sample at that
     time (-1 if none); at a repeated reference time only the last row is
@@ -284,7 +290,7 @@ def aligned(result_time, reference_time):
     best = np.full(len(reference_time), -1)
     for candidate in (index - 1, index):
         candidate = np.clip(candidate, 0, len(result_time) - 1)
-        close = np.abs(result_time[candidate] - reference_time) <= TIME_MATCH * np.maximum(1.0, np.abs(reference_time))
+        close = np.abs(result_time[candidate] - reference_time) <= time_slack(reference_time)
         best = np.where((best < 0) & close, candidate, best)
     return np.where(last, best, -2)
 
@@ -339,7 +345,8 @@ def _polyline_at(times, values, at):
 def tube_bounds(reference_time, reference_values, times, widths, span=None):
     """The tube's lower and upper bound at each of times (NaN outside the
     reference's time range: there the reference says nothing); widths:
-    (time, value). span: the whole reference's (first, last) time where
+    (time, value); a reference sample at the window's edge counts (up to
+    the rounding of its time). span: the whole reference's (first, last) time where
     reference_time is a window of it that holds every sample within the
     tube's time of each of times and one more on either side (None: its
     own)."""
@@ -351,8 +358,11 @@ def tube_bounds(reference_time, reference_values, times, widths, span=None):
         if not t_first <= t <= t_last:
             continue
         start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
+        slack = time_slack(t)  # a sample exactly at the allowed time counts, however t - tube_time rounds
         inside = reference_values[
-            np.searchsorted(reference_time, start, "left") : np.searchsorted(reference_time, end, "right")
+            np.searchsorted(reference_time, start - slack, "left") : np.searchsorted(
+                reference_time, end + slack, "right"
+            )
         ]
         edges = [
             _polyline_at(reference_time, reference_values, start),

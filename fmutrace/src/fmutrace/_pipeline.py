@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ._cases import load_case, read_options, read_start_values
-from ._comparison import Band, Mode, Pointwise, Tube, Verdict, aligned
+from ._comparison import Band, Mode, Pointwise, Tube, Verdict, aligned, time_slack
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
@@ -355,7 +355,7 @@ class _Comparer:
         reference = self.reference
         last = float(reference["time"][-1])
         # the samples whose window ends before the last row (or all of them once the reference is whole)
-        covered = np.inf if rows is None else last - mode.time
+        covered = np.inf if rows is None else last - mode.time - 2 * float(time_slack(last))
         while True:
             if self.compared >= self.reached:
                 before = self.reached
@@ -378,7 +378,8 @@ class _Comparer:
             if take < len(result):
                 break
         # the rows the next sample's window needs: from the one before its time - the tube's time on
-        keep = int(np.searchsorted(reference["time"], float(result["time"][take]) - mode.time, side="left")) - 1
+        at = float(result["time"][take])
+        keep = int(np.searchsorted(reference["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
         self.reference = reference[max(keep, 0) :]
 
     def _add(self, bands):
