@@ -112,3 +112,209 @@ def test_ramp_active_one_cycle_late_passes_a_one_cycle_tube_of_value_0(tmp_path,
     changed(folder, reference, rampActive=late(reference["rampActive"], 2))
     outcome = run_folder_case(CaseFiles(folder, folder.name), target, settings, Streaming(*chunks))
     assert outcome.status == "fail" and outcome.messages[0].startswith("rampActive leaves the band"), outcome.messages
+
+
+# ---- 2. discrete signals: exact in value, changes within k cycles --------------
+
+GRID = np.arange(20) * 0.1  # a result on its communication points
+
+
+def discrete(reference_values, result_values, cycles):
+    reference, result = trace(GRID, b=reference_values), trace(GRID, b=result_values)
+    return compare_traces(result, reference, fmutrace.Discrete(cycles))
+
+
+def step_at(k, low=0, high=1):
+    return np.where(np.arange(20) >= k, high, low)
+
+
+def test_a_boolean_late_by_two_cycles_fails_with_one_and_passes_with_two():
+    for cycles, passes in [(0, False), (1, False), (2, True), (3, True)]:
+        assert discrete(step_at(5), step_at(7), cycles).passed is passes, cycles
+        assert discrete(step_at(7), step_at(5), cycles).passed is passes, cycles  # two early
+    message = discrete(step_at(5), step_at(7), 1).messages()[0]
+    assert "comes 2 cycles late" in message and "more than the 1 allowed" in message, message
+
+
+def test_a_status_word_flipped_for_one_cycle_fails_whatever_the_time_allowance():
+    status = np.full(20, 0x8200)
+    flipped = status.copy()
+    flipped[9] = 0x8201
+    for cycles in (0, 1, 5):
+        comparison = discrete(status, flipped, cycles)
+        assert not comparison.passed and "a change the reference lacks" in comparison.messages()[0], cycles
+    # the reference's one-cycle flip missing from the result fails too
+    assert not discrete(flipped, status, 3).passed
+
+
+def test_a_change_to_another_value_fails_where_a_tube_would_interpolate():
+    """16#8200 -> 16#8201 is not 16#8200 -> 16#8202, however close the numbers."""
+    comparison = discrete(step_at(5, 0x8200, 0x8201), step_at(5, 0x8200, 0x8202), 2)
+    assert (
+        not comparison.passed
+        and "changes to 33282 at t=0.5 where the reference's next change is to 33281" in comparison.messages()[0]
+    )
+
+
+def test_the_time_allowance_used_is_stated():
+    comparison = discrete(step_at(5), step_at(6), 2)
+    assert comparison.passed
+    assert comparison.deviations[0].allowance == "time allowance used: 1 of 2 cycles at t=0.6000000000000001"
+
+
+def test_a_sparser_reference_holds_the_result_at_its_times():
+    """A reference every 0.3 s: its change from 0 (t=0.3) to 1 (t=0.6) can
+    be at any cycle of (0.3, 0.6] without using the allowance."""
+    times = GRID[::3]
+    reference = trace(times, b=(times >= 0.55).astype(float))
+    for k in (4, 5, 6):
+        assert compare_traces(trace(GRID, b=step_at(k)), reference, fmutrace.Discrete(0)).passed, k
+    assert not compare_traces(trace(GRID, b=step_at(7)), reference, fmutrace.Discrete(0)).passed
+    assert compare_traces(trace(GRID, b=step_at(7)), reference, fmutrace.Discrete(1)).passed
+
+
+# ---- 4. units in the last place ----------------------------------------------
+
+
+def ulps(reference_values, result_values, n, arithmetic):
+    reference = trace(np.arange(len(reference_values)), x=reference_values)
+    result = trace(np.arange(len(result_values)), x=result_values)
+    return compare_traces(result, reference, fmutrace.Ulps(n, arithmetic))
+
+
+F32 = np.float32
+
+
+def up(x, k=1, t=F32):
+    x = t(x)
+    for _ in range(k):
+        x = np.nextafter(x, t(np.inf))
+    return float(x)
+
+
+@pytest.mark.parametrize(
+    "reference,result,distance",
+    [
+        (1.0, up(1.0), 1),
+        (2.0**20, up(2.0**20, 3), 3),  # binary32's ulp there is 2^-3, binary64's 2^-32
+        (0.0, up(0.0), 1),  # the smallest subnormal
+        (-float(up(0.0)), up(0.0), 2),  # across zero: -s, (-0 = +0), +s
+        (-0.0, 0.0, 0),
+        (float(np.finfo(F32).tiny), up(np.finfo(F32).tiny, 2), 2),  # normal from the smallest normal
+        (float(up(0.0, 5)), up(0.0, 7), 2),  # subnormals
+        (-1.5, float(-np.nextafter(F32(1.5), F32(2))), 1),
+    ],
+)
+def test_binary32_ulps_count_binary32_numbers(reference, result, distance):
+    assert ulps([reference], [result], distance, "binary32").passed
+    if distance:
+        assert not ulps([reference], [result], distance - 1, "binary32").passed
+
+
+def test_binary32_rounds_both_first_and_binary64_counts_doubles():
+    """0.1 printed by a recorder and the REAL 0.1 (0.100000001490116...) are
+    the same binary32 number, 2^29 - ... binary64 numbers apart."""
+    real = float(F32(0.1))
+    assert ulps([0.1], [real], 0, "binary32").passed
+    assert not ulps([0.1], [real], 1000, "binary64").passed
+    assert ulps([1.0], [up(1.0, 2, np.float64)], 2, "binary64").passed
+    assert not ulps([1.0], [up(1.0, 2, np.float64)], 1, "binary64").passed
+
+
+def test_ulps_nan_and_infinities():
+    nan, inf = float("nan"), float("inf")
+    assert ulps([nan, inf, -inf], [nan, inf, -inf], 0, "binary32").passed
+    assert not ulps([nan], [1.0], 4, "binary32").passed
+    assert not ulps([float(np.finfo(F32).max)], [inf], 4, "binary32").passed
+    assert not ulps([inf], [-inf], 4, "binary64").passed
+    # the largest binary64 numbers apart across zero: no overflow
+    assert not ulps([-float(np.finfo(np.float64).max)], [float(np.finfo(np.float64).max)], 4, "binary64").passed
+
+
+# ---- 3. per-signal criteria --------------------------------------------------
+
+
+def run_case(folder, mode, chunks=(False, 1, 8)):
+    return run_folder_case(CaseFiles(folder, folder.name), fmu_target(), CaseSettings(mode, "none"), Streaming(*chunks))
+
+
+Y_STATUS_RAMP = {"y": fmutrace.Tolerance(abs_tol=1e-6), "status": fmutrace.Exact(), "rampActive": fmutrace.Discrete(1)}
+
+
+@pytest.mark.parametrize("chunks", [(False, 1, 8), (False, 100_000, 1 << 22)], ids=["chunks", "one chunk"])
+def test_y_within_1e_6_status_exact_ramp_active_up_to_one_cycle_late(tmp_path, chunks):
+    folder, reference = own_output_case(tmp_path)
+    y, ramp = reference["y"].copy(), reference["rampActive"].copy()
+    criteria = fmutrace.Criteria(Y_STATUS_RAMP)
+    changed(folder, reference, y=y + 0.5e-6, rampActive=late(ramp, 1))
+    outcome = run_case(folder, criteria, chunks)
+    assert outcome.status == "pass", outcome.messages
+    changed(folder, reference, rampActive=late(ramp, 2))
+    outcome = run_case(folder, criteria, chunks)
+    assert outcome.status == "fail" and len(outcome.deviations) == 1
+    assert outcome.messages[0].startswith("rampActive (exact, up to 1 cycle early or late): the reference's change")
+    assert "comes 2 cycles early" in outcome.messages[0]  # (the reference is the late one)
+    changed(folder, reference, y=y + 2e-6, rampActive=ramp)
+    outcome = run_case(folder, criteria, chunks)
+    assert outcome.status == "fail" and len(outcome.deviations) == 1
+    assert outcome.messages[0].startswith("y (relative tolerance 0, absolute tolerance 1e-06) leaves the band")
+
+
+def test_a_pattern_and_a_default_and_the_first_match_wins():
+    criteria = fmutrace.Criteria({"ramp*": fmutrace.Discrete(2), "r*": fmutrace.Exact(), "*": Tube(0.1, 0.0)})
+    assert criteria.given("rampActive") == fmutrace.Discrete(2)
+    assert criteria.given("runningTime") == fmutrace.Exact()
+    assert criteria.given("y") == Tube(0.1, 0.0)
+    # a discrete signal under a tube: exact in value, the tube's time in whole cycles
+    discrete = fmutrace.Criteria({"*": Tube(0.25, 1.0)}, discrete=frozenset({"status"}))
+    assert discrete.mode_of("status", 0.1) == fmutrace.Discrete(2) and discrete.mode_of("y", 0.1) == Tube(0.25, 1.0)
+    assert discrete.mode_of("status", 0.125) == fmutrace.Discrete(2)
+
+
+def test_a_status_word_is_recognised_from_the_fmu_and_never_interpolated(tmp_path):
+    """The issue: under a one-cycle tube a status word flipped to 16#8200
+    for one cycle passed. Per-signal criteria know status is an Integer."""
+    folder, reference = own_output_case(tmp_path)
+    status = reference["status"].copy()
+    status[40] = 0x8200
+    changed(folder, reference, status=status)
+    assert run_case(folder, Tube(0.1, 0.0)).status == "pass"  # the old judgement, unchanged
+    outcome = run_case(folder, fmutrace.Criteria({"*": Tube(0.1, 0.0)}))
+    assert outcome.status == "fail", outcome.messages
+    assert outcome.messages[0] == (
+        "status (exact, up to 1 cycle early or late): "
+        "the reference's change to 33280 at t=4.0 is missing from the result"
+    )
+
+
+def test_a_time_tolerance_hiding_a_value_error_shows_its_use(tmp_path):
+    """A +10 glitch of y at one sample passes a one-cycle tube (its neighbours
+    are in the window); the verdict says the sample needed nearly the whole
+    time: y rises 0.2 a cycle there, so the reference's polyline from the
+    sample before (y - 0.2) to the glitch (y + 10.2) passes y at 10/10.2 of
+    the cycle before."""
+    folder, reference = own_output_case(tmp_path)
+    y = reference["y"].copy()
+    y[20] += 10
+    changed(folder, reference, y=y)
+    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0)}))
+    assert outcome.status == "pass"
+    assert f"time allowance used: {0.1 * 10 / 10.2:.6g} of 0.1 s (98%) at t=2.0" in outcome.messages[0]
+    assert outcome.messages[0].startswith("y (tube of 0.1 s and 0): ")
+
+
+def test_a_case_folder_carries_its_criteria(tmp_path):
+    folder, reference = own_output_case(tmp_path)
+    changed(folder, reference, y=reference["y"] + 0.5e-6, rampActive=late(reference["rampActive"], 1))
+    assert run_case(folder, fmutrace.Exact()).status == "fail"
+    (folder / "RateLimiter_criteria.csv").write_text(
+        "# signal,mode\ny,tol:abs=1e-6,rel=0\nramp*,discrete:cycles=1\n*,exact\n"
+    )
+    outcome = run_case(folder, fmutrace.Exact())
+    assert outcome.status == "pass", outcome.messages
+    # the case's criteria before the campaign's: the command's y=exact does not override the file's
+    assert run_case(folder, fmutrace.Criteria({"y": fmutrace.Exact()})).status == "pass"
+    for text, where in [("nosuch,exact\n", "line 1, column 1"), ("y,tube:time=1\n", "line 1, column 2")]:
+        (folder / "RateLimiter_criteria.csv").write_text(text)
+        outcome = run_case(folder, fmutrace.Exact())
+        assert outcome.status == "invalid" and where in outcome.messages[0], outcome.messages
