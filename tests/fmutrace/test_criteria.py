@@ -5,10 +5,14 @@ last place. Expected verdicts are worked by hand from the criteria's
 definitions (docs/fmutrace.md, Comparison), never taken from fmutrace's
 output."""
 
+import contextlib
+import io
+
 import numpy as np
 import pytest
 
 import fmutrace
+from fmutrace import cli
 from fmutrace import Tube, write_trace
 from fmutrace._comparison import compare_traces
 from fmutrace._pipeline import CaseFiles, Streaming, run_folder_case
@@ -318,3 +322,56 @@ def test_a_case_folder_carries_its_criteria(tmp_path):
         (folder / "RateLimiter_criteria.csv").write_text(text)
         outcome = run_case(folder, fmutrace.Exact())
         assert outcome.status == "invalid" and where in outcome.messages[0], outcome.messages
+
+
+def command(*args):
+    out = io.StringIO()
+    with contextlib.redirect_stderr(io.StringIO()) as err:
+        status = cli.main(["compare", str(fmu_path(BUILD_DIR, "RateLimiter", 3)), *map(str, args)], out=out)
+    return status, out.getvalue(), err.getvalue()
+
+
+def test_the_command_states_each_signals_criterion(tmp_path):
+    folder, reference = own_output_case(tmp_path)
+    changed(folder, reference, y=reference["y"] + 0.5e-6, rampActive=late(reference["rampActive"], 1))
+    assert command(tmp_path)[0] == 1
+    status, out, _ = command(tmp_path, "--signal", "y=tol:abs=1e-6,rel=0", "--signal", "ramp*=discrete:cycles=1")
+    assert status == 0, out
+    status, out, _ = command(tmp_path, "--signal", "y=tol:abs=1e-7", "--signal", "*=discrete:cycles=1")
+    assert status == 1 and "y (relative tolerance 0, absolute tolerance 1e-07) leaves the band" in out, out
+    # the rest by the other flags: a one-cycle tube, rampActive judged exactly, one cycle late allowed
+    status, out, _ = command(tmp_path, "--signal", "y=tol:abs=1e-6", "--tube-time", 0.1, "--tube-value", 0)
+    assert status == 0, out
+
+
+@pytest.mark.parametrize(
+    "mode,message",
+    [
+        ("tol:abs", "--signal y=tol:abs: mode 'tol:abs': expected tol:abs=...,rel=..."),
+        ("tube:time=1", "a tube needs both time= and value="),
+        ("ulps:1,binary16", "Ulps.arithmetic must be one of binary32, binary64"),
+        ("discrete:cycles=-1", "Discrete.cycles must be a whole number >= 0"),
+        ("discrete:cycles=0.5", "cycles '0.5' is not a number"),
+        ("tol:abs=-1", "Tolerance(abs_tol=...) must be a finite number >= 0, not -1.0"),
+        ("fuzzy", "mode 'fuzzy' is none of: exact, tol:abs=A,rel=R"),
+    ],
+)
+def test_a_bad_mode_is_refused_with_its_flag(tmp_path, mode, message):
+    own_output_case(tmp_path)
+    status, _, err = command(tmp_path, "--signal", f"y={mode}")
+    assert status == 2 and message in err and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize(
+    "mode",
+    [
+        fmutrace.Exact(),
+        fmutrace.Tolerance(1e-3, 1e-9),
+        Tube(0.01, 0.0),
+        fmutrace.Discrete(3),
+        fmutrace.Ulps(4, "binary32"),
+        fmutrace.Ulps(0, "binary64"),
+    ],
+)
+def test_a_mode_reads_back_from_its_words(mode):
+    assert fmutrace.parse_mode(mode.spec()) == mode

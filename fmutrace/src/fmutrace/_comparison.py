@@ -396,7 +396,8 @@ class Discrete(Mode):
             deviation.time, deviation.value = float(rt[cycle[bad]]), float(x[cycle[bad]])
             deviation.lower = deviation.upper = float(expected[bad])
         elif k and shift_at is not None:
-            deviation.allowance = f"time allowance used: {shift_most} of {k} cycles at t={shift_at!r}"
+            where = f" at t={shift_at!r}" if shift_most else ""
+            deviation.allowance = f"time allowance used: {shift_most} of {k} cycles{where}"
         return deviation, ok
 
 
@@ -551,8 +552,9 @@ class Criteria(Mode):
             if isinstance(mode, Tube) and mode.time > 0:
                 used, at = mode.time_used(result, reference, name)
                 if at is not None:
+                    where = f" at t={at!r}" if used else ""
                     deviation.allowance = (
-                        f"time allowance used: {used:.6g} of {mode.time:g} s ({used / mode.time:.0%}) at t={at!r}"
+                        f"time allowance used: {used:.6g} of {mode.time:g} s ({used / mode.time:.0%}){where}"
                     )
             deviations[name], bands[name] = deviation, banded[name]
         return deviations, bands, "; ".join(problems)
@@ -570,6 +572,24 @@ def criteria_for(mode: Mode, pairs=(), discrete=frozenset()) -> Mode:
         default = named.get("*", mode.default)
         return Criteria(given.signals + mode.signals, default, frozenset(discrete))
     return Criteria(given.signals, dict(pairs).get("*", mode), frozenset(discrete))
+
+
+def signal_criteria(assignments, default: Mode, names: Names = ()) -> Mode:
+    """The mode of the command's --signal NAME=MODE assignments (pairs of
+    texts; '*' the default) over default (the other options' mode); default
+    itself without any. InputError for a mode that is not one, naming the
+    setting in names (the caller's words)."""
+    if not assignments:
+        return default
+    pairs = []
+    for pattern, words in assignments:
+        try:
+            pairs.append((pattern, parse_mode(words)))
+        except InputError as error:
+            raise InputError(f"{name_of(names, signals=(pattern, words))}: {error}") from None
+    if any(p == "*" for p, _ in pairs) and default != EXACT:
+        raise InputError(f"give the rest's mode once: {name_of(names, signals=('*', '...'))} or a tolerance or tube")
+    return Criteria(tuple(pairs), default)
 
 
 MODE_WORDS = "exact, tol:abs=A,rel=R, tube:time=S,value=V, discrete[:cycles=K], ulps:N[,binary32|binary64]"
