@@ -375,3 +375,8 @@ def test_a_bad_mode_is_refused_with_its_flag(tmp_path, mode, message):
 )
 def test_a_mode_reads_back_from_its_words(mode):
     assert fmutrace.parse_mode(mode.spec()) == mode
+
+
+def test_ulps_beyond_binary32s_range_is_its_infinity():
+    assert ulps([1e300], [float("inf")], 0, "binary32").passed
+    assert not ulps([1e300], [float("inf")], 4, "binary64").passed

@@ -458,18 +458,20 @@ class Ulps(Pointwise):
 
     def bounds(self, values, expected):
         nan_a, nan_b = np.isnan(values), np.isnan(expected)
-        infinite = np.isinf(values) | np.isinf(expected)
+        with np.errstate(over="ignore"):  # (beyond the arithmetic's range: its infinity)
+            rounded_a, rounded_b = (v.astype(ARITHMETICS[self.arithmetic][0]) for v in (values, expected))
+        infinite_b = np.isinf(rounded_b)
         with np.errstate(invalid="ignore"):
             ok = np.where(
-                nan_a | nan_b | infinite,
-                (nan_a & nan_b) | (values == expected),
+                nan_a | nan_b | np.isinf(rounded_a) | infinite_b,
+                (nan_a & nan_b) | (rounded_a == rounded_b),
                 self.distance(values, expected) <= self.n,
             )
-        base = _ordinal(np.where(nan_b | np.isinf(expected), 0.0, expected), self.arithmetic)
+        base = _ordinal(np.where(nan_b | infinite_b, 0.0, expected), self.arithmetic)
         finite_max = _ordinal(np.array([FINITE_MAX[self.arithmetic]]), self.arithmetic)[0]
         lower = _from_ordinal(np.maximum(base - self.n, -finite_max), self.arithmetic)
         upper = _from_ordinal(np.minimum(base + self.n, finite_max), self.arithmetic)
-        special = nan_b | np.isinf(expected)
+        special = nan_b | infinite_b
         return np.where(special, expected, lower), np.where(special, expected, upper), ok
 
 
