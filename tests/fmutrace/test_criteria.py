@@ -380,3 +380,19 @@ def test_a_mode_reads_back_from_its_words(mode):
 def test_ulps_beyond_binary32s_range_is_its_infinity():
     assert ulps([1e300], [float("inf")], 0, "binary32").passed
     assert not ulps([1e300], [float("inf")], 4, "binary64").passed
+
+
+def test_per_signal_criteria_draw_their_plot_and_report(tmp_path):
+    folder, reference = own_output_case(tmp_path)
+    changed(folder, reference, rampActive=late(reference["rampActive"], 2))
+    criteria = fmutrace.Criteria({"y": Tube(0.1, 0.0), "rampActive": fmutrace.Discrete(1)})
+    outcome = run_folder_case(CaseFiles(folder, folder.name), fmu_target(), CaseSettings(criteria, "all"))
+    assert outcome.status == "fail" and outcome.png.startswith(b"\x89PNG")
+    campaign = fmutrace.compare(fmu_path(BUILD_DIR, "RateLimiter", 3), tmp_path, mode=criteria, report=tmp_path / "r")
+    assert campaign.exit_code == 1
+    summary = (tmp_path / "r" / "summary.md").read_text()
+    assert (
+        "per signal: y: tube of 0.1 s and 0; rampActive: exact, up to 1 cycle early or late; the rest: exact" in summary
+    )
+    assert r"rampActive \(exact, up to 1 cycle early or late\): the reference's change" in summary  # (Markdown)
+    assert r"y \(tube of 0.1 s and 0\): 81 samples within the band; time allowance used: 0 of 0.1 s \(0%\) |" in summary

@@ -255,6 +255,7 @@ class Tube(Mode):
             if not times[0] <= t <= times[-1]:
                 continue
             need = _distance_to_polyline(times, values, float(t), float(v), self.value, self.time + time_slack(t))
+            need = 0.0 if need <= time_slack(t) else need  # (the same instant, up to the times' rounding)
             if need <= self.time + time_slack(t) and (at is None or need > most):
                 most, at = min(need, self.time), float(t)
         return most, at
