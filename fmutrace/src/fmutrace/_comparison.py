@@ -402,7 +402,10 @@ class Discrete(Mode):
         return deviation, ok
 
 
-ARITHMETICS = {"binary32": (np.float32, np.int32, 0x7FFFFFFF), "binary64": (np.float64, np.int64, 0x7FFFFFFFFFFFFFFF)}
+ARITHMETIC_TYPES = {
+    "binary32": (np.float32, np.int32, 0x7FFFFFFF),
+    "binary64": (np.float64, np.int64, 0x7FFFFFFFFFFFFFFF),
+}
 
 
 FINITE_MAX = {"binary32": float(np.finfo(np.float32).max), "binary64": float(np.finfo(np.float64).max)}
@@ -411,14 +414,14 @@ FINITE_MAX = {"binary32": float(np.finfo(np.float32).max), "binary64": float(np.
 def _ordinal(values, arithmetic):
     """Each value rounded to the arithmetic, as its place on the line of
     that arithmetic's numbers (adjacent numbers 1 apart, +0 and -0 both 0)."""
-    float_type, int_type, magnitude = ARITHMETICS[arithmetic]
+    float_type, int_type, magnitude = ARITHMETIC_TYPES[arithmetic]
     with np.errstate(over="ignore"):
         bits = values.astype(float_type).view(int_type).astype(np.int64)
     return np.where(bits < 0, -(bits & magnitude), bits)
 
 
 def _from_ordinal(ordinal, arithmetic):
-    float_type, int_type, magnitude = ARITHMETICS[arithmetic]
+    float_type, int_type, magnitude = ARITHMETIC_TYPES[arithmetic]
     sign = np.int64(magnitude) + 1 if arithmetic == "binary32" else np.iinfo(np.int64).min
     bits = np.where(ordinal < 0, (-ordinal) | sign, ordinal)
     return bits.astype(int_type).view(float_type).astype(np.float64)
@@ -439,8 +442,8 @@ class Ulps(Pointwise):
     def __post_init__(self):
         if not (isinstance(self.n, int) and self.n >= 0):
             raise InputError(f"Ulps.n must be a whole number >= 0, not {self.n!r}")
-        if self.arithmetic not in ARITHMETICS:
-            raise InputError(f"Ulps.arithmetic must be one of {', '.join(ARITHMETICS)}, not {self.arithmetic!r}")
+        if self.arithmetic not in ARITHMETIC_TYPES:
+            raise InputError(f"Ulps.arithmetic must be one of {', '.join(ARITHMETIC_TYPES)}, not {self.arithmetic!r}")
 
     def describe(self):
         return f"within {self.n} ulp{'s' if self.n != 1 else ''} of {self.arithmetic}"
@@ -460,7 +463,7 @@ class Ulps(Pointwise):
     def bounds(self, values, expected):
         nan_a, nan_b = np.isnan(values), np.isnan(expected)
         with np.errstate(over="ignore"):  # (beyond the arithmetic's range: its infinity)
-            rounded_a, rounded_b = (v.astype(ARITHMETICS[self.arithmetic][0]) for v in (values, expected))
+            rounded_a, rounded_b = (v.astype(ARITHMETIC_TYPES[self.arithmetic][0]) for v in (values, expected))
         infinite_b = np.isinf(rounded_b)
         with np.errstate(invalid="ignore"):
             ok = np.where(
