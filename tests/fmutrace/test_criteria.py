@@ -396,3 +396,17 @@ def test_per_signal_criteria_draw_their_plot_and_report(tmp_path):
     )
     assert r"rampActive \(exact, up to 1 cycle early or late\): the reference's change" in summary  # (Markdown)
     assert r"y \(tube of 0.1 s and 0\): 81 samples within the band; time allowance used: 0 of 0.1 s \(0%\) |" in summary
+
+
+def test_one_discrete_or_ulps_mode_for_every_signal(tmp_path):
+    folder, reference = own_output_case(tmp_path / "late")
+    ramp, y = reference["rampActive"].copy(), reference["y"].copy()
+    changed(folder, reference, rampActive=late(ramp, 1))
+    fmu = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    assert fmutrace.compare(fmu, tmp_path / "late", mode=fmutrace.Discrete(1)).passed
+    assert not fmutrace.compare(fmu, tmp_path / "late", mode=fmutrace.Discrete(0)).passed
+    moved = int(np.flatnonzero(y != 0)[0])
+    y[moved] = float(np.nextafter(np.float32(y[moved]), np.float32(np.inf)))  # one binary32 ulp up
+    changed(folder, reference, y=y, rampActive=ramp)
+    assert fmutrace.compare(fmu, tmp_path / "late", mode=fmutrace.Ulps(1, "binary32")).passed
+    assert not fmutrace.compare(fmu, tmp_path / "late", mode=fmutrace.Ulps(0, "binary32")).passed

@@ -569,8 +569,9 @@ class Criteria(Mode):
 def criteria_for(mode: Mode, pairs=(), discrete=frozenset()) -> Mode:
     """The mode a case is judged by: mode with a case's own criteria
     (pairs: (pattern, Mode), "*" the default) before the campaign's, the
-    FMU's discrete signals named; mode itself when neither is per-signal."""
-    if not pairs and not isinstance(mode, Criteria):
+    FMU's discrete signals named; mode itself when neither is per-signal
+    (a Discrete mode for every signal is a Criteria of that default)."""
+    if not pairs and not isinstance(mode, (Criteria, Discrete)):  # (Discrete judges the whole trace, as Criteria)
         return mode
     given = Criteria(pairs)
     if isinstance(mode, Criteria):
