@@ -29,7 +29,9 @@ Real). A label follows from the fault and the criterion's definition
 - no fault: passes every criterion above.
 
 Each fault but the last three is also put the other way round (in the
-reference, the result clean): a label holds both ways.
+reference, the result clean): a label holds both ways. Beside them, the
+known hard cases of funnel's and csv-compare's issue trackers, rebuilt
+from their descriptions (hard_cases).
 """
 
 import dataclasses
@@ -190,6 +192,47 @@ def scenario_pairs(folder):
         yield pair("signal missing", None, "exact", None, "fail")
 
 
+def grid(first, last, step):
+    return np.round(np.arange(round((last - first) / step) + 1) * step + first, 12)
+
+
+def hard_cases():
+    """The known hard cases of funnel's and csv-compare's issue trackers,
+    rebuilt from their descriptions (one signal x each), labelled from
+    what their reporters expected."""
+    t = grid(0.0, 1.0, 0.1)
+    short = grid(0.0, 0.4, 0.1)
+    longer = np.where(t <= 0.4, t, 100.0)
+    events = np.array([0.0, 0.1, 0.2, 0.2, 0.3, 0.4, 0.4, 0.5])
+    steps = np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0])
+    constant = np.full(len(t), 293586.68524)
+    cases = [
+        # lbl-srg/funnel#54: a value tolerance of 0 (below 1e-10) was taken as a wider one
+        ("funnel#54 a zero value tolerance", t, np.zeros(len(t)), t, np.full(len(t), 1e-11), "tol:abs=0",
+         {"atolx": 0.0, "atoly": 0.0}, "fail"),
+        # modelica-tools/csv-compare#77: a reference shorter than the run says nothing after its end
+        ("csv-compare#77 a reference shorter than the result", short, short, t, longer, "tube:time=0.01,value=0.001",
+         {"atolx": 0.01, "atoly": 0.001}, "pass"),
+        # modelica-tools/csv-compare#74: a constant reference's relative tube too tight
+        ("csv-compare#74 a constant reference, relative tolerance", t, constant, t, constant * (1 + 1e-6),
+         "tol:abs=0,rel=0.001", {"atolx": 0.0, "atoly": 0.0, "ltoly": 1e-3}, "pass"),
+        # modelica-tools/csv-compare#20: a trace with events compared with itself reported errors
+        ("csv-compare#20 a trace with events against itself", events, steps, events, steps,
+         "tube:time=0.01,value=0.001", {"atolx": 0.01, "atoly": 0.001}, "pass"),
+    ]  # fmt: skip
+    for fault, ref_t, ref_v, res_t, res_v, criterion, funnel, label in cases:
+        yield Pair(
+            f"hard/{fault.split()[0]}/x/{fault}/{criterion}",
+            one_signal(ref_t, ref_v, "x"),
+            one_signal(res_t, res_v, "x"),
+            "x",
+            criterion,
+            funnel,
+            label,
+            False,
+        )
+
+
 ONE_WAY = ("none", "signal missing", "event half a cycle late")  # (the fault is where it is said to be)
 
 
@@ -205,4 +248,4 @@ def corpus():
                 model, scenario, signal, fault, criterion = pair.name.split("/", 4)
                 name = f"{model}/{scenario}/{signal}/{fault} (in the reference)/{criterion}"
                 pairs.append(dataclasses.replace(pair, name=name, reference=pair.result, result=pair.reference))
-    return pairs
+    return pairs + list(hard_cases())
