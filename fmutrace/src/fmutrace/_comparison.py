@@ -284,6 +284,10 @@ def _shown(value):
     return repr(int(number)) if number.is_integer() and abs(number) < 2**53 else repr(number)
 
 
+def _cycles(n):
+    return f"{n} cycle{'' if n == 1 else 's'}"
+
+
 def _same(a, b):
     """Equal values, NaN equal to NaN."""
     return (a == b) | (np.isnan(a) & np.isnan(b))
@@ -311,7 +315,7 @@ class Discrete(Mode):
     def describe(self):
         if not self.cycles:
             return "exact"
-        return f"exact, up to {self.cycles} cycle{'s' if self.cycles > 1 else ''} early or late"
+        return f"exact, up to {_cycles(self.cycles)} early or late"
 
     def spec(self):
         return f"discrete:cycles={self.cycles}"
@@ -384,7 +388,7 @@ class Discrete(Mode):
                 when = "late" if j > latest else "early"
                 problem = (
                     f"the reference's change to {_shown(expected[row])} at t={float(rt[latest])!r} comes "
-                    f"{shift} cycles {when} (t={float(rt[j])!r}), more than the {k} allowed"
+                    f"{_cycles(shift)} {when} (t={float(rt[j])!r}), more than the {k} allowed"
                 )
             if problem:
                 ok[row] = False
@@ -398,7 +402,7 @@ class Discrete(Mode):
             deviation.lower = deviation.upper = float(expected[bad])
         elif k and shift_at is not None:
             where = f" at t={shift_at!r}" if shift_most else ""
-            deviation.allowance = f"time allowance used: {shift_most} of {k} cycles{where}"
+            deviation.allowance = f"time allowance used: {shift_most} of {_cycles(k)}{where}"
         return deviation, ok
 
 
