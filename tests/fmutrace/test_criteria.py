@@ -421,3 +421,20 @@ def test_one_discrete_or_ulps_mode_for_every_signal(tmp_path):
     changed(folder, reference, y=y, rampActive=ramp)
     assert fmutrace.compare(fmu, tmp_path / "late", mode=fmutrace.Ulps(1, "binary32")).passed
     assert not fmutrace.compare(fmu, tmp_path / "late", mode=fmutrace.Ulps(0, "binary32")).passed
+
+
+def test_a_sparser_reference_sees_the_results_changes_at_its_samples_only():
+    """A reference every third cycle: a ramp that moves every cycle agrees
+    at each of its samples; a flip and back between two samples is not
+    seen; a change one cycle late across a sample is one cycle late."""
+    ramp = np.arange(20.0)
+    reference = trace(GRID[::3], b=ramp[::3])
+    assert compare_traces(trace(GRID, b=ramp), reference, fmutrace.Discrete(0)).passed
+    flat = np.zeros(20)
+    blip = flat.copy()
+    blip[4] = 1  # between the samples at cycles 3 and 6
+    assert compare_traces(trace(GRID, b=blip), trace(GRID[::3], b=flat[::3]), fmutrace.Discrete(0)).passed
+    sparse_step = trace(GRID[::3], b=step_at(6)[::3])  # changes in (3, 6]
+    assert compare_traces(trace(GRID, b=step_at(7)), sparse_step, fmutrace.Discrete(1)).passed
+    assert not compare_traces(trace(GRID, b=step_at(7)), sparse_step, fmutrace.Discrete(0)).passed
+    assert not compare_traces(trace(GRID, b=step_at(8)), sparse_step, fmutrace.Discrete(1)).passed

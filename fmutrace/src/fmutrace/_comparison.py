@@ -284,6 +284,11 @@ def _shown(value):
     return repr(int(number)) if number.is_integer() and abs(number) < 2**53 else repr(number)
 
 
+def _changed(values):
+    """The indexes where values change (NaN equal to NaN)."""
+    return np.flatnonzero(~_same(values[1:], values[:-1])) + 1
+
+
 def _cycles(n):
     return f"{n} cycle{'' if n == 1 else 's'}"
 
@@ -299,7 +304,9 @@ class Discrete(Mode):
     found in the result within cycles result samples (communication
     points: PLC cycles) early or late, and no change of the result that the
     reference lacks. A reference sample holds the result's value of the
-    last communication point at or before its time (sample and hold)."""
+    last communication point at or before its time (sample and hold); a
+    reference sparser than the result sees the result's changes at its own
+    samples only."""
 
     cycles: int = 0
 
@@ -344,6 +351,11 @@ class Discrete(Mode):
                 bands[name] = Band(times, values, expected, expected, ok, values - expected)
         return deviations, bands, ""
 
+    @staticmethod
+    def _last_change(x, after, until):
+        """The last result sample in (after, until] where x changes."""
+        return after + int(_changed(x[after : until + 1])[-1])
+
     def _changes(self, name, rt, x, cycle, expected):
         """(Deviation, ok per reference sample) of result x against the
         expected values at the result samples cycle."""
@@ -352,10 +364,11 @@ class Discrete(Mode):
         if not len(cycle):
             return deviation, ok
         k = self.cycles
-        ref_at = np.flatnonzero(~_same(expected[1:], expected[:-1])) + 1  # reference rows that change
-        first, last = int(cycle[0]), int(cycle[-1])
-        seg = x[first : last + 1]
-        res_at = np.flatnonzero(~_same(seg[1:], seg[:-1])) + 1 + first  # result samples that change
+        ref_at = _changed(expected)  # reference rows that change
+        # the result's changes that its samples at the reference's rows show (between two rows the reference
+        # says nothing), each at the last cycle it changed in that interval
+        first = int(cycle[0])
+        res_at = [self._last_change(x, int(cycle[s - 1]), int(cycle[s])) for s in _changed(x[cycle])]
         problem, shift_most, shift_at = "", 0, None
         if not _same(x[first], expected[0]):
             problem = f"starts at {_shown(x[first])}, expected {_shown(expected[0])} at t={float(rt[first])!r}"
