@@ -360,10 +360,13 @@ def test_the_command_states_each_signals_criterion(tmp_path):
     [
         ("tol:abs", "--signal y=tol:abs: mode 'tol:abs': expected tol:abs=...,rel=..."),
         ("tube:time=1", "a tube needs both time= and value="),
-        ("ulps:1,binary16", "Ulps.arithmetic must be one of binary32, binary64"),
-        ("discrete:cycles=-1", "Discrete.cycles must be a whole number >= 0"),
+        ("ulps:1,binary16", "mode 'ulps:1,binary16': the arithmetic is one of binary32, binary64"),
+        ("ulps:-1", "the number of ulps '-1' is not a whole number >= 0"),
+        ("discrete:cycles=-1", "mode 'discrete:cycles=-1': cycles must be a finite number >= 0, not -1"),
         ("discrete:cycles=0.5", "cycles '0.5' is not a number"),
-        ("tol:abs=-1", "Tolerance(abs_tol=...) must be a finite number >= 0, not -1.0"),
+        ("tol:rel=nan", "rel must be a finite number >= 0, not nan"),
+        ("tol:abs=-1", "--signal y=tol:abs=-1: mode 'tol:abs=-1': abs must be a finite number >= 0, not -1"),
+        ("tube:time=inf,value=0", "time must be a finite number >= 0, not inf"),
         ("fuzzy", "mode 'fuzzy' is none of: exact, tol:abs=A,rel=R"),
     ],
 )
@@ -438,3 +441,14 @@ def test_a_sparser_reference_sees_the_results_changes_at_its_samples_only():
     assert compare_traces(trace(GRID, b=step_at(7)), sparse_step, fmutrace.Discrete(1)).passed
     assert not compare_traces(trace(GRID, b=step_at(7)), sparse_step, fmutrace.Discrete(0)).passed
     assert not compare_traces(trace(GRID, b=step_at(8)), sparse_step, fmutrace.Discrete(1)).passed
+
+
+def test_criteria_refuse_what_is_not_a_mode():
+    with pytest.raises(fmutrace.InputError, match="the mode of 'y' must be a mode object, not 'exact'"):
+        fmutrace.Criteria({"y": "exact"})
+    with pytest.raises(fmutrace.InputError, match="must be a mode object"):
+        fmutrace.Criteria({"*": fmutrace.Criteria()})
+    with pytest.raises(fmutrace.InputError, match="Discrete.cycles must be a whole number >= 0, not 1.5"):
+        fmutrace.Discrete(1.5)
+    with pytest.raises(fmutrace.InputError, match="Ulps.arithmetic must be one of binary32, binary64"):
+        fmutrace.Ulps(1, "decimal64")

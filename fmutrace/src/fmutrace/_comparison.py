@@ -638,6 +638,8 @@ def parse_mode(text: str) -> Mode:
                 given[key] = int(value) if key in whole else float(value)
             except ValueError:
                 raise InputError(f"mode {text!r}: {key} {value.strip()!r} is not a number") from None
+            if not (given[key] >= 0 and math.isfinite(given[key])):
+                raise InputError(f"mode {text!r}: {key} must be a finite number >= 0, not {value.strip()}")
         return given
 
     if kind == "exact" and not items:
@@ -653,11 +655,12 @@ def parse_mode(text: str) -> Mode:
     if kind == "discrete":
         return Discrete(numbers(("cycles",), whole=("cycles",)).get("cycles", 0))
     if kind == "ulps" and 1 <= len(items) <= 2:
-        try:
-            n = int(items[0])
-        except ValueError:
-            raise InputError(f"mode {text!r}: the number of ulps {items[0]!r} is not a whole number") from None
-        return Ulps(n, items[1].lower() if len(items) == 2 else "binary64")
+        arithmetic = items[1].lower() if len(items) == 2 else "binary64"
+        if not items[0].isdigit():
+            raise InputError(f"mode {text!r}: the number of ulps {items[0]!r} is not a whole number >= 0")
+        if arithmetic not in ARITHMETIC_TYPES:
+            raise InputError(f"mode {text!r}: the arithmetic is one of {', '.join(ARITHMETIC_TYPES)}")
+        return Ulps(int(items[0]), arithmetic)
     raise InputError(f"mode {text!r} is none of: {MODE_WORDS}")
 
 
