@@ -452,3 +452,13 @@ def test_criteria_refuse_what_is_not_a_mode():
         fmutrace.Discrete(1.5)
     with pytest.raises(fmutrace.InputError, match="Ulps.arithmetic must be one of binary32, binary64"):
         fmutrace.Ulps(1, "decimal64")
+
+
+def test_a_campaign_with_criteria_resumes_and_refuses_other_criteria(tmp_path):
+    folder, reference = own_output_case(tmp_path / "cases")
+    report = tmp_path / "report"
+    assert command(tmp_path / "cases", "--signal", "ramp*=discrete:cycles=1", "--report", report)[0] == 0
+    status, out, _ = command(tmp_path / "cases", "--signal", "ramp*=discrete:cycles=1", "--report", report, "--resume")
+    assert status == 0 and "on the journal" in out, out
+    status, _, err = command(tmp_path / "cases", "--signal", "ramp*=discrete:cycles=2", "--report", report, "--resume")
+    assert status == 2 and "fmutrace: error:" in err, err
