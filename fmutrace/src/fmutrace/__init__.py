@@ -12,7 +12,20 @@ __version__ = "0.2.0"  # the package's version (pyproject.toml reads it from her
 
 from ._campaign import compare
 from ._cases import Case, find_cases, load_case
-from ._comparison import Comparison, Deviation, Exact, Mode, Tolerance, Tube, compare_traces, comparison_mode
+from ._comparison import (
+    Comparison,
+    Criteria,
+    Deviation,
+    Discrete,
+    Exact,
+    Mode,
+    Tolerance,
+    Tube,
+    Ulps,
+    compare_traces,
+    comparison_mode,
+    parse_mode,
+)
 from ._errors import ExitStatus, InputError, SimulationError, TraceError
 from ._executors import RunOptions
 from ._fmu import Fmu
@@ -26,7 +39,9 @@ __all__ = [
     "Case",
     "CaseOutcome",
     "Comparison",
+    "Criteria",
     "Deviation",
+    "Discrete",
     "Exact",
     "ExitStatus",
     "Fmu",
@@ -39,11 +54,13 @@ __all__ = [
     "Tolerance",
     "TraceError",
     "Tube",
+    "Ulps",
     "compare",
     "compare_traces",
     "comparison_mode",
     "find_cases",
     "load_case",
+    "parse_mode",
     "read_trace",
     "simulate",
     "write_trace",

@@ -6,6 +6,9 @@
   <Model>_ref.opt    StartTime, StopTime, StepSize, RelTol (optional: the
                      reference's first and last time, the FMU's default step)
   <Model>_start.csv  start values, one "name,value" line each (optional)
+  <Model>_criteria.csv  per-signal criteria, one "signal,mode" line each:
+                     a variable's name or an fnmatch pattern, "*" for the
+                     rest; the mode as --signal writes it (optional)
   README.md          its first line describes the case (optional)
 
 Every file is checked against the FMU before anything runs: a problem is
@@ -22,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ._comparison import Comparison, Mode, compare_traces
+from ._comparison import Comparison, Mode, compare_traces, criteria_for, parse_mode
 from ._errors import InputError, TraceError
 from ._fmu import Fmu
 from ._traces import data_lines, parse_number, read_text, read_trace, split_cells, steps_problem
 
 OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
-FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "README.md")
+FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "_criteria.csv", "README.md")
 
 
 @dataclass
@@ -41,16 +44,17 @@ class Case:
     inputs: np.ndarray | None  # structured array, or None
     reference: np.ndarray  # structured array
     description: str = ""
+    criteria: tuple = ()  # its own per-signal criteria: ((pattern, Mode), ...)
 
     @property
     def outputs(self):
         """The reference's signals: what is recorded and compared."""
         return [n for n in self.reference.dtype.names or () if n != "time"]
 
-    def comparison(self, result, mode: Mode) -> Comparison:
-        """The FMU's result against the reference, in mode (a recording
-        compares each signal on its own samples)."""
-        return compare_traces(result, self.reference, mode)
+    def comparison(self, result, mode: Mode, discrete=frozenset()) -> Comparison:
+        """The FMU's result against the reference, in mode with the case's
+        own criteria (discrete: the FMU's discrete signals, Fmu.discrete_names)."""
+        return compare_traces(result, self.reference, criteria_for(mode, self.criteria, discrete))
 
 
 def read_options(path, text, reference, fmu):
@@ -105,6 +109,24 @@ def read_start_values(path, text, fmu):
     return values
 
 
+def read_criteria(path, text, fmu) -> tuple:
+    """The per-signal criteria of a "signal,mode" file, ((pattern, Mode), ...):
+    a name without a pattern's characters must be a variable of the FMU."""
+    pairs = []
+    for number, line in data_lines(text or ""):
+        signal, sep, words = line.partition(",")
+        signal = signal.strip().strip('"')
+        if not sep or not signal:
+            raise TraceError(path, number, 1, f"expected 'signal,mode', found {line.strip()!r}")
+        if not any(c in signal for c in "*?[") and fmu.variable_problem(signal):
+            raise TraceError(path, number, 1, fmu.variable_problem(signal))
+        try:
+            pairs.append((signal, parse_mode(words.strip().strip('"'))))
+        except InputError as error:
+            raise TraceError(path, number, 2, str(error)) from None
+    return tuple(pairs)
+
+
 def case_texts(folder, model):
     """{file name: text} of the case's files that exist (what a worker
     without this file system needs)."""
@@ -146,6 +168,7 @@ def load_case(folder: str | PathLike, fmu: Fmu, name: str | None = None, texts: 
         inputs=inputs,
         reference=reference,
         description=readme[0].lstrip("# ").strip() if readme else "",
+        criteria=read_criteria(folder / f"{model}_criteria.csv", text(f"{model}_criteria.csv"), fmu),
     )
 
 

@@ -23,7 +23,9 @@ that instant on, is the one compared. A reference sample without a
 result sample at its time fails.
 """
 
+import fnmatch
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -65,19 +67,23 @@ class Deviation:
     largest_excess: float | None = None
     largest_at: float | None = None
     note: str = ""
+    criterion: str = ""  # the signal's own criterion (per-signal criteria only)
+    allowance: str = ""  # how much of a time allowance was used, where it came closest to failing
 
     NUMBERS: ClassVar[tuple] = ("time", "value", "lower", "upper", "excess", "largest_excess", "largest_at")
 
     def describe(self) -> str:
+        who = f"{self.name} ({self.criterion})" if self.criterion else self.name
+        used = f"; {self.allowance}" if self.allowance else ""
         if self.passed:
-            return f"{self.name}: {self.compared} samples within the band"
+            return f"{who}: {self.compared} samples within the band{used}"
         if self.note:
-            return f"{self.name}: {self.note}"
+            return f"{who}: {self.note}{used}"
         band = f"{self.lower!r}" if self.lower == self.upper else f"[{self.lower!r}, {self.upper!r}]"
         return (
-            f"{self.name} leaves the band first at t={self.time!r}: {self.value!r}, expected {band}, "
+            f"{who} leaves the band first at t={self.time!r}: {self.value!r}, expected {band}, "
             f"off by {self.excess:.6g}; {self.failed} of {self.compared} samples outside, "
-            f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}"
+            f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}{used}"
         )
 
     def to_json(self) -> dict:
@@ -109,7 +115,8 @@ class Comparison:
     def messages(self) -> list:
         if self.problem:
             return [self.problem]
-        return [d.describe() for d in self.deviations if not d.passed]
+        failing = [d.describe() for d in self.deviations if not d.passed]
+        return failing + [d.describe() for d in self.deviations if d.passed and d.allowance]  # (time allowances)
 
 
 class Mode:
@@ -131,6 +138,15 @@ class Mode:
     def bands(self, result, reference, names) -> tuple:
         """({name: Band}, problem): problem names what the result lacks ("" if nothing)."""
         raise NotImplementedError
+
+    def spec(self) -> str:
+        """The mode in the words of --signal NAME=MODE and criteria files (parse_mode reads it back)."""
+        raise NotImplementedError
+
+    def judge(self, result, reference, names) -> tuple:
+        """({name: Deviation}, {name: Band}, problem): the verdict of every signal."""
+        bands, problem = self.bands(result, reference, names)
+        return {name: _verdict(name, band) for name, band in bands.items()}, bands, problem
 
 
 class Pointwise(Mode):
@@ -171,6 +187,9 @@ class Exact(Pointwise):
     def describe(self):
         return "exact (bit for bit)"
 
+    def spec(self):
+        return "exact"
+
     def bounds(self, values, expected):
         both_nan = np.isnan(values) & np.isnan(expected)
         return expected, expected, (values.view(np.uint64) == expected.view(np.uint64)) | both_nan
@@ -188,6 +207,9 @@ class Tolerance(Pointwise):
 
     def describe(self):
         return f"relative tolerance {self.rel_tol:g}, absolute tolerance {self.abs_tol:g}"
+
+    def spec(self):
+        return f"tol:abs={self.abs_tol!r},rel={self.rel_tol!r}"
 
     def bounds(self, values, expected):
         with np.errstate(invalid="ignore"):
@@ -218,6 +240,26 @@ class Tube(Mode):
     def describe(self):
         return f"tube of {self.time:g} s and {self.value:g}"
 
+    def spec(self):
+        return f"tube:time={self.time!r},value={self.value!r}"
+
+    def time_used(self, result, reference, name):
+        """(seconds, at): the largest time, over the result's samples inside
+        the tube, to the nearest point of the reference's polyline within
+        the tube's value of the sample, and that sample's time: how much of
+        the tube's time a sample needed (a time allowance that hides a value
+        error uses all of it). (0, None) if none is inside."""
+        times, values = reference["time"], reference[name].astype(np.float64)
+        most, at = 0.0, None
+        for t, v in zip(result["time"], result[name].astype(np.float64), strict=True):
+            if not times[0] <= t <= times[-1]:
+                continue
+            need = _distance_to_polyline(times, values, float(t), float(v), self.value, self.time + time_slack(t))
+            need = 0.0 if need <= time_slack(t) else need  # (the same instant, up to the times' rounding)
+            if need <= self.time + time_slack(t) and (at is None or need > most):
+                most, at = min(need, self.time), float(t)
+        return most, at
+
     def bands(self, result, reference, names):
         return {name: self.band(result, reference, name) for name in names}, ""
 
@@ -234,6 +276,392 @@ class Tube(Mode):
             ok = (values >= lower) & (values <= upper)
             outside = np.where(values > upper, values - upper, np.where(values < lower, values - lower, 0.0))
         return Band(result["time"][inside], values, lower, upper, ok, outside)
+
+
+def _shown(value):
+    """A discrete signal's value as its reader writes it: whole numbers without a fraction."""
+    number = float(value)
+    return repr(int(number)) if number.is_integer() and abs(number) < 2**53 else repr(number)
+
+
+def _changed(values):
+    """The indexes where values change (NaN equal to NaN)."""
+    return np.flatnonzero(~_same(values[1:], values[:-1])) + 1
+
+
+def _cycles(n):
+    return f"{n} cycle{'' if n == 1 else 's'}"
+
+
+def _same(a, b):
+    """Equal values, NaN equal to NaN."""
+    return (a == b) | (np.isnan(a) & np.isnan(b))
+
+
+@dataclass(frozen=True)
+class Discrete(Mode):
+    """Exact in value, never interpolated, each change of the reference
+    found in the result within cycles result samples (communication
+    points: PLC cycles) early or late, and no change of the result that the
+    reference lacks. A reference sample holds the result's value of the
+    last communication point at or before its time (sample and hold); a
+    reference sparser than the result sees the result's changes at its own
+    samples only."""
+
+    cycles: int = 0
+
+    name: ClassVar[str] = "discrete"
+    fills_band = False
+    reference_line = {"drawstyle": "steps-post", "color": "0.6", "linewidth": 4}
+    deviation_label = "result - ref"
+
+    def __post_init__(self):
+        if not (isinstance(self.cycles, int) and self.cycles >= 0):
+            raise InputError(f"Discrete.cycles must be a whole number >= 0, not {self.cycles!r}")
+
+    def describe(self):
+        if not self.cycles:
+            return "exact"
+        return f"exact, up to {_cycles(self.cycles)} early or late"
+
+    def spec(self):
+        return f"discrete:cycles={self.cycles}"
+
+    def bands(self, result, reference, names):
+        deviations, bands, problem = self.judge(result, reference, names)
+        return bands, problem
+
+    def judge(self, result, reference, names):
+        rt = result["time"]
+        ref_t = reference["time"]
+        last_row = np.ones(len(ref_t), dtype=bool)
+        last_row[:-1] = ref_t[1:] != ref_t[:-1]  # (at a repeated time: the value from that instant on)
+        held = np.searchsorted(rt, ref_t + time_slack(ref_t), "right") - 1
+        use = last_row & (held >= 0)
+        cycle, times = held[use], ref_t[use]
+        deviations, bands = {}, {}
+        for name in names:
+            expected = reference[name][use].astype(np.float64)
+            result_values = result[name].astype(np.float64)
+            values = result_values[cycle]
+            deviation, ok = self._changes(name, rt, result_values, cycle, expected)
+            deviation.compared = len(times)
+            deviations[name] = deviation
+            with np.errstate(invalid="ignore", over="ignore"):
+                bands[name] = Band(times, values, expected, expected, ok, values - expected)
+        return deviations, bands, ""
+
+    @staticmethod
+    def _last_change(x, after, until):
+        """The last result sample in (after, until] where x changes."""
+        return after + int(_changed(x[after : until + 1])[-1])
+
+    def _changes(self, name, rt, x, cycle, expected):
+        """(Deviation, ok per reference sample) of result x against the
+        expected values at the result samples cycle."""
+        ok = np.ones(len(cycle), dtype=bool)
+        deviation = Deviation(name, True)
+        if not len(cycle):
+            return deviation, ok
+        k = self.cycles
+        ref_at = _changed(expected)  # reference rows that change
+        # the result's changes that its samples at the reference's rows show (between two rows the reference
+        # says nothing), each at the last cycle it changed in that interval
+        first = int(cycle[0])
+        res_at = [self._last_change(x, int(cycle[s - 1]), int(cycle[s])) for s in _changed(x[cycle])]
+        problem, shift_most, shift_at = "", 0, None
+        if not _same(x[first], expected[0]):
+            problem = f"starts at {_shown(x[first])}, expected {_shown(expected[0])} at t={float(rt[first])!r}"
+            ok[0] = False
+        for m in range(max(len(ref_at), len(res_at))):
+            if problem:
+                break
+            if m >= len(ref_at):
+                j = int(res_at[m])
+                problem = f"changes to {_shown(x[j])} at t={float(rt[j])!r}, a change the reference lacks"
+                ok[min(int(np.searchsorted(cycle, j)), len(ok) - 1)] = False
+                break
+            row = int(ref_at[m])
+            earliest, latest = int(cycle[row - 1]) + 1, int(cycle[row])
+            if m >= len(res_at):
+                problem = (
+                    f"the reference's change to {_shown(expected[row])} at t={float(rt[latest])!r} "
+                    "is missing from the result"
+                )
+                ok[row] = False
+                break
+            j = int(res_at[m])
+            shift = max(earliest - j, j - latest, 0)
+            if not _same(x[j], expected[row]):
+                problem = (
+                    f"changes to {_shown(x[j])} at t={float(rt[j])!r} where the reference's next change is "
+                    f"to {_shown(expected[row])} at t={float(rt[latest])!r}"
+                )
+            elif shift > k:
+                when = "late" if j > latest else "early"
+                problem = (
+                    f"the reference's change to {_shown(expected[row])} at t={float(rt[latest])!r} comes "
+                    f"{_cycles(shift)} {when} (t={float(rt[j])!r}), more than the {k} allowed"
+                )
+            if problem:
+                ok[row] = False
+                break
+            if shift_at is None or shift > shift_most:
+                shift_most, shift_at = shift, float(rt[j])
+        if problem:
+            bad = int(np.argmin(ok))
+            deviation.passed, deviation.failed, deviation.note = False, 1, problem
+            deviation.time, deviation.value = float(rt[cycle[bad]]), float(x[cycle[bad]])
+            deviation.lower = deviation.upper = float(expected[bad])
+        elif k and shift_at is not None:
+            where = f" at t={shift_at!r}" if shift_most else ""
+            deviation.allowance = f"time allowance used: {shift_most} of {_cycles(k)}{where}"
+        return deviation, ok
+
+
+ARITHMETIC_TYPES = {
+    "binary32": (np.float32, np.int32, 0x7FFFFFFF),
+    "binary64": (np.float64, np.int64, 0x7FFFFFFFFFFFFFFF),
+}
+
+
+FINITE_MAX = {"binary32": float(np.finfo(np.float32).max), "binary64": float(np.finfo(np.float64).max)}
+
+
+def _ordinal(values, arithmetic):
+    """Each value rounded to the arithmetic, as its place on the line of
+    that arithmetic's numbers (adjacent numbers 1 apart, +0 and -0 both 0)."""
+    float_type, int_type, magnitude = ARITHMETIC_TYPES[arithmetic]
+    with np.errstate(over="ignore"):
+        bits = values.astype(float_type).view(int_type).astype(np.int64)
+    return np.where(bits < 0, -(bits & magnitude), bits)
+
+
+def _from_ordinal(ordinal, arithmetic):
+    float_type, int_type, magnitude = ARITHMETIC_TYPES[arithmetic]
+    sign = np.int64(magnitude) + 1 if arithmetic == "binary32" else np.iinfo(np.int64).min
+    bits = np.where(ordinal < 0, (-ordinal) | sign, ordinal)
+    return bits.astype(int_type).view(float_type).astype(np.float64)
+
+
+@dataclass(frozen=True)
+class Ulps(Pointwise):
+    """Within n units in the last place of a named arithmetic: result and
+    reference rounded to it (binary32: a REAL controller's numbers), then
+    their distance counted in its numbers (across zero too; NaN matches
+    NaN, an infinity only itself)."""
+
+    n: int = 1
+    arithmetic: str = "binary64"
+
+    name: ClassVar[str] = "ulps"
+
+    def __post_init__(self):
+        if not (isinstance(self.n, int) and self.n >= 0):
+            raise InputError(f"Ulps.n must be a whole number >= 0, not {self.n!r}")
+        if self.arithmetic not in ARITHMETIC_TYPES:
+            raise InputError(f"Ulps.arithmetic must be one of {', '.join(ARITHMETIC_TYPES)}, not {self.arithmetic!r}")
+
+    def describe(self):
+        return f"within {self.n} ulp{'s' if self.n != 1 else ''} of {self.arithmetic}"
+
+    def spec(self):
+        return f"ulps:{self.n},{self.arithmetic}"
+
+    def distance(self, values, expected):
+        """Each pair's distance in the arithmetic's numbers (capped above n)."""
+        a, b = _ordinal(values, self.arithmetic), _ordinal(expected, self.arithmetic)
+        cap = self.n + 1
+        across = (a > 0) & (b < 0) | (a < 0) & (b > 0)
+        with np.errstate(over="ignore"):
+            near = np.abs(a - b)
+        return np.where(across, np.minimum(np.abs(a), cap) + np.minimum(np.abs(b), cap), np.minimum(near, cap))
+
+    def bounds(self, values, expected):
+        nan_a, nan_b = np.isnan(values), np.isnan(expected)
+        with np.errstate(over="ignore"):  # (beyond the arithmetic's range: its infinity)
+            rounded_a, rounded_b = (v.astype(ARITHMETIC_TYPES[self.arithmetic][0]) for v in (values, expected))
+        infinite_b = np.isinf(rounded_b)
+        with np.errstate(invalid="ignore"):
+            ok = np.where(
+                nan_a | nan_b | np.isinf(rounded_a) | infinite_b,
+                (nan_a & nan_b) | (rounded_a == rounded_b),
+                self.distance(values, expected) <= self.n,
+            )
+        base = _ordinal(np.where(nan_b | infinite_b, 0.0, expected), self.arithmetic)
+        finite_max = _ordinal(np.array([FINITE_MAX[self.arithmetic]]), self.arithmetic)[0]
+        lower = _from_ordinal(np.maximum(base - self.n, -finite_max), self.arithmetic)
+        upper = _from_ordinal(np.minimum(base + self.n, finite_max), self.arithmetic)
+        special = nan_b | infinite_b
+        return np.where(special, expected, lower), np.where(special, expected, upper), ok
+
+
+@dataclass(frozen=True)
+class Criteria(Mode):
+    """Each signal its own mode: the first of signals (name or fnmatch
+    pattern -> mode; "*" is the default) that matches its name, else
+    default. A discrete signal (discrete: the names of the FMU's variables
+    of a discrete type, Fmu.discrete_names, given by whoever knows the FMU)
+    is never interpolated or judged by its magnitude: under a tube it is
+    judged Discrete with the tube's time in whole cycles, under a
+    tolerance or ulps exactly."""
+
+    signals: tuple = ()  # ((pattern, Mode), ...); a mapping is turned into one
+    default: Mode = field(default_factory=Exact)
+    discrete: frozenset = frozenset()
+
+    name: ClassVar[str] = "criteria"
+    fills_band = True
+    reference_line = {"color": "0.5", "linewidth": 1}
+    deviation_label = "result - ref, or outside the tube"
+
+    def __post_init__(self):
+        signals = self.signals.items() if isinstance(self.signals, Mapping) else self.signals
+        pairs = []
+        for pattern, mode in signals:
+            if not isinstance(mode, Mode) or isinstance(mode, Criteria):
+                raise InputError(f"Criteria: the mode of {pattern!r} must be a mode object, not {mode!r}")
+            if pattern == "*":
+                object.__setattr__(self, "default", mode)
+            else:
+                pairs.append((str(pattern), mode))
+        object.__setattr__(self, "signals", tuple(pairs))
+        object.__setattr__(self, "discrete", frozenset(self.discrete))
+        if not isinstance(self.default, Mode) or isinstance(self.default, Criteria):
+            raise InputError(f"Criteria: the default must be a mode object, not {self.default!r}")
+
+    def settings(self):
+        return {"signals": [[p, m.spec()] for p, m in self.signals], "default": self.default.spec()}
+
+    def describe(self):
+        named = "; ".join(f"{p}: {m.describe()}" for p, m in self.signals)
+        return f"per signal: {named + '; ' if named else ''}the rest: {self.default.describe()}"
+
+    def spec(self):
+        raise InputError("per-signal criteria cannot be one signal's mode")
+
+    def given(self, name) -> Mode:
+        """The mode given for signal name (first matching pattern, else the default)."""
+        for pattern, mode in self.signals:
+            if pattern == name or fnmatch.fnmatchcase(name, pattern):
+                return mode
+        return self.default
+
+    def mode_of(self, name, step) -> Mode:
+        """The mode signal name is judged by; step: the result's communication step."""
+        mode = self.given(name)
+        if name not in self.discrete or isinstance(mode, (Exact, Discrete)):
+            return mode
+        if isinstance(mode, Tube):
+            return Discrete(int(math.floor(mode.time / step + TIME_MATCH))) if step > 0 else Discrete(0)
+        return Discrete(0)
+
+    def bands(self, result, reference, names):
+        deviations, bands, problem = self.judge(result, reference, names)
+        return bands, problem
+
+    def judge(self, result, reference, names):
+        step = float(result["time"][1] - result["time"][0]) if len(result) > 1 else 0.0
+        deviations, bands, problems = {}, {}, []
+        for name in names:
+            mode = self.mode_of(name, step)
+            judged, banded, problem = mode.judge(result, reference, [name])
+            if problem and problem not in problems:
+                problems.append(problem)
+            if name not in judged:
+                continue
+            deviation = judged[name]
+            deviation.criterion = mode.describe()
+            if isinstance(mode, Tube) and mode.time > 0:
+                used, at = mode.time_used(result, reference, name)
+                if at is not None:
+                    where = f" at t={at!r}" if used else ""
+                    deviation.allowance = (
+                        f"time allowance used: {used:.6g} of {mode.time:g} s ({used / mode.time:.0%}){where}"
+                    )
+            deviations[name], bands[name] = deviation, banded[name]
+        return deviations, bands, "; ".join(problems)
+
+
+def criteria_for(mode: Mode, pairs=(), discrete=frozenset()) -> Mode:
+    """The mode a case is judged by: mode with a case's own criteria
+    (pairs: (pattern, Mode), "*" the default) before the campaign's, the
+    FMU's discrete signals named; mode itself when neither is per-signal
+    (a Discrete mode for every signal is a Criteria of that default)."""
+    if not pairs and not isinstance(mode, (Criteria, Discrete)):  # (Discrete judges the whole trace, as Criteria)
+        return mode
+    given = Criteria(pairs)
+    if isinstance(mode, Criteria):
+        named = dict(pairs)
+        default = named.get("*", mode.default)
+        return Criteria(given.signals + mode.signals, default, frozenset(discrete))
+    return Criteria(given.signals, dict(pairs).get("*", mode), frozenset(discrete))
+
+
+def signal_criteria(assignments, default: Mode, names: Names = ()) -> Mode:
+    """The mode of the command's --signal NAME=MODE assignments (pairs of
+    texts; '*' the default) over default (the other options' mode); default
+    itself without any. InputError for a mode that is not one, naming the
+    setting in names (the caller's words)."""
+    if not assignments:
+        return default
+    pairs = []
+    for pattern, words in assignments:
+        try:
+            pairs.append((pattern, parse_mode(words)))
+        except InputError as error:
+            raise InputError(f"{name_of(names, signals=(pattern, words))}: {error}") from None
+    if any(p == "*" for p, _ in pairs) and default != EXACT:
+        raise InputError(f"give the rest's mode once: {name_of(names, signals=('*', '...'))} or a tolerance or tube")
+    return Criteria(tuple(pairs), default)
+
+
+MODE_WORDS = "exact, tol:abs=A,rel=R, tube:time=S,value=V, discrete[:cycles=K], ulps:N[,binary32|binary64]"
+
+
+def parse_mode(text: str) -> Mode:
+    """A mode from its words (Mode.spec's): exact, tol:abs=1e-6,rel=0,
+    tube:time=0.01,value=0, discrete:cycles=1, ulps:4,binary32.
+    InputError if text is none of them."""
+    kind, _, rest = text.strip().partition(":")
+    kind = kind.strip().lower()
+    items = [item.strip() for item in rest.split(",")] if rest.strip() else []
+
+    def numbers(allowed, whole=()):
+        given = {}
+        for item in items:
+            key, sep, value = item.partition("=")
+            key = key.strip().lower()
+            if not sep or key not in allowed or key in given:
+                raise InputError(f"mode {text!r}: expected {kind}:{','.join(k + '=...' for k in allowed)}")
+            try:
+                given[key] = int(value) if key in whole else float(value)
+            except ValueError:
+                raise InputError(f"mode {text!r}: {key} {value.strip()!r} is not a number") from None
+            if not (given[key] >= 0 and math.isfinite(given[key])):
+                raise InputError(f"mode {text!r}: {key} must be a finite number >= 0, not {value.strip()}")
+        return given
+
+    if kind == "exact" and not items:
+        return EXACT
+    if kind in ("tol", "tolerance"):
+        given = numbers(("abs", "rel"))
+        return Tolerance(given.get("rel", 0.0), given.get("abs", 0.0))
+    if kind == "tube":
+        given = numbers(("time", "value"))
+        if len(given) != 2:
+            raise InputError(f"mode {text!r}: a tube needs both time= and value=")
+        return Tube(given["time"], given["value"])
+    if kind == "discrete":
+        return Discrete(numbers(("cycles",), whole=("cycles",)).get("cycles", 0))
+    if kind == "ulps" and 1 <= len(items) <= 2:
+        arithmetic = items[1].lower() if len(items) == 2 else "binary64"
+        if not items[0].isdigit():
+            raise InputError(f"mode {text!r}: the number of ulps {items[0]!r} is not a whole number >= 0")
+        if arithmetic not in ARITHMETIC_TYPES:
+            raise InputError(f"mode {text!r}: the arithmetic is one of {', '.join(ARITHMETIC_TYPES)}")
+        return Ulps(int(items[0]), arithmetic)
+    raise InputError(f"mode {text!r} is none of: {MODE_WORDS}")
 
 
 def _check_widths(widths, names: Names = ()):
@@ -273,6 +701,12 @@ def comparison_mode(
     return Tolerance(rel_tol, abs_tol) if (rel_tol or abs_tol) else EXACT
 
 
+def time_slack(t):
+    """How far apart two times may be and still be the same instant (the
+    rule aligned uses): communication points are sums of steps."""
+    return TIME_MATCH * np.maximum(1.0, np.abs(t))
+
+
 def aligned(result_time, reference_time):
     """For each reference time, the index of the result sample at that
     time (-1 if none); at a repeated reference time only the last row is
@@ -284,7 +718,7 @@ def aligned(result_time, reference_time):
     best = np.full(len(reference_time), -1)
     for candidate in (index - 1, index):
         candidate = np.clip(candidate, 0, len(result_time) - 1)
-        close = np.abs(result_time[candidate] - reference_time) <= TIME_MATCH * np.maximum(1.0, np.abs(reference_time))
+        close = np.abs(result_time[candidate] - reference_time) <= time_slack(reference_time)
         best = np.where((best < 0) & close, candidate, best)
     return np.where(last, best, -2)
 
@@ -305,7 +739,7 @@ class Verdict:
             return
         d.passed, d.failed = False, d.failed + failed
         times, values, lower, upper = band.times, band.values, band.lower, band.upper
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             excess = np.where(values > upper, values - upper, lower - values)
         excess = np.where(np.isnan(excess), np.inf, excess)
         excess = np.where(ok, -np.inf, excess)
@@ -324,6 +758,35 @@ def _verdict(name, band):
     return verdict.deviation
 
 
+def _distance_to_polyline(times, values, t, v, width, reach):
+    """The smallest |tau - t| (at most reach; inf if none) at which the
+    polyline (times, values) lies within width of v."""
+    lo = int(np.searchsorted(times, t - reach, "left"))
+    hi = int(np.searchsorted(times, t + reach, "right"))
+    best = math.inf
+    for k in range(max(lo - 1, 0), min(hi + 1, len(times))):
+        t0, p0 = times[k], values[k]
+        if abs(p0 - v) <= width:
+            best = min(best, abs(t0 - t))
+        if k + 1 >= len(times):
+            continue
+        t1, p1 = times[k + 1], values[k + 1]
+        if math.isnan(p0) or math.isnan(p1) or t1 == t0:  # (a jump is reached at its time)
+            if t1 == t0 and min(p0, p1) - width <= v <= max(p0, p1) + width:
+                best = min(best, abs(t0 - t))
+            continue
+        if p1 == p0:
+            a, b = (0.0, 1.0) if abs(p0 - v) <= width else (1.0, 0.0)
+        else:
+            a, b = sorted(((v - width - p0) / (p1 - p0), (v + width - p0) / (p1 - p0)))
+        a, b = max(a, 0.0), min(b, 1.0)
+        if a > b:
+            continue
+        start, end = t0 + a * (t1 - t0), t0 + b * (t1 - t0)
+        best = min(best, 0.0 if start <= t <= end else min(abs(start - t), abs(end - t)))
+    return best
+
+
 def _polyline_at(times, values, at):
     """The reference polyline at time at (inside its time range)."""
     k = int(np.searchsorted(times, at, side="right")) - 1
@@ -339,7 +802,8 @@ def _polyline_at(times, values, at):
 def tube_bounds(reference_time, reference_values, times, widths, span=None):
     """The tube's lower and upper bound at each of times (NaN outside the
     reference's time range: there the reference says nothing); widths:
-    (time, value). span: the whole reference's (first, last) time where
+    (time, value); a reference sample at the window's edge counts (up to
+    the rounding of its time). span: the whole reference's (first, last) time where
     reference_time is a window of it that holds every sample within the
     tube's time of each of times and one more on either side (None: its
     own)."""
@@ -351,8 +815,11 @@ def tube_bounds(reference_time, reference_values, times, widths, span=None):
         if not t_first <= t <= t_last:
             continue
         start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
+        slack = time_slack(t)  # a sample exactly at the allowed time counts, however t - tube_time rounds
         inside = reference_values[
-            np.searchsorted(reference_time, start, "left") : np.searchsorted(reference_time, end, "right")
+            np.searchsorted(reference_time, start - slack, "left") : np.searchsorted(
+                reference_time, end + slack, "right"
+            )
         ]
         edges = [
             _polyline_at(reference_time, reference_values, start),
@@ -375,5 +842,5 @@ def compare_traces(result, reference, mode: Mode = EXACT) -> Comparison:
         return Comparison(problem=f"the result has no signal {', '.join(missing)}")
     if len(result) == 0:
         return Comparison(problem="the result has no samples")
-    bands, problem = mode.bands(result, reference, names)
-    return Comparison([_verdict(name, band) for name, band in bands.items()], problem, bands)
+    deviations, bands, problem = mode.judge(result, reference, names)
+    return Comparison(list(deviations.values()), problem, bands)

@@ -33,6 +33,8 @@ INTEGER_RANGES = {
     "UInt64": (0, 2**64 - 1),
 }
 REAL_TYPES = ("Real", "Float32", "Float64")  # FMI 2 and FMI 3 floating-point types
+# FMI 2 and FMI 3 types of a PLC's BOOL, INT, DINT, WORD, enumerations and status words
+DISCRETE_TYPES = ("Boolean", "Enumeration", *INTEGER_RANGES)
 
 
 class Fmu:
@@ -81,6 +83,10 @@ class Fmu:
             f"{self.path}: {self.label} has no binary for this platform: no {binary} in the FMU "
             f"(it has binaries for: {', '.join(present) or 'none'})"
         )
+
+    def discrete_names(self) -> frozenset:
+        """The variables whose values are whole: compared exactly, never interpolated."""
+        return frozenset(name for name, v in self.variables.items() if v.type in DISCRETE_TYPES)
 
     @property
     def outputs(self):

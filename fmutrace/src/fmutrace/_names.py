@@ -19,6 +19,7 @@ API_NAMES = {
     "tube_time": "Tube.time",
     "tube_value": "Tube.value",
     "resume": "compare.resume",
+    "signals": "Criteria.signals",
 }
 
 Names = Mapping[str, str] | Iterable[tuple[str, str]]  # setting -> the caller's word; pairs too

@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cases import load_case, read_options, read_start_values
-from ._comparison import Band, Mode, Pointwise, Tube, Verdict, aligned
+from ._cases import load_case, read_criteria, read_options, read_start_values
+from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned, criteria_for, time_slack
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
@@ -78,6 +78,7 @@ class ChunkedCase:
     # what the outcome's messages add after the comparison's: more_messages(passed, deviations)
     more_messages: Callable | None = None
     started: float = field(default_factory=time.perf_counter)
+    criteria: tuple = ()  # the case's own per-signal criteria: ((pattern, Mode), ...)
 
 
 @dataclass(frozen=True)
@@ -117,6 +118,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         read = load_case(folder, fmu, name, files.texts)
         inputs, reference = read.inputs, read.reference
         options, start_values, description = read.options, read.start_values, read.description
+        criteria = read.criteria
         input_names = _signal_names(inputs) if inputs is not None else ()
         table = None if inputs is None else (lambda: iter([inputs]))
         ref_chunks: Iterator = iter([reference])  # (one table)
@@ -124,7 +126,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
     else:
         ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
         texts = {}  # the small files' texts (the reference and the inputs are read in chunks)
-        for file_name in (f"{model}_ref.opt", f"{model}_start.csv", "README.md"):
+        for file_name in (f"{model}_ref.opt", f"{model}_start.csv", f"{model}_criteria.csv", "README.md"):
             if (folder / file_name).exists():
                 texts[file_name] = read_text(folder / file_name)
         ref_chunks = trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes)
@@ -138,6 +140,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         bounds["time"] = [first_ref["time"][0], last]
         options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
         start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
+        criteria = read_criteria(folder / f"{model}_criteria.csv", texts.get(f"{model}_criteria.csv"), fmu)
         input_names, table = (), None
         if in_path.exists():
             in_chunks = trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
@@ -168,6 +171,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         [ref_chunks],
         outputs,
         max(options["StopTime"], last),
+        criteria=criteria,
     )
 
 
@@ -179,8 +183,10 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
     start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
     n = round((stop - start) / step)
     bar = streaming.progress or SampleProgress(n + 1)
-    state = _Comparer(case, settings.mode, bar)
-    state.keep_all = len(case.references) > 1  # each table compared from the run's start: the run kept whole
+    mode = criteria_for(settings.mode, case.criteria, target.fmu.discrete_names())
+    state = _Comparer(case, mode, bar)
+    # each table compared from the run's start (several tables, per-signal criteria): the run kept whole
+    state.keep_all = len(case.references) > 1 or isinstance(mode, Criteria)
     seen = False  # the input envelopes are filled on the first reading of the table only
 
     def inputs():
@@ -213,7 +219,9 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
         state.results = results
         try:
             for reference in case.references:
-                if isinstance(settings.mode, Tube):
+                if isinstance(mode, Criteria):
+                    state.whole_rows([chunk for chunk in reference if len(chunk)])
+                elif isinstance(mode, Tube):
                     for chunk in reference:
                         state.tube_rows(chunk)
                     state.tube_rows(None)
@@ -337,6 +345,31 @@ class _Comparer:
                 bands[s] = Band(compared_times, values, lower, upper, ok, values - expected)
         self._add(bands)
 
+    def whole_rows(self, chunks):
+        """Per-signal criteria: the reference's chunks compared at once with
+        the whole run (Criteria.judge; a discrete signal's changes and a
+        tube's time used need the whole trace)."""
+        if not chunks:
+            return
+        rows = np.concatenate(chunks)
+        times, names = rows["time"], _signal_names(rows)
+        for s in names:
+            self.envelopes[("ref", s)].add(times, rows[s])
+        self.result_until(math.inf)
+        if not self.window:
+            self.absent_here, self.first_absent_here = len(rows), float(times[0])
+            return
+        result = np.concatenate([c for _, c in self.window])
+        assert isinstance(self.mode, Criteria)
+        deviations, bands, problem = self.mode.judge(result, rows, names)
+        if problem:  # the pointwise signals' reference times without a result sample
+            index = aligned(result["time"], times)
+            missing = np.flatnonzero(index == -1)
+            self.absent_here, self.first_absent_here = len(missing), float(times[missing[0]])
+        self._add(bands)
+        for s, deviation in deviations.items():
+            self.signals[s].deviation = deviation
+
     def tube_rows(self, rows):
         """A tube's comparison as Tube.bands makes it on the whole: adds
         reference rows (None: there are no more) and compares the result
@@ -355,7 +388,7 @@ class _Comparer:
         reference = self.reference
         last = float(reference["time"][-1])
         # the samples whose window ends before the last row (or all of them once the reference is whole)
-        covered = np.inf if rows is None else last - mode.time
+        covered = np.inf if rows is None else last - mode.time - 2 * float(time_slack(last))
         while True:
             if self.compared >= self.reached:
                 before = self.reached
@@ -378,7 +411,8 @@ class _Comparer:
             if take < len(result):
                 break
         # the rows the next sample's window needs: from the one before its time - the tube's time on
-        keep = int(np.searchsorted(reference["time"], float(result["time"][take]) - mode.time, side="left")) - 1
+        at = float(result["time"][take])
+        keep = int(np.searchsorted(reference["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
         self.reference = reference[max(keep, 0) :]
 
     def _add(self, bands):
@@ -427,6 +461,7 @@ class _Comparer:
         outcome.status = Status.PASS if passed else Status.FAIL
         outcome.deviations = [d for d in deviations if not d.passed]
         outcome.messages = [problem] if problem else [d.describe() for d in deviations if not d.passed]
+        outcome.messages += [d.describe() for d in deviations if d.passed and d.allowance]  # (per-signal criteria)
         if case.more_messages is not None:
             outcome.messages += case.more_messages(passed, outcome.deviations)
         if settings.plots == "all" or (settings.plots == "failed" and not passed):
@@ -438,7 +473,7 @@ class _Comparer:
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
             try:
-                outcome.png = draw(figure, settings.mode, labels["fmu"])
+                outcome.png = draw(figure, self.mode, labels["fmu"])
                 outcome.result_path = self.result.keep() or ""
             except Exception as error:  # (matplotlib's errors are many) a figure lost, not the verdict
                 outcome.messages.append(f"no plot: drawing it failed ({type(error).__name__}: {error})")

@@ -14,7 +14,7 @@ import sys
 
 from . import __version__
 from ._campaign import compare
-from ._comparison import comparison_mode
+from ._comparison import MODE_WORDS, comparison_mode, signal_criteria
 from ._executors import RunOptions
 from ._errors import ExitStatus, InputError, SimulationError
 from ._fmu import Fmu, is_fmu_file
@@ -47,6 +47,7 @@ FLAGS = {
     "tube_time": "--tube-time",
     "tube_value": "--tube-value",
     "resume": "--resume",
+    "signals": "--signal",
 }
 
 
@@ -144,6 +145,14 @@ def parser():
         help="tube half-width in time (with --tube-value), for traces sampled at other instants",
     )
     cmp.add_argument(FLAGS["tube_value"], type=_non_negative, metavar="V", help="tube half-width in value")
+    cmp.add_argument(
+        FLAGS["signals"],
+        type=_assignment,
+        action="append",
+        default=[],
+        metavar="NAME=MODE",
+        help=f"a signal's own criterion (a name or pattern, '*' for the rest; repeatable); MODE: {MODE_WORDS}",
+    )
     cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
     cmp.add_argument(
         "--jobs",
@@ -291,7 +300,11 @@ def compare_command(args, out):
     result = compare(
         fmus,
         cases,
-        mode=comparison_mode(args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, names=FLAGS),
+        mode=signal_criteria(
+            args.signal,
+            comparison_mode(args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, names=FLAGS),
+            FLAGS,
+        ),
         report=args.report,
         junit=args.junit,
         plots=args.plots,
