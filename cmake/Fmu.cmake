@@ -137,16 +137,36 @@ function(add_fmu model version)
   endif()
   list(SORT entries)
 
+  # the product models carry their reference scenarios as FMI-LS-REF experiments
+  # (modelDescription/references.py): the zip's entries are then its list
+  set(zip_entries -- ${entries})
+  set(references)
+  if(NOT ARG_TOML)
+    set(scenarios_dir ${CMAKE_SOURCE_DIR}/tests/scenarios/${model})
+    file(GLOB_RECURSE scenario_files CONFIGURE_DEPENDS ${scenarios_dir}/*)
+    list(JOIN entries "\n" entry_lines)
+    file(CONFIGURE OUTPUT ${gen}/fmi${version}/entries.txt CONTENT "${entry_lines}\n" @ONLY)
+    set(references ${gen}/fmi${version}/entries_ls_ref.txt)
+    add_custom_command(
+      OUTPUT ${references}
+      COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/modelDescription/references.py ${toml} ${scenarios_dir}
+              ${stage} ${gen}/fmi${version}/entries.txt ${references}
+      DEPENDS ${CMAKE_SOURCE_DIR}/modelDescription/references.py ${toml} ${scenario_files}
+              ${gen}/fmi${version}/entries.txt
+      COMMENT "Writing the reference experiments of fmi${version}/${model}")
+    set(zip_entries --files-from=${references})
+  endif()
+
   set(fmu ${out_dir}/${model}.fmu)
   add_custom_command(
     OUTPUT ${fmu}
     ${copies}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${out_dir}
-    COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" -- ${entries}
+    COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" ${zip_entries}
     COMMAND zip_normalize ${fmu}
     WORKING_DIRECTORY ${stage}
     DEPENDS zip_normalize ${lib} ${sources} ${unit} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs}
-            ${CMAKE_SOURCE_DIR}/LICENSE
+            ${CMAKE_SOURCE_DIR}/LICENSE ${references}
             ${cross_libraries}
     COMMENT "Packaging fmi${version}/${model}.fmu")
   add_custom_target(${lib}_fmu DEPENDS ${fmu})

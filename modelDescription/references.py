@@ -1,0 +1,201 @@
+#!/usr/bin/env python3
+"""Write the FMI-LS-REF folder of one FMU (docs/fmi.md, "Reference
+experiments"): its model's reference scenarios (tests/scenarios/<Model>/)
+as MA-HS-Experiments files, a smoke test and a validation set, each
+scenario's stimuli, reference and parameter set (SSP 1.0 .ssv), the
+manifest (fmi-ls-manifest.xml) that lists every file with its SHA-256 and
+each reference's comparison criteria; then the FMU's sorted zip entries.
+
+    references.py <Model>.toml <scenarios folder> <stage folder> <entries in> <entries out>
+
+The scenarios are the only source: the files are copied byte for byte
+(the references are the hand-worked ones), the experiment's times come
+from <Model>_ref.opt, its parameters from <Model>_start.csv.
+"""
+
+import hashlib
+import math
+import shutil
+import sys
+import tomllib
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+FOLDER = "extra/org.fmi-standard.fmi-ls-ref"
+MANIFEST = "fmi-ls-manifest.xml"
+LS_VERSION = "1.0.0-alpha.1"  # the version the standard's schema and example name
+ANNOTATION = "org.fmutrace"  # the annotation fmutrace writes and reads (docs/fmi.md)
+NAMESPACE = "urn:fmutrace:ls-ref:1"
+SMOKE_TESTS = 3  # the smoke test: the first scenarios by name
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+SSV_TYPES = {"Real": "Real", "Integer": "Integer", "Boolean": "Boolean", "String": "String"}
+OPTIONS = {"StartTime": "startTime", "StopTime": "stopTime", "StepSize": "stepSize", "RelTol": "tolerance"}
+
+
+def lines(path):
+    """The "name,value" lines of a small CSV file, comments and blanks left out."""
+    if not path.exists():
+        return []
+    rows = []
+    for line in path.read_text().splitlines():
+        line = line.strip()
+        if line and not line.startswith("#"):
+            name, _, value = line.partition(",")
+            rows.append((name.strip(), value.strip()))
+    return rows
+
+
+def ssv_value(type_name, literal):
+    """The SSV element of a start value's literal (xs:double spells NaN, INF)."""
+    if type_name == "Real":
+        value = float(literal)
+        if math.isnan(value):
+            literal = "NaN"
+        elif math.isinf(value):
+            literal = "INF" if value > 0 else "-INF"
+    elif type_name == "Boolean":
+        literal = literal.lower()
+    return f"<ssv:{type_name} value={quoteattr(literal)}/>"
+
+
+def parameter_set(name, values, types):
+    rows = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<ssv:ParameterSet xmlns:ssv="{SSV}" version="1.0" name={quoteattr(name)}>',
+        "  <ssv:Parameters>",
+    ]
+    for variable, literal in values:
+        type_name = SSV_TYPES.get(types[variable], "Integer")  # an enumeration: its integer
+        rows.append(f"    <ssv:Parameter name={quoteattr(variable)}>{ssv_value(type_name, literal)}</ssv:Parameter>")
+    return "\n".join(rows + ["  </ssv:Parameters>", "</ssv:ParameterSet>", ""])
+
+
+def experiments(title, description, scenarios):
+    rows = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f"<Experiments name={quoteattr(title)} description={quoteattr(description)}>",
+    ]
+    for s in scenarios:
+        times = "".join(f" {OPTIONS[k]}={quoteattr(v)}" for k, v in s["options"] if k in OPTIONS)
+        rows.append(f"  <Experiment name={quoteattr(s['name'])} description={quoteattr(s['description'])}{times}>")
+        if s["parameters"]:
+            rows.append(f'    <Parameters type="application/x-ssp-parameter-set" source="{s["parameters"]}"/>')
+        if s["stimuli"]:
+            rows.append(f'    <Stimuli type="text/csv" source="{s["stimuli"]}"/>')
+        rows.append(f'    <References type="text/csv" source="{s["reference"]}"/>')
+        rows.append("  </Experiment>")
+    return "\n".join(rows + ["</Experiments>", ""])
+
+
+def related(source, role, description, digest, labels=(), criteria=()):
+    """A manifest entry: its labels, then the annotation with its SHA-256
+    and, for a reference, each signal's criterion."""
+    rows = [
+        f'  <Related type="{media_type(source)}" source="{source}" role="{role}" description={quoteattr(description)}>'
+    ]
+    rows += [f"    <Label name={quoteattr(label)}/>" for label in labels]
+    rows += [
+        "    <Annotations>",
+        f'      <Annotation type="{ANNOTATION}">',
+        f'        <fmutrace:File xmlns:fmutrace="{NAMESPACE}" sha256="{digest}"/>',
+    ]
+    rows += [
+        f'        <fmutrace:Criterion xmlns:fmutrace="{NAMESPACE}" signal={quoteattr(s)} mode={quoteattr(m)}/>'
+        for s, m in criteria
+    ]
+    return rows + ["      </Annotation>", "    </Annotations>", "  </Related>"]
+
+
+def media_type(source):
+    return {
+        ".exp": "application/x-ma-hs-experiments",
+        ".ssv": "application/x-ssp-parameter-set",
+        ".csv": "text/csv",
+    }[Path(source).suffix]
+
+
+def reference_criteria(reference, criteria_file):
+    """Each reference signal's criterion: the scenario's <Model>_criteria.csv
+    for the signals it names, exact (the scenarios' bit-for-bit comparison)
+    for the others."""
+    header = reference.read_text().splitlines()[0]
+    signals = [n.strip().strip('"') for n in header.split(",")[1:]]
+    given = dict(lines(criteria_file))
+    default = given.pop("*", "exact")
+    return [(name, given.pop(name, default)) for name in signals] + sorted(given.items())
+
+
+def write(toml, scenarios_dir, stage, entries_in, entries_out):
+    spec = tomllib.loads(Path(toml).read_text())
+    model = spec["model"]["identifier"]
+    types = {v["name"]: v["type"] for v in spec["variable"]}
+    out = Path(stage) / FOLDER
+    shutil.rmtree(out, ignore_errors=True)
+    out.mkdir(parents=True)
+    files = {}  # source -> bytes
+
+    scenarios = []
+    for folder in sorted(p for p in Path(scenarios_dir).iterdir() if (p / f"{model}_ref.csv").exists()):
+        name = folder.name
+        readme = folder / "README.md"
+        first = readme.read_text().strip().splitlines()[0].lstrip("# ").strip() if readme.exists() else ""
+        s = {"name": name, "description": first, "options": lines(folder / f"{model}_ref.opt")}
+        s["reference"] = f"{name}/reference.csv"
+        files[s["reference"]] = (folder / f"{model}_ref.csv").read_bytes()
+        s["criteria"] = reference_criteria(folder / f"{model}_ref.csv", folder / f"{model}_criteria.csv")
+        s["stimuli"] = None
+        if (folder / f"{model}_in.csv").exists():
+            s["stimuli"] = f"{name}/stimuli.csv"
+            files[s["stimuli"]] = (folder / f"{model}_in.csv").read_bytes()
+        start = lines(folder / f"{model}_start.csv")
+        s["parameters"] = None
+        if start:
+            s["parameters"] = f"{name}/parameters.ssv"
+            files[s["parameters"]] = parameter_set(name, start, types).encode()
+        scenarios.append(s)
+
+    roles = (
+        ("smoke-test", f"{model}: smoke test, the first {SMOKE_TESTS} reference scenarios", scenarios[:SMOKE_TESTS]),
+        ("validation", f"{model}: validation, all {len(scenarios)} hand-worked reference scenarios", scenarios),
+    )
+    manifest = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        '<fmiReferences xmlns:fmi-ls="http://fmi-standard.org/fmi-ls-manifest"',
+        '  fmi-ls:fmi-ls-name="org.fmi-standard.fmi-ls-ref"',
+        f'  fmi-ls:fmi-ls-version="{LS_VERSION}"',
+        '  fmi-ls:fmi-ls-description="Layered Standard providing information on related files included in an FMU.">',
+    ]
+    for role, description, chosen in roles:
+        source = f"{role}.exp"
+        files[source] = experiments(f"{model} {role}", description, chosen).encode()
+        manifest += related(source, f"experiment/{role}", description, sha256(files[source]))
+    for s in scenarios:
+        label = [f"experiment:{s['name']}"]
+        if s["parameters"]:
+            digest = sha256(files[s["parameters"]])
+            manifest += related(s["parameters"], "testcase", f"{s['name']}: parameters", digest, label)
+        if s["stimuli"]:
+            digest = sha256(files[s["stimuli"]])
+            manifest += related(s["stimuli"], "testcase", f"{s['name']}: stimuli", digest, label)
+        digest = sha256(files[s["reference"]])
+        manifest += related(s["reference"], "result", f"{s['name']}: reference", digest, label, s["criteria"])
+    manifest += ["</fmiReferences>", ""]
+    files[MANIFEST] = "\n".join(manifest).encode()
+
+    for source, data in files.items():
+        path = out / source
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
+    entries = Path(entries_in).read_text().split()
+    entries += [f"{FOLDER}/{source}" for source in files]
+    Path(entries_out).write_text("".join(f"{e}\n" for e in sorted(entries)))
+
+
+def sha256(data):
+    return hashlib.sha256(data).hexdigest()
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 6:
+        sys.exit(__doc__.split("\n\n")[1])
+    write(*sys.argv[1:])
