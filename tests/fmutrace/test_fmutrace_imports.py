@@ -32,11 +32,13 @@ LAYERS = [
             "fmutrace._plot",
             "fmutrace._report",
             "fmutrace._journal",
+            "fmutrace._lsref",
         },
     ),
     ("one case", {"fmutrace._pipeline", "fmutrace._recording", "fmutrace._worker"}),
     ("where cases run", {"fmutrace._workers", "fmutrace._executors"}),
     ("campaign", {"fmutrace._campaign"}),
+    ("checks", {"fmutrace._check"}),
     ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__"}),
 ]
 PUBLIC = {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.recordings"}  # the readers' package

@@ -12,6 +12,7 @@ __version__ = "0.2.0"  # the package's version (pyproject.toml reads it from her
 
 from ._campaign import compare
 from ._cases import Case, find_cases, load_case
+from ._check import check
 from ._comparison import (
     Comparison,
     Criteria,
@@ -55,6 +56,7 @@ __all__ = [
     "TraceError",
     "Tube",
     "Ulps",
+    "check",
     "compare",
     "compare_traces",
     "comparison_mode",

@@ -2,6 +2,7 @@
 
   fmutrace run FMU [--input IN.csv] [--set NAME=VALUE]... [-o OUT.csv] ...
   fmutrace compare FMU... CASE... [--report DIR] [--rel-tol R] ...
+  fmutrace check FMU... [--role smoke-test|validation] [--report DIR] ...
 
 Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
 simulation, 2 bad input, 130 interrupted); compare's is its worst case's.
@@ -11,13 +12,16 @@ import argparse
 import contextlib
 import os
 import sys
+from functools import partial
 
 from . import __version__
 from ._campaign import compare
+from ._check import check
 from ._comparison import MODE_WORDS, comparison_mode, signal_criteria
 from ._executors import RunOptions
 from ._errors import ExitStatus, InputError, SimulationError
 from ._fmu import Fmu, is_fmu_file
+from ._lsref import ROLES
 from ._simulation import SimulationOptions, simulate_chunks
 from ._outcome import Status
 from ._report import text
@@ -32,6 +36,7 @@ EXAMPLES = """examples:
   fmutrace compare build/fmi3/RateLimiter.fmu my_traces/ --report report/
   fmutrace compare build/fmi3/LGF_LimRateOfChangeCI.fmu LGF_Ramp.csv     (a TwinCAT Scope export, say)
   fmutrace compare build/fmi2/*.fmu build/fmi3/*.fmu tests/scenarios --jobs 2 --junit junit.xml
+  fmutrace check build/fmi3/RateLimiter.fmu --role smoke-test     (the experiments it carries)
 """
 
 
@@ -94,7 +99,7 @@ def parser():
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     main.add_argument("--version", action="version", version=f"fmutrace {__version__}")
-    commands = main.add_subparsers(dest="command", required=True, metavar="{run,compare}")
+    commands = main.add_subparsers(dest="command", required=True, metavar="{run,compare,check}")
 
     run = commands.add_parser(
         "run",
@@ -117,13 +122,17 @@ def parser():
 
     cmp = commands.add_parser(
         "compare",
-        help="replay cases and recordings and compare with their references",
+        aliases=["check"],
+        help="replay cases and recordings and compare with their references; "
+        "check (or compare with FMUs alone): the experiments the FMUs carry (FMI-LS-REF)",
         description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
         "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
         "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
         "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF4, WinCC data logs, "
         "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
-        "Exact (bit for bit) unless a tolerance or a tube is given.",
+        "Exact (bit for bit) unless a tolerance or a tube is given. With FMUs alone (fmutrace "
+        "check FMU...): the experiments each FMU carries (FMI-LS-REF), by the criteria their "
+        "references carry.",
     )
     cmp.add_argument(
         "paths",
@@ -152,6 +161,11 @@ def parser():
         default=[],
         metavar="NAME=MODE",
         help=f"a signal's own criterion (a name or pattern, '*' for the rest; repeatable); MODE: {MODE_WORDS}",
+    )
+    cmp.add_argument(
+        "--role",
+        choices=ROLES,
+        help="with FMUs alone: the experiments of this role (default: every experiment the FMU carries)",
     )
     cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
     cmp.add_argument(
@@ -261,8 +275,8 @@ def compare_command(args, out):
     cases = [p for p in args.paths if p not in fmus]
     if not fmus:
         raise InputError("no FMU given: name one or more .fmu files before the case folders")
-    if not cases:
-        raise InputError("no case folder given: name the folders of cases after the FMUs")
+    if args.role and cases:
+        raise InputError("--role chooses among the experiments an FMU carries: give the FMUs alone")
     if args.resume and not args.report:
         raise InputError("--resume continues the campaign of a report folder: give it with --report")
     recordings = any(map(is_recording, cases))
@@ -297,9 +311,8 @@ def compare_command(args, out):
             "own settings (<Model>_ref.opt, <Model>_start.csv)",
             file=sys.stderr,
         )
-    result = compare(
-        fmus,
-        cases,
+    campaign = partial(compare, fmus, cases) if cases else partial(check, fmus, role=args.role)
+    result = campaign(
         mode=signal_criteria(
             args.signal,
             comparison_mode(args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, names=FLAGS),

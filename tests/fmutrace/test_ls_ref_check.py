@@ -1,0 +1,218 @@
+"""fmutrace check: the experiments an FMI-LS-REF FMU carries, run and
+compared as compare runs case folders (issue 43). Our FMUs' own
+experiments; an LS-REF FMU another tool wrote, built here from the
+standard's example manifest with its own stimuli and a reference worked by
+hand (README's first simulation: RateLimiter, rateUpPar 2, u steps 0 -> 10
+at t = 1, one 0.5 s cycle rises by 1); tampered files and checksums."""
+
+import contextlib
+import hashlib
+import io
+import re
+import zipfile
+
+import pytest
+
+import fmutrace
+from fmutrace import cli
+from support.fmu_driver import BUILD_DIR, MODELS
+from support.ls_ref import EXAMPLE, FOLDER
+from support.scenarios import fmu_path
+
+MANIFEST = f"{FOLDER}/fmi-ls-manifest.xml"
+ONE_JOB = fmutrace.RunOptions(jobs=1)
+
+
+def command(*args):
+    out = io.StringIO()
+    with contextlib.redirect_stderr(io.StringIO()) as err:
+        status = cli.main([*map(str, args), "--jobs", "1"], out=out)
+    return status, out.getvalue(), err.getvalue()
+
+
+def rewritten(source, target, changes, drop=lambda name: False):
+    """A copy of the FMU source with the entries changes names replaced (or added)."""
+    with zipfile.ZipFile(source) as old, zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as new:
+        for item in old.infolist():
+            if item.filename not in changes and not drop(item.filename):
+                new.writestr(item, old.read(item.filename))
+        for name, data in changes.items():
+            new.writestr(name, data)
+    return target
+
+
+def carried(name, model="RateLimiter", version=3):
+    with zipfile.ZipFile(fmu_path(BUILD_DIR, model, version)) as z:
+        return z.read(f"{FOLDER}/{name}")
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_every_fmu_passes_its_smoke_test(model, version, tmp_path):
+    result = fmutrace.check(fmu_path(BUILD_DIR, model, version), role="smoke-test", run=ONE_JOB)
+    assert result.passed, result.summary()
+    assert len(result.cases) == 3
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_every_fmu_passes_its_validation(model, version):
+    result = fmutrace.check(fmu_path(BUILD_DIR, model, version), role="validation", run=fmutrace.RunOptions(jobs=2))
+    expected = len(list((BUILD_DIR.parent / "tests" / "scenarios" / model).glob(f"*/{model}_ref.csv")))
+    assert result.passed, result.summary()
+    assert len(result.cases) == expected
+
+
+def test_the_command_reports_as_compare_does(tmp_path):
+    fmu = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    status, out, err = command(
+        "check", fmu, "--role", "smoke-test", "--report", tmp_path / "r", "--junit", tmp_path / "j.xml"
+    )
+    assert status == 0, out + err
+    assert (tmp_path / "r" / "index.html").exists()
+    junit = (tmp_path / "j.xml").read_text()
+    assert junit.count("<testcase") == 3 and "<failure" not in junit
+    # compare with the FMU alone does the same
+    status, out, err = command("compare", fmu, "--role", "smoke-test")
+    assert status == 0, out + err
+    # --role chooses among carried experiments only
+    status, _, err = command("compare", fmu, BUILD_DIR.parent / "tests" / "scenarios", "--role", "validation")
+    assert status == 2 and "--role" in err
+
+
+def test_a_changed_reference_fails_its_checksum(tmp_path):
+    reference = "asymmetric/reference.csv"
+    data = carried(reference).replace(b"\n2.5,3\n", b"\n2.5,3.5\n")
+    assert data != carried(reference)
+    fmu = rewritten(
+        fmu_path(BUILD_DIR, "RateLimiter", 3), tmp_path / "RateLimiter.fmu", {f"{FOLDER}/{reference}": data}
+    )
+    status, out, err = command("check", fmu)
+    assert status == 2, out + err
+    assert f"{FOLDER}/{reference}: its SHA-256 is not the manifest's" in err
+
+
+def test_a_changed_checksum_fails_and_a_consistent_change_is_a_difference(tmp_path):
+    source = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    reference = "asymmetric/reference.csv"
+    manifest = carried("fmi-ls-manifest.xml").decode()
+    old = hashlib.sha256(carried(reference)).hexdigest()
+    fmu = rewritten(source, tmp_path / "a.fmu", {MANIFEST: manifest.replace(old, "0" * 64)})
+    status, _, err = command("check", fmu, "--role", "smoke-test")
+    assert status == 2 and "its SHA-256 is not the manifest's" in err
+    # the reference changed and its checksum with it: the FMU now differs from it (y at 2.5 s is 3, docs/rules.md)
+    data = carried(reference).replace(b"\n2.5,3\n", b"\n2.5,3.5\n")
+    new = hashlib.sha256(data).hexdigest()
+    fmu = rewritten(source, tmp_path / "b.fmu", {MANIFEST: manifest.replace(old, new), f"{FOLDER}/{reference}": data})
+    result = fmutrace.check(fmu, role="validation", run=ONE_JOB)
+    failed = [o.case for o in result.failed(results=False)]
+    assert failed == ["validation/asymmetric"], result.summary()
+    assert result.exit_code == 1
+
+
+def test_the_criteria_a_reference_carries_judge_it(tmp_path):
+    """A reference 0.5 off at 2.5 s: its carried criterion (exact) fails it
+    whatever the user's tolerance; a carried tolerance of 1 passes it."""
+    source = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    reference = "asymmetric/reference.csv"
+    manifest = carried("fmi-ls-manifest.xml").decode()
+    data = carried(reference).replace(b"\n2.5,3\n", b"\n2.5,3.5\n")
+    manifest = manifest.replace(hashlib.sha256(carried(reference)).hexdigest(), hashlib.sha256(data).hexdigest())
+    changes = {MANIFEST: manifest, f"{FOLDER}/{reference}": data}
+    fmu = rewritten(source, tmp_path / "a.fmu", changes)
+    assert command("check", fmu, "--role", "validation", "--abs-tol", "1")[0] == 1
+    start = manifest.index(f'source="{reference}"')
+    criterion = 'signal="y" mode="exact"'
+    at = manifest.index(criterion, start)
+    changes[MANIFEST] = manifest[:at] + 'signal="y" mode="tol:abs=1,rel=0"' + manifest[at + len(criterion) :]
+    fmu = rewritten(source, tmp_path / "b.fmu", changes)
+    status, out, err = command("check", fmu, "--role", "validation")
+    assert status == 0, out + err
+
+
+def test_a_bad_manifest_is_bad_input(tmp_path):
+    source = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    for manifest, message in [
+        (b"<fmiReferences", "not XML"),
+        (b"<other/>", "not an FMI-LS-REF manifest"),
+    ]:
+        fmu = rewritten(source, tmp_path / "x.fmu", {MANIFEST: manifest})
+        status, _, err = command("check", fmu)
+        assert status == 2 and message in err, err
+    bare = rewritten(source, tmp_path / "bare.fmu", {}, drop=lambda name: name.startswith(FOLDER))
+    status, _, err = command("check", bare)
+    assert status == 2 and "carries no FMI-LS-REF experiments" in err, err
+
+
+# ---- an LS-REF FMU another tool wrote ------------------------------------------------
+
+# its stimuli and reference: README's first simulation, worked by hand
+STIMULI = "Time;u\n0;0\n1;10\n"  # another dialect: ';' and 'Time'
+TIMES = [k / 2 for k in range(17)]
+REFERENCE = "time,y\n" + "".join(f"{t},{min(max(2 * (t - 1), 0), 10):g}\n" for t in TIMES)
+EXPERIMENTS = """<?xml version="1.0" encoding="UTF-8"?>
+<Experiments name="smoke tests">
+  <Experiment name="step" startTime="0" stopTime="8" stepSize="0.5">
+    <Parameters type="application/x-ssp-parameter-set" source="baseline-params.ssv"/>
+    <Stimuli type="text/csv" source="data/step_in.csv"/>
+    <References type="text/csv" source="data/step_ref.csv"/>
+  </Experiment>
+</Experiments>
+"""
+BASELINE = """<?xml version="1.0" encoding="UTF-8"?>
+<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" version="1.0" name="baseline">
+  <ssv:Parameters>
+    <ssv:Parameter name="rateUpPar"><ssv:Real value="2"/></ssv:Parameter>
+  </ssv:Parameters>
+</ssv:ParameterSet>
+"""
+
+
+def foreign_fmu(tmp_path, reference=REFERENCE):
+    """RateLimiter (FMI 3) without our experiments, with the standard's
+    example manifest as it is (it names files that are not there: a model
+    source, other parameter sets, meta-data) and the files its experiment
+    needs: no checksums, no criteria."""
+    changes = {
+        MANIFEST: EXAMPLE.read_bytes(),
+        f"{FOLDER}/smoke-tests.exp": EXPERIMENTS,
+        f"{FOLDER}/baseline-params.ssv": BASELINE,
+        f"{FOLDER}/data/step_in.csv": STIMULI,
+        f"{FOLDER}/data/step_ref.csv": reference,
+    }
+    return rewritten(
+        fmu_path(BUILD_DIR, "RateLimiter", 3), tmp_path / "Foreign.fmu", changes, lambda n: n.startswith(FOLDER)
+    )
+
+
+def test_the_reference_is_the_one_worked_by_hand():
+    assert REFERENCE.splitlines()[1:5] == ["0.0,0", "0.5,0", "1.0,0", "1.5,1"]
+    assert REFERENCE.splitlines()[-5:] == ["6.0,10", "6.5,10", "7.0,10", "7.5,10", "8.0,10"]
+
+
+def test_an_ls_ref_fmu_another_tool_wrote_is_checked(tmp_path):
+    fmu = foreign_fmu(tmp_path)
+    status, out, err = command("check", fmu)
+    assert status == 0, out + err
+    assert "1 passed" in out or re.search(r"\b1\b.*pass", out), out
+    # an experiment without a sub-role is a smoke test (the standard); it is no validation
+    assert command("check", fmu, "--role", "smoke-test")[0] == 0
+    status, _, err = command("check", fmu, "--role", "validation")
+    assert status == 2 and "carries no experiment of role validation" in err
+
+
+def test_without_criteria_the_users_choice_judges(tmp_path):
+    off = REFERENCE.replace("\n1.5,1\n", "\n1.5,1.000000001\n")
+    fmu = foreign_fmu(tmp_path, off)
+    assert command("check", fmu)[0] == 1  # the stated default: bit for bit
+    assert command("check", fmu, "--abs-tol", "1e-8")[0] == 0
+    assert command("check", fmu, "--abs-tol", "1e-10")[0] == 1
+
+
+def test_an_experiment_file_outside_the_fmu_is_refused(tmp_path):
+    fmu = foreign_fmu(tmp_path)
+    escaped = EXPERIMENTS.replace("data/step_ref.csv", "../../../step_ref.csv")
+    bad = rewritten(fmu, tmp_path / "Escaped.fmu", {f"{FOLDER}/smoke-tests.exp": escaped})
+    status, _, err = command("check", bad)
+    assert status == 2 and "leaves the FMU" in err, err
