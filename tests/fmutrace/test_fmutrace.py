@@ -372,7 +372,7 @@ def test_bad_input_exits_2_naming_file_line_and_column(bad, tmp_path):
         ),
         (("run", "{fmu}", "--set", "rateUpPar"), "expected NAME=VALUE"),
         (("run", "missing.fmu"), "missing.fmu: no such FMU file"),
-        (("compare", "{fmu}"), "no case folder given"),
+        (("compare", "{lag}"), "carries no FMI-LS-REF experiments (no extra/org.fmi-standard.fmi-ls-ref/fmi-ls"),
         (("compare", "{cases}"), "no FMU given"),
         (("compare", "{fmu}", "{nothing}"), "no such folder"),
         (("compare", "{lag}", "{cases}"), "no case of FirstOrderLag (FMI 3) (no FirstOrderLag_ref.csv)"),

@@ -81,6 +81,16 @@ def test_the_command_reports_as_compare_does(tmp_path):
     assert status == 2 and "--role" in err
 
 
+def test_fmus_of_one_model_run_its_experiments_each_and_are_each_checked(tmp_path):
+    fmus = [fmu_path(BUILD_DIR, "RateLimiter", 2), fmu_path(BUILD_DIR, "RateLimiter", 3)]
+    result = fmutrace.check(fmus, role="smoke-test", run=ONE_JOB)
+    assert result.passed and len(result.cases) == 6, result.summary()
+    reference = "asymmetric/reference.csv"
+    tampered = rewritten(fmus[1], tmp_path / "RateLimiter.fmu", {f"{FOLDER}/{reference}": b"time,y\n0,0\n"})
+    status, _, err = command("check", fmus[0], tampered, "--role", "smoke-test")
+    assert status == 2 and f"{tampered}: {FOLDER}/{reference}: its SHA-256" in err, err
+
+
 def test_a_changed_reference_fails_its_checksum(tmp_path):
     reference = "asymmetric/reference.csv"
     data = carried(reference).replace(b"\n2.5,3\n", b"\n2.5,3.5\n")

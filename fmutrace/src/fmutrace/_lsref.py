@@ -53,7 +53,9 @@ def manifest(fmu_zip: zipfile.ZipFile, label: str) -> list[Related]:
     try:
         root = ElementTree.fromstring(fmu_zip.read(MANIFEST))
     except KeyError:
-        raise InputError(f"{label} carries no FMI-LS-REF experiments (no {MANIFEST})") from None
+        raise InputError(
+            f"{label} carries no FMI-LS-REF experiments (no {MANIFEST}): give case folders after it"
+        ) from None
     except ElementTree.ParseError as error:
         raise InputError(f"{label}: {MANIFEST}: not XML ({error})") from None
     if root.tag != "fmiReferences" or root.get(f"{LS}fmi-ls-name") != LS_NAME:
