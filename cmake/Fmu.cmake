@@ -114,6 +114,7 @@ function(add_fmu model version)
               ${toml} ${stage} ${version} ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c
       DEPENDS ${lib} ${toml} ${CMAKE_SOURCE_DIR}/modelDescription/document.py ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c
               ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.h ${gen}/fmi${version}/modelDescription.xml
+              ${gen}/fmi${version}/entries_ls_ref.txt  # (its page lists the experiments: references.py below)
       COMMENT "Documenting fmi${version}/${model}")
     list(APPEND entries ${doc_files})
   endif()

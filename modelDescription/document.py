@@ -118,7 +118,49 @@ def licence(stage):
     )
 
 
-def page(model, version, codes, licence_html):
+INTERFACES = (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
+LS_REF = "extra/org.fmi-standard.fmi-ls-ref"
+
+
+def interfaces(stage, version):
+    """What the FMU carries, as a sentence: the interfaces its model
+    description declares, its C sources, the layered standard."""
+    root = ElementTree.parse(stage / "modelDescription.xml").getroot()
+    kinds = " and ".join(name for tag, name in INTERFACES if root.find(tag) is not None)
+    carried = [f"FMI {version}.0 {kinds}", "its C sources (<code>sources/</code>, any platform can compile them)"]
+    if (stage / LS_REF / "fmi-ls-manifest.xml").exists():
+        carried.append("its reference experiments (FMI-LS-REF, below)")
+    return "It carries " + ", ".join(carried[:-1]) + " and " + carried[-1] + "."
+
+
+def experiments(stage, model):
+    """The experiments the FMU carries (references.py wrote them), each file
+    with its role, its experiments and the one command that runs them."""
+    files = sorted((stage / LS_REF).glob("*.exp"))
+    if not files:
+        return ""
+    fmu = f"{model['model']['identifier']}.fmu"
+    parts = [
+        "<h2>Reference experiments (FMI-LS-REF)</h2>",
+        f"<p>The FMU carries its hand-worked reference scenarios in <code>{LS_REF}/</code>: the manifest "
+        "<code>fmi-ls-manifest.xml</code> lists every file with its SHA-256 and each reference signal's comparison "
+        "criterion (an <code>org.fmutrace</code> annotation), each experiment file (MA-HS-Experiments) its "
+        "experiments' times, parameter set (SSP <code>.ssv</code>), stimuli and reference (CSV). Run them all, "
+        f"compared with those criteria:</p><pre>fmutrace check {fmu}</pre>"
+        f"<p>(<code>--role smoke-test</code> for the smoke test alone; fmutrace is in the project's repository.)</p>",
+    ]
+    for path in files:
+        root = ElementTree.parse(path).getroot()
+        parts.append(f"<h3>{html.escape(path.name)}: {html.escape(root.get('description', ''))}</h3><ul>")
+        parts += [
+            f"<li><code>{html.escape(e.get('name'))}</code>: {html.escape(e.get('description', ''))}</li>"
+            for e in root.iterfind("Experiment")
+        ]
+        parts.append("</ul>")
+    return "\n".join(parts)
+
+
+def page(model, version, codes, licence_html, carried="", experiments_html=""):
     m = model["model"]
     style = (
         "body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}\n"
@@ -162,7 +204,7 @@ def page(model, version, codes, licence_html):
 <style>{style}</style>
 </head><body>
 <h1>{html.escape(m["identifier"])}</h1>
-<p>{html.escape(m.get("description", ""))}. FMI {version}.0 Co-Simulation.</p>
+<p>{html.escape(m.get("description", ""))}. {carried}</p>
 <h2>What it does</h2>
 <p>Each communication step stands for the PLC's cyclic interrupt: in every cycle the output moves towards the
 input by at most the rising or falling rate times the cycle length, or follows it at once where the block's
@@ -178,6 +220,7 @@ so long runs do not drift.</p>
 {status}
 <h2>Default experiment</h2>
 <p>start {cell(de.get("startTime"))} s, stop {cell(de.get("stopTime"))} s, step {cell(de.get("stepSize"))} s.</p>
+{experiments_html}
 <h2>Errors</h2>
 <p>A call that cannot be carried out (wrong state, unknown or wrong-type variable, a value outside its range, a
 step size that is not finite and positive, a communication point that is not the FMU's time) returns an error
@@ -195,7 +238,15 @@ def main(toml, stage, version, status_source):
     docs = stage / "documentation"
     docs.mkdir(parents=True, exist_ok=True)
     (docs / "index.html").write_text(
-        page(model, int(version), status_codes(status_source), licence(stage)), encoding="utf-8"
+        page(
+            model,
+            int(version),
+            status_codes(status_source),
+            licence(stage),
+            interfaces(stage, int(version)),
+            experiments(stage, model),
+        ),
+        encoding="utf-8",
     )
     ramp_plot(model, stage, docs / "ramp.png")
     if int(version) == 2:

@@ -117,3 +117,21 @@ def test_every_reference_carries_each_signals_criterion():
         header = files[related.get("source")].decode().splitlines()[0].split(",")[1:]
         criteria = {c.get("signal"): c.get("mode") for c in related.iterfind("Annotations/Annotation/ft:Criterion", NS)}
         assert criteria == dict.fromkeys(header, "exact")  # no scenario has its own: bit for bit
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_the_documentation_names_the_interfaces_and_the_experiments(model, version):
+    with zipfile.ZipFile(fmu_file(model, version)) as z:
+        page = z.read("documentation/index.html").decode()
+        description = etree.fromstring(z.read("modelDescription.xml"))
+    kinds = [
+        name
+        for tag, name in (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
+        if description.find(tag) is not None
+    ]
+    assert kinds == ["Co-Simulation", "Model Exchange"]  # what every product model implements (docs/fmi.md)
+    assert f"It carries FMI {version}.0 Co-Simulation and Model Exchange" in page
+    assert f"<pre>fmutrace check {model}.fmu</pre>" in page
+    for name in scenario_names(model):
+        assert f"<li><code>{name}</code>" in page
