@@ -15,6 +15,7 @@ import pytest
 
 import fmutrace
 from fmutrace import cli
+from fmutrace._lsref import wanted
 from support.fmu_driver import BUILD_DIR, MODELS
 from support.ls_ref import EXAMPLE, FOLDER
 from support.scenarios import fmu_path
@@ -226,3 +227,11 @@ def test_an_experiment_file_outside_the_fmu_is_refused(tmp_path):
     bad = rewritten(fmu, tmp_path / "Escaped.fmu", {f"{FOLDER}/smoke-tests.exp": escaped})
     status, _, err = command("check", bad)
     assert status == 2 and "leaves the FMU" in err, err
+
+
+def test_which_experiment_files_run():
+    # no sub-role: a smoke test (the standard); an uncertainty analysis has no reference to compare with
+    assert [wanted("experiment", r) for r in (None, "smoke-test", "validation")] == [True, True, False]
+    assert [wanted("experiment/validation", r) for r in (None, "smoke-test", "validation")] == [True, False, True]
+    assert not any(wanted("experiment/uncertainty-analysis", r) for r in (None, "smoke-test", "validation"))
+    assert not wanted("parameter", None) and not wanted("result", None)

@@ -105,11 +105,12 @@ def checked(fmu_zip, label, path, digests):
 
 def wanted(role: str, chosen: str | None) -> bool:
     """Whether an experiment file of role is run for the role chosen (None:
-    every one); an experiment without a sub-role is a smoke test (the standard)."""
+    smoke tests and validations); an experiment without a sub-role is a
+    smoke test (the standard); an uncertainty analysis is never run."""
     if role != "experiment" and not role.startswith("experiment/"):
         return False
     sub = role.partition("/")[2] or "smoke-test"
-    return chosen is None or sub == chosen
+    return sub in ROLES and (chosen is None or sub == chosen)
 
 
 def experiments(fmu_zip, label, role: str | None = None):
