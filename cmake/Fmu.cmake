@@ -148,12 +148,22 @@ function(add_fmu model version)
     list(JOIN entries "\n" entry_lines)
     file(CONFIGURE OUTPUT ${gen}/fmi${version}/entries.txt CONTENT "${entry_lines}\n" @ONLY)
     set(references ${gen}/fmi${version}/entries_ls_ref.txt)
+    # the state after the first half of the first scenario, from the staged FMU (state.py)
+    set(state ${gen}/fmi${version}/first_half.fmustate)
+    add_custom_command(
+      OUTPUT ${state}
+      COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
+      COMMAND ${RUN_FMU_TOOL} ${VENV_PYTHON} ${CMAKE_SOURCE_DIR}/modelDescription/state.py ${stage} ${version}
+              ${scenarios_dir} ${state}
+      DEPENDS ${lib} ${CMAKE_SOURCE_DIR}/modelDescription/state.py ${CMAKE_SOURCE_DIR}/modelDescription/references.py
+              ${gen}/fmi${version}/modelDescription.xml ${scenario_files}
+      COMMENT "Serializing a state of fmi${version}/${model}")
     add_custom_command(
       OUTPUT ${references}
       COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/modelDescription/references.py ${toml} ${scenarios_dir}
-              ${stage} ${gen}/fmi${version}/entries.txt ${references}
+              ${stage} ${gen}/fmi${version}/entries.txt ${references} ${state}
       DEPENDS ${CMAKE_SOURCE_DIR}/modelDescription/references.py ${toml} ${scenario_files}
-              ${gen}/fmi${version}/entries.txt
+              ${gen}/fmi${version}/entries.txt ${state}
       COMMENT "Writing the reference experiments of fmi${version}/${model}")
     set(zip_entries --files-from=${references})
   endif()

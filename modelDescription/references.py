@@ -6,7 +6,10 @@ scenario's stimuli, reference and parameter set (SSP 1.0 .ssv), the
 manifest (fmi-ls-manifest.xml) that lists every file with its SHA-256 and
 each reference's comparison criteria; then the FMU's sorted zip entries.
 
-    references.py <Model>.toml <scenarios folder> <stage folder> <entries in> <entries out>
+    references.py <Model>.toml <scenarios folder> <stage folder> <entries in> <entries out> [<state>]
+
+<state>: the serialized state state.py wrote (after the first half of the
+first scenario), carried with the role serialized-state.
 
 The scenarios are the only source: the files are copied byte for byte
 (the references are the hand-worked ones), the experiment's times come
@@ -87,9 +90,9 @@ def experiments(title, description, scenarios):
     return "\n".join(rows + ["</Experiments>", ""])
 
 
-def related(source, role, description, digest, labels=(), criteria=()):
+def related(source, role, description, digest, labels=(), criteria=(), extra=None):
     """A manifest entry: its labels, then the annotation with its SHA-256
-    and, for a reference, each signal's criterion."""
+    and, for a reference, each signal's criterion (extra: one more element)."""
     rows = [
         f'  <Related type="{media_type(source)}" source="{source}" role="{role}" description={quoteattr(description)}>'
     ]
@@ -103,6 +106,7 @@ def related(source, role, description, digest, labels=(), criteria=()):
         f'        <fmutrace:Criterion xmlns:fmutrace="{NAMESPACE}" signal={quoteattr(s)} mode={quoteattr(m)}/>'
         for s, m in criteria
     ]
+    rows += [f"        {extra}"] if extra else []
     return rows + ["      </Annotation>", "    </Annotations>", "  </Related>"]
 
 
@@ -111,6 +115,7 @@ def media_type(source):
         ".exp": "application/x-ma-hs-experiments",
         ".ssv": "application/x-ssp-parameter-set",
         ".csv": "text/csv",
+        ".fmustate": "application/octet-stream",
     }[Path(source).suffix]
 
 
@@ -125,7 +130,39 @@ def reference_criteria(reference, criteria_file):
     return [(name, given.pop(name, default)) for name in signals] + sorted(given.items())
 
 
-def write(toml, scenarios_dir, stage, entries_in, entries_out):
+def scenario_folders(scenarios_dir, model):
+    """The model's scenario folders, by name: the smoke test's come first."""
+    return sorted(p for p in Path(scenarios_dir).iterdir() if (p / f"{model}_ref.csv").exists())
+
+
+def half_steps(options):
+    """(start, step, steps of the first half, steps in all) of a scenario's
+    options (_ref.opt): where the carried state is taken."""
+    start, stop, step = (float(options[k]) for k in ("StartTime", "StopTime", "StepSize"))
+    steps = round((stop - start) / step)
+    return start, step, steps // 2, steps
+
+
+def state_entry(scenario, state):
+    """The carried state's file name, bytes and manifest entry."""
+    start, step, half, steps = half_steps(dict(scenario["options"]))
+    name = scenario["name"]
+    source = f"serialized-state/{name}.fmustate"
+    data = Path(state).read_bytes()
+    time = start + half * step
+    description = (
+        f"{name}: the FMU's state after {half} of its {steps} communication steps (t = {time:g} s), "
+        "serialized; deserialized, the second half meets the reference"
+    )
+    extra = f'<fmutrace:State xmlns:fmutrace="{NAMESPACE}" experiment="{name}" steps="{half}" time="{time!r}"/>'
+    return (
+        source,
+        data,
+        related(source, "serialized-state", description, sha256(data), [f"experiment:{name}"], (), extra),
+    )
+
+
+def write(toml, scenarios_dir, stage, entries_in, entries_out, state=None):
     spec = tomllib.loads(Path(toml).read_text())
     model = spec["model"]["identifier"]
     types = {v["name"]: v["type"] for v in spec["variable"]}
@@ -135,7 +172,7 @@ def write(toml, scenarios_dir, stage, entries_in, entries_out):
     files = {}  # source -> bytes
 
     scenarios = []
-    for folder in sorted(p for p in Path(scenarios_dir).iterdir() if (p / f"{model}_ref.csv").exists()):
+    for folder in scenario_folders(scenarios_dir, model):
         name = folder.name
         readme = folder / "README.md"
         first = readme.read_text().strip().splitlines()[0].lstrip("# ").strip() if readme.exists() else ""
@@ -179,6 +216,9 @@ def write(toml, scenarios_dir, stage, entries_in, entries_out):
             manifest += related(s["stimuli"], "testcase", f"{s['name']}: stimuli", digest, label)
         digest = sha256(files[s["reference"]])
         manifest += related(s["reference"], "result", f"{s['name']}: reference", digest, label, s["criteria"])
+    if state:
+        source, files[source], entry = state_entry(scenarios[0], state)
+        manifest += entry
     manifest += ["</fmiReferences>", ""]
     files[MANIFEST] = "\n".join(manifest).encode()
 
@@ -196,6 +236,6 @@ def sha256(data):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 6:
+    if len(sys.argv) not in (6, 7):
         sys.exit(__doc__.split("\n\n")[1])
     write(*sys.argv[1:])
