@@ -8,7 +8,6 @@ at t = 1, one 0.5 s cycle rises by 1); tampered files and checksums."""
 import contextlib
 import hashlib
 import io
-import re
 import zipfile
 
 import pytest
@@ -206,7 +205,7 @@ def test_an_ls_ref_fmu_another_tool_wrote_is_checked(tmp_path):
     fmu = foreign_fmu(tmp_path)
     status, out, err = command("check", fmu)
     assert status == 0, out + err
-    assert "1 passed" in out or re.search(r"\b1\b.*pass", out), out
+    assert "1 of 1 cases pass" in out, out
     # an experiment without a sub-role is a smoke test (the standard); it is no validation
     assert command("check", fmu, "--role", "smoke-test")[0] == 0
     status, _, err = command("check", fmu, "--role", "validation")
