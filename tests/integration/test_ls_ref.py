@@ -9,6 +9,7 @@ import hashlib
 import io
 import math
 import re
+import struct
 import zipfile
 
 import pytest
@@ -135,3 +136,21 @@ def test_the_documentation_names_the_interfaces_and_the_experiments(model, versi
     assert f"<pre>fmutrace check {model}.fmu</pre>" in page
     for name in scenario_names(model):
         assert f"<li><code>{name}</code>" in page
+
+
+BUDGET = 64 * 1024  # what the experiments may add to an FMU (docs/fmi.md)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("model", MODELS)
+def test_the_experiments_stay_within_their_size_budget(model, version):
+    path = fmu_file(model, version)
+    data = path.read_bytes()
+    added = 0
+    with zipfile.ZipFile(path) as z:
+        for i in z.infolist():
+            if i.filename.startswith(FOLDER):  # its bytes in the zip: local header, data, descriptor, central entry
+                name_length, extra_length = struct.unpack_from("<HH", data, i.header_offset + 26)
+                local = 30 + name_length + extra_length + i.compress_size + (16 if i.flag_bits & 8 else 0)
+                added += local + 46 + len(i.orig_filename.encode()) + len(i.extra) + len(i.comment)
+    assert 0 < added <= BUDGET, added
