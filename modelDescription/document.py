@@ -157,6 +157,12 @@ def experiments(stage, model):
             for e in root.iterfind("Experiment")
         ]
         parts.append("</ul>")
+    for state in sorted((stage / LS_REF / "serialized-state").glob("*.fmustate")):
+        parts.append(
+            f"<p><code>serialized-state/{html.escape(state.name)}</code>: the FMU's state half-way through the "
+            f"experiment <code>{html.escape(state.stem)}</code>, serialized (the manifest gives the step and time): "
+            "deserialized on any platform, the experiment's second half meets its reference.</p>"
+        )
     return "\n".join(parts)
 
 

@@ -136,6 +136,7 @@ def test_the_documentation_names_the_interfaces_and_the_experiments(model, versi
     assert f"<pre>fmutrace check {model}.fmu</pre>" in page
     for name in scenario_names(model):
         assert f"<li><code>{name}</code>" in page
+    assert f"<code>serialized-state/{scenario_names(model)[0]}.fmustate</code>" in page
 
 
 BUDGET = 64 * 1024  # what the experiments may add to an FMU (docs/fmi.md)
