@@ -234,3 +234,22 @@ def test_which_experiment_files_run():
     assert [wanted("experiment/validation", r) for r in (None, "smoke-test", "validation")] == [True, False, True]
     assert not any(wanted("experiment/uncertainty-analysis", r) for r in (None, "smoke-test", "validation"))
     assert not wanted("parameter", None) and not wanted("result", None)
+
+
+def test_experiment_names_stay_inside_the_case_folder(tmp_path):
+    """An experiment's name becomes a folder: '../..' and separators are
+    made safe, two experiments of one name both run; a source may be
+    percent-encoded (a relative URI)."""
+    experiments = EXPERIMENTS.replace('name="step"', 'name="../../escape"')
+    second = experiments[experiments.index("  <Experiment ") : experiments.index("</Experiments>")]
+    second = second.replace('stepSize="0.5"', 'stepSize="0.5" tolerance="1e-6"')  # another experiment, one name
+    experiments = experiments.replace("</Experiments>", second + "</Experiments>")
+    experiments = experiments.replace('source="data/step_ref.csv"', 'source="data/step%5Fref.csv"', 1)
+    fmu = rewritten(foreign_fmu(tmp_path), tmp_path / "Named.fmu", {f"{FOLDER}/smoke-tests.exp": experiments})
+    result = fmutrace.check(fmu, run=ONE_JOB, report=tmp_path / "report")
+    assert result.passed and len(result.cases) == 2, result.summary()
+    assert not (tmp_path / "escape").exists() and not (tmp_path / "report" / "escape").exists()
+    root = (tmp_path / "report" / "experiments").resolve()  # <root>/<n>-<Model>/<file>/<experiment>/
+    written = sorted((tmp_path / "report" / "experiments").rglob("RateLimiter_ref.csv"))
+    assert len(written) == 2 and all(p.resolve().parents[3] == root for p in written), written
+    assert written[0].parent.name + "-2" == written[1].parent.name  # one name, made unique

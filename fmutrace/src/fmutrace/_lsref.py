@@ -15,11 +15,13 @@ no checksums or criteria is read as it is (the campaign's mode judges it).
 import hashlib
 import posixpath
 import zipfile
+from urllib.parse import unquote
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.etree import ElementTree
 
 from ._errors import InputError
+from ._report import file_name
 
 FOLDER = "extra/org.fmi-standard.fmi-ls-ref/"
 MANIFEST = FOLDER + "fmi-ls-manifest.xml"
@@ -42,7 +44,7 @@ class Related:
 
 @dataclass
 class Experiment:
-    name: str  # <experiment file's stem>/<experiment's name>
+    name: str  # <experiment file's stem>/<experiment's name>, each a safe file name, unique
     description: str
     options: dict  # cross-check option -> text
     files: dict  # "parameters", "stimuli", "references" -> path in the FMU
@@ -83,7 +85,7 @@ def _inside(label, base, source):
     for an absolute URI or one that leaves the FMU."""
     if "://" in source or source.startswith("/"):
         raise InputError(f"{label}: {source!r}: only files inside the FMU are read (a relative path)")
-    path = posixpath.normpath(posixpath.join(base, source))
+    path = posixpath.normpath(posixpath.join(base, unquote(source)))
     if path.startswith("../") or path == "..":
         raise InputError(f"{label}: {source!r} leaves the FMU")
     return path
@@ -123,7 +125,9 @@ def experiments(fmu_zip, label, role: str | None = None):
     for path in digests:  # a tampered file fails whatever is run
         checked(fmu_zip, label, path, digests)
     criteria = {r.source: r.criteria for r in entries if r.criteria}
-    found, seen = [], set()
+    found: list[Experiment] = []
+    seen: set[tuple] = set()
+    names: set[str] = set()
     for related in entries:
         if not wanted(related.role, role):
             continue
@@ -143,14 +147,25 @@ def experiments(fmu_zip, label, role: str | None = None):
                     files[key] = _inside(label, base, child.get("source"))
             if "references" not in files:
                 raise InputError(f"{label}: {related.source}: experiment {name!r} has no References")
-            if (name, files["references"]) in seen:  # the smoke test's experiments are the validation's too
-                continue
-            seen.add((name, files["references"]))
             options = {key: element.get(attr) for attr, key in OPTIONS if element.get(attr) is not None}
-            found.append(Experiment(f"{stem}/{name}", element.get("description", ""), options, files))
+            identity = (name, tuple(options.items()), tuple(sorted(files.items())))
+            if identity in seen:  # the smoke test's experiments are the validation's too
+                continue
+            seen.add(identity)
+            folder = unique(f"{file_name(stem)}/{file_name(name)}", names)
+            found.append(Experiment(folder, element.get("description", ""), options, files))
     if not found:
         raise InputError(f"{label} carries no experiment{f' of role {role}' if role else ''}")
     return found, criteria, digests
+
+
+def unique(name, taken):
+    """name, or name-2, name-3, ... if it is taken (two experiments of one name)."""
+    candidate, n = name, 2
+    while candidate in taken:
+        candidate, n = f"{name}-{n}", n + 1
+    taken.add(candidate)
+    return candidate
 
 
 def parameter_lines(label, path, data):
