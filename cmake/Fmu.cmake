@@ -105,7 +105,7 @@ function(add_fmu model version)
     else()
       set(icon terminalsAndIcons/icon.png)
     endif()
-    set(doc_files documentation/index.html documentation/ramp.png ${icon})
+    set(doc_files documentation/index.html documentation/fmi-ls-ref.html documentation/ramp.png ${icon})
     list(TRANSFORM doc_files PREPEND ${stage}/ OUTPUT_VARIABLE docs)
     add_custom_command(
       OUTPUT ${docs}

@@ -120,6 +120,7 @@ def licence(stage):
 
 INTERFACES = (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
 LS_REF = "extra/org.fmi-standard.fmi-ls-ref"
+STANDALONE = '<p>(Also in <a href="fmi-ls-ref.html">fmi-ls-ref.html</a>, as the layered standard recommends.)</p>'
 
 
 def interfaces(stage, version):
@@ -135,13 +136,15 @@ def interfaces(stage, version):
 
 def experiments(stage, model):
     """The experiments the FMU carries (references.py wrote them), each file
-    with its role, its experiments and the one command that runs them."""
+    with its role, its experiments and the one command that runs them: a
+    section of index.html, and documentation/fmi-ls-ref.html (where the
+    standard recommends it)."""
     files = sorted((stage / LS_REF).glob("*.exp"))
     if not files:
         return ""
     fmu = f"{model['model']['identifier']}.fmu"
     parts = [
-        "<h2>Reference experiments (FMI-LS-REF)</h2>",
+        '<h2 id="reference-experiments">Reference experiments (FMI-LS-REF)</h2>',
         f"<p>The FMU carries its hand-worked reference scenarios in <code>{LS_REF}/</code>: the manifest "
         "<code>fmi-ls-manifest.xml</code> lists every file with its SHA-256 and each reference signal's comparison "
         "criterion (an <code>org.fmutrace</code> annotation), each experiment file (MA-HS-Experiments) its "
@@ -243,6 +246,17 @@ def main(toml, stage, version, status_source):
     stage = Path(stage).resolve()
     docs = stage / "documentation"
     docs.mkdir(parents=True, exist_ok=True)
+    section = experiments(stage, model)
+    (docs / "fmi-ls-ref.html").write_text(
+        f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{html.escape(model["model"]["identifier"])}: reference
+experiments</title></head><body>
+{section or "<p>This FMU carries no reference experiments.</p>"}
+<p><a href="index.html">The FMU's documentation</a>.</p>
+</body></html>
+""",
+        encoding="utf-8",
+    )
     (docs / "index.html").write_text(
         page(
             model,
@@ -250,7 +264,7 @@ def main(toml, stage, version, status_source):
             status_codes(status_source),
             licence(stage),
             interfaces(stage, int(version)),
-            experiments(stage, model),
+            section.replace("</h2>", f"</h2>\n{STANDALONE}", 1),
         ),
         encoding="utf-8",
     )

@@ -125,6 +125,7 @@ def test_every_reference_carries_each_signals_criterion():
 def test_the_documentation_names_the_interfaces_and_the_experiments(model, version):
     with zipfile.ZipFile(fmu_file(model, version)) as z:
         page = z.read("documentation/index.html").decode()
+        standalone = z.read("documentation/fmi-ls-ref.html").decode()  # where the standard recommends it
         description = etree.fromstring(z.read("modelDescription.xml"))
     kinds = [
         name
@@ -134,9 +135,12 @@ def test_the_documentation_names_the_interfaces_and_the_experiments(model, versi
     assert kinds == ["Co-Simulation", "Model Exchange"]  # what every product model implements (docs/fmi.md)
     assert f"It carries FMI {version}.0 Co-Simulation and Model Exchange" in page
     assert f"<pre>fmutrace check {model}.fmu</pre>" in page
-    for name in scenario_names(model):
-        assert f"<li><code>{name}</code>" in page
-    assert f"<code>serialized-state/{scenario_names(model)[0]}.fmustate</code>" in page
+    assert '<a href="fmi-ls-ref.html">' in page
+    for text in (page, standalone):
+        assert f"<pre>fmutrace check {model}.fmu</pre>" in text
+        for name in scenario_names(model):
+            assert f"<li><code>{name}</code>" in text
+        assert f"<code>serialized-state/{scenario_names(model)[0]}.fmustate</code>" in text
 
 
 BUDGET = 64 * 1024  # what the experiments may add to an FMU (docs/fmi.md)
