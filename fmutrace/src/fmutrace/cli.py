@@ -165,7 +165,7 @@ def parser():
     cmp.add_argument(
         "--role",
         choices=ROLES,
-        help="with FMUs alone: the experiments of this role (default: every experiment the FMU carries)",
+        help="with FMUs alone: the experiments of this role (default: both, each experiment once)",
     )
     cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
     cmp.add_argument(
