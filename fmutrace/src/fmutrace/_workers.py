@@ -24,6 +24,7 @@ together.
 
 import collections
 import ctypes
+import math
 import os
 import pickle
 import selectors
@@ -268,7 +269,8 @@ class Pool:
                 self._give(self._start())
             while self.workers:
                 deadlines = [(self._deadline(w), w) for w in self.workers.values()]
-                soonest = min((d for d, _ in deadlines if d is not None), default=None)
+                wakes = [d for d, _ in deadlines if d is not None] + [self._worth_from() or math.inf]
+                soonest = min(wakes) if min(wakes) < math.inf else None
                 timeout = None if soonest is None else max(0.0, soonest - time.monotonic())
                 for key, _ in self.selector.select(timeout):
                     worker: _Worker = key.data
@@ -280,7 +282,7 @@ class Pool:
                         why = self._overdue(worker.running_since is not None)
                         self._stop(worker, kill=True)
                         self._lost(worker, why)
-                while self.chosen and self.queue and len(self.workers) < self.most and self._pays():
+                while self._pays():
                     self._give(self._start())
         finally:
             for worker in list(self.workers.values()):
@@ -350,12 +352,24 @@ class Pool:
     def _pays(self) -> bool:
         """Another worker pays for its start-up: the work left, spread over
         one more worker, is START_PAYS times a start-up or more."""
+        start = self._worth_from()
+        return start is not None and time.monotonic() >= start
+
+    def _worth_from(self) -> float | None:
+        """When another worker starts paying for itself (None: not on what
+        is known). Before a case has finished, the case running longest is
+        the measure: at least as long as it has run so far (so that a
+        campaign of long cases does not wait for the first to end)."""
+        if not (self.chosen and self.queue and len(self.workers) < self.most) or self.start_up is None:
+            return None
         per_case = self._per_case()
-        if self.start_up is None or per_case is None:
-            return False
-        # on a first case alone (its warm-up included): only when it pays ten times over
-        margin = START_PAYS * (1 if self.measured[False][1] else 10)
-        return len(self.queue) * per_case / (len(self.workers) + 1) > margin * self.start_up
+        # on first cases alone (their warm-up included): only when it pays ten times over
+        margin = START_PAYS * (1 if self.measured[False][1] else 10) * self.start_up
+        needed = margin * (len(self.workers) + 1) / len(self.queue)  # the per-case seconds that make it pay
+        if per_case is not None:
+            return -math.inf if per_case > needed else None
+        running = [w.running_since for w in self.workers.values() if w.running_since is not None]
+        return min(running) + needed if running else None
 
     def _per_case(self) -> float | None:
         """Seconds a case takes, measured: on the cases after each worker's
