@@ -133,6 +133,78 @@ def test_mdf4_channels_keep_their_groups_time_bases(tmp_path):
     assert channel(recording, "value").values.tolist() == samples.SIEMENS["value"]
 
 
+def _mdf_block_field(data, block_id, offset_after_links):
+    """The byte offset of a field of the first block block_id (MDF 4: a block is its id, 4 reserved
+    bytes, its length and its link count as uint64, the links, then its data)."""
+    at = data.index(block_id)
+    links = int.from_bytes(data[at + 16 : at + 24], "little")
+    return at + 24 + 8 * links + offset_after_links
+
+
+def _asammdf_channels(path):
+    from asammdf import MDF
+
+    mdf = MDF(str(path))
+    try:
+        return {
+            mdf.get(group=g, index=i).name: (mdf.get(group=g, index=i).timestamps, mdf.get(group=g, index=i).samples)
+            for g, group in enumerate(mdf.groups)
+            for i in range(len(group.channels))
+            if i != mdf.masters_db.get(g)
+        }
+    finally:
+        mdf.close()
+
+
+def test_an_mdf4_file_its_logger_has_not_finalized_is_read_as_asammdf_reads_it(tmp_path):
+    """MDF 4.1, 'Unfinalized MDF': the identification is 'UnFinMF ' and the standard flags (uint16 at
+    byte 60) say what the writer left undone; bit 0: the channel groups' cycle counts (left 0 here)."""
+    data = bytearray(samples.write_mdf(tmp_path / "finalized.mf4", outputs_every=3).read_bytes())
+    data[:8] = b"UnFinMF "
+    data[60:62] = (1).to_bytes(2, "little")
+    count = _mdf_block_field(data, b"##CG", 8)  # record id, then the cycle count
+    data[count : count + 8] = bytes(8)
+    path = tmp_path / "logger.mf4"
+    path.write_bytes(bytes(data))
+    recording = read_one(path)
+    assert recording.format == "ASAM MDF4"
+    assert any("not finalized" in note for note in recording.notes)
+    expected = _asammdf_channels(path)
+    assert [c.name for c in recording.channels] == list(expected)
+    for found in recording.channels:
+        stamps, values = expected[found.name]
+        assert found.stamps.tolist() == stamps.tolist() and found.values.tolist() == values.tolist()
+    assert channel(recording, "delayedValue").times.tolist() == [0.0, 0.75, 1.5, 2.25, 3.0]
+
+
+def test_an_mdf_3_file_is_named_mdf_3(tmp_path):
+    from asammdf import MDF, Signal
+
+    mdf = MDF(version="3.30")
+    mdf.append([Signal(np.array(samples.SIEMENS["value"], dtype=float), np.arange(14) * CYCLE, name="value")])
+    mdf.save(str(tmp_path / "old.mdf"), overwrite=True)
+    mdf.close()
+    recording = read_one(tmp_path / "old.mdf")
+    assert recording.format == "ASAM MDF 3"
+    assert channel(recording, "value").values.tolist() == samples.SIEMENS["value"]
+
+
+def test_an_mdf_channel_group_declaring_more_samples_than_the_step_bound_is_refused_unread(tmp_path):
+    """A channel group's cycle count (uint64 after its record id) is what its data blocks hold; a small
+    (compressed) file may declare hundreds of millions: refused before they are read, named."""
+    data = bytearray(samples.write_mdf(tmp_path / "finalized.mf4").read_bytes())
+    count = _mdf_block_field(data, b"##CG", 8)
+    data[count : count + 8] = (300_000_000).to_bytes(8, "little")
+    path = tmp_path / "huge.mf4"
+    path.write_bytes(bytes(data))
+    with pytest.raises(TraceError) as error:
+        read_file(path)
+    assert str(error.value) == (
+        f"{path}: channel 'MAIN.fbRamp.value' (and 1 more) of channel group 0: 300,000,000 samples, each a "
+        "cycle of its own: more than the bound of 200,000,000 steps"
+    )
+
+
 def test_niagara_points_are_named_by_their_file_unless_the_file_names_them():
     recording = read_one(SAMPLES / "niagara_siemens")
     assert sorted(c.name for c in recording.channels) == ["delayedValue", "setChangeRate", "value"]
@@ -252,7 +324,7 @@ def test_a_file_of_no_known_format_says_what_was_tried_and_why_not(tmp_path):
     with pytest.raises(TraceError) as error:
         read_file(path)
     message = str(error.value)
-    assert message.startswith(f"{path}: no known recording format; tried ASAM MDF4: not MDF")
+    assert message.startswith(f"{path}: no known recording format; tried ASAM MDF (3 or 4): not MDF")
     for name in FORMAT_NAMES:
         assert f"{name}: " in message
     assert "no channel header block" in message and "VarName, TimeString" in message

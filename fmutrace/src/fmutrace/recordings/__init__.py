@@ -4,7 +4,7 @@ normalised, columnar Recording (recordings._model) whatever the recorder.
 The format is recognised from the content, in this order (the first that
 fits reads the file):
 
-  ASAM MDF4                              mdf.py
+  ASAM MDF 4 and 3                       mdf.py
   Beckhoff TwinCAT Scope View CSV        twincat.py
   WinCC data log CSV                     vendors.py
   Niagara history export (one point)     vendors.py
@@ -31,7 +31,7 @@ TEXT_FORMATS = (
     ("CODESYS 2.3 trace (ASCII file)", vendors.sniff_codesys23, vendors.read_codesys23),
     ("table (TIA Portal trace CSV, CODESYS V3 export, CSV/TSV)", tables.sniff, tables.read),
 )
-FORMAT_NAMES = ("ASAM MDF4",) + tuple(name for name, _, _ in TEXT_FORMATS)
+FORMAT_NAMES = ("ASAM MDF (3 or 4)",) + tuple(name for name, _, _ in TEXT_FORMATS)
 
 __all__ = [
     "Channel",
@@ -60,7 +60,7 @@ def read_file(path):
     text = texts.read(path)
     if not text.text.strip():
         raise TraceError(path, 0, 0, "empty file")
-    reasons = [f"ASAM MDF4: {mdf.sniff(head)}"]
+    reasons = [f"{FORMAT_NAMES[0]}: {mdf.sniff(head)}"]
     for name, sniff, read in TEXT_FORMATS:
         why = sniff(text)
         if why is None:

@@ -55,7 +55,7 @@ class Table:
             head = file.read(HEAD_BYTES)
             at_end = not file.read(1)
         if mdf.sniff(head[:64]) is None:
-            raise NotPlain("MDF4")
+            raise NotPlain("MDF")
         if not at_end:
             head = head[: head.rfind(b"\n") + 1]
         decoded, self.encoding = texts.decode(self.path, head)
