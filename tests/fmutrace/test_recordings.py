@@ -563,3 +563,62 @@ def test_twincat_sample_time_with_a_decimal_comma_in_a_comma_separated_export(tm
         r"\(a decimal comma, ',' separating\?\)",
     ):
         read_file(path)
+
+
+def test_twincat_for_each_sampletime_whose_header_rows_leave_out_their_trailing_empty_cells(tmp_path):
+    """Scope View's 'For each sampletime' export writes a property row without its last empty cells
+    ('SymbolComment', then nothing for the channels of the last group)."""
+    path = tmp_path / "per_sample_time.csv"
+    path.write_text(
+        "Name\tScope\nFile\tx.csv\n\n\n"
+        "Name\ta\tb\tName\tc\td\n"
+        "SymbolComment\t\t\tSymbolComment\n"
+        "SampleTime[ms]\t1\t1\tSampleTime[ms]\t2\t2\n"
+        "SymbolName\tMAIN.a\tMAIN.b\tSymbolName\tMAIN.c\tMAIN.d\n"
+        "\n0\t1\t2\t0\t3\t4\n1\t5\t6\n2\t7\t8\t2\t9\t10\n"
+    )
+    recording = read_one(path)
+    assert recording.sample_time == 0.001
+    assert channel(recording, "a").times.tolist() == [0.0, 0.001, 0.002]
+    assert channel(recording, "b").values.tolist() == [2.0, 6.0, 8.0]
+    assert channel(recording, "c").times.tolist() == [0.0, 0.002]
+    assert channel(recording, "d").values.tolist() == [4.0, 10.0]
+    assert channel(recording, "d").symbol == "MAIN.d"
+
+
+WINCC_HEADER = '"VarName";"TimeString";"VarValue";"Validity";"Time_ms"'
+
+
+def _wincc_row(tag, second, value, time_ms):
+    return f'"{tag}";"20.11.2026 14:00:{second:02d}";{value};1;{time_ms}'
+
+
+def test_wincc_system_rows_with_fewer_cells_are_no_samples(tmp_path):
+    """$RT_OFF$ (runtime stopped), $RT_DIS$ (logging disabled) and $RT_COUNT$ (a count, fewer cells)."""
+    base = 46346541666.6667  # 20.11.2026 14:00:00 as OLE days times 1e6
+    lines = [WINCC_HEADER, _wincc_row("$RT_DIS$", 0, 0, "46346541655,0926"), '"$RT_COUNT$";3']
+    lines += [_wincc_row("Ramp_y", k, k * 2, f"{base + k * 1e6 / 86400:.4f}".replace(".", ",")) for k in range(3)]
+    lines.append(_wincc_row("$RT_OFF$", 3, 0, f"{base + 3e6 / 86400:.4f}".replace(".", ",")))
+    path = tmp_path / "log.csv"
+    path.write_text("\r\n".join(lines) + "\r\n")
+    recording = read_one(path)
+    assert [c.name for c in recording.channels] == ["Ramp_y"]
+    assert recording.time_unit == "OLE days" and recording.step_size == 1.0
+    y = recording.channels[0]
+    assert y.values.tolist() == [0.0, 2.0, 4.0] and y.lines.tolist() == [4, 5, 6]
+    assert np.abs(y.times - [0.0, 1.0, 2.0]).max() < 9e-6
+    assert "3 marker rows" in recording.notes[0]
+
+
+def test_wincc_time_ms_with_a_tab_for_its_decimal_mark_falls_back_to_time_string(tmp_path):
+    """A PC whose locale wrote a tab for the decimal mark: Time_ms is no number, TimeString is the time."""
+    lines = [WINCC_HEADER] + [_wincc_row("Ramp_y", k, k * 2, f"4634654{1666 + k * 12}\t{k}") for k in range(3)]
+    path = tmp_path / "tab.csv"
+    path.write_text("\r\n".join(lines) + "\r\n")
+    recording = read_one(path)
+    assert recording.time_unit == "date" and "Time_ms is damaged" in recording.time_source
+    assert recording.channels[0].times.tolist() == [0.0, 1.0, 2.0]
+    assert recording.notes == [
+        f"{path}, line 2, column 5: '4634654{1666}\\t0' in column 'Time_ms' is not a number, TRUE/FALSE or an "
+        "IEC literal (16#...): the time is TimeString's instead"
+    ]

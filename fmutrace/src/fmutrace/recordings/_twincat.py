@@ -59,6 +59,20 @@ def sniff(text):
     return why if found is None else None
 
 
+def _padded(key, cells, name_cells, key_columns):
+    """A property row that leaves out its trailing empty cells (Scope View
+    does with 'For each sampletime': 'SymbolComment', then nothing for the
+    last channels) filled up to the Name row, when its keys stand where
+    the Name row's do; any other row as it is."""
+    keys = [j for j, c in enumerate(cells) if c == key]
+    if len(cells) >= len(name_cells) or keys != key_columns[: len(keys)]:
+        return cells
+    filled = cells + [""] * (len(name_cells) - len(cells))
+    for j in key_columns:
+        filled[j] = key
+    return filled
+
+
 def _realigned(text, line, key, cells, name_row, separator):
     """A property row with more cells than the Name row: Scope View writes
     a decimal comma in SampleTime[ms] even with ',' as the separator
@@ -110,6 +124,7 @@ def read(text):
     key_columns = [j for j, c in enumerate(name_cells) if c == "Name"]
     for key, (line, cells) in list(header.items()):
         if len(cells) != len(name_cells):
+            cells = _padded(key, cells, name_cells, key_columns)
             header[key] = (line, _realigned(text, line, key, cells, (name_cells, key_columns), separator))
     rows, lines = grids.body(text, index, separator if separator != " " else " ")
     if not rows:
