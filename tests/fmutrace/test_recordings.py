@@ -622,3 +622,28 @@ def test_wincc_time_ms_with_a_tab_for_its_decimal_mark_falls_back_to_time_string
         f"{path}, line 2, column 5: '4634654{1666}\\t0' in column 'Time_ms' is not a number, TRUE/FALSE or an "
         "IEC literal (16#...): the time is TimeString's instead"
     ]
+
+
+def test_a_map_to_a_symbol_several_channels_share_is_refused_naming_each(tmp_path):
+    """Scope View channels of one symbol (scaled, shifted, ...): --map y=MAIN.var_REAL means none of them."""
+    path = tmp_path / "same_symbol.csv"
+    path.write_text(
+        "Name\tScope\nFile\tx.csv\n\n\n"
+        "Name\tvar_REAL32\tName\tfunc_scaled\tName\tu\n"
+        "SampleTime[ms]\t1\tSampleTime[ms]\t1\tSampleTime[ms]\t1\n"
+        "SymbolName\tMAIN.var_REAL\tSymbolName\tMAIN.var_REAL\tSymbolName\tMAIN.u\n"
+        "\n0\t1\t0\t-1\t0\t5\n1\t2\t1\t-2\t1\t5\n"
+    )
+    recording = read_one(path)
+    variables = variables_of(u="input", y="output")
+    with pytest.raises(InputError) as error:
+        plan(recording, variables, "M", [("y", "MAIN.var_REAL")], names=FLAGS)
+    assert str(error.value) == (
+        f"--map y=MAIN.var_REAL: 2 channels of {path} are 'MAIN.var_REAL': 'var_REAL32' (symbol "
+        "'MAIN.var_REAL', column 2); 'func_scaled' (symbol 'MAIN.var_REAL', column 4); map one by its name, "
+        "e.g. --map y=var_REAL32"
+    )
+    chosen = plan(recording, variables, "M", [("y", "func_scaled")])
+    assert [(v, c.name) for v, c in chosen.compares] == [("y", "func_scaled")]
+    with pytest.raises(InputError, match=r"2 channels of .* are 'var_REAL'"):  # a last component is no way out
+        plan(recording, variables, "M", [("y", "var_REAL")])

@@ -69,14 +69,38 @@ def _role(variable):
     return None, f"a {variable.variability} {variable.causality} of the FMU: it can neither drive nor be compared"
 
 
-def _find_channel(recording, wanted):
-    for channel in recording.channels:
-        if wanted in (channel.name, channel.symbol):
-            return channel
-    named = [c for c in recording.channels if wanted in (last_component(c.name), last_component(c.symbol or c.name))]
+def _candidates(recording, wanted):
+    """The channels a map's CHANNEL may mean: the one of that name, else
+    those of that symbol, else those whose name's or symbol's last
+    component it is; more than one is ambiguous."""
+    named = [c for c in recording.channels if c.name == wanted]
     if len(named) == 1:
-        return named[0]
-    return None
+        return named
+    exact = [c for c in recording.channels if wanted in (c.name, c.symbol)]
+    if exact:
+        return exact
+    return [c for c in recording.channels if wanted in (last_component(c.name), last_component(c.symbol or c.name))]
+
+
+def _ambiguous(recording, mapping, candidates, names):
+    """The refusal of a map that means several channels: each of them, and how to name one."""
+    variable, wanted = mapping
+    listed = "; ".join(
+        f"{c.name!r} ("
+        + (f"symbol {c.symbol!r}, " if c.symbol else "")
+        + (f"column {c.column})" if c.column else f"in {c.file})")
+        for c in candidates
+    )
+    unique = [c for c in candidates if sum(o.name == c.name for o in recording.channels) == 1]
+    how = (
+        f"map one by its name, e.g. {name_of(names, maps=(variable, unique[0].name))}"
+        if unique
+        else "their names are not unique either: export them under names of their own"
+    )
+    return InputError(
+        f"{name_of(names, maps=mapping)}: {len(candidates)} channels of {recording.label} are {wanted!r}: "
+        f"{listed}; {how}"
+    )
 
 
 def plan(recording, variables, label, maps=(), names: Names = ()):
@@ -87,13 +111,15 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
     for variable, wanted in maps:
         if variable not in variables:
             raise InputError(f"{name_of(names, maps=(variable, wanted))}: {label} has no variable {variable!r}")
-        channel = _find_channel(recording, wanted)
-        if channel is None:
+        candidates = _candidates(recording, wanted)
+        if not candidates:
             raise InputError(
                 f"{name_of(names, maps=(variable, wanted))}: {recording.label} has no channel {wanted!r} "
                 f"(its channels: {', '.join(c.name for c in recording.channels)})"
             )
-        taken[variable] = channel
+        if len(candidates) > 1:
+            raise _ambiguous(recording, (variable, wanted), candidates, names)
+        taken[variable] = candidates[0]
     mapped = {id(c) for c in taken.values()}
     folded: dict[str, list[str]] = {}
     for name in variables:
