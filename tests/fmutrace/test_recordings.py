@@ -16,7 +16,9 @@ import pytest
 from fmutrace import InputError, TraceError
 from fmutrace.cli import FLAGS
 from fmutrace.recordings import FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file, read_recording
+from fmutrace._recorded import recorded_case
 from fmutrace.recordings._align import align
+from fmutrace.recordings._options import RecordingOptions
 from fmutrace.recordings._text import decode, numbers
 from fmutrace._traces import split_cells as split
 from fmutrace.recordings._timebase import parse_date, unit_in_name
@@ -647,3 +649,62 @@ def test_a_map_to_a_symbol_several_channels_share_is_refused_naming_each(tmp_pat
     assert [(v, c.name) for v, c in chosen.compares] == [("y", "func_scaled")]
     with pytest.raises(InputError, match=r"2 channels of .* are 'var_REAL'"):  # a last component is no way out
         plan(recording, variables, "M", [("y", "var_REAL")])
+
+
+def _fmu_of(**causalities):
+    """What recorded_case needs of an FMU: its variables, label, model and start values."""
+    return SimpleNamespace(
+        variables=variables_of(**causalities), label="M", model="M", default_step=None, start_value=lambda n, v: v
+    )
+
+
+def _mdf_of_groups(path, groups):
+    """An MDF4 file with a channel group per (stamps, {name: values}), by asammdf's writer."""
+    from asammdf import MDF, Signal
+
+    mdf = MDF(version="4.10")
+    for stamps, signals in groups:
+        mdf.append([Signal(np.asarray(v, dtype=float), np.asarray(stamps), name=n) for n, v in signals.items()])
+    mdf.save(str(path), overwrite=True)
+    mdf.close()
+    return str(path)
+
+
+def test_the_step_comes_from_the_mapped_channels_not_from_unmapped_faster_ones(tmp_path):
+    """A CAN log: Speed and Heading each 1 s apart (from t = 0.3 s), other messages at 100 Hz from t = 0."""
+    fast = np.arange(500) / 100
+    slow = 0.3 + np.arange(5)
+    path = _mdf_of_groups(
+        tmp_path / "can.mf4",
+        [(fast, {"EngineTemp": fast * 0, "Rpm": fast}), (slow, {"Speed": np.arange(5)}), (slow, {"Heading": [5] * 5})],
+    )
+    options = RecordingOptions(maps={"u": "Speed", "y": "Heading"}, names=FLAGS)
+    case = recorded_case(path, _fmu_of(u="input", y="output"), "can", options)
+    assert case.options["StepSize"] == 1.0
+    assert case.inputs["time"].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+    assert case.reference["time"].tolist() == [1.0, 2.0, 3.0, 4.0, 5.0]
+    assert case.coarse == "" and not [n for n in case.notes if "off a cycle end" in n]
+
+
+def test_an_unmapped_channel_at_time_zero_does_not_set_the_origin(tmp_path):
+    """An XCP measurement: a calibration value at t = 0, the mapped channels every 1 ms from 0.5 ms."""
+    daq = 0.0005 + np.arange(100) / 1000
+    path = _mdf_of_groups(
+        tmp_path / "xcp.mf4", [([0.0], {"Calibration": [1.0]}), (daq, {"u": np.arange(100), "y": np.arange(100)})]
+    )
+    case = recorded_case(path, _fmu_of(u="input", y="output"), "xcp", RecordingOptions())
+    assert case.options["StepSize"] == 0.001
+    assert np.abs(case.inputs["time"] - np.arange(100) / 1000).max() < 1e-15
+    assert not [n for n in case.notes if "off a cycle end" in n], case.notes
+    assert "ignored: Calibration" in " ".join(case.notes)
+
+
+def test_a_channel_off_the_grid_is_named_with_the_step_that_would_fit_it(tmp_path):
+    """u every 0.25 s, y every 0.3 s: y's stamps are off a 0.25 s grid; a step of 0.3 s fits them."""
+    path = _mdf_of_groups(
+        tmp_path / "two_rates.mf4",
+        [(np.arange(13) * 0.25, {"u": np.zeros(13)}), (np.arange(10) * 0.3, {"y": np.zeros(10)})],
+    )
+    case = recorded_case(path, _fmu_of(u="input", y="output"), "r", RecordingOptions(names=FLAGS))
+    [note] = [n for n in case.notes if n.startswith("y: ")]
+    assert "more than 0.1 of a cycle" in note and note.endswith("Its own stamps fit a step of 0.3 s (--step-size 0.3).")

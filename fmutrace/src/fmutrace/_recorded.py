@@ -63,8 +63,9 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     if len(found) != 1:
         raise InputError(f"{path}: holds {len(found)} recordings: give them one by one (or their files)")
     recording = found[0]
-    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names)
     matched = plan(recording, fmu.variables, fmu.label, options.maps, options.names)
+    used = [c for _, c in matched.drives + matched.compares]  # the time base: what is compared, nothing else
+    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names, used or None)
     aligned = align(recording, matched, options.timing, fmu.label, options.names)
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     names = [v for reference in aligned.references for v in reference.dtype.names[1:]]

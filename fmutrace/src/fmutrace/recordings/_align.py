@@ -27,7 +27,7 @@ import numpy as np
 
 from .._errors import InputError
 from .._names import Names, name_of
-from ._timebase import OFF_CYCLE, cycles
+from ._timebase import OFF_CYCLE, cycles, finest_interval
 
 TIMINGS = ("cycle", "fmi")
 
@@ -47,9 +47,11 @@ def _cycles_of(channel, step, notes, names):
     index, off = cycles(channel.times, step)
     if len(off):
         i = int(off[0])
-        notes.append(
-            off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step)
-        )
+        note = off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step)
+        own = finest_interval([channel])
+        if own is not None and cycles(channel.times, own)[1].size == 0 and own != step:
+            note += f" Its own stamps fit a step of {own!r} s ({name_of(names, step_size=own)})."
+        notes.append(note)
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])

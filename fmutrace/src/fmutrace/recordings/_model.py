@@ -17,6 +17,7 @@ class Channel:
     lines: np.ndarray | None = None  # line of each sample in a text file (int64), else None
     symbol: str = ""  # a fuller name the recorder gives too (TwinCAT's SymbolName)
     times: np.ndarray | None = None  # seconds from the recording's first sample (normalise())
+    sample_time: float | None = None  # its sample interval in seconds, when the file declares it (TwinCAT)
 
     def where(self, index):
         """'file, line L' of sample index (or the file and channel)."""

@@ -162,15 +162,18 @@ def dates(cells, text, line_of, column, name):
 
 
 # -- seconds from the first sample -------------------------------------------------
-def normalise(recording, time_unit=None, step_size=None, default_step=None, names: Names = ()):
-    """Set every channel's times (seconds from the recording's first
-    sample, over all channels) and the recording's step_size: step_size if
-    given, else the sample time the file declares, else the finest interval
-    between its time stamps (the recorder sampled every cycle), else
-    default_step (the FMU's) for cycle counts. time_unit overrides the
-    recording's. Refuses a recording whose length in steps is absurd,
-    naming the unit it assumed. names: the caller's words for the
-    settings (RecordingOptions.names)."""
+def normalise(recording, time_unit=None, step_size=None, default_step=None, names: Names = (), using=None):
+    """Set every channel's times (seconds from the first sample of the
+    channels using names, by default all of them) and the recording's
+    step_size: step_size if given, else the sample time the file declares
+    for those channels, else the finest interval between their time
+    stamps (the recorder sampled every cycle), else default_step (the
+    FMU's) for cycle counts. using: the channels compared or driven (the
+    others never change the time base: a CAN log's unmapped 100 Hz
+    messages, an XCP calibration channel at t = 0). time_unit overrides
+    the recording's. Refuses a recording whose length in steps is absurd,
+    naming the unit it assumed. names: the caller's words for the settings
+    (RecordingOptions.names)."""
     if time_unit:
         if recording.time_unit in ("date", "OLE days") and time_unit != recording.time_unit:
             raise InputError(
@@ -180,11 +183,13 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
         recording.time_unit, recording.time_source = time_unit, name_of(names, "time_unit")
         recording.unit_given = True
     unit = recording.time_unit
-    channels = [c for c in recording.channels if len(c.stamps)]
+    channels = [c for c in (recording.channels if using is None else using) if len(c.stamps)]
     if not channels:
         raise TraceError(recording.label, 0, 0, "no samples: the recording holds no channel with values")
+    declared = [c.sample_time for c in channels if c.sample_time]
+    sample_time = min(declared) if declared else recording.sample_time
     if unit == "cycles":
-        step = step_size or recording.sample_time or default_step
+        step = step_size or sample_time or default_step
         if not step:
             raise InputError(
                 f"{recording.label}: its time is a cycle count: give the cycle time with {name_of(names, 'step_size')}"
@@ -194,13 +199,16 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
             name_of(names, "step_size")
             if step_size
             else "the recording's sample time"
-            if recording.sample_time
+            if sample_time
             else "the FMU's default step size"
         )
     origin = min(c.stamps[0] for c in channels)
     factor = recording.step_size if unit == "cycles" else 1e-9 if unit == "date" else TIME_FACTORS[unit]
     for channel in recording.channels:
-        channel.times = _minus(channel.stamps, origin) * factor
+        if len(channel.stamps):
+            channel.times = _minus(channel.stamps, origin) * factor
+        else:
+            channel.times = np.empty(0)
     span = max(float(c.times[-1]) for c in channels)
     assumed = f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit]
     if too_long(span):
@@ -212,8 +220,8 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
     if unit != "cycles":
         if step_size:
             recording.step_size, recording.step_source = step_size, name_of(names, "step_size")
-        elif recording.sample_time:
-            recording.step_size, recording.step_source = recording.sample_time, "the recording's sample time"
+        elif sample_time:
+            recording.step_size, recording.step_source = sample_time, "the recording's sample time"
         else:
             step = finest_interval(channels)
             if step is None:

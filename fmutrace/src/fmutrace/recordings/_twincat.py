@@ -182,6 +182,7 @@ def read(text):
                     decimal_comma,
                 )
                 channel.symbol = prop("SymbolName", j)
+                channel.sample_time = ms * 1e-3
                 channels.append(channel)
             continue
         cells = table[:, time_column]
@@ -204,6 +205,8 @@ def read(text):
                 text, table[:, j], grids.Rows(lines, stamps, stamp_present), j + 1, prop("Name", j), decimal_comma
             )
             channel.symbol = prop("SymbolName", j)
+            declared = texts.cell_value(prop("SampleTime[ms]", j) or prop("SampleTime", j))
+            channel.sample_time = declared * 1e-3 if declared else None
             channels.append(channel)
     unit = "FILETIME" if filetime else "ms"
     source = (
