@@ -708,3 +708,20 @@ def test_a_channel_off_the_grid_is_named_with_the_step_that_would_fit_it(tmp_pat
     case = recorded_case(path, _fmu_of(u="input", y="output"), "r", RecordingOptions(names=FLAGS))
     [note] = [n for n in case.notes if n.startswith("y: ")]
     assert "more than 0.1 of a cycle" in note and note.endswith("Its own stamps fit a step of 0.3 s (--step-size 0.3).")
+
+
+def test_a_wincc_log_of_too_many_steps_is_told_the_option_that_works(tmp_path):
+    """Logged on change: five samples 1 ms apart, one an hour later. Its time stamps are OLE days, so
+    no time unit applies: the advice is the step size, and with the step size given it is read."""
+    base = 46346541666.6667
+    stamps = [base + k * 1e3 / 86400 for k in range(5)] + [base + 3600e6 / 86400]
+    lines = [WINCC_HEADER] + [_wincc_row("Ramp_y", 0, k, f"{t:.4f}") for k, t in enumerate(stamps)]
+    path = tmp_path / "on_change.csv"
+    path.write_text("\r\n".join(lines).replace(";", ",") + "\r\n")
+    with pytest.raises(InputError) as error:
+        normalise(read_recording(path)[0], names=FLAGS)
+    assert str(error.value).endswith("steps for 6 samples: give the recorder's cycle with --step-size")
+    assert "--time-unit" not in str(error.value)
+    with pytest.raises(InputError, match="does not apply"):  # what the old advice led to
+        normalise(read_recording(path)[0], time_unit="s", names=FLAGS)
+    assert normalise(read_recording(path)[0], step_size=0.5, names=FLAGS).step_size == 0.5

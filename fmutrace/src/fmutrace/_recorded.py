@@ -12,11 +12,12 @@ import numpy as np
 
 from ._cases import Case
 from ._errors import InputError
+from ._names import shortest
 from .recordings import read_recording
 from .recordings._align import align
 from .recordings._matching import plan
 from .recordings._options import RecordingOptions
-from .recordings._timebase import UNIT_NAMES, normalise
+from .recordings._timebase import UNIT_NAMES, nominal, normalise
 
 
 @dataclass
@@ -41,7 +42,13 @@ class RecordedCase(Case):
             if len(at):
                 i = int(at[0])
                 messages.append(
-                    first_differs(deviation, cycle, channel.where(i), float(channel.times[i]), float(channel.values[i]))
+                    first_differs(
+                        deviation,
+                        cycle,
+                        channel.where(i),
+                        nominal(float(channel.times[i]), cycle, step),
+                        float(channel.values[i]),
+                    )
                 )
         if self.coarse:
             messages.append(self.coarse)
@@ -51,7 +58,7 @@ class RecordedCase(Case):
 def first_differs(deviation, cycle, where, time, recorded):
     """Where a failing signal's first deviation is in the recording."""
     return (
-        f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={time:.9g} s "
+        f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={shortest(time)} s "
         f"from its first sample): recorded {recorded!r}, the FMU gives {deviation.value!r}"
     )
 
@@ -72,7 +79,7 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     unit = UNIT_NAMES.get(recording.time_unit, recording.time_unit)
     description = (
         f"{recording.format}: {len(recording)} samples, time as {unit} ({recording.time_source}), "
-        f"step {recording.step_size:g} s ({recording.step_source})"
+        f"step {shortest(recording.step_size)} s ({recording.step_source})"
     )
     return RecordedCase(
         name=name,

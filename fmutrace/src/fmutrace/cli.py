@@ -306,14 +306,26 @@ def compare_command(args, out):
         if o.passed and not o.messages:
             continue
         print(f"{o.status.upper()}  {text(o.case)} on {text(o.fmu)}", file=out)
-        for message in o.messages[:10]:
+        for message in o.messages[:SHOWN_MESSAGES]:
             print(f"      {text(message)}", file=out)
+        if len(o.messages) > SHOWN_MESSAGES:
+            print(f"      {_the_rest(len(o.messages) - SHOWN_MESSAGES, args.report)}", file=out)
     print(result.headline(), file=out)
     if args.report:
         print(f"report: {text(args.report.rstrip('/'))}/index.html", file=out)
     if args.junit:
         print(f"JUnit XML: {text(args.junit)}", file=out)
     return result.exit_code
+
+
+SHOWN_MESSAGES = 10  # of a case on the terminal; the report's results.json holds them all
+
+
+def _the_rest(count, report):
+    """Where the messages of a case the terminal does not show are."""
+    if report:
+        return f"(and {count} more messages: all of them in {text(report.rstrip('/'))}/results.json)"
+    return f"(and {count} more messages: --report DIR writes all of them into DIR/results.json)"
 
 
 def main(argv=None, out=None):

@@ -20,8 +20,10 @@ import numpy as np
 
 from .._traces import MAX_STEPS
 from .._errors import InputError, TraceError
-from .._names import Names, name_of
-from ._model import TIME_FACTORS
+from .._names import Names, name_of, shortest
+from fractions import Fraction
+
+from ._model import TIME_DIVISORS, TIME_FACTORS
 
 OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
 MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless the caller gave the unit)
@@ -203,12 +205,8 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
             else "the FMU's default step size"
         )
     origin = min(c.stamps[0] for c in channels)
-    factor = recording.step_size if unit == "cycles" else 1e-9 if unit == "date" else TIME_FACTORS[unit]
     for channel in recording.channels:
-        if len(channel.stamps):
-            channel.times = _minus(channel.stamps, origin) * factor
-        else:
-            channel.times = np.empty(0)
+        channel.times = seconds(_minus(channel.stamps, origin), unit, recording.step_size)
     span = max(float(c.times[-1]) for c in channels)
     assumed = f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit]
     if too_long(span):
@@ -236,12 +234,20 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
             recording.step_size, recording.step_source = step, source
     steps = span / recording.step_size
     samples = max(len(c.times) for c in channels)
-    if too_many_steps(steps, samples, recording.unit_given):
+    certain = recording.unit_given or unit in ("date", "OLE days")  # no unit can be misread
+    if too_many_steps(steps, samples, recording.unit_given or (certain and bool(step_size))):
+        step = name_of(names, "step_size")
+        cycle = "a coarser cycle" if step_size else "the recorder's cycle"
+        advice = (
+            f"give {cycle} with {step}"
+            if certain
+            else f"if that is not its unit, give {name_of(names, 'time_unit')} (s, ms, us, ns, cycles, filetime)"
+            + ("" if step_size else f", or the recorder's cycle with {step}")
+        )
         raise InputError(
             f"{recording.label}: with its time read as {assumed} and a step of "
-            f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
-            f"{steps:.3g} steps for {samples} samples: if that is not its unit, give {name_of(names, 'time_unit')} "
-            "(s, ms, us, ns, cycles, filetime)"
+            f"{shortest(recording.step_size)} s ({recording.step_source}) the recording would take "
+            f"{steps:.3g} steps for {samples} samples: {advice}"
         )
     return recording
 
@@ -253,6 +259,46 @@ def _minus(stamps, origin):
     if stamps.dtype.kind == "M":
         return (stamps - origin).astype("timedelta64[ns]").astype(np.int64).astype(np.float64)
     return stamps.astype(np.float64) - float(origin)
+
+
+def seconds(elapsed, unit, step=None):
+    """Stamps minus the origin (float64, in unit) as seconds, each rounded once: divided by a unit's
+    whole fraction of a second, cycle counts by cycle_times."""
+    if unit == "cycles":
+        whole = np.rint(elapsed)
+        if np.array_equal(whole, elapsed):
+            return cycle_times(whole.astype(np.int64), step)
+        return elapsed * step
+    if unit in TIME_DIVISORS:
+        return elapsed / TIME_DIVISORS[unit]
+    return elapsed * TIME_FACTORS[unit]
+
+
+def cycle_times(index, step):
+    """The times index * step of whole cycles, each the double nearest the exact decimal product when
+    the step is a short decimal (p / q): (index * p) / q, one rounding, so cycle 42 of 0.0001 s is
+    0.0042, not 0.004200000000000001; index * step where that cannot be exact."""
+    index = np.asarray(index)
+    numerator, denominator = Fraction(repr(float(step))).as_integer_ratio()
+    largest = int(np.abs(index).max()) if len(index) else 0
+    if denominator > 1 << 53 or largest * abs(numerator) > 1 << 53:
+        return index * step
+    return (index * numerator).astype(np.float64) / float(denominator)
+
+
+def nominal(time, cycle, step):
+    """A sample's time (seconds) as a message shows it: its cycle's time from the whole cycle when it
+    is on that cycle (the arithmetic of reading it adds no noise then: 0.0042, not
+    0.004200000000000001), else as read (as_read)."""
+    exact = float(cycle_times(np.array([cycle]), step)[0])
+    return exact if abs(time - exact) <= OFF_CYCLE * step else as_read(time)
+
+
+def as_read(time):
+    """A time read from a stamp (seconds) without the few ulps its conversion added (10.0004 ms is
+    0.010000400000000001 s divided, 0.0100004 s as written): 15 significant digits, which every
+    decimal of 15 digits survives."""
+    return float(f"{float(time):.15g}")
 
 
 def too_long(span):
