@@ -321,3 +321,19 @@ def test_times_in_messages_are_the_cycles_times_without_float_noise(tmp_path, re
     line = 43 if read == "streamed" else 44
     assert f"sample of cycle 41 ({path}, line {line}, t=0.0041 s from its first sample)" in done.stdout
     assert "step 0.0001 s (the finest interval" in done.stdout and "00000" not in done.stdout
+
+
+def test_a_folder_of_several_recordings_is_each_of_them(tmp_path):
+    """docs/recordings.md: a RECORDING is one exported file, or a folder of them. Each file is a
+    recording; the folder's single-point histories (Niagara) together are one."""
+    folder = tmp_path / "plant"
+    folder.mkdir()
+    for name in ("twincat_siemens.csv", "tia_portal_siemens.csv"):
+        (folder / name).write_bytes((SAMPLES / name).read_bytes())
+    for point in (SAMPLES / "niagara_siemens").iterdir():
+        (folder / point.name).write_bytes(point.read_bytes())
+    done = compare(SIEMENS[3], folder)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "3 of 3 cases pass" in done.stdout
+    for case in ("plant/tia_portal_siemens.csv", "plant/twincat_siemens.csv", "plant on"):
+        assert f"PASS  {case}" in done.stdout

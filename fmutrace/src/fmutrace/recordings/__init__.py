@@ -125,12 +125,16 @@ def is_recording(path):
 
 def recording_paths(paths):
     """The recordings among paths given to compare: [(path, name)], where
-    path is one file or folder, or several single-point files (Niagara)
-    joined by os.pathsep: together they make one recording."""
+    path is one file, or several single-point files (Niagara) joined by
+    os.pathsep: together they make one recording. A folder is its files:
+    each a recording (named folder/file), its single-point files together
+    one (named by the folder)."""
     items, points = [], []
     for path in paths:
         path = os.fspath(path)
-        if os.path.isfile(path) and _is_single_point(path):
+        if os.path.isdir(path):
+            items += _folder_items(path)
+        elif os.path.isfile(path) and _is_single_point(path):
             points.append(path)
         else:
             items.append((path, Path(path).name))
@@ -138,6 +142,20 @@ def recording_paths(paths):
         name = Path(points[0]).parent.name if len(points) > 1 else Path(points[0]).name
         items.append((os.pathsep.join(points), name))
     return _unique(items)
+
+
+def _folder_items(folder):
+    """recording_paths' items of the files of a folder (an empty folder is one item: reading it says so)."""
+    try:
+        files = _files([folder])
+    except InputError:
+        return [(folder, Path(folder).name)]
+    points = [f for f in files if _is_single_point(f)]
+    name = Path(os.path.abspath(folder)).name
+    items = [(f, f"{name}/{Path(f).name}") for f in files if f not in points]
+    if points:
+        items.append((os.pathsep.join(points) if len(points) > 1 else points[0], name))
+    return items
 
 
 def _unique(items):
