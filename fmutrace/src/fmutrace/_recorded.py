@@ -77,8 +77,9 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     names = [v for reference in aligned.references for v in reference.dtype.names[1:]]
     unit = UNIT_NAMES.get(recording.time_unit, recording.time_unit)
+    samples = max(len(c.values) for c in used or recording.channels)  # of the channels compared or driven
     description = (
-        f"{recording.format}: {len(recording)} samples, time as {unit} ({recording.time_source}), "
+        f"{recording.format}: {samples} samples, time as {unit} ({recording.time_source}), "
         f"step {shortest(recording.step_size)} s ({recording.step_source})"
     )
     return RecordedCase(

@@ -85,7 +85,7 @@ def _read(path, scratch):
                 signal = mdf.get(group=group_index, index=channel_index)
                 samples = np.asarray(signal.samples)
                 if samples.dtype.kind not in "biuf" or samples.ndim != 1:
-                    notes.append(f"channel {signal.name!r} (group {group_index}) holds {samples.dtype} values: ignored")
+                    notes.append(f"channel {signal.name!r} (group {group_index}) holds {_kind(samples)}: ignored")
                     continue
                 channels.append(
                     Channel(
@@ -120,3 +120,12 @@ def _check_count(path, mdf, group_index, group):
     if len(names) > 1:
         named += f" (and {len(names) - 1} more)"
     raise TraceError(path, 0, 0, f"{named} of channel group {group_index}: {problem}")
+
+
+def _kind(samples):
+    """What a channel that is no number holds, in words."""
+    if samples.dtype.names:
+        return f"records of {len(samples.dtype.names)} fields (a bus frame?)"
+    if samples.ndim != 1:
+        return f"arrays of {samples.shape[1:]} values"
+    return f"{samples.dtype} values"
