@@ -10,11 +10,14 @@ import gzip
 import hashlib
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from fmutrace import TraceError
+from fmutrace._recorded import recorded_case
+from fmutrace.recordings._options import RecordingOptions
 from fmutrace.recordings import normalise, read_file
 from support import scope_view
 from support.fmu_driver import BUILD_DIR
@@ -153,3 +156,12 @@ def test_a_scope_view_export_through_the_command_on_the_channels_mapped(tmp_path
     assert "--map y=MAIN.var_REAL: 9 channels of" in done.stderr
     assert "'func_scaled' (symbol 'MAIN.var_REAL', column 26)" in done.stderr
     assert done.stderr.rstrip().endswith("map one by its name, e.g. --map y=var_REAL32")
+
+
+def test_a_map_to_a_can_logger_channel_without_samples_says_so():
+    """The CANedge file's LIN channels hold no frame: mapped, they are named as holding none."""
+    output = SimpleNamespace(causality="output", variability="continuous")
+    fmu = SimpleNamespace(variables={"y": output}, label="M", model="M", default_step=None, start_value=lambda n, v: v)
+    path = str(CORPUS / "canedge" / "17BD1DB7_00000170.MF4")
+    with pytest.raises(TraceError, match=r"no samples: the channels compared or driven \('LIN_Frame.ID'\) hold none"):
+        recorded_case(path, fmu, "can", RecordingOptions(maps={"y": "LIN_Frame.ID"}))

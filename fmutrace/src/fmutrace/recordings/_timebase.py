@@ -186,6 +186,9 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
         recording.unit_given = True
     unit = recording.time_unit
     channels = [c for c in (recording.channels if using is None else using) if len(c.stamps)]
+    if not channels and using:
+        named = ", ".join(repr(c.name) for c in using)
+        raise TraceError(recording.label, 0, 0, f"no samples: the channels compared or driven ({named}) hold none")
     if not channels:
         raise TraceError(recording.label, 0, 0, "no samples: the recording holds no channel with values")
     declared = [c.sample_time for c in channels if c.sample_time]
