@@ -725,3 +725,15 @@ def test_a_wincc_log_of_too_many_steps_is_told_the_option_that_works(tmp_path):
     with pytest.raises(InputError, match="does not apply"):  # what the old advice led to
         normalise(read_recording(path)[0], time_unit="s", names=FLAGS)
     assert normalise(read_recording(path)[0], step_size=0.5, names=FLAGS).step_size == 0.5
+
+
+def test_three_channels_meaning_one_variable_are_refused_naming_all_three(tmp_path):
+    path = tmp_path / "thrice.csv"
+    path.write_text("time,MAIN.a.value,MAIN.b.value,MAIN.c.value,delayedValue\n0,1,2,3,0\n")
+    with pytest.raises(InputError) as error:
+        plan(read_recording(path)[0], SIEMENS_VARIABLES, "M", names=FLAGS)
+    assert str(error.value) == (
+        f"{path}: channels 'MAIN.a.value' (column 2 of {path}), 'MAIN.b.value' (column 3 of {path}) and "
+        f"'MAIN.c.value' (column 4 of {path}) all mean value: say which with --map value=CHANNEL, "
+        "e.g. --map value=MAIN.a.value"
+    )

@@ -103,6 +103,18 @@ def _ambiguous(recording, mapping, candidates, names):
     )
 
 
+def _all_mean(recording, variable, found, names):
+    """The refusal of several channels that mean one variable: each of them, and how to choose one."""
+    listed = [f"{c.name!r}{_column(c)}" for c in found]
+    channels = " and ".join([", ".join(listed[:-1]), listed[-1]])
+    say = f"say which with {name_of(names, maps=(variable, 'CHANNEL'))}"
+    example = name_of(names, maps=(variable, found[0].name))
+    return InputError(
+        f"{recording.label}: channels {channels} {'both' if len(found) == 2 else 'all'} mean {variable}: "
+        f"{say}, e.g. {example}"
+    )
+
+
 def plan(recording, variables, label, maps=(), names: Names = ()):
     """The Plan of a recording for an FMU whose variables (name ->
     fmpy ScalarVariable) are given; maps: (VARIABLE, CHANNEL) pairs;
@@ -125,6 +137,7 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
     for name in variables:
         folded.setdefault(name.lower(), []).append(name)
     result = Plan()
+    matches: dict[str, list] = {}  # variable -> the unmapped channels that mean it
     for channel in recording.channels:
         if id(channel) in mapped:
             continue
@@ -148,16 +161,14 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
                 (channel, f"no variable of {label} is named {last_component(channel.symbol or channel.name)!r}")
             )
             continue
+        matches.setdefault(variable, []).append(channel)
+    for variable, found in matches.items():
         if variable in taken:
-            other = taken[variable]
-            if any(v == variable for v, _ in maps):
-                result.ignored.append((channel, f"{variable} is mapped to {other.name!r}"))
-                continue
-            raise InputError(
-                f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
-                f"{_column(channel)} both mean {variable}: say which with {name_of(names, maps=(variable, 'CHANNEL'))}"
-            )
-        taken[variable] = channel
+            result.ignored += [(c, f"{variable} is mapped to {taken[variable].name!r}") for c in found]
+        elif len(found) > 1:
+            raise _all_mean(recording, variable, found, names)
+        else:
+            taken[variable] = found[0]
     for variable, channel in taken.items():
         role, why = _role(variables[variable])
         if role == "drive":
