@@ -737,3 +737,16 @@ def test_three_channels_meaning_one_variable_are_refused_naming_all_three(tmp_pa
         f"'MAIN.c.value' (column 4 of {path}) all mean value: say which with --map value=CHANNEL, "
         "e.g. --map value=MAIN.a.value"
     )
+
+
+def test_a_wincc_log_over_a_year_long_is_not_told_a_time_unit_which_its_stamps_refuse(tmp_path):
+    base = 46346541666.6667
+    lines = [WINCC_HEADER] + [_wincc_row("Ramp_y", 0, k, f"{base + k * 400e6:.4f}") for k in range(3)]  # 463 days apart
+    path = tmp_path / "years.csv"
+    path.write_text("\r\n".join(lines).replace(";", ",") + "\r\n")
+    with pytest.raises(InputError) as error:
+        normalise(read_recording(path)[0], names=FLAGS)
+    assert str(error.value).endswith(
+        "days): more than a year: compare a part of it (--time-unit does not apply to OLE days (days since 30 Dec "
+        "1899, times 1e6))"
+    )

@@ -213,10 +213,15 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
     span = max(float(c.times[-1]) for c in channels)
     assumed = f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit]
     if too_long(span):
+        advice = (
+            f"more than a year: compare a part of it ({name_of(names, 'time_unit')} does not apply to "
+            f"{UNIT_NAMES[unit]})"
+            if unit in ("date", "OLE days")
+            else f"if that is not its unit, give {name_of(names, 'time_unit')} (s, ms, us, ns, cycles, filetime)"
+        )
         raise InputError(
             f"{recording.label}: with its time read as {assumed}, the recording would span "
-            f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give {name_of(names, 'time_unit')} "
-            "(s, ms, us, ns, cycles, filetime)"
+            f"{span:.4g} s ({span / 86400:.4g} days): {advice}"
         )
     if unit != "cycles":
         if step_size:
