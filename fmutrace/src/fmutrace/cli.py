@@ -120,7 +120,7 @@ def parser():
         description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
         "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
         "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
-        "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF4, WinCC data logs, "
+        "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF 4 and 3, WinCC data logs, "
         "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
         "Exact (bit for bit) unless a tolerance or a tube is given.",
     )
