@@ -165,3 +165,29 @@ def test_a_map_to_a_can_logger_channel_without_samples_says_so():
     path = str(CORPUS / "canedge" / "17BD1DB7_00000170.MF4")
     with pytest.raises(TraceError, match=r"no samples: the channels compared or driven \('LIN_Frame.ID'\) hold none"):
         recorded_case(path, fmu, "can", RecordingOptions(maps={"y": "LIN_Frame.ID"}))
+
+
+def test_decoded_can_signals_take_the_step_of_the_channels_mapped(tmp_path):
+    """FCBF0606 decoded with its DBC (asammdf, canmatrix): EngineSpeed every 0.1 s and
+    WheelBasedVehicleSpeed about every 1 s, each message with its own stamps. The speed mapped alone
+    (PassThrough's u and y) takes a 1 s step, not the 0.1 s of the unmapped engine speed; its stamps
+    are matched to the nearest cycle from its first, and those more than a tenth of a cycle off (its
+    sender's 100 ms task slips now and then) are counted as this test counts them."""
+    from asammdf import MDF
+
+    raw = MDF(str(CORPUS / "canedge" / "FCBF0606_00000001-60B621D9.MF4"))
+    decoded = raw.extract_bus_logging({"CAN": [(str(CORPUS / "canedge" / "CSS-Electronics-SAE-J1939-DEMO.dbc"), 0)]})
+    path = tmp_path / "decoded.mf4"
+    decoded.save(str(path), overwrite=True)
+    stamps = decoded.get("WheelBasedVehicleSpeed").timestamps
+    raw.close()
+    decoded.close()
+    cycles = (stamps - stamps[0]) / 1.0
+    off = int((np.abs(cycles - np.rint(cycles)) > 0.1).sum())
+    command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(PASS_THROUGH), str(path)]
+    maps = ["--map", "u=WheelBasedVehicleSpeed", "--map", "y=WheelBasedVehicleSpeed"]
+    done = run_bounded(command + maps, timeout=600, what="fmutrace compare")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert f"{len(stamps)} samples" in done.stdout and "step 1 s (the finest interval" in done.stdout
+    assert done.stdout.count(f"WheelBasedVehicleSpeed: {off} of its {len(stamps)} time stamps are more") == 1
+    assert "ignored: EngineSpeed" in done.stdout

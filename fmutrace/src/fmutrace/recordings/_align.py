@@ -51,7 +51,8 @@ def _cycles_of(channel, step, notes, names):
         own = finest_interval([channel])
         if own is not None and cycles(channel.times, own)[1].size == 0 and own != step:
             note += f" Its own stamps fit a step of {shortest(own)} s ({name_of(names, step_size=own)})."
-        notes.append(note)
+        if note not in notes:  # a channel that drives and is compared is said once
+            notes.append(note)
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])
