@@ -337,3 +337,16 @@ def test_a_folder_of_several_recordings_is_each_of_them(tmp_path):
     assert "3 of 3 cases pass" in done.stdout
     for case in ("plant/tia_portal_siemens.csv", "plant/twincat_siemens.csv", "plant on"):
         assert f"PASS  {case}" in done.stdout
+
+
+@pytest.mark.parametrize("read", ["streamed", "whole"])
+def test_a_channel_that_drives_and_is_compared_is_noted_off_its_cycle_once(tmp_path, read):
+    """u drives PassThrough's u and is compared with its y; its stamps jitter by 0.15 of a cycle."""
+    rows = [f"{k * 10 + (1.5 if k % 2 else 0)},{k}" for k in range(20)]
+    if read == "whole":
+        rows.insert(10, "")
+    path = tmp_path / "jitter.csv"
+    path.write_text("time [ms],u\n" + "\n".join(rows) + "\n")
+    done = compare(PASS_THROUGH, path, "--map", "u=u", "--map", "y=u", "--step-size", "0.01")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("u: 10 of its 20 time stamps are more than 0.1 of a cycle (0.001 s) off") == 1

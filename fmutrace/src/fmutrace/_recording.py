@@ -139,10 +139,12 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         notes = []
         if cycles.off:
             line, time = cycles.first_off
-            notes = [
-                off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
-                for _, channel in drives + compares
-            ]
+            notes = list(
+                dict.fromkeys(  # a channel that drives and is compared is said once, as read whole
+                    off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
+                    for _, channel in drives + compares
+                )
+            )
         notes += matched.describe()
         unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
         description = (
