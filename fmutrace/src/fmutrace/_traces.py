@@ -300,6 +300,14 @@ def steps_problem(start, stop, step) -> str | None:
     return None
 
 
+def samples_problem(samples) -> str | None:
+    """Why a channel of so many samples is refused (None if it is not): each sample is a cycle of its
+    own, so it asks for at least as many steps, under steps_problem's bound; checked before they are read."""
+    if samples > MAX_STEPS:
+        return f"{samples:,} samples, each a cycle of its own: more than the bound of {MAX_STEPS:,} steps"
+    return None
+
+
 def trace_chunks(
     path: str | PathLike, known: Callable[[str], str | None] | None = None, chunk_bytes: int = CHUNK_BYTES
 ) -> Iterator[np.ndarray]:
