@@ -172,12 +172,21 @@ def _read_exactly(fd, size) -> bytes | None:
 
 
 def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
-    """A worker's loop: batches in, a STARTED record and an outcome per case out, until None."""
+    """A worker's loop: batches in, an outcome per case out, until None;
+    a STARTED record before a case where its start matters (every case
+    with a per-case timeout, else the worker's first: its start-up ends
+    there). A record fewer saves the campaign's process a wake-up."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the campaign's to handle (it stops its workers)
     _die_with_parent()
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes (or the command's output)
     fmus: dict[str, bytes] = {}
+    first = [True]
+
+    def started():
+        if first[0] or settings.case_timeout is not None:
+            write(STARTED)
+        first[0] = False
 
     def write(data: bytes):
         view = memoryview(HEADER.pack(len(data)) + data)
@@ -197,7 +206,7 @@ def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
         path, data, fmu, items = message
         if data is not None:
             fmus[path] = data
-        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=lambda: write(STARTED)):
+        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
             write(pickle.dumps(outcome))
 
 
@@ -255,6 +264,7 @@ class Pool:
         self.workers: dict[int, _Worker] = {}  # by its pipe from the worker
         self.selector = selectors.DefaultSelector()
         self.finished: Callable = lambda i, outcome: None
+        self.announced = settings.case_timeout is not None  # every case's start is said (else the first's)
 
     def run(self, todo, finished):
         """Runs todo, [(i, FMU path, (folder, name, texts or None))];
@@ -335,7 +345,9 @@ class Pool:
         data, file = self.fmus[path]
         first = path not in worker.fmus
         worker.fmus.add(path)
-        worker.sent_at, worker.running_since = time.monotonic(), None
+        worker.sent_at = time.monotonic()
+        # its next case starts now, unless it says when (with a timeout, or as a new worker's first)
+        worker.running_since = None if self.announced or worker.first_case else worker.sent_at
         try:
             _send(worker.to_worker, (path, data if first else None, file, [item for _, _, item in worker.batch]))
         except OSError:  # it died before it read the batch: its end shows on its pipe
@@ -406,7 +418,7 @@ class Pool:
                 continue
             outcome = pickle.loads(record)
             i = worker.batch.popleft()[0]
-            worker.running_since = None
+            worker.running_since = None if self.announced else time.monotonic()  # (the next one's start)
             measure = self.measured[worker.first_case]
             measure[0] += outcome.seconds
             measure[1] += 1
