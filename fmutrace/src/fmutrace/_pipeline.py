@@ -234,14 +234,13 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
                         state.tube_rows(chunk)
                     state.tube_rows(None)
                 else:
-                    held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-                    for chunk in reference:
-                        if held is not None:
-                            chunk = np.concatenate([held, chunk])
-                        held = chunk[-1:]
-                        state.compare_rows(chunk[:-1], chunk["time"][-1])
-                    if held is not None:
-                        state.compare_rows(held, np.nan)
+                    # each chunk with the next one's first time (a repeated time spans chunks), the last with NaN
+                    chunks = (c for c in reference if len(c))
+                    chunk = next(chunks, None)
+                    while chunk is not None:
+                        following = next(chunks, None)
+                        state.compare_rows(chunk, np.nan if following is None else following["time"][0])
+                        chunk = following
                 state.next_reference()
             state.result_until(math.inf)  # the rest of the run: an FMU failing there fails the case
         except SimulationError as error:
