@@ -5,9 +5,9 @@ reported by itself while the others go on.
 A worker is a child process: forked from this one where that is safe
 (Linux, no other Python thread: it starts in milliseconds with fmutrace
 already imported), else a new Python running `main` below. It reads
-batches of cases on a pipe and writes back, per case, an empty record
-when it starts it and then its outcome (length-prefixed pickles; what the
-FMU prints goes nowhere). This process, one thread, waits on every
+batches of cases on a pipe and writes back each case's outcome, and an
+empty record when it starts a case whose start matters (length-prefixed
+pickles; what the FMU prints goes nowhere). This process, one thread, waits on every
 worker's pipe with a deadline: a worker whose pipe closes died, and the
 case it ran gets an error naming the signal; a case over the per-case
 timeout gets its worker killed. Either way the rest of the batch goes
@@ -432,15 +432,16 @@ class Pool:
         """The worker is gone: its running case (the first of its batch)
         fails saying why, the rest of the batch goes back to the queue,
         and a new worker takes over if cases are left."""
-        self.lost += 1
-        i, path, (_, name, _) = worker.batch.popleft()
-        started = worker.running_since if worker.running_since is not None else worker.sent_at
-        self.queue.extendleft(reversed(worker.batch))
-        worker.batch.clear()
-        labels = self.fmus[path][1].labels
-        outcome = CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=time.monotonic() - started)
-        self.finished(i, outcome)
-        if self.queue and (len(self.workers) < self.most):
+        if worker.batch:  # (else it went between two batches: no case to blame)
+            self.lost += 1
+            i, path, (_, name, _) = worker.batch.popleft()
+            started = worker.running_since if worker.running_since is not None else worker.sent_at
+            self.queue.extendleft(reversed(worker.batch))
+            worker.batch.clear()
+            labels = self.fmus[path][1].labels
+            seconds = time.monotonic() - started
+            self.finished(i, CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=seconds))
+        if self.queue and len(self.workers) < self.most:
             self._give(self._start())
 
     def _overdue(self, running: bool) -> str:
