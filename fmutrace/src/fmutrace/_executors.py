@@ -108,6 +108,19 @@ class InProcess(Executor):
                 runner.close()
 
 
+class _ForWorkers:
+    """A campaign's todo as workers.Pool takes it, read as it goes."""
+
+    def __init__(self, todo):
+        self.todo = todo
+
+    def __len__(self):
+        return len(self.todo)
+
+    def __iter__(self):
+        return ((i, fmu.path, (str(folder), name, None)) for i, fmu, folder, name in self.todo)
+
+
 class LocalProcesses(Executor):
     """Local worker processes (workers.Pool): jobs of them, or None: as
     many as pay for themselves."""
@@ -119,7 +132,7 @@ class LocalProcesses(Executor):
         fmus = {path: (work.fmu_bytes[path], work.fmus[path]) for path in work.fmus}
         pool = Pool(fmus, work.settings, self.jobs)
         try:
-            pool.run([(i, fmu.path, (str(folder), name, None)) for i, fmu, folder, name in todo], finished)
+            pool.run(_ForWorkers(todo), finished)
         finally:
             self.where = f"{pool.peak} local process{'es' if pool.peak != 1 else ''}"
             if pool.lost:

@@ -24,6 +24,7 @@ together.
 
 import collections
 import ctypes
+import gc
 import math
 import os
 import pickle
@@ -116,6 +117,7 @@ def _start_worker(settings: CaseSettings, others: list[_Worker]) -> _Worker:
         up_read, up_write = os.pipe()
         pid = os.fork()
         if pid == 0:  # the worker: nothing of this process's but the pipes, never back into its code
+            gc.freeze()  # what it inherited stays shared: the collector's passes would copy every page of it
             code = 1
             try:
                 for worker in others:
@@ -242,6 +244,41 @@ def _last_words(file):
     return f"; it said: {lines[-1][:200]}" if lines else ""
 
 
+class _Queue:
+    """The cases no worker has yet: taken from todo as batches need them (a
+    campaign's list of cases is never copied, so memory stays flat in its
+    length), the cases a lost worker gave back first."""
+
+    def __init__(self, todo, count: int):
+        self.todo, self.left = iter(todo), count
+        self.front: collections.deque = collections.deque()  # given back, or looked at
+
+    def __len__(self):
+        return self.left
+
+    def _first(self):
+        if not self.front:
+            item = next(self.todo, None)
+            if item is None:
+                return None
+            self.front.append(item)
+        return self.front[0]
+
+    def take(self, size: int) -> list:
+        """Up to size cases of one FMU, in todo's order."""
+        batch: list = []
+        path = None
+        while len(batch) < size and (item := self._first()) is not None and path in (None, item[1]):
+            path = item[1]
+            batch.append(self.front.popleft())
+        self.left -= len(batch)
+        return batch
+
+    def give_back(self, items):
+        self.front.extendleft(reversed(items))
+        self.left += len(items)
+
+
 class Pool:
     """Runs a campaign's cases in workers (see the module's text).
 
@@ -260,16 +297,17 @@ class Pool:
         # the work's measure: seconds and count of the cases finished, each worker's first apart (it carries
         # the worker's warm-up: the FMU's first instance, lazy imports)
         self.measured = {True: [0.0, 0], False: [0.0, 0]}  # first? -> [seconds, cases]
-        self.queue: collections.deque = collections.deque()
+        self.queue = _Queue((), 0)
         self.workers: dict[int, _Worker] = {}  # by its pipe from the worker
         self.selector = selectors.DefaultSelector()
         self.finished: Callable = lambda i, outcome: None
         self.announced = settings.case_timeout is not None  # every case's start is said (else the first's)
 
     def run(self, todo, finished):
-        """Runs todo, [(i, FMU path, (folder, name, texts or None))];
-        finished(i, outcome) as each case ends."""
-        self.queue.extend(todo)
+        """Runs todo, a sized iterable of (i, FMU path, (folder, name,
+        texts or None)), read as it goes; finished(i, outcome) as each
+        case ends."""
+        self.queue = _Queue(todo, len(todo))
         self.finished = finished
         unpack_root()  # made here: the workers unpack into it, and this process removes it however they end
         if plotting_first(self.settings) and can_fork():
@@ -339,9 +377,8 @@ class Pool:
         if not self.queue:
             self._stop(worker)
             return
-        size, path = self._batch_size(), self.queue[0][1]
-        while self.queue and len(worker.batch) < size and self.queue[0][1] == path:
-            worker.batch.append(self.queue.popleft())
+        worker.batch.extend(self.queue.take(self._batch_size()))
+        path = worker.batch[0][1]
         data, file = self.fmus[path]
         first = path not in worker.fmus
         worker.fmus.add(path)
@@ -436,7 +473,7 @@ class Pool:
             self.lost += 1
             i, path, (_, name, _) = worker.batch.popleft()
             started = worker.running_since if worker.running_since is not None else worker.sent_at
-            self.queue.extendleft(reversed(worker.batch))
+            self.queue.give_back(list(worker.batch))
             worker.batch.clear()
             labels = self.fmus[path][1].labels
             seconds = time.monotonic() - started
