@@ -19,6 +19,7 @@ reference scenario in chunks of one step and one row).
 
 import contextlib
 import itertools
+import json
 import math
 import time
 from collections.abc import Callable, Iterator
@@ -35,7 +36,7 @@ from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
-from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
+from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw, page_data
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK
 from ._traces import CHUNK_BYTES, NotPlain, TraceWriter, last_time, read_text, trace_chunks
@@ -464,6 +465,7 @@ class _Comparer:
         outcome.messages += [d.describe() for d in deviations if d.passed and d.allowance]  # (per-signal criteria)
         if case.more_messages is not None:
             outcome.messages += case.more_messages(passed, outcome.deviations)
+        outcome.criteria = self.mode.describe()
         if settings.plots == "all" or (settings.plots == "failed" and not passed):
             figure = Figure(
                 case.title,
@@ -472,11 +474,14 @@ class _Comparer:
                 [(s, *envelopes[("deviation", s)].line()) for s in outputs],
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
-            try:
-                outcome.png = draw(figure, self.mode, labels["fmu"])
-                outcome.result_path = self.result.keep() or ""
-            except Exception as error:  # (matplotlib's errors are many) a figure lost, not the verdict
-                outcome.messages.append(f"no plot: drawing it failed ({type(error).__name__}: {error})")
+            criteria = {s: d.criterion or outcome.criteria for s, d in zip(outputs, deviations, strict=True)}
+            outcome.plot_js = "window.fmutracePlot = " + json.dumps(page_data(figure, labels["fmu"], criteria)) + ";\n"
+            outcome.result_path = self.result.keep() or ""
+            if settings.png:
+                try:
+                    outcome.png = draw(figure, self.mode, labels["fmu"])
+                except Exception as error:  # (matplotlib's errors are many) a figure lost, not the verdict
+                    outcome.messages.append(f"no plot: drawing it failed ({type(error).__name__}: {error})")
         outcome.seconds = time.perf_counter() - case.started
         return outcome
 

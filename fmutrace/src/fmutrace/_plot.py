@@ -229,3 +229,56 @@ def _clear(ax):
     # the limits of a new axis: an axis left empty shows 0..1, a drawn one autoscales when it is drawn
     ax.set_xlim(0, 1, auto=True)
     ax.set_ylim(0, 1, auto=True)
+
+
+def _points(times, values, window=None) -> list:
+    """[times, values] of a line as lists for a page; window (times,
+    values at full resolution) replaces the line's points in its span."""
+    times, values = np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
+    if window is not None and len(window[0]):
+        w_t, w_v = np.asarray(window[0], dtype=np.float64), np.asarray(window[1], dtype=np.float64)
+        outside = (times < w_t[0]) | (times > w_t[-1])
+        k = int(np.searchsorted(times[outside], w_t[0]))
+        times = np.concatenate((times[outside][:k], w_t, times[outside][k:]))
+        values = np.concatenate((values[outside][:k], w_v, values[outside][k:]))
+    return [times.tolist(), values.tolist()]
+
+
+def page_data(figure: Figure, label: str, criteria: dict) -> dict:
+    """What a case page's interactive plots show (plain lists, NaN kept:
+    the page reads them as JavaScript): per signal its reference, result,
+    band and deviation, decimated as the figure's, with the samples around
+    the first deviation at full resolution; the inputs; where the first
+    deviation is and the span to frame on open. criteria: signal -> the
+    criterion it is judged by."""
+    zoom = {}
+    frame = None
+    if figure.zoom:
+        at, lines = figure.zoom
+        for name, times, values, lower, upper, deviation in lines:
+            zoom[name] = (times, values, lower, upper, deviation)
+            if len(times):
+                low, high = float(times[0]), float(times[-1])
+                frame = [min(frame[0], low), max(frame[1], high)] if frame else [low, high]
+    signals = []
+    for (name, ref, result, band), (_, dev_t, dev_v) in zip(figure.signals, figure.deviations, strict=True):
+        z = zoom.get(name)
+        signals.append(
+            {
+                "name": shown(name),
+                "criterion": shown(criteria.get(name, "")),
+                "reference": _points(*ref),
+                "result": _points(result[0], result[1], window=z and (z[0], z[1])),
+                "lower": _points(band[0], band[1], window=z and (z[0], z[2])) if band is not None else None,
+                "upper": _points(band[0], band[2], window=z and (z[0], z[3])) if band is not None else None,
+                "deviation": _points(dev_t, dev_v, window=z and (z[0], z[4])),
+            }
+        )
+    return {
+        "title": shown(figure.title),
+        "label": shown(label),
+        "inputs": [{"name": shown(name), "line": _points(t, v)} for name, t, v in figure.inputs],
+        "signals": signals,
+        "first_deviation": figure.zoom[0] if figure.zoom else None,
+        "frame": frame,
+    }
