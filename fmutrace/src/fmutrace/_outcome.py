@@ -46,6 +46,7 @@ class CaseOutcome:
     result: np.ndarray | None = None  # structured array
     png: bytes = b""  # the static figure (plots "png")
     plot_js: str = ""  # the case page's plot data, a script (report.py writes it beside the page)
+    plot_tiles: list = field(default_factory=list)  # a long case's finer level, a script per part of its span
     result_path: str = ""  # a long case's result, in a file of its own (the report moves it in)
     csv: str = ""  # paths in the report folder
     plot: str = ""

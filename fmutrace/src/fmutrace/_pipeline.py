@@ -36,7 +36,7 @@ from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
-from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw, page_data
+from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, draw, needs_tiles, page_data, page_tile
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK
 from ._traces import CHUNK_BYTES, NotPlain, TraceWriter, last_time, read_text, trace_chunks
@@ -475,7 +475,19 @@ class _Comparer:
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
             criteria = {s: d.criterion or outcome.criteria for s, d in zip(outputs, deviations, strict=True)}
-            outcome.plot_js = "window.fmutracePlot = " + json.dumps(page_data(figure, labels["fmu"], criteria)) + ";\n"
+            data = page_data(figure, labels["fmu"], criteria)
+            if needs_tiles(envelopes.values()):
+                any_line = next(iter(envelopes.values()))
+                data["tiles"], data["span"] = DETAIL, [any_line.t0, any_line.t0 + any_line.span]
+                inputs = [(s, envelopes[("input", s)]) for s in case.input_names]
+                signals = [
+                    (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation")))
+                    for s in outputs
+                ]
+                outcome.plot_tiles = [
+                    f"fmutraceTile({json.dumps(page_tile(k, inputs, signals))});\n" for k in range(DETAIL)
+                ]
+            outcome.plot_js = f"window.fmutracePlot = {json.dumps(data)};\n"
             outcome.result_path = self.result.keep() or ""
             if settings.png:
                 try:

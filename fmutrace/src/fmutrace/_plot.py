@@ -11,6 +11,7 @@ not grow with the length. A long case fills its envelopes chunk by chunk."""
 import importlib
 import io
 import threading
+import warnings
 
 import numpy as np
 
@@ -22,6 +23,7 @@ COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
 ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
 
 
+DETAIL = 16  # an envelope's columns per figure column: a case page's finer level, sent in tiles of COLUMNS
 FOLD_SAMPLES = 1 << 16  # samples an envelope holds before it folds them into its columns
 
 
@@ -33,10 +35,11 @@ class Envelope:
     the columns once FOLD_SAMPLES of them wait, or when the line is drawn:
     a short case that gets no figure never pays for its envelopes."""
 
-    def __init__(self, t0: float, t1: float, columns: int = COLUMNS):
+    def __init__(self, t0: float, t1: float, columns: int = COLUMNS * DETAIL):
         self.t0, self.span, self.columns = float(t0), max(float(t1) - float(t0), 1e-300), columns
         self.waiting: list[tuple[np.ndarray, np.ndarray]] = []
         self.waiting_samples = 0
+        self.samples = 0  # added in all
         self.folded = False  # the columns below hold samples (they are made then)
         self.first_t = self.first_v = self.last_t = self.last_v = self.low = self.high = np.full(0, np.nan)
 
@@ -46,6 +49,7 @@ class Envelope:
             return
         self.waiting.append((times, values))
         self.waiting_samples += len(times)
+        self.samples += len(times)
         if self.waiting_samples >= FOLD_SAMPLES:
             self._fold()
 
@@ -75,17 +79,47 @@ class Envelope:
         self.last_t[c], self.last_v[c] = times[ends], values[ends]
         self.low[c], self.high[c] = np.fmin(self.low[c], low), np.fmax(self.high[c], high)
 
-    def line(self):
-        """(times, values) to draw: per filled column its first sample, its
-        range at its middle, its last sample."""
+    def line(self, factor: int = DETAIL):
+        """(times, values) to draw: per column (of columns / factor, each
+        joining factor of the envelope's) its first sample, its range at
+        its middle, its last sample."""
         self._fold()
         if not self.folded:
             return np.empty(0), np.empty(0)
-        filled = ~np.isnan(self.first_t)
-        middle = (self.first_t + self.last_t) / 2
-        times = np.stack([self.first_t, middle, middle, self.last_t], axis=1)[filled].ravel()
-        values = np.stack([self.first_v, self.low, self.high, self.last_v], axis=1)[filled].ravel()
-        return times, values
+        return _line(*_joined(self._arrays(), factor))
+
+    def tile(self, k: int, per: int = COLUMNS):
+        """(times, values) of the envelope's own columns k * per .. (k + 1) * per, at its full detail."""
+        self._fold()
+        if not self.folded:
+            return np.empty(0), np.empty(0)
+        return _line(*(a[k * per : (k + 1) * per] for a in self._arrays()))
+
+    def _arrays(self):
+        return self.first_t, self.first_v, self.last_t, self.last_v, self.low, self.high
+
+
+def _joined(arrays, factor):
+    """An envelope's columns (first_t, first_v, last_t, last_v, low, high) joined factor at a time."""
+    if factor == 1:
+        return arrays
+    first_t, first_v, last_t, last_v, low, high = (a.reshape(-1, factor) for a in arrays)
+    filled = ~np.isnan(first_t)
+    first = np.argmax(filled, axis=1)  # the first filled column of each group, the last below
+    last = factor - 1 - np.argmax(filled[:, ::-1], axis=1)
+    rows = np.arange(len(first_t))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # (a group of empty columns: NaN, as it should)
+        lowest, highest = np.nanmin(low, axis=1), np.nanmax(high, axis=1)
+    return first_t[rows, first], first_v[rows, first], last_t[rows, last], last_v[rows, last], lowest, highest
+
+
+def _line(first_t, first_v, last_t, last_v, low, high):
+    filled = ~np.isnan(first_t)
+    middle = (first_t + last_t) / 2
+    times = np.stack([first_t, middle, middle, last_t], axis=1)[filled].ravel()
+    values = np.stack([first_v, low, high, last_v], axis=1)[filled].ravel()
+    return times, values
 
 
 class Figure:
@@ -281,4 +315,38 @@ def page_data(figure: Figure, label: str, criteria: dict) -> dict:
         "signals": signals,
         "first_deviation": figure.zoom[0] if figure.zoom else None,
         "frame": frame,
+    }
+
+
+def needs_tiles(envelopes) -> bool:
+    """Whether a page gains by the finer level: a line has more samples than the figure's columns show."""
+    return any(e.samples > 2 * COLUMNS for e in envelopes)
+
+
+def page_tile(k: int, inputs, signals) -> dict:
+    """Tile k of DETAIL of a case page's finer level: the lines' own
+    envelope columns over the k-th part of the time span. inputs: [(name,
+    Envelope)]; signals: [(name, reference, result, lower or None, upper
+    or None, deviation)], Envelopes."""
+    first = next(e for _, *lines in signals for e in lines if e is not None) if signals else inputs[0][1]
+    part = first.span / DETAIL
+
+    def points(envelope):
+        return None if envelope is None else [a.tolist() for a in envelope.tile(k)]
+
+    return {
+        "k": k,
+        "from": first.t0 + k * part,
+        "to": first.t0 + (k + 1) * part,
+        "inputs": [points(e) for _, e in inputs],
+        "signals": [
+            {
+                "reference": points(ref),
+                "result": points(result),
+                "lower": points(lower),
+                "upper": points(upper),
+                "deviation": points(deviation),
+            }
+            for _, ref, result, lower, upper, deviation in signals
+        ],
     }

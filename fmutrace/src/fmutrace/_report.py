@@ -97,6 +97,16 @@ def write_case_files(outcome: CaseOutcome, report_dir):
     if outcome.plot_js:
         Path(f"{stem}{PLOT_DATA}").write_text(outcome.plot_js, encoding="utf-8")
         outcome.plot_data = os.path.relpath(f"{stem}{PLOT_DATA}", report_dir)
+    for k, tile in enumerate(outcome.plot_tiles):
+        made = _tile(stem, k)
+        if os.path.islink(made):
+            os.unlink(made)
+        Path(made).write_text(tile, encoding="utf-8")
+
+
+def _tile(stem, k) -> str:
+    """The file of a case's plot data tile k (the page loads it by this name as the reader zooms)."""
+    return f"{stem}{PLOT_DATA.removesuffix('.js')}.{k}.js"
 
 
 @contextlib.contextmanager
@@ -277,8 +287,10 @@ def _case_page(o: CaseOutcome, report_dir: Path, campaign_criteria) -> str:
     )
     files = [f'<a href="{link(o.csv)}">result CSV</a>'] if o.csv else []
     files += [f'<a href="{link(o.plot)}">static figure (PNG)</a>'] if o.plot else []
+    tiles = html.escape(quote(stem.name + PLOT_DATA.removesuffix("js")))  # its tiles' names before k.js
     plots = (
-        f'<div id="plots" class="plots"></div>\n<script src="{assets}/uPlot.iife.min.js"></script>\n'
+        f'<div id="plots" class="plots" data-tiles="{tiles}"></div>\n'
+        f'<script src="{assets}/uPlot.iife.min.js"></script>\n'
         f'<script src="{link(o.plot_data)}"></script>\n<script src="{assets}/case.js"></script>\n'
         if o.plot_data
         else "<p>No plot: this case was not plotted (<code>--plots</code>).</p>"

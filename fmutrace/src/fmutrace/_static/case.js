@@ -37,6 +37,74 @@
     return out;
   }
 
+  // a long case's finer level: tiles of its span, each a script beside the page (<case>.plot.<k>.js),
+  // loaded as the reader zooms in; a line drawn from the tiles loaded where there are some, else the overview
+  var tiles = {}, pending = {}, refreshing = false;
+
+  function overview(source) {
+    return source[0] === "inputs" ? data.inputs[source[1]].line : data.signals[source[1]][source[2]];
+  }
+
+  function lineOf(source) {
+    var base = overview(source), ks = Object.keys(tiles);
+    if (!ks.length || !base) { return base; }
+    var part = (data.span[1] - data.span[0]) / data.tiles, points = [];
+    // the compared samples around the first deviation: at full resolution in the overview (not the reference, inputs)
+    var f = source[0] === "signals" && source[2] !== "reference" ? data.frame : null;
+    function framed(t) { return !!f && t >= f[0] && t <= f[1]; }
+    function loaded(t) { return !framed(t) && !!tiles[Math.min(data.tiles - 1, Math.floor((t - data.span[0]) / part))]; }
+    for (var i = 0; i < base[0].length; i++) {
+      if (!loaded(base[0][i])) { points.push([base[0][i], base[1][i], points.length]); }
+    }
+    ks.forEach(function (k) {
+      var tile = tiles[k];
+      var line = source[0] === "inputs" ? tile.inputs[source[1]] : tile.signals[source[1]][source[2]];
+      if (!line) { return; }
+      for (var j = 0; j < line[0].length; j++) {
+        if (line[0][j] >= tile.from && line[0][j] < tile.to && !framed(line[0][j])) { points.push([line[0][j], line[1][j], points.length]); }
+      }
+    });
+    points.sort(function (a, b) { return a[0] - b[0] || a[2] - b[2]; });
+    return [points.map(function (p) { return p[0]; }), points.map(function (p) { return p[1]; })];
+  }
+
+  function refresh() {
+    if (refreshing) { return; }
+    refreshing = true;
+    setTimeout(function () {
+      refreshing = false;
+      var min = charts[0].scales.x.min, max = charts[0].scales.x.max;
+      syncing = true;
+      charts.forEach(function (c) {
+        c.setData(aligned(c.fmutraceSources.map(lineOf)), false);
+        c.setScale("x", { min: min, max: max });
+      });
+      syncing = false;
+      root.dataset.tilesLoaded = Object.keys(tiles).length;
+    }, 0);
+  }
+
+  window.fmutraceTile = function (tile) {
+    tiles[tile.k] = tile;
+    delete pending[tile.k];
+    refresh();
+  };
+
+  function refine(min, max) {
+    if (!data.tiles || !root.dataset.tiles) { return; }
+    var span = data.span[1] - data.span[0], part = span / data.tiles;
+    if (max - min > span / 2) { return; }
+    var first = Math.max(0, Math.floor((min - data.span[0]) / part));
+    var last = Math.min(data.tiles - 1, Math.floor((max - data.span[0]) / part));
+    for (var k = first; k <= last; k++) {
+      if (tiles[k] || pending[k]) { continue; }
+      pending[k] = true;
+      var script = document.createElement("script");
+      script.src = root.dataset.tiles + k + ".js";
+      document.head.appendChild(script);
+    }
+  }
+
   function marker(u) {
     var at = data.first_deviation;
     if (at === null || at === undefined) { return; }
@@ -67,11 +135,12 @@
     root.dataset.xmin = min;
     root.dataset.xmax = max;
     syncing = false;
+    refine(min, max);
   }
 
   function width() { return Math.max(280, root.clientWidth - 4); }
 
-  function chart(title, names, styles, lines, height) {
+  function chart(title, names, styles, sources, height) {
     var box = document.createElement("div");
     box.className = "plot";
     var h = document.createElement("h3");
@@ -93,7 +162,8 @@
       cursor: { sync: { key: "fmutrace" }, drag: { x: true, y: false } },
       hooks: { setScale: [scaled], draw: [marker] }
     };
-    var u = new uPlot(options, aligned(lines), box);
+    var u = new uPlot(options, aligned(sources.map(lineOf)), box);
+    u.fmutraceSources = sources;
     u.over.addEventListener("wheel", function (e) {
       e.preventDefault();
       var min = u.scales.x.min, max = u.scales.x.max, span = max - min;
@@ -143,21 +213,21 @@
   if (data.inputs.length) {
     chart("inputs", data.inputs.map(function (i) { return "input " + i.name; }),
       data.inputs.map(function (_, k) { return { stroke: ["#1f77b4", "#2ca02c", "#9467bd", "#8c564b"][k % 4], paths: uPlot.paths.stepped({ align: 1 }) }; }),
-      data.inputs.map(function (i) { return i.line; }), 160);
+      data.inputs.map(function (_, k) { return ["inputs", k]; }), 160);
   }
-  data.signals.forEach(function (s) {
+  data.signals.forEach(function (s, n) {
     var names = [s.name + " reference", s.name + " " + data.label];
     var styles = [{ stroke: "#777" }, { stroke: "#e8710a", paths: uPlot.paths.stepped({ align: 1 }) }];
-    var lines = [s.reference, s.result];
+    var lines = [["signals", n, "reference"], ["signals", n, "result"]];
     if (s.lower && s.upper) {
       names.push("lower", "upper");
       styles.push({ stroke: "#bbb", width: 1 }, { stroke: "#bbb", width: 1, band: true });
-      lines.push(s.lower, s.upper);
+      lines.push(["signals", n, "lower"], ["signals", n, "upper"]);
     }
     var title = s.name + (s.criterion ? " (" + s.criterion + ")" : "");
     chart(title, names, styles, lines, 230).root.parentNode.dataset.signal = s.name;
     chart(s.name + ": deviation", [s.name + " deviation"], [{ stroke: "#d62728", paths: uPlot.paths.stepped({ align: 1 }) }],
-      [s.deviation], 130).root.parentNode.dataset.signal = s.name;
+      [["signals", n, "deviation"]], 130).root.parentNode.dataset.signal = s.name;
   });
   if (data.frame) { frame(); } else if (charts.length) { root.dataset.xmin = charts[0].scales.x.min; root.dataset.xmax = charts[0].scales.x.max; }
   window.addEventListener("resize", function () {
