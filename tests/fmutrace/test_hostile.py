@@ -274,6 +274,11 @@ def test_markdown_and_html_show_a_name_as_text(tmp_path):
     assert "<b>" not in summary and "](javascript" not in summary, summary
     page = (tmp_path / "report" / "index.html").read_text()
     assert "<b>bold" not in page and "&lt;b&gt;bold" in page
+    [case_page] = [p for p in (tmp_path / "report").rglob("*.html") if p.name != "index.html"]
+    page = case_page.read_text()
+    assert "<b>bold" not in page and "&lt;b&gt;bold" in page
+    data = case_page.with_name(case_page.name.removesuffix(".html") + ".plot.js").read_text()
+    assert "<" not in data and "\\u003cb>bold" in data  # (JSON's escape: the name itself once read)
 
 
 def test_control_characters_in_names_leave_junit_xml_valid(tmp_path):

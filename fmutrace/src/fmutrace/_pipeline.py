@@ -19,7 +19,6 @@ reference scenario in chunks of one step and one row).
 
 import contextlib
 import itertools
-import json
 import math
 import time
 from collections.abc import Callable, Iterator
@@ -36,7 +35,7 @@ from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
-from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, draw, needs_tiles, page_data, page_tile
+from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, as_script, draw, needs_tiles, page_data, page_tile
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK
 from ._traces import CHUNK_BYTES, NotPlain, TraceWriter, last_time, read_text, trace_chunks
@@ -485,9 +484,9 @@ class _Comparer:
                     for s in outputs
                 ]
                 outcome.plot_tiles = [
-                    f"fmutraceTile({json.dumps(page_tile(k, inputs, signals))});\n" for k in range(DETAIL)
+                    as_script("fmutraceTile(", page_tile(k, inputs, signals), ");") for k in range(DETAIL)
                 ]
-            outcome.plot_js = f"window.fmutracePlot = {json.dumps(data)};\n"
+            outcome.plot_js = as_script("window.fmutracePlot = ", data, ";")
             outcome.result_path = self.result.keep() or ""
             if settings.png:
                 try:

@@ -10,6 +10,7 @@ not grow with the length. A long case fills its envelopes chunk by chunk."""
 
 import importlib
 import io
+import json
 import threading
 import warnings
 
@@ -350,3 +351,10 @@ def page_tile(k: int, inputs, signals) -> dict:
             for _, ref, result, lower, upper, deviation in signals
         ],
     }
+
+
+def as_script(head: str, data, tail: str) -> str:
+    """head + data as JSON + tail: a script line; NaN and infinities as
+    JavaScript's, and no '<' (names from users' files as text even where
+    a page would hold the script inline)."""
+    return head + json.dumps(data).replace("<", "\\u003c") + tail + "\n"
