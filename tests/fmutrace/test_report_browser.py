@@ -24,6 +24,7 @@ from fmutrace import RunOptions, compare
 from support.fmu_driver import BUILD_DIR
 
 PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi2" / "PassThrough.fmu"
+PASS_THROUGH_3 = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
 CHROMIUM, CHROMEDRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"  # Debian's (cmake/TestTools.cmake)
 OPT = "StartTime,0\nStopTime,0.5\nStepSize,0.1\nRelTol,1e-6\n"
 INPUT = "time,u\n0,1\n0.2,3\n"
@@ -110,15 +111,31 @@ def wait_for(browser, script, seconds=10):
     return value
 
 
+def cases_shown(browser):
+    rows = browser.find_elements("css selector", "#cases tbody tr")
+    return [(r.find_element("tag name", "a").text, r.get_attribute("data-fmu")) for r in rows if r.is_displayed()]
+
+
 def test_a_passing_campaign(browser, tmp_path):
+    """Three cases on the FMI 2 and FMI 3 PassThrough: counted per FMU and
+    per model, filtered by FMU, sorted by name."""
     for name in ("one", "two", "three"):
         write_case(tmp_path / "cases" / name)
-    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report", run=RunOptions(jobs=1))
+    fmus = [PASS_THROUGH, PASS_THROUGH_3]
+    campaign = compare(fmus, [tmp_path / "cases"], report=tmp_path / "report", run=RunOptions(jobs=1))
     assert campaign.passed
     open_page(browser, tmp_path / "report" / "index.html")
-    assert (number(browser, "total"), number(browser, "pass"), number(browser, "fail")) == (3, 3, 0)
-    assert visible_rows(browser) == ["pass"] * 3
+    assert (number(browser, "total"), number(browser, "pass"), number(browser, "fail")) == (6, 6, 0)
+    per_fmu, per_model = (t.text.splitlines() for t in browser.find_elements("css selector", "table.counts"))
+    assert per_fmu[2:] == ["PassThrough (FMI 2) 3 0 0 0", "PassThrough (FMI 3) 3 0 0 0"], per_fmu
+    assert per_model[2:] == ["PassThrough 6 0 0 0"], per_model
+    assert visible_rows(browser) == ["pass"] * 6
     no_horizontal_scrolling(browser, "passing_index.png")
+    browser.find_element("css selector", "#f-fmu option:nth-child(3)").click()
+    assert cases_shown(browser) == [(name, "PassThrough (FMI 3)") for name in ("one", "three", "two")]
+    browser.find_element("xpath", "//th[text()='case']").click()  # ascending, then descending
+    browser.find_element("xpath", "//th[text()='case']").click()
+    assert cases_shown(browser) == [(name, "PassThrough (FMI 3)") for name in ("two", "three", "one")]
     assert console_errors(browser) == []
     browser.find_element("link text", "two").click()
     wait_for(browser, "return document.getElementById('plots').dataset.xmax")
