@@ -198,7 +198,8 @@ def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
 def test_a_second_campaign_into_the_same_report_folder_is_refused(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 30)
     report = tmp_path / "report"
-    first = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all"])
+    # (drawn as PNG: 30 cases that last seconds)
+    first = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "png"])
     wait_for(lambda: (report / "results.jsonl").exists() and journal_keys(report), "the first campaign's start")
     code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1]))
     assert code == 2, out + err
