@@ -1,7 +1,8 @@
 """A case's figure for the report: its inputs, each compared signal
 (reference, result, and the band where the mode draws one) and the
-deviation, as PNG bytes; for a failing case beside it the same zoomed on
-the first deviation.
+deviation, as the data of its page's interactive plots (page_data, and
+page_tile for a long case's finer level) and, when asked, as PNG bytes;
+for a failing case beside it the same zoomed on the first deviation.
 
 A line of millions of samples is drawn decimated to what the figure can
 show: per pixel column the first and last sample and the smallest and

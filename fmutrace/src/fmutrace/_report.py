@@ -74,8 +74,8 @@ def check_inside(report_dir, path):
 
 
 def write_case_files(outcome: CaseOutcome, report_dir):
-    """<fmu folder>/<case>_out.csv and .png; their paths into outcome. A
-    case's name with '/' makes folders."""
+    """<fmu folder>/<case>_out.csv, .png, .plot.js and its tiles; their
+    paths into outcome. A case's name with '/' makes folders."""
     if outcome.result is None and not outcome.png and not outcome.result_path and not outcome.plot_js:
         return
     stem = report_path(report_dir, outcome.fmu_folder, *outcome.case.split("/"))
