@@ -209,15 +209,22 @@
     show(f[0] - pad, f[1] + pad);
   }
 
+  // a held value (an input, the result) drawn as steps; but a long case's lines are envelopes (a column's
+  // first, lowest, highest, last sample), which steps would draw as a staircase that is not there: straight
+  function held(style) {
+    if (!data.tiles) { style.paths = uPlot.paths.stepped({ align: 1 }); }
+    return style;
+  }
+
   tools();
   if (data.inputs.length) {
     chart("inputs", data.inputs.map(function (i) { return "input " + i.name; }),
-      data.inputs.map(function (_, k) { return { stroke: ["#1f77b4", "#2ca02c", "#9467bd", "#8c564b"][k % 4], paths: uPlot.paths.stepped({ align: 1 }) }; }),
+      data.inputs.map(function (_, k) { return held({ stroke: ["#1f77b4", "#2ca02c", "#9467bd", "#8c564b"][k % 4] }); }),
       data.inputs.map(function (_, k) { return ["inputs", k]; }), 160);
   }
   data.signals.forEach(function (s, n) {
     var names = [s.name + " reference", s.name + " " + data.label];
-    var styles = [{ stroke: "#777" }, { stroke: "#e8710a", paths: uPlot.paths.stepped({ align: 1 }) }];
+    var styles = [{ stroke: "#777" }, held({ stroke: "#e8710a" })];
     var lines = [["signals", n, "reference"], ["signals", n, "result"]];
     if (s.lower && s.upper) {
       names.push("lower", "upper");
@@ -226,7 +233,7 @@
     }
     var title = s.name + (s.criterion ? " (" + s.criterion + ")" : "");
     chart(title, names, styles, lines, 230).root.parentNode.dataset.signal = s.name;
-    chart(s.name + ": deviation", [s.name + " deviation"], [{ stroke: "#d62728", paths: uPlot.paths.stepped({ align: 1 }) }],
+    chart(s.name + ": deviation", [s.name + " deviation"], [held({ stroke: "#d62728" })],
       [["signals", n, "deviation"]], 130).root.parentNode.dataset.signal = s.name;
   });
   if (data.frame) { frame(); } else if (charts.length) { root.dataset.xmin = charts[0].scales.x.min; root.dataset.xmax = charts[0].scales.x.max; }
