@@ -219,6 +219,14 @@ def test_a_long_trace_opens_framed_and_refines_as_it_is_zoomed(browser, tmp_path
     )
     assert time.monotonic() - started < 10
     assert low <= 2500 <= high and high - low < 10, (low, high)
+    reference_framed = browser.execute_script(
+        "var u = window.fmutraceCharts[1], n = 0;"  # (0: the inputs; 1: y; series 1: its reference)
+        "for (var i = 0; i < u.data[0].length; i++) { if (u.data[0][i] >= arguments[0] && u.data[0][i] <= arguments[1]"
+        " && u.data[1][i] !== null) { n++; } } return n",
+        low,
+        high,
+    )
+    assert reference_framed >= 81, reference_framed  # the 40 compared samples each side at full resolution
     no_horizontal_scrolling(browser, "long_case.png")
     before = browser.execute_script("return window.fmutraceCharts[1].data[0].length")
     browser.execute_script("window.fmutraceCharts[0].setScale('x', {min: 1000, max: 1100})")

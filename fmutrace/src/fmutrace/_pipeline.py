@@ -263,6 +263,7 @@ class _Comparer:
         }
         self.zoom_at: float | None = None  # the first failing sample's time, the zoom's lines around it
         self.zoom_lines: list | None = None
+        self.expected: dict[str, np.ndarray] = {}  # name -> the reference at the samples of its band being added
         self.recent: dict[str, tuple] = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower,
         # upper, deviation)
         # reference times without a result sample: their count and the first's time, of the first table with any
@@ -338,7 +339,7 @@ class _Comparer:
         assert isinstance(self.mode, Pointwise)  # (stream_case gives a tube's rows to tube_rows)
         picked, compared_times, bands = result[index[use]], times[use], {}
         for s in names:
-            expected = rows[s][use].astype(np.float64)
+            expected = self.expected[s] = rows[s][use].astype(np.float64)
             values = picked[s].astype(np.float64)
             lower, upper, ok = self.mode.bounds(values, expected)
             with np.errstate(invalid="ignore", over="ignore"):
@@ -430,17 +431,18 @@ class _Comparer:
                 self.envelopes[("upper", s)].add(band.times, band.upper)
             if self.zoom_lines is None and verdict.failed > before and verdict.time is not None:
                 failing_now.append(verdict.time)
-            self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation)
+            expected = self.expected.pop(s, None)  # (known on a pointwise comparison's rows)
+            self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation, expected)
         if failing_now and self.zoom_lines is None:
             at = min(failing_now)
             self.zoom_at, self.zoom_lines = at, []
             for s in self.outputs:
                 if s not in self.recent:
                     continue
-                t, v, lo, up, dev = self.recent[s]
+                t, v, lo, up, dev, ref = self.recent[s]
                 k = int(np.searchsorted(t, at))
                 w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
-                self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w]))
+                self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w], None if ref is None else ref[w]))
 
     def band(self, name):
         """The band's edges to draw, (times, lower, upper), or None."""

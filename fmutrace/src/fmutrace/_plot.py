@@ -128,7 +128,8 @@ class Figure:
     """What a case's figure shows, each line already decimated:
     inputs [(name, times, values)], signals [(name, (ref times, values),
     (result times, values), band or None)], deviations [(name, times,
-    values)], and zoom: None, or the same three around the first
+    values)], and zoom: None, or (its time, [(name, times, values,
+    lower, upper, deviation[, reference or None])]) around the first
     deviation (full resolution)."""
 
     def __init__(self, title, inputs, signals, deviations, zoom=None):
@@ -194,7 +195,7 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         at, lines = figure.zoom
         zoom_axes = list(grid[has_inputs:, 1])
         zoom_deviation = zoom_axes.pop()
-        for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines, strict=False):
+        for ax, (name, times, values, lower, upper, deviation, *_) in zip(zoom_axes, lines, strict=False):
             ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
             ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=_plain(name))
             ax.axvline(at, color="C3", linewidth=0.8)
@@ -291,8 +292,8 @@ def page_data(figure: Figure, label: str, criteria: dict) -> dict:
     frame = None
     if figure.zoom:
         at, lines = figure.zoom
-        for name, times, values, lower, upper, deviation in lines:
-            zoom[name] = (times, values, lower, upper, deviation)
+        for name, times, values, lower, upper, deviation, *reference in lines:
+            zoom[name] = (times, values, lower, upper, deviation, reference[0] if reference else None)
             if len(times):
                 low, high = float(times[0]), float(times[-1])
                 frame = [min(frame[0], low), max(frame[1], high)] if frame else [low, high]
@@ -303,7 +304,8 @@ def page_data(figure: Figure, label: str, criteria: dict) -> dict:
             {
                 "name": shown(name),
                 "criterion": shown(criteria.get(name, "")),
-                "reference": _points(*ref),
+                "reference": _points(ref[0], ref[1], window=z and z[5] is not None and (z[0], z[5])),
+                "reference_framed": bool(z and z[5] is not None),
                 "result": _points(result[0], result[1], window=z and (z[0], z[1])),
                 "lower": _points(band[0], band[1], window=z and (z[0], z[2])) if band is not None else None,
                 "upper": _points(band[0], band[2], window=z and (z[0], z[3])) if band is not None else None,

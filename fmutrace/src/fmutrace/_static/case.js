@@ -49,8 +49,10 @@
     var base = overview(source), ks = Object.keys(tiles);
     if (!ks.length || !base) { return base; }
     var part = (data.span[1] - data.span[0]) / data.tiles, points = [];
-    // the compared samples around the first deviation: at full resolution in the overview (not the reference, inputs)
-    var f = source[0] === "signals" && source[2] !== "reference" ? data.frame : null;
+    // the compared samples around the first deviation: at full resolution in the overview (the reference where
+    // the comparison knew it there, not the inputs)
+    var framed_here = source[0] === "signals" && (source[2] !== "reference" || data.signals[source[1]].reference_framed);
+    var f = framed_here ? data.frame : null;
     function framed(t) { return !!f && t >= f[0] && t <= f[1]; }
     function loaded(t) { return !framed(t) && !!tiles[Math.min(data.tiles - 1, Math.floor((t - data.span[0]) / part))]; }
     for (var i = 0; i < base[0].length; i++) {
