@@ -13,8 +13,8 @@ plain loop of fmpy.simulate_fmu calls.
 2. The plain loop as a user writes it, in one process, on a sample of
    the 1,000-step cases: fmpy's read_csv of the inputs, simulate_fmu,
    read_csv of the reference, np.array_equal; per trace.
-3. Per campaign, the command three ways (the report, --plots failed,
-   --rel-tol 1e-9): the default, --jobs 1 and --jobs N; wall time from the
+3. Per campaign, the command three ways (the report and --rel-tol 1e-9,
+   the plots the command's default): the default, --jobs 1 and --jobs N; wall time from the
    command's start to its exit and its CPU (its workers' included).
 Prints a table and the targets; exit 1 if a figure misses its target
 (not with --smoke: figures on a few steps mean nothing).
@@ -124,7 +124,7 @@ def command(fmu, root, jobs, report):
     """(wall seconds, CPU seconds, headline) of fmutrace compare on root's
     cases with --jobs jobs (None: the default)."""
     fmutrace = Path(sys.executable).parent / "fmutrace"
-    args = [str(fmutrace), "compare", str(fmu), str(root), "--report", str(report), "--plots", "failed"]
+    args = [str(fmutrace), "compare", str(fmu), str(root), "--report", str(report)]
     args += ["--rel-tol", "1e-9"] + ([] if jobs is None else ["--jobs", str(jobs)])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()

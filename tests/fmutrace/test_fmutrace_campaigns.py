@@ -335,3 +335,22 @@ def test_the_default_starts_the_workers_the_work_pays_for(plots, count, workers,
     assert code == 0 and f"{count} of {count} cases pass" in out, out + err
     expected = min(workers, len(os.sched_getaffinity(0)))
     assert f" on {expected} local process{'es' if expected > 1 else ''})." in out, out
+
+
+def test_dask_batches_take_the_size_measured_when_each_starts():
+    """A Dask batch's size is asked as the batch starts (one case before any
+    is measured, then about a second of measured work), and a batch never
+    holds two FMUs' cases."""
+    from fmutrace import _executors
+
+    first, second = object(), object()
+    todo = [(i, first if i < 7 else second, f"case_{i}", f"case_{i}") for i in range(10)]
+    sizes = iter([1, 3, 3, 2, 5])
+    batches = list(_executors._batches(todo, lambda: next(sizes), ship_texts=False))
+    assert [(fmu is first, [i for i, *_ in batch]) for fmu, batch in batches] == [
+        (True, [0]),
+        (True, [1, 2, 3]),
+        (True, [4, 5, 6]),
+        (False, [7, 8]),
+        (False, [9]),
+    ]

@@ -21,6 +21,7 @@ import samples  # noqa: E402
 FMUTRACE = Path(sys.executable).parent / "fmutrace"
 SIEMENS = {v: BUILD_DIR / f"fmi{v}" / "LGF_LimRateOfChangeCI.fmu" for v in (2, 3)}
 RATE_LIMITER = {v: BUILD_DIR / f"fmi{v}" / "RateLimiter.fmu" for v in (2, 3)}
+PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"  # y is u, each cycle
 WINCC_MAPS = [
     "--map",
     "value=DB_Ramp_value",
@@ -160,7 +161,7 @@ def bad(tmp_path, name, text, *options, encoding="utf-8"):
 
 def test_a_file_of_no_known_format_says_which_formats_were_tried(tmp_path):
     said = bad(tmp_path, "notes.txt", "Commissioning notes\nthe ramp looked fine\n")
-    assert "notes.txt: no known recording format; tried ASAM MDF4: not MDF" in said
+    assert "notes.txt: no known recording format; tried ASAM MDF (3 or 4): not MDF" in said
     for name in (
         "Beckhoff TwinCAT Scope View CSV: no channel header block",
         "WinCC data log CSV: no header",
@@ -279,3 +280,72 @@ def test_a_10_ms_recording_with_printed_decimals_passes_within_them(tmp_path):
     done = compare(RATE_LIMITER[3], path, "--abs-tol", "5e-7")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "step 0.01 s" in done.stdout
+
+
+def test_a_case_of_more_messages_than_the_terminal_shows_says_how_many_and_where_they_are(tmp_path):
+    """Twelve channels no variable is named after: 15 messages (the description, drives, compared, 12
+    ignored); the command shows 10, then the count of the rest and the file that holds them all."""
+    junk = [f"spare{n}" for n in range(12)]
+    lines = ["time [ms];value;setChangeRate;delayedValue;" + ";".join(junk)]
+    for k in range(14):
+        row = [samples.SIEMENS[n][k] for n in ("value", "setChangeRate", "delayedValue")]
+        lines.append(";".join([str(k * 250)] + [str(v) for v in row] + ["0"] * 12))
+    path = tmp_path / "many.csv"
+    path.write_text("\n".join(lines) + "\n")
+    done = compare(SIEMENS[3], path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    shown = [line for line in done.stdout.splitlines() if line.startswith("      ")]
+    assert len(shown) == 11 and "ignored: spare6" in shown[9]
+    assert shown[10] == "      (and 5 more messages: --report DIR writes all of them into DIR/results.json)"
+    done = compare(SIEMENS[3], path, "--report", tmp_path / "report")
+    assert f"(and 5 more messages: all of them in {tmp_path / 'report'}/results.json)" in done.stdout
+    [case] = json.loads((tmp_path / "report" / "results.json").read_text())["cases"]
+    assert len(case["messages"]) == 15 and case["messages"][-1].startswith("ignored: spare11")
+
+
+@pytest.mark.parametrize("read", ["streamed", "whole"])
+def test_times_in_messages_are_the_cycles_times_without_float_noise(tmp_path, read):
+    """0.1 ms cycles: 42 * 0.0001 and 4.2 / 1000 are both 0.004200000000000001 in floats; the messages
+    say 0.0042 (the time of cycle 42, computed from the whole cycle). A blank line makes the
+    recording read whole instead of streamed: the same words."""
+    rows = [f"{k / 10},{k},{-1 if k == 41 else k}" for k in range(60)]
+    if read == "whole":
+        rows.insert(30, "")
+    path = tmp_path / "fast.csv"
+    path.write_text("time [ms],u,y\n" + "\n".join(rows) + "\n")
+    done = compare(PASS_THROUGH, path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "y leaves the band first at t=0.0042: 41.0, expected -1.0" in done.stdout
+    assert "the most by 42 at t=0.0042\n" in done.stdout
+    line = 43 if read == "streamed" else 44
+    assert f"sample of cycle 41 ({path}, line {line}, t=0.0041 s from its first sample)" in done.stdout
+    assert "step 0.0001 s (the finest interval" in done.stdout and "00000" not in done.stdout
+
+
+def test_a_folder_of_several_recordings_is_each_of_them(tmp_path):
+    """docs/recordings.md: a RECORDING is one exported file, or a folder of them. Each file is a
+    recording; the folder's single-point histories (Niagara) together are one."""
+    folder = tmp_path / "plant"
+    folder.mkdir()
+    for name in ("twincat_siemens.csv", "tia_portal_siemens.csv"):
+        (folder / name).write_bytes((SAMPLES / name).read_bytes())
+    for point in (SAMPLES / "niagara_siemens").iterdir():
+        (folder / point.name).write_bytes(point.read_bytes())
+    done = compare(SIEMENS[3], folder)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "3 of 3 cases pass" in done.stdout
+    for case in ("plant/tia_portal_siemens.csv", "plant/twincat_siemens.csv", "plant on"):
+        assert f"PASS  {case}" in done.stdout
+
+
+@pytest.mark.parametrize("read", ["streamed", "whole"])
+def test_a_channel_that_drives_and_is_compared_is_noted_off_its_cycle_once(tmp_path, read):
+    """u drives PassThrough's u and is compared with its y; its stamps jitter by 0.15 of a cycle."""
+    rows = [f"{k * 10 + (1.5 if k % 2 else 0)},{k}" for k in range(20)]
+    if read == "whole":
+        rows.insert(10, "")
+    path = tmp_path / "jitter.csv"
+    path.write_text("time [ms],u\n" + "\n".join(rows) + "\n")
+    done = compare(PASS_THROUGH, path, "--map", "u=u", "--map", "y=u", "--step-size", "0.01")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("u: 10 of its 20 time stamps are more than 0.1 of a cycle (0.001 s) off") == 1

@@ -18,6 +18,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from fmutrace import RunOptions, _report, compare
@@ -665,6 +666,45 @@ def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(tmp_path):
     assert done.returncode == 2, output(done)
     assert "damaged.mf4: not a readable MDF file" in done.stderr, done.stderr
     assert not list(shared.iterdir())
+
+
+def test_a_damaged_unfinalized_mdf_file_leaves_no_copy_and_no_traceback(tmp_path):
+    """As above, identified as a CAN logger leaves its file ('UnFinMF '): read as MDF now, so damaged it
+    is invalid the same way: exit 2, one line, the copy gone."""
+    shared = tmp_path / "tmp"
+    shared.mkdir()
+    identification = b"UnFinMF 4.11    fmutrace" + bytes(4) + (411).to_bytes(2, "little") + bytes(30)
+    identification += (1).to_bytes(2, "little") + bytes(2)
+    (tmp_path / "logger.mf4").write_bytes(identification + b"##HD" + b"\xff" * 200)
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "logger.mf4", env=dict(os.environ, TMPDIR=str(shared)))
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert "logger.mf4: not a readable MDF file" in done.stderr, done.stderr
+    assert not list(shared.iterdir())
+
+
+def test_a_small_mdf_file_declaring_more_samples_than_the_bound_is_refused_before_reading(tmp_path):
+    """Issue 37: a small MDF4 file whose channel group declares 300 million samples (its cycle count,
+    the uint64 after the CG block's record id) is refused at once, naming the file, channel, count and
+    bound; nothing is read or allocated for them."""
+    from asammdf import MDF, Signal
+
+    mdf = MDF(version="4.10")
+    mdf.append([Signal(np.arange(3.0), np.arange(3.0), name="u"), Signal(np.arange(3.0), np.arange(3.0), name="y")])
+    mdf.save(str(tmp_path / "small.mf4"), overwrite=True)
+    mdf.close()
+    data = bytearray((tmp_path / "small.mf4").read_bytes())
+    at = data.index(b"##CG")
+    count = at + 24 + 8 * int.from_bytes(data[at + 16 : at + 24], "little") + 8
+    data[count : count + 8] = (300_000_000).to_bytes(8, "little")
+    (tmp_path / "small.mf4").write_bytes(bytes(data))
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "small.mf4", timeout=60)
+    no_traceback(done)
+    assert done.returncode == 2, output(done)
+    assert (
+        f"{tmp_path / 'small.mf4'}: channel 'u' (and 1 more) of channel group 0: 300,000,000 samples, each a cycle "
+        "of its own: more than the bound of 200,000,000 steps"
+    ) in done.stderr
 
 
 def test_recording_options_on_case_folders_are_not_left_unused_silently(tmp_path):

@@ -16,7 +16,9 @@ import pytest
 from fmutrace import InputError, TraceError
 from fmutrace.cli import FLAGS
 from fmutrace.recordings import FORMAT_NAMES, is_recording, last_component, normalise, plan, read_file, read_recording
+from fmutrace._recorded import recorded_case
 from fmutrace.recordings._align import align
+from fmutrace.recordings._options import RecordingOptions
 from fmutrace.recordings._text import decode, numbers
 from fmutrace._traces import split_cells as split
 from fmutrace.recordings._timebase import parse_date, unit_in_name
@@ -131,6 +133,78 @@ def test_mdf4_channels_keep_their_groups_time_bases(tmp_path):
     ]
     assert channel(recording, "delayedValue").times.tolist() == [0.0, 0.75, 1.5, 2.25, 3.0]
     assert channel(recording, "value").values.tolist() == samples.SIEMENS["value"]
+
+
+def _mdf_block_field(data, block_id, offset_after_links):
+    """The byte offset of a field of the first block block_id (MDF 4: a block is its id, 4 reserved
+    bytes, its length and its link count as uint64, the links, then its data)."""
+    at = data.index(block_id)
+    links = int.from_bytes(data[at + 16 : at + 24], "little")
+    return at + 24 + 8 * links + offset_after_links
+
+
+def _asammdf_channels(path):
+    from asammdf import MDF
+
+    mdf = MDF(str(path))
+    try:
+        return {
+            mdf.get(group=g, index=i).name: (mdf.get(group=g, index=i).timestamps, mdf.get(group=g, index=i).samples)
+            for g, group in enumerate(mdf.groups)
+            for i in range(len(group.channels))
+            if i != mdf.masters_db.get(g)
+        }
+    finally:
+        mdf.close()
+
+
+def test_an_mdf4_file_its_logger_has_not_finalized_is_read_as_asammdf_reads_it(tmp_path):
+    """MDF 4.1, 'Unfinalized MDF': the identification is 'UnFinMF ' and the standard flags (uint16 at
+    byte 60) say what the writer left undone; bit 0: the channel groups' cycle counts (left 0 here)."""
+    data = bytearray(samples.write_mdf(tmp_path / "finalized.mf4", outputs_every=3).read_bytes())
+    data[:8] = b"UnFinMF "
+    data[60:62] = (1).to_bytes(2, "little")
+    count = _mdf_block_field(data, b"##CG", 8)  # record id, then the cycle count
+    data[count : count + 8] = bytes(8)
+    path = tmp_path / "logger.mf4"
+    path.write_bytes(bytes(data))
+    recording = read_one(path)
+    assert recording.format == "ASAM MDF4"
+    assert any("not finalized" in note for note in recording.notes)
+    expected = _asammdf_channels(path)
+    assert [c.name for c in recording.channels] == list(expected)
+    for found in recording.channels:
+        stamps, values = expected[found.name]
+        assert found.stamps.tolist() == stamps.tolist() and found.values.tolist() == values.tolist()
+    assert channel(recording, "delayedValue").times.tolist() == [0.0, 0.75, 1.5, 2.25, 3.0]
+
+
+def test_an_mdf_3_file_is_named_mdf_3(tmp_path):
+    from asammdf import MDF, Signal
+
+    mdf = MDF(version="3.30")
+    mdf.append([Signal(np.array(samples.SIEMENS["value"], dtype=float), np.arange(14) * CYCLE, name="value")])
+    mdf.save(str(tmp_path / "old.mdf"), overwrite=True)
+    mdf.close()
+    recording = read_one(tmp_path / "old.mdf")
+    assert recording.format == "ASAM MDF 3"
+    assert channel(recording, "value").values.tolist() == samples.SIEMENS["value"]
+
+
+def test_an_mdf_channel_group_declaring_more_samples_than_the_step_bound_is_refused_unread(tmp_path):
+    """A channel group's cycle count (uint64 after its record id) is what its data blocks hold; a small
+    (compressed) file may declare hundreds of millions: refused before they are read, named."""
+    data = bytearray(samples.write_mdf(tmp_path / "finalized.mf4").read_bytes())
+    count = _mdf_block_field(data, b"##CG", 8)
+    data[count : count + 8] = (300_000_000).to_bytes(8, "little")
+    path = tmp_path / "huge.mf4"
+    path.write_bytes(bytes(data))
+    with pytest.raises(TraceError) as error:
+        read_file(path)
+    assert str(error.value) == (
+        f"{path}: channel 'MAIN.fbRamp.value' (and 1 more) of channel group 0: 300,000,000 samples, each a "
+        "cycle of its own: more than the bound of 200,000,000 steps"
+    )
 
 
 def test_niagara_points_are_named_by_their_file_unless_the_file_names_them():
@@ -252,7 +326,7 @@ def test_a_file_of_no_known_format_says_what_was_tried_and_why_not(tmp_path):
     with pytest.raises(TraceError) as error:
         read_file(path)
     message = str(error.value)
-    assert message.startswith(f"{path}: no known recording format; tried ASAM MDF4: not MDF")
+    assert message.startswith(f"{path}: no known recording format; tried ASAM MDF (3 or 4): not MDF")
     for name in FORMAT_NAMES:
         assert f"{name}: " in message
     assert "no channel header block" in message and "VarName, TimeString" in message
@@ -491,3 +565,188 @@ def test_twincat_sample_time_with_a_decimal_comma_in_a_comma_separated_export(tm
         r"\(a decimal comma, ',' separating\?\)",
     ):
         read_file(path)
+
+
+def test_twincat_for_each_sampletime_whose_header_rows_leave_out_their_trailing_empty_cells(tmp_path):
+    """Scope View's 'For each sampletime' export writes a property row without its last empty cells
+    ('SymbolComment', then nothing for the channels of the last group)."""
+    path = tmp_path / "per_sample_time.csv"
+    path.write_text(
+        "Name\tScope\nFile\tx.csv\n\n\n"
+        "Name\ta\tb\tName\tc\td\n"
+        "SymbolComment\t\t\tSymbolComment\n"
+        "SampleTime[ms]\t1\t1\tSampleTime[ms]\t2\t2\n"
+        "SymbolName\tMAIN.a\tMAIN.b\tSymbolName\tMAIN.c\tMAIN.d\n"
+        "\n0\t1\t2\t0\t3\t4\n1\t5\t6\n2\t7\t8\t2\t9\t10\n"
+    )
+    recording = read_one(path)
+    assert recording.sample_time == 0.001
+    assert channel(recording, "a").times.tolist() == [0.0, 0.001, 0.002]
+    assert channel(recording, "b").values.tolist() == [2.0, 6.0, 8.0]
+    assert channel(recording, "c").times.tolist() == [0.0, 0.002]
+    assert channel(recording, "d").values.tolist() == [4.0, 10.0]
+    assert channel(recording, "d").symbol == "MAIN.d"
+
+
+WINCC_HEADER = '"VarName";"TimeString";"VarValue";"Validity";"Time_ms"'
+
+
+def _wincc_row(tag, second, value, time_ms):
+    return f'"{tag}";"20.11.2026 14:00:{second:02d}";{value};1;{time_ms}'
+
+
+def test_wincc_system_rows_with_fewer_cells_are_no_samples(tmp_path):
+    """$RT_OFF$ (runtime stopped), $RT_DIS$ (logging disabled) and $RT_COUNT$ (a count, fewer cells)."""
+    base = 46346541666.6667  # 20.11.2026 14:00:00 as OLE days times 1e6
+    lines = [WINCC_HEADER, _wincc_row("$RT_DIS$", 0, 0, "46346541655,0926"), '"$RT_COUNT$";3']
+    lines += [_wincc_row("Ramp_y", k, k * 2, f"{base + k * 1e6 / 86400:.4f}".replace(".", ",")) for k in range(3)]
+    lines.append(_wincc_row("$RT_OFF$", 3, 0, f"{base + 3e6 / 86400:.4f}".replace(".", ",")))
+    path = tmp_path / "log.csv"
+    path.write_text("\r\n".join(lines) + "\r\n")
+    recording = read_one(path)
+    assert [c.name for c in recording.channels] == ["Ramp_y"]
+    assert recording.time_unit == "OLE days" and recording.step_size == 1.0
+    y = recording.channels[0]
+    assert y.values.tolist() == [0.0, 2.0, 4.0] and y.lines.tolist() == [4, 5, 6]
+    assert np.abs(y.times - [0.0, 1.0, 2.0]).max() < 9e-6
+    assert "3 marker rows" in recording.notes[0]
+
+
+def test_wincc_time_ms_with_a_tab_for_its_decimal_mark_falls_back_to_time_string(tmp_path):
+    """A PC whose locale wrote a tab for the decimal mark: Time_ms is no number, TimeString is the time."""
+    lines = [WINCC_HEADER] + [_wincc_row("Ramp_y", k, k * 2, f"4634654{1666 + k * 12}\t{k}") for k in range(3)]
+    path = tmp_path / "tab.csv"
+    path.write_text("\r\n".join(lines) + "\r\n")
+    recording = read_one(path)
+    assert recording.time_unit == "date" and "Time_ms is damaged" in recording.time_source
+    assert recording.channels[0].times.tolist() == [0.0, 1.0, 2.0]
+    assert recording.notes == [
+        f"{path}, line 2, column 5: '4634654{1666}\\t0' in column 'Time_ms' is not a number, TRUE/FALSE or an "
+        "IEC literal (16#...): the time is TimeString's instead"
+    ]
+
+
+def test_a_map_to_a_symbol_several_channels_share_is_refused_naming_each(tmp_path):
+    """Scope View channels of one symbol (scaled, shifted, ...): --map y=MAIN.var_REAL means none of them."""
+    path = tmp_path / "same_symbol.csv"
+    path.write_text(
+        "Name\tScope\nFile\tx.csv\n\n\n"
+        "Name\tvar_REAL32\tName\tfunc_scaled\tName\tu\n"
+        "SampleTime[ms]\t1\tSampleTime[ms]\t1\tSampleTime[ms]\t1\n"
+        "SymbolName\tMAIN.var_REAL\tSymbolName\tMAIN.var_REAL\tSymbolName\tMAIN.u\n"
+        "\n0\t1\t0\t-1\t0\t5\n1\t2\t1\t-2\t1\t5\n"
+    )
+    recording = read_one(path)
+    variables = variables_of(u="input", y="output")
+    with pytest.raises(InputError) as error:
+        plan(recording, variables, "M", [("y", "MAIN.var_REAL")], names=FLAGS)
+    assert str(error.value) == (
+        f"--map y=MAIN.var_REAL: 2 channels of {path} are 'MAIN.var_REAL': 'var_REAL32' (symbol "
+        "'MAIN.var_REAL', column 2); 'func_scaled' (symbol 'MAIN.var_REAL', column 4); map one by its name, "
+        "e.g. --map y=var_REAL32"
+    )
+    chosen = plan(recording, variables, "M", [("y", "func_scaled")])
+    assert [(v, c.name) for v, c in chosen.compares] == [("y", "func_scaled")]
+    with pytest.raises(InputError, match=r"2 channels of .* are 'var_REAL'"):  # a last component is no way out
+        plan(recording, variables, "M", [("y", "var_REAL")])
+
+
+def _fmu_of(**causalities):
+    """What recorded_case needs of an FMU: its variables, label, model and start values."""
+    return SimpleNamespace(
+        variables=variables_of(**causalities), label="M", model="M", default_step=None, start_value=lambda n, v: v
+    )
+
+
+def _mdf_of_groups(path, groups):
+    """An MDF4 file with a channel group per (stamps, {name: values}), by asammdf's writer."""
+    from asammdf import MDF, Signal
+
+    mdf = MDF(version="4.10")
+    for stamps, signals in groups:
+        mdf.append([Signal(np.asarray(v, dtype=float), np.asarray(stamps), name=n) for n, v in signals.items()])
+    mdf.save(str(path), overwrite=True)
+    mdf.close()
+    return str(path)
+
+
+def test_the_step_comes_from_the_mapped_channels_not_from_unmapped_faster_ones(tmp_path):
+    """A CAN log: Speed and Heading each 1 s apart (from t = 0.3 s), other messages at 100 Hz from t = 0."""
+    fast = np.arange(500) / 100
+    slow = 0.3 + np.arange(5)
+    path = _mdf_of_groups(
+        tmp_path / "can.mf4",
+        [(fast, {"EngineTemp": fast * 0, "Rpm": fast}), (slow, {"Speed": np.arange(5)}), (slow, {"Heading": [5] * 5})],
+    )
+    options = RecordingOptions(maps={"u": "Speed", "y": "Heading"}, names=FLAGS)
+    case = recorded_case(path, _fmu_of(u="input", y="output"), "can", options)
+    assert case.options["StepSize"] == 1.0
+    assert case.inputs["time"].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+    assert case.reference["time"].tolist() == [1.0, 2.0, 3.0, 4.0, 5.0]
+    assert case.coarse == "" and not [n for n in case.notes if "off a cycle end" in n]
+
+
+def test_an_unmapped_channel_at_time_zero_does_not_set_the_origin(tmp_path):
+    """An XCP measurement: a calibration value at t = 0, the mapped channels every 1 ms from 0.5 ms."""
+    daq = 0.0005 + np.arange(100) / 1000
+    path = _mdf_of_groups(
+        tmp_path / "xcp.mf4", [([0.0], {"Calibration": [1.0]}), (daq, {"u": np.arange(100), "y": np.arange(100)})]
+    )
+    case = recorded_case(path, _fmu_of(u="input", y="output"), "xcp", RecordingOptions())
+    assert case.options["StepSize"] == 0.001
+    assert np.abs(case.inputs["time"] - np.arange(100) / 1000).max() < 1e-15
+    assert not [n for n in case.notes if "off a cycle end" in n], case.notes
+    assert "ignored: Calibration" in " ".join(case.notes)
+
+
+def test_a_channel_off_the_grid_is_named_with_the_step_that_would_fit_it(tmp_path):
+    """u every 0.25 s, y every 0.3 s: y's stamps are off a 0.25 s grid; a step of 0.3 s fits them."""
+    path = _mdf_of_groups(
+        tmp_path / "two_rates.mf4",
+        [(np.arange(13) * 0.25, {"u": np.zeros(13)}), (np.arange(10) * 0.3, {"y": np.zeros(10)})],
+    )
+    case = recorded_case(path, _fmu_of(u="input", y="output"), "r", RecordingOptions(names=FLAGS))
+    [note] = [n for n in case.notes if n.startswith("y: ")]
+    assert "more than 0.1 of a cycle" in note and note.endswith("Its own stamps fit a step of 0.3 s (--step-size 0.3).")
+
+
+def test_a_wincc_log_of_too_many_steps_is_told_the_option_that_works(tmp_path):
+    """Logged on change: five samples 1 ms apart, one an hour later. Its time stamps are OLE days, so
+    no time unit applies: the advice is the step size, and with the step size given it is read."""
+    base = 46346541666.6667
+    stamps = [base + k * 1e3 / 86400 for k in range(5)] + [base + 3600e6 / 86400]
+    lines = [WINCC_HEADER] + [_wincc_row("Ramp_y", 0, k, f"{t:.4f}") for k, t in enumerate(stamps)]
+    path = tmp_path / "on_change.csv"
+    path.write_text("\r\n".join(lines).replace(";", ",") + "\r\n")
+    with pytest.raises(InputError) as error:
+        normalise(read_recording(path)[0], names=FLAGS)
+    assert str(error.value).endswith("steps for 6 samples: give the recorder's cycle with --step-size")
+    assert "--time-unit" not in str(error.value)
+    with pytest.raises(InputError, match="does not apply"):  # what the old advice led to
+        normalise(read_recording(path)[0], time_unit="s", names=FLAGS)
+    assert normalise(read_recording(path)[0], step_size=0.5, names=FLAGS).step_size == 0.5
+
+
+def test_three_channels_meaning_one_variable_are_refused_naming_all_three(tmp_path):
+    path = tmp_path / "thrice.csv"
+    path.write_text("time,MAIN.a.value,MAIN.b.value,MAIN.c.value,delayedValue\n0,1,2,3,0\n")
+    with pytest.raises(InputError) as error:
+        plan(read_recording(path)[0], SIEMENS_VARIABLES, "M", names=FLAGS)
+    assert str(error.value) == (
+        f"{path}: channels 'MAIN.a.value' (column 2 of {path}), 'MAIN.b.value' (column 3 of {path}) and "
+        f"'MAIN.c.value' (column 4 of {path}) all mean value: say which with --map value=CHANNEL, "
+        "e.g. --map value=MAIN.a.value"
+    )
+
+
+def test_a_wincc_log_over_a_year_long_is_not_told_a_time_unit_which_its_stamps_refuse(tmp_path):
+    base = 46346541666.6667
+    lines = [WINCC_HEADER] + [_wincc_row("Ramp_y", 0, k, f"{base + k * 400e6:.4f}") for k in range(3)]  # 463 days apart
+    path = tmp_path / "years.csv"
+    path.write_text("\r\n".join(lines).replace(";", ",") + "\r\n")
+    with pytest.raises(InputError) as error:
+        normalise(read_recording(path)[0], names=FLAGS)
+    assert str(error.value).endswith(
+        "days): more than a year: compare a part of it (--time-unit does not apply to OLE days (days since 30 Dec "
+        "1899, times 1e6))"
+    )

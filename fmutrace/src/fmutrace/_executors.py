@@ -32,6 +32,7 @@ from ._workers import Pool
 from .recordings import is_recording
 
 BATCH_CASES = 256  # cases per Dask task at most
+DASK_BATCH_SECONDS = 1.0  # of measured work per Dask task
 BATCH_TEXT_BYTES = 2_000_000  # of case files' text per task at most, when they are sent
 BATCH_ATTEMPTS = 3  # a batch lost with its worker is sent again, so many times in all
 # Dask keeps its last messages for its developers (distributed.admin.low-level-log-length, 1000): a
@@ -166,8 +167,16 @@ class Dask(Executor):
         client.upload_file(str(package_zip()))  # fmutrace to every worker: nothing to install there but packages
         workers = len(client.scheduler_info()["workers"])
         shared = {path: client.scatter(data, broadcast=True) for path, data in work.fmu_bytes.items()}
-        # about 8 batches per worker; at most BATCH_CASES cases each (a task's cost is a few milliseconds)
-        size = max(1, min(BATCH_CASES, -(-len(todo) // (8 * workers))))
+        # about DASK_BATCH_SECONDS of measured work per batch (one case before any is measured), at most
+        # BATCH_CASES, and at least 8 batches per worker: a task costs its round trip and the scheduler's work
+        share = max(1, -(-len(todo) // (8 * workers)))
+        measured = [0.0, 0]  # seconds and count of the cases finished
+
+        def size():
+            if not measured[1]:
+                return 1
+            return max(1, min(BATCH_CASES, share, round(DASK_BATCH_SECONDS * measured[1] / max(measured[0], 1e-9))))
+
         batches = _batches(todo, size, ship_texts=not self.shared_files)
         in_flight = as_completed()
         submitted = {}  # future -> (fmu, batch, isolated, attempt)
@@ -212,6 +221,8 @@ class Dask(Executor):
                     for _, _, name, _ in batch
                 ]
             for (i, _, _, _), outcome in zip(batch, outcomes, strict=True):
+                measured[0] += outcome.seconds
+                measured[1] += 1
                 finished(i, outcome)
             del outcomes
             submit_next()
@@ -251,15 +262,18 @@ def package_zip() -> Path:
 
 def _batches(todo, size, ship_texts):
     """Consecutive runs of one FMU's cases, [(fmu, [(i, folder, name, texts)])]:
-    at most size cases, and with their files' texts (ship_texts) at most
-    BATCH_TEXT_BYTES of them, so that a worker's queue stays small."""
+    at most size() cases (asked as each batch starts), and with their
+    files' texts (ship_texts) at most BATCH_TEXT_BYTES of them, so that a
+    worker's queue stays small."""
     batch: list[tuple] = []
-    current, volume = None, 0
+    current, volume, most = None, 0, 1
     for i, fmu, folder, name in todo:
         texts = case_texts(folder, fmu.model) if ship_texts and not is_recording(folder) else None
-        if batch and (fmu is not current or len(batch) == size or volume >= BATCH_TEXT_BYTES):
+        if batch and (fmu is not current or len(batch) >= most or volume >= BATCH_TEXT_BYTES):
             yield current, batch
             batch, volume = [], 0
+        if not batch:
+            most = size()
         current = fmu
         volume += sum(map(len, texts.values())) if texts else 0
         batch.append((i, str(folder), name, texts))

@@ -31,7 +31,7 @@ def name_of(names: Names, *settings: str, **values: object) -> str:
     y=Y'), or the object a setting is set on ('Tube(time=0.5, value=0)',
     'RecordingOptions(maps={'y': 'Y'})'; one object's settings together).
     names: setting -> the caller's word (a flag starts with '-'); a
-    setting it lacks has its API name. A value: a float (written %.6g),
+    setting it lacks has its API name. A value: a float (its shortest text),
     a str, or a (name, value) pair of a mapping setting."""
     words = dict(names)
     given = [(s, ...) for s in settings] + list(values.items())
@@ -53,9 +53,16 @@ def name_of(names: Names, *settings: str, **values: object) -> str:
     return " ".join(parts)
 
 
+def shortest(value) -> str:
+    """A number as the shortest text that reads back to the same float
+    (repr's), without a trailing '.0': 0.25, 2, 1e-05."""
+    written = repr(float(value))
+    return written[:-2] if written.endswith(".0") else written
+
+
 def _text(value, flag):
     if isinstance(value, float):
-        return f"{value:.6g}"
+        return shortest(value)
     if isinstance(value, tuple):
         name, setting = value
         return f"{name}={setting}" if flag else f"{{{name!r}: {setting!r}}}"

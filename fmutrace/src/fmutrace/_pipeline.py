@@ -125,17 +125,25 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         outputs, last = read.outputs, float(reference["time"][-1])
     else:
         ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
+        try:
+            present = set(os.listdir(folder))  # (one look at the folder, not one per file)
+        except OSError:
+            present = set()
         texts = {}  # the small files' texts (the reference and the inputs are read in chunks)
         for file_name in (f"{model}_ref.opt", f"{model}_start.csv", f"{model}_criteria.csv", "README.md"):
-            if (folder / file_name).exists():
+            if file_name in present:
                 texts[file_name] = read_text(folder / file_name)
         ref_chunks = trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes)
         try:
-            first_ref = next(ref_chunks)
-            last = last_time(ref_path)
-        except (OSError, ValueError, StopIteration) as error:
+            if os.path.getsize(ref_path) <= streaming.chunk_bytes:  # a chunk or two: read now, its end known
+                ref_chunks = iter(ref_read := list(ref_chunks))
+                first_ref, last = ref_read[0], float(ref_read[-1]["time"][-1])
+            else:
+                first_ref = next(ref_chunks)
+                last = last_time(ref_path)
+                ref_chunks = itertools.chain([first_ref], ref_chunks)  # (each file read once)
+        except (OSError, ValueError, StopIteration, IndexError) as error:
             raise NotPlain(str(error)) from None
-        ref_chunks = itertools.chain([first_ref], ref_chunks)  # (each file read once)
         bounds = np.zeros(2, dtype=[("time", np.float64)])
         bounds["time"] = [first_ref["time"][0], last]
         options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
@@ -226,14 +234,13 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
                         state.tube_rows(chunk)
                     state.tube_rows(None)
                 else:
-                    held = None  # the reference's last row so far: compared with the next chunk (a repeated time)
-                    for chunk in reference:
-                        if held is not None:
-                            chunk = np.concatenate([held, chunk])
-                        held = chunk[-1:]
-                        state.compare_rows(chunk[:-1], chunk["time"][-1])
-                    if held is not None:
-                        state.compare_rows(held, np.nan)
+                    # each chunk with the next one's first time (a repeated time spans chunks), the last with NaN
+                    chunks = (c for c in reference if len(c))
+                    chunk = next(chunks, None)
+                    while chunk is not None:
+                        following = next(chunks, None)
+                        state.compare_rows(chunk, np.nan if following is None else following["time"][0])
+                        chunk = following
                 state.next_reference()
             state.result_until(math.inf)  # the rest of the run: an FMU failing there fails the case
         except SimulationError as error:

@@ -12,11 +12,12 @@ import numpy as np
 
 from ._cases import Case
 from ._errors import InputError
+from ._names import shortest
 from .recordings import read_recording
 from .recordings._align import align
 from .recordings._matching import plan
 from .recordings._options import RecordingOptions
-from .recordings._timebase import UNIT_NAMES, normalise
+from .recordings._timebase import UNIT_NAMES, nominal, normalise
 
 
 @dataclass
@@ -41,7 +42,13 @@ class RecordedCase(Case):
             if len(at):
                 i = int(at[0])
                 messages.append(
-                    first_differs(deviation, cycle, channel.where(i), float(channel.times[i]), float(channel.values[i]))
+                    first_differs(
+                        deviation,
+                        cycle,
+                        channel.where(i),
+                        nominal(float(channel.times[i]), cycle, step),
+                        float(channel.values[i]),
+                    )
                 )
         if self.coarse:
             messages.append(self.coarse)
@@ -51,7 +58,7 @@ class RecordedCase(Case):
 def first_differs(deviation, cycle, where, time, recorded):
     """Where a failing signal's first deviation is in the recording."""
     return (
-        f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={time:.9g} s "
+        f"{deviation.name} first differs at the recording's sample of cycle {cycle} ({where}, t={shortest(time)} s "
         f"from its first sample): recorded {recorded!r}, the FMU gives {deviation.value!r}"
     )
 
@@ -63,15 +70,17 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     if len(found) != 1:
         raise InputError(f"{path}: holds {len(found)} recordings: give them one by one (or their files)")
     recording = found[0]
-    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names)
     matched = plan(recording, fmu.variables, fmu.label, options.maps, options.names)
+    used = [c for _, c in matched.drives + matched.compares]  # the time base: what is compared, nothing else
+    normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names, used or None)
     aligned = align(recording, matched, options.timing, fmu.label, options.names)
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     names = [v for reference in aligned.references for v in reference.dtype.names[1:]]
     unit = UNIT_NAMES.get(recording.time_unit, recording.time_unit)
+    samples = max(len(c.values) for c in used or recording.channels)  # of the channels compared or driven
     description = (
-        f"{recording.format}: {len(recording)} samples, time as {unit} ({recording.time_source}), "
-        f"step {recording.step_size:g} s ({recording.step_source})"
+        f"{recording.format}: {samples} samples, time as {unit} ({recording.time_source}), "
+        f"step {shortest(recording.step_size)} s ({recording.step_source})"
     )
     return RecordedCase(
         name=name,

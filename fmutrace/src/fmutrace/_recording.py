@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 from ._errors import InputError
+from ._names import shortest
 from ._pipeline import ChunkedCase, Streaming, run_chunked_case
 from ._outcome import CaseOutcome, Status
 from ._recorded import first_differs, recorded_case
@@ -97,7 +98,7 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
     except (NotPlain, InputError, OSError, ValueError):
         return None
     drives, compares = matched.drives, matched.compares
-    stop = max(cycles.last + shift, 1) * step
+    stop = float(timebase.cycle_times(np.array([max(cycles.last + shift, 1)]), step)[0])
     pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": []}
     row = 0  # the next block's first row, which is its cycle (stream.time_column_pass)
 
@@ -112,12 +113,12 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         row += len(times)
         if drives:
             chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
-            chunk["time"] = index * step
+            chunk["time"] = timebase.cycle_times(index, step)
             for variable, channel in drives:
                 chunk[variable] = table.values(cells, line_numbers, channel.name)
             pending["inputs"].append(chunk)
         chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in compares])
-        chunk["time"] = (index + shift) * step
+        chunk["time"] = timebase.cycle_times(index + shift, step)
         for variable, channel in compares:
             chunk[variable] = table.values(cells, line_numbers, channel.name)
         pending["refs"].append(chunk)
@@ -138,15 +139,17 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         notes = []
         if cycles.off:
             line, time = cycles.first_off
-            notes = [
-                off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
-                for _, channel in drives + compares
-            ]
+            notes = list(
+                dict.fromkeys(  # a channel that drives and is compared is said once, as read whole
+                    off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
+                    for _, channel in drives + compares
+                )
+            )
         notes += matched.describe()
         unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
         description = (
             f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
-            f"step {step:g} s ({recording.step_source})"
+            f"step {shortest(step)} s ({recording.step_source})"
         )
         if passed:
             return [description] + notes
@@ -195,5 +198,7 @@ def _explain(table, deviations, channels, step, shift):
     for deviation in deviations:
         if deviation.name in found:
             line, time, value = found[deviation.name]
-            messages.append(first_differs(deviation, wanted[deviation.name], f"{table.path}, line {line}", time, value))
+            cycle = wanted[deviation.name]
+            shown = timebase.nominal(time, cycle, step)
+            messages.append(first_differs(deviation, cycle, f"{table.path}, line {line}", shown, value))
     return messages

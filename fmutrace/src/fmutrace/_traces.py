@@ -300,6 +300,14 @@ def steps_problem(start, stop, step) -> str | None:
     return None
 
 
+def samples_problem(samples) -> str | None:
+    """Why a channel of so many samples is refused (None if it is not): each sample is a cycle of its
+    own, so it asks for at least as many steps, under steps_problem's bound; checked before they are read."""
+    if samples > MAX_STEPS:
+        return f"{samples:,} samples, each a cycle of its own: more than the bound of {MAX_STEPS:,} steps"
+    return None
+
+
 def trace_chunks(
     path: str | PathLike, known: Callable[[str], str | None] | None = None, chunk_bytes: int = CHUNK_BYTES
 ) -> Iterator[np.ndarray]:
@@ -311,8 +319,17 @@ def trace_chunks(
     shows, and read_trace reads or explains it. Both readers convert a
     number correctly rounded: the same bits (a test checks it)."""
     try:
-        with open(path, encoding="utf-8-sig") as file:
-            header = file.readline()
+        file = open(path, "rb")  # (closed below, however the chunks end)
+    except OSError as error:
+        raise NotPlain(str(error)) from None
+    with file:
+        yield from _plain_chunks(file, known, chunk_bytes)
+
+
+def _plain_chunks(file, known, chunk_bytes) -> Iterator[np.ndarray]:
+    """trace_chunks' work on the open file (one opening for the header and the blocks)."""
+    try:
+        header = file.readline().decode("utf-8-sig")
     except (OSError, UnicodeDecodeError) as error:
         raise NotPlain(str(error)) from None
     if _separator(header) != "," or header.lstrip().startswith("#"):
@@ -336,7 +353,7 @@ def trace_chunks(
     rows = 0
     # blocks of whole lines cut here, each parsed by itself: pyarrow's own streaming reader holds on to
     # memory that grows with the file (measured: 80 MB at 360,000 rows, 240 MB at 17,280,000)
-    for block in _line_blocks(path, chunk_bytes):
+    for block in _line_blocks(file, chunk_bytes):
         try:
             table = pcsv.read_csv(
                 io.BytesIO(block),
@@ -379,31 +396,30 @@ def last_time(path):
         while True:
             begin = max(0, end - size)
             file.seek(begin)
-            lines = [line for line in file.read(end - begin).splitlines() if line.strip()]
-            if len(lines) >= 2 or begin == 0:  # a line break before the last line: it is whole
-                return float(lines[-1].split(b",")[0])
+            text = file.read(end - begin).rstrip()
+            start = max(text.rfind(b"\n"), text.rfind(b"\r")) + 1
+            if start or begin == 0:  # a line break before the last line: it is whole
+                return float(text[start:].split(b",")[0])
             size *= 4
 
 
-def _line_blocks(path, size):
-    """The file's bytes after its header line in blocks of about size, each ending at a line's end."""
-    with open(path, "rb") as file:
-        file.readline()
-        rest = b""
-        while True:
-            data = file.read(size)
-            if not data:
-                break
-            data = rest + data
-            cut = data.rfind(b"\n") + 1
-            if cut == 0:
-                rest = data
-                continue
-            block, rest = data[:cut], data[cut:]
-            if block.strip():
-                yield block
-        if rest.strip():
-            yield rest
+def _line_blocks(file, size):
+    """The open file's bytes from here on in blocks of about size, each ending at a line's end."""
+    rest = b""
+    while True:
+        data = file.read(size)
+        if not data:
+            break
+        data = rest + data
+        cut = data.rfind(b"\n") + 1
+        if cut == 0:
+            rest = data
+            continue
+        block, rest = data[:cut], data[cut:]
+        if block.strip():
+            yield block
+    if rest.strip():
+        yield rest
 
 
 class NotPlain(Exception):

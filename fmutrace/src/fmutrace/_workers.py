@@ -5,9 +5,9 @@ reported by itself while the others go on.
 A worker is a child process: forked from this one where that is safe
 (Linux, no other Python thread: it starts in milliseconds with fmutrace
 already imported), else a new Python running `main` below. It reads
-batches of cases on a pipe and writes back, per case, an empty record
-when it starts it and then its outcome (length-prefixed pickles; what the
-FMU prints goes nowhere). This process, one thread, waits on every
+batches of cases on a pipe and writes back each case's outcome, and an
+empty record when it starts a case whose start matters (length-prefixed
+pickles; what the FMU prints goes nowhere). This process, one thread, waits on every
 worker's pipe with a deadline: a worker whose pipe closes died, and the
 case it ran gets an error naming the signal; a case over the per-case
 timeout gets its worker killed. Either way the rest of the batch goes
@@ -24,6 +24,7 @@ together.
 
 import collections
 import ctypes
+import math
 import os
 import pickle
 import selectors
@@ -171,12 +172,21 @@ def _read_exactly(fd, size) -> bytes | None:
 
 
 def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
-    """A worker's loop: batches in, a STARTED record and an outcome per case out, until None."""
+    """A worker's loop: batches in, an outcome per case out, until None;
+    a STARTED record before a case where its start matters (every case
+    with a per-case timeout, else the worker's first: its start-up ends
+    there). A record fewer saves the campaign's process a wake-up."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the campaign's to handle (it stops its workers)
     _die_with_parent()
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)  # what the FMU or fmpy prints must not mix with the outcomes (or the command's output)
     fmus: dict[str, bytes] = {}
+    first = [True]
+
+    def started():
+        if first[0] or settings.case_timeout is not None:
+            write(STARTED)
+        first[0] = False
 
     def write(data: bytes):
         view = memoryview(HEADER.pack(len(data)) + data)
@@ -196,7 +206,7 @@ def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
         path, data, fmu, items = message
         if data is not None:
             fmus[path] = data
-        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=lambda: write(STARTED)):
+        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
             write(pickle.dumps(outcome))
 
 
@@ -254,6 +264,7 @@ class Pool:
         self.workers: dict[int, _Worker] = {}  # by its pipe from the worker
         self.selector = selectors.DefaultSelector()
         self.finished: Callable = lambda i, outcome: None
+        self.announced = settings.case_timeout is not None  # every case's start is said (else the first's)
 
     def run(self, todo, finished):
         """Runs todo, [(i, FMU path, (folder, name, texts or None))];
@@ -268,7 +279,8 @@ class Pool:
                 self._give(self._start())
             while self.workers:
                 deadlines = [(self._deadline(w), w) for w in self.workers.values()]
-                soonest = min((d for d, _ in deadlines if d is not None), default=None)
+                wakes = [d for d, _ in deadlines if d is not None] + [self._worth_from() or math.inf]
+                soonest = min(wakes) if min(wakes) < math.inf else None
                 timeout = None if soonest is None else max(0.0, soonest - time.monotonic())
                 for key, _ in self.selector.select(timeout):
                     worker: _Worker = key.data
@@ -280,7 +292,7 @@ class Pool:
                         why = self._overdue(worker.running_since is not None)
                         self._stop(worker, kill=True)
                         self._lost(worker, why)
-                while self.chosen and self.queue and len(self.workers) < self.most and self._pays():
+                while self._pays():
                     self._give(self._start())
         finally:
             for worker in list(self.workers.values()):
@@ -333,7 +345,9 @@ class Pool:
         data, file = self.fmus[path]
         first = path not in worker.fmus
         worker.fmus.add(path)
-        worker.sent_at, worker.running_since = time.monotonic(), None
+        worker.sent_at = time.monotonic()
+        # its next case starts now, unless it says when (with a timeout, or as a new worker's first)
+        worker.running_since = None if self.announced or worker.first_case else worker.sent_at
         try:
             _send(worker.to_worker, (path, data if first else None, file, [item for _, _, item in worker.batch]))
         except OSError:  # it died before it read the batch: its end shows on its pipe
@@ -350,12 +364,24 @@ class Pool:
     def _pays(self) -> bool:
         """Another worker pays for its start-up: the work left, spread over
         one more worker, is START_PAYS times a start-up or more."""
+        start = self._worth_from()
+        return start is not None and time.monotonic() >= start
+
+    def _worth_from(self) -> float | None:
+        """When another worker starts paying for itself (None: not on what
+        is known). Before a case has finished, the case running longest is
+        the measure: at least as long as it has run so far (so that a
+        campaign of long cases does not wait for the first to end)."""
+        if not (self.chosen and self.queue and len(self.workers) < self.most) or self.start_up is None:
+            return None
         per_case = self._per_case()
-        if self.start_up is None or per_case is None:
-            return False
-        # on a first case alone (its warm-up included): only when it pays ten times over
-        margin = START_PAYS * (1 if self.measured[False][1] else 10)
-        return len(self.queue) * per_case / (len(self.workers) + 1) > margin * self.start_up
+        # on first cases alone (their warm-up included): only when it pays ten times over
+        margin = START_PAYS * (1 if self.measured[False][1] else 10) * self.start_up
+        needed = margin * (len(self.workers) + 1) / len(self.queue)  # the per-case seconds that make it pay
+        if per_case is not None:
+            return -math.inf if per_case > needed else None
+        running = [w.running_since for w in self.workers.values() if w.running_since is not None]
+        return min(running) + needed if running else None
 
     def _per_case(self) -> float | None:
         """Seconds a case takes, measured: on the cases after each worker's
@@ -392,7 +418,7 @@ class Pool:
                 continue
             outcome = pickle.loads(record)
             i = worker.batch.popleft()[0]
-            worker.running_since = None
+            worker.running_since = None if self.announced else time.monotonic()  # (the next one's start)
             measure = self.measured[worker.first_case]
             measure[0] += outcome.seconds
             measure[1] += 1
@@ -406,15 +432,16 @@ class Pool:
         """The worker is gone: its running case (the first of its batch)
         fails saying why, the rest of the batch goes back to the queue,
         and a new worker takes over if cases are left."""
-        self.lost += 1
-        i, path, (_, name, _) = worker.batch.popleft()
-        started = worker.running_since if worker.running_since is not None else worker.sent_at
-        self.queue.extendleft(reversed(worker.batch))
-        worker.batch.clear()
-        labels = self.fmus[path][1].labels
-        outcome = CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=time.monotonic() - started)
-        self.finished(i, outcome)
-        if self.queue and (len(self.workers) < self.most):
+        if worker.batch:  # (else it went between two batches: no case to blame)
+            self.lost += 1
+            i, path, (_, name, _) = worker.batch.popleft()
+            started = worker.running_since if worker.running_since is not None else worker.sent_at
+            self.queue.extendleft(reversed(worker.batch))
+            worker.batch.clear()
+            labels = self.fmus[path][1].labels
+            seconds = time.monotonic() - started
+            self.finished(i, CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=seconds))
+        if self.queue and len(self.workers) < self.most:
             self._give(self._start())
 
     def _overdue(self, running: bool) -> str:

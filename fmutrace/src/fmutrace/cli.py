@@ -121,7 +121,7 @@ def parser():
         description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
         "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
         "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
-        "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF4, WinCC data logs, "
+        "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF 4 and 3, WinCC data logs, "
         "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
         "Exact (bit for bit) unless a tolerance or a tube is given.",
     )
@@ -320,14 +320,26 @@ def compare_command(args, out):
         if o.passed and not o.messages:
             continue
         print(f"{o.status.upper()}  {text(o.case)} on {text(o.fmu)}", file=out)
-        for message in o.messages[:10]:
+        for message in o.messages[:SHOWN_MESSAGES]:
             print(f"      {text(message)}", file=out)
+        if len(o.messages) > SHOWN_MESSAGES:
+            print(f"      {_the_rest(len(o.messages) - SHOWN_MESSAGES, args.report)}", file=out)
     print(result.headline(), file=out)
     if args.report:
         print(f"report: {text(args.report.rstrip('/'))}/index.html", file=out)
     if args.junit:
         print(f"JUnit XML: {text(args.junit)}", file=out)
     return result.exit_code
+
+
+SHOWN_MESSAGES = 10  # of a case on the terminal; the report's results.json holds them all
+
+
+def _the_rest(count, report):
+    """Where the messages of a case the terminal does not show are."""
+    if report:
+        return f"(and {count} more messages: all of them in {text(report.rstrip('/'))}/results.json)"
+    return f"(and {count} more messages: --report DIR writes all of them into DIR/results.json)"
 
 
 def main(argv=None, out=None):

@@ -4,7 +4,7 @@ normalised, columnar Recording (recordings._model) whatever the recorder.
 The format is recognised from the content, in this order (the first that
 fits reads the file):
 
-  ASAM MDF4                              mdf.py
+  ASAM MDF 4 and 3                       mdf.py
   Beckhoff TwinCAT Scope View CSV        twincat.py
   WinCC data log CSV                     vendors.py
   Niagara history export (one point)     vendors.py
@@ -31,7 +31,7 @@ TEXT_FORMATS = (
     ("CODESYS 2.3 trace (ASCII file)", vendors.sniff_codesys23, vendors.read_codesys23),
     ("table (TIA Portal trace CSV, CODESYS V3 export, CSV/TSV)", tables.sniff, tables.read),
 )
-FORMAT_NAMES = ("ASAM MDF4",) + tuple(name for name, _, _ in TEXT_FORMATS)
+FORMAT_NAMES = ("ASAM MDF (3 or 4)",) + tuple(name for name, _, _ in TEXT_FORMATS)
 
 __all__ = [
     "Channel",
@@ -60,7 +60,7 @@ def read_file(path):
     text = texts.read(path)
     if not text.text.strip():
         raise TraceError(path, 0, 0, "empty file")
-    reasons = [f"ASAM MDF4: {mdf.sniff(head)}"]
+    reasons = [f"{FORMAT_NAMES[0]}: {mdf.sniff(head)}"]
     for name, sniff, read in TEXT_FORMATS:
         why = sniff(text)
         if why is None:
@@ -125,12 +125,16 @@ def is_recording(path):
 
 def recording_paths(paths):
     """The recordings among paths given to compare: [(path, name)], where
-    path is one file or folder, or several single-point files (Niagara)
-    joined by os.pathsep: together they make one recording."""
+    path is one file, or several single-point files (Niagara) joined by
+    os.pathsep: together they make one recording. A folder is its files:
+    each a recording (named folder/file), its single-point files together
+    one (named by the folder)."""
     items, points = [], []
     for path in paths:
         path = os.fspath(path)
-        if os.path.isfile(path) and _is_single_point(path):
+        if os.path.isdir(path):
+            items += _folder_items(path)
+        elif os.path.isfile(path) and _is_single_point(path):
             points.append(path)
         else:
             items.append((path, Path(path).name))
@@ -138,6 +142,20 @@ def recording_paths(paths):
         name = Path(points[0]).parent.name if len(points) > 1 else Path(points[0]).name
         items.append((os.pathsep.join(points), name))
     return _unique(items)
+
+
+def _folder_items(folder):
+    """recording_paths' items of the files of a folder (an empty folder is one item: reading it says so)."""
+    try:
+        files = _files([folder])
+    except InputError:
+        return [(folder, Path(folder).name)]
+    points = [f for f in files if _is_single_point(f)]
+    name = Path(os.path.abspath(folder)).name
+    items = [(f, f"{name}/{Path(f).name}") for f in files if f not in points]
+    if points:
+        items.append((os.pathsep.join(points) if len(points) > 1 else points[0], name))
+    return items
 
 
 def _unique(items):

@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._errors import InputError
-from .._names import Names, name_of
-from ._timebase import OFF_CYCLE, cycles
+from .._names import Names, name_of, shortest
+from ._timebase import OFF_CYCLE, as_read, cycle_times, cycles, finest_interval
 
 TIMINGS = ("cycle", "fmi")
 
@@ -47,15 +47,18 @@ def _cycles_of(channel, step, notes, names):
     index, off = cycles(channel.times, step)
     if len(off):
         i = int(off[0])
-        notes.append(
-            off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step)
-        )
+        note = off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step)
+        own = finest_interval([channel])
+        if own is not None and cycles(channel.times, own)[1].size == 0 and own != step:
+            note += f" Its own stamps fit a step of {shortest(own)} s ({name_of(names, step_size=own)})."
+        if note not in notes:  # a channel that drives and is compared is said once
+            notes.append(note)
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])
         raise InputError(
-            f"{channel.where(i + 1)}: samples of {channel.name} at t={float(channel.times[i]):.9g} s and "
-            f"t={float(channel.times[i + 1]):.9g} s fall on the same cycle of {step:g} s: the step is "
+            f"{channel.where(i + 1)}: samples of {channel.name} at t={shortest(as_read(channel.times[i]))} s and "
+            f"t={shortest(as_read(channel.times[i + 1]))} s fall on the same cycle of {shortest(step)} s: the step is "
             f"coarser than the recording (give the recorder's cycle with {name_of(names, 'step_size')})"
         )
     return index
@@ -66,8 +69,8 @@ def off_cycle_note(name, off, samples, where, time, step):
     the first (where: its file and line, time: seconds)."""
     return (
         f"{name}: {off} of its {samples} time stamps are more than {OFF_CYCLE:g} of a cycle "
-        f"({OFF_CYCLE * step:g} s) off a cycle end, matched to the nearest one; the first at {where}: "
-        f"t={time:.9g} s, {time / step:.3f} cycles: is the step size the recorder's cycle?"
+        f"({shortest(OFF_CYCLE * step)} s) off a cycle end, matched to the nearest one; the first at {where}: "
+        f"t={shortest(as_read(time))} s, {time / step:.3f} cycles: is the step size the recorder's cycle?"
     )
 
 
@@ -99,7 +102,7 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = ()):
         indices = [_cycles_of(channel, step, notes, names) for _, channel in plan.drives]
         grid = np.unique(np.concatenate(indices))
         inputs = np.empty(len(grid), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in plan.drives])
-        inputs["time"] = grid * step
+        inputs["time"] = cycle_times(grid, step)
         for (variable, channel), index in zip(plan.drives, indices, strict=True):
             where = np.searchsorted(index, grid, side="right") - 1
             inputs[variable] = channel.values[np.maximum(where, 0)]
@@ -115,13 +118,13 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = ()):
         groups.setdefault(index.tobytes(), (index, []))[1].append((variable, channel))
     for index, members in groups.values():
         reference = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in members])
-        reference["time"] = (index + shift) * step
+        reference["time"] = cycle_times(index + shift, step)
         for variable, channel in members:
             reference[variable] = channel.values
         references.append(reference)
     if inputs is not None:
         last = max(last, int(np.rint(inputs["time"][-1] / step)))
-    stop = max(last + shift, 1) * step
+    stop = float(cycle_times(np.array([max(last + shift, 1)]), step)[0])
     aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step, notes=notes)
     if coarse:
         aligned.coarse = _coarse_note(coarse, plan, step, names)
@@ -132,7 +135,7 @@ def _coarse_note(coarse, plan, step, names):
     """What inputs sampled every N cycles mean, and a tolerance that is."""
     every = max(n for _, n in coarse)
     sampled = ", ".join(f"{v} every {n} cycles" for v, n in coarse)
-    lag = (every - 1) * step
+    lag = float(cycle_times(np.array([every - 1]), step)[0])
     spans = []
     for variable, channel in plan.compares:
         index = np.rint(channel.times / step)
@@ -144,7 +147,7 @@ def _coarse_note(coarse, plan, step, names):
             spans.append((variable, rate * (every - 1)))
     tolerance = max((s for _, s in spans), default=0.0)
     return (
-        f"the recording's inputs were sampled coarser than the step ({sampled}; step {step:g} s): between two "
+        f"the recording's inputs were sampled coarser than the step ({sampled}; step {shortest(step)} s): between two "
         "samples the FMU holds the last recorded value while the controller saw values the recording does not "
         f"hold, so its output may lead or lag the recorded one by up to {every - 1} cycles and an exact "
         "comparison cannot hold. A meaningful comparison allows that lag: "

@@ -69,14 +69,50 @@ def _role(variable):
     return None, f"a {variable.variability} {variable.causality} of the FMU: it can neither drive nor be compared"
 
 
-def _find_channel(recording, wanted):
-    for channel in recording.channels:
-        if wanted in (channel.name, channel.symbol):
-            return channel
-    named = [c for c in recording.channels if wanted in (last_component(c.name), last_component(c.symbol or c.name))]
+def _candidates(recording, wanted):
+    """The channels a map's CHANNEL may mean: the one of that name, else
+    those of that symbol, else those whose name's or symbol's last
+    component it is; more than one is ambiguous."""
+    named = [c for c in recording.channels if c.name == wanted]
     if len(named) == 1:
-        return named[0]
-    return None
+        return named
+    exact = [c for c in recording.channels if wanted in (c.name, c.symbol)]
+    if exact:
+        return exact
+    return [c for c in recording.channels if wanted in (last_component(c.name), last_component(c.symbol or c.name))]
+
+
+def _ambiguous(recording, mapping, candidates, names):
+    """The refusal of a map that means several channels: each of them, and how to name one."""
+    variable, wanted = mapping
+    listed = "; ".join(
+        f"{c.name!r} ("
+        + (f"symbol {c.symbol!r}, " if c.symbol else "")
+        + (f"column {c.column})" if c.column else f"in {c.file})")
+        for c in candidates
+    )
+    unique = [c for c in candidates if sum(o.name == c.name for o in recording.channels) == 1]
+    how = (
+        f"map one by its name, e.g. {name_of(names, maps=(variable, unique[0].name))}"
+        if unique
+        else "their names are not unique either: export them under names of their own"
+    )
+    return InputError(
+        f"{name_of(names, maps=mapping)}: {len(candidates)} channels of {recording.label} are {wanted!r}: "
+        f"{listed}; {how}"
+    )
+
+
+def _all_mean(recording, variable, found, names):
+    """The refusal of several channels that mean one variable: each of them, and how to choose one."""
+    listed = [f"{c.name!r}{_column(c)}" for c in found]
+    channels = " and ".join([", ".join(listed[:-1]), listed[-1]])
+    say = f"say which with {name_of(names, maps=(variable, 'CHANNEL'))}"
+    example = name_of(names, maps=(variable, found[0].name))
+    return InputError(
+        f"{recording.label}: channels {channels} {'both' if len(found) == 2 else 'all'} mean {variable}: "
+        f"{say}, e.g. {example}"
+    )
 
 
 def plan(recording, variables, label, maps=(), names: Names = ()):
@@ -87,18 +123,21 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
     for variable, wanted in maps:
         if variable not in variables:
             raise InputError(f"{name_of(names, maps=(variable, wanted))}: {label} has no variable {variable!r}")
-        channel = _find_channel(recording, wanted)
-        if channel is None:
+        candidates = _candidates(recording, wanted)
+        if not candidates:
             raise InputError(
                 f"{name_of(names, maps=(variable, wanted))}: {recording.label} has no channel {wanted!r} "
                 f"(its channels: {', '.join(c.name for c in recording.channels)})"
             )
-        taken[variable] = channel
+        if len(candidates) > 1:
+            raise _ambiguous(recording, (variable, wanted), candidates, names)
+        taken[variable] = candidates[0]
     mapped = {id(c) for c in taken.values()}
     folded: dict[str, list[str]] = {}
     for name in variables:
         folded.setdefault(name.lower(), []).append(name)
     result = Plan()
+    matches: dict[str, list] = {}  # variable -> the unmapped channels that mean it
     for channel in recording.channels:
         if id(channel) in mapped:
             continue
@@ -122,16 +161,14 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
                 (channel, f"no variable of {label} is named {last_component(channel.symbol or channel.name)!r}")
             )
             continue
+        matches.setdefault(variable, []).append(channel)
+    for variable, found in matches.items():
         if variable in taken:
-            other = taken[variable]
-            if any(v == variable for v, _ in maps):
-                result.ignored.append((channel, f"{variable} is mapped to {other.name!r}"))
-                continue
-            raise InputError(
-                f"{recording.label}: channels {other.name!r}{_column(other)} and {channel.name!r}"
-                f"{_column(channel)} both mean {variable}: say which with {name_of(names, maps=(variable, 'CHANNEL'))}"
-            )
-        taken[variable] = channel
+            result.ignored += [(c, f"{variable} is mapped to {taken[variable].name!r}") for c in found]
+        elif len(found) > 1:
+            raise _all_mean(recording, variable, found, names)
+        else:
+            taken[variable] = found[0]
     for variable, channel in taken.items():
         role, why = _role(variables[variable])
         if role == "drive":

@@ -17,6 +17,7 @@ class Channel:
     lines: np.ndarray | None = None  # line of each sample in a text file (int64), else None
     symbol: str = ""  # a fuller name the recorder gives too (TwinCAT's SymbolName)
     times: np.ndarray | None = None  # seconds from the recording's first sample (normalise())
+    sample_time: float | None = None  # its sample interval in seconds, when the file declares it (TwinCAT)
 
     def where(self, index):
         """'file, line L' of sample index (or the file and channel)."""
@@ -51,3 +52,6 @@ class Recording:
 
 
 TIME_FACTORS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "FILETIME": 1e-7, "OLE days": 86400e-6}
+# units that are a whole fraction of a second: divided by it (one rounding: 4.2 ms is 0.0042 s, not
+# 0.004200000000000001 as 4.2 * 1e-3 gives); dates are in ns
+TIME_DIVISORS = {"ms": 1e3, "us": 1e6, "ns": 1e9, "FILETIME": 1e7, "date": 1e9}

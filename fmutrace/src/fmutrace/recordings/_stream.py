@@ -55,7 +55,7 @@ class Table:
             head = file.read(HEAD_BYTES)
             at_end = not file.read(1)
         if mdf.sniff(head[:64]) is None:
-            raise NotPlain("MDF4")
+            raise NotPlain("MDF")
         if not at_end:
             head = head[: head.rfind(b"\n") + 1]
         decoded, self.encoding = texts.decode(self.path, head)
@@ -78,9 +78,6 @@ class Table:
         timebase.normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names)
         self.recording = recording
         self.origin = float(recording.channels[0].stamps[0])
-        self.factor = (
-            recording.step_size if recording.time_unit == "cycles" else timebase.TIME_FACTORS[recording.time_unit]
-        )
         self.step_given = (
             recording.time_unit == "cycles" or recording.step_source != "the finest interval between its time stamps"
         )
@@ -119,7 +116,14 @@ class Table:
                     line_numbers = np.arange(number, number + len(stamps), dtype=np.int64)
                 else:
                     cells, line_numbers, stamps = self._cells(block, codec, number)
-                yield number, cells, line_numbers, timebase._minus(stamps, self.origin) * self.factor
+                yield (
+                    number,
+                    cells,
+                    line_numbers,
+                    timebase.seconds(
+                        timebase._minus(stamps, self.origin), self.recording.time_unit, self.recording.step_size
+                    ),
+                )
                 number += len(stamps)
 
     def _numbers(self, block, time_only=False):

@@ -67,7 +67,7 @@ def decode(path, data):
         if zeros_even > len(head) * 0.4 and zeros_odd == 0:
             return _strict(path, data, "utf-16-be", "UTF-16 BE")
     if b"\x00" in head:
-        raise TraceError(path, 0, 0, "a binary file, not text (and not MDF4)")
+        raise TraceError(path, 0, 0, "a binary file, not text (and not MDF)")
     try:
         return data.decode("utf-8"), "UTF-8"
     except UnicodeDecodeError:

@@ -20,8 +20,10 @@ import numpy as np
 
 from .._traces import MAX_STEPS
 from .._errors import InputError, TraceError
-from .._names import Names, name_of
-from ._model import TIME_FACTORS
+from .._names import Names, name_of, shortest
+from fractions import Fraction
+
+from ._model import TIME_DIVISORS, TIME_FACTORS
 
 OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
 MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless the caller gave the unit)
@@ -162,15 +164,18 @@ def dates(cells, text, line_of, column, name):
 
 
 # -- seconds from the first sample -------------------------------------------------
-def normalise(recording, time_unit=None, step_size=None, default_step=None, names: Names = ()):
-    """Set every channel's times (seconds from the recording's first
-    sample, over all channels) and the recording's step_size: step_size if
-    given, else the sample time the file declares, else the finest interval
-    between its time stamps (the recorder sampled every cycle), else
-    default_step (the FMU's) for cycle counts. time_unit overrides the
-    recording's. Refuses a recording whose length in steps is absurd,
-    naming the unit it assumed. names: the caller's words for the
-    settings (RecordingOptions.names)."""
+def normalise(recording, time_unit=None, step_size=None, default_step=None, names: Names = (), using=None):
+    """Set every channel's times (seconds from the first sample of the
+    channels using names, by default all of them) and the recording's
+    step_size: step_size if given, else the sample time the file declares
+    for those channels, else the finest interval between their time
+    stamps (the recorder sampled every cycle), else default_step (the
+    FMU's) for cycle counts. using: the channels compared or driven (the
+    others never change the time base: a CAN log's unmapped 100 Hz
+    messages, an XCP calibration channel at t = 0). time_unit overrides
+    the recording's. Refuses a recording whose length in steps is absurd,
+    naming the unit it assumed. names: the caller's words for the settings
+    (RecordingOptions.names)."""
     if time_unit:
         if recording.time_unit in ("date", "OLE days") and time_unit != recording.time_unit:
             raise InputError(
@@ -180,11 +185,16 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
         recording.time_unit, recording.time_source = time_unit, name_of(names, "time_unit")
         recording.unit_given = True
     unit = recording.time_unit
-    channels = [c for c in recording.channels if len(c.stamps)]
+    channels = [c for c in (recording.channels if using is None else using) if len(c.stamps)]
+    if not channels and using:
+        named = ", ".join(repr(c.name) for c in using)
+        raise TraceError(recording.label, 0, 0, f"no samples: the channels compared or driven ({named}) hold none")
     if not channels:
         raise TraceError(recording.label, 0, 0, "no samples: the recording holds no channel with values")
+    declared = [c.sample_time for c in channels if c.sample_time]
+    sample_time = min(declared) if declared else recording.sample_time
     if unit == "cycles":
-        step = step_size or recording.sample_time or default_step
+        step = step_size or sample_time or default_step
         if not step:
             raise InputError(
                 f"{recording.label}: its time is a cycle count: give the cycle time with {name_of(names, 'step_size')}"
@@ -194,26 +204,30 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
             name_of(names, "step_size")
             if step_size
             else "the recording's sample time"
-            if recording.sample_time
+            if sample_time
             else "the FMU's default step size"
         )
     origin = min(c.stamps[0] for c in channels)
-    factor = recording.step_size if unit == "cycles" else 1e-9 if unit == "date" else TIME_FACTORS[unit]
     for channel in recording.channels:
-        channel.times = _minus(channel.stamps, origin) * factor
+        channel.times = seconds(_minus(channel.stamps, origin), unit, recording.step_size)
     span = max(float(c.times[-1]) for c in channels)
     assumed = f"{UNIT_NAMES[unit]} ({recording.time_source})" if unit != "date" else UNIT_NAMES[unit]
     if too_long(span):
+        advice = (
+            f"more than a year: compare a part of it ({name_of(names, 'time_unit')} does not apply to "
+            f"{UNIT_NAMES[unit]})"
+            if unit in ("date", "OLE days")
+            else f"if that is not its unit, give {name_of(names, 'time_unit')} (s, ms, us, ns, cycles, filetime)"
+        )
         raise InputError(
             f"{recording.label}: with its time read as {assumed}, the recording would span "
-            f"{span:.4g} s ({span / 86400:.4g} days): if that is not its unit, give {name_of(names, 'time_unit')} "
-            "(s, ms, us, ns, cycles, filetime)"
+            f"{span:.4g} s ({span / 86400:.4g} days): {advice}"
         )
     if unit != "cycles":
         if step_size:
             recording.step_size, recording.step_source = step_size, name_of(names, "step_size")
-        elif recording.sample_time:
-            recording.step_size, recording.step_source = recording.sample_time, "the recording's sample time"
+        elif sample_time:
+            recording.step_size, recording.step_source = sample_time, "the recording's sample time"
         else:
             step = finest_interval(channels)
             if step is None:
@@ -228,12 +242,20 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
             recording.step_size, recording.step_source = step, source
     steps = span / recording.step_size
     samples = max(len(c.times) for c in channels)
-    if too_many_steps(steps, samples, recording.unit_given):
+    certain = recording.unit_given or unit in ("date", "OLE days")  # no unit can be misread
+    if too_many_steps(steps, samples, recording.unit_given or (certain and bool(step_size))):
+        step = name_of(names, "step_size")
+        cycle = "a coarser cycle" if step_size else "the recorder's cycle"
+        advice = (
+            f"give {cycle} with {step}"
+            if certain
+            else f"if that is not its unit, give {name_of(names, 'time_unit')} (s, ms, us, ns, cycles, filetime)"
+            + ("" if step_size else f", or the recorder's cycle with {step}")
+        )
         raise InputError(
             f"{recording.label}: with its time read as {assumed} and a step of "
-            f"{recording.step_size:g} s ({recording.step_source}) the recording would take "
-            f"{steps:.3g} steps for {samples} samples: if that is not its unit, give {name_of(names, 'time_unit')} "
-            "(s, ms, us, ns, cycles, filetime)"
+            f"{shortest(recording.step_size)} s ({recording.step_source}) the recording would take "
+            f"{steps:.3g} steps for {samples} samples: {advice}"
         )
     return recording
 
@@ -245,6 +267,46 @@ def _minus(stamps, origin):
     if stamps.dtype.kind == "M":
         return (stamps - origin).astype("timedelta64[ns]").astype(np.int64).astype(np.float64)
     return stamps.astype(np.float64) - float(origin)
+
+
+def seconds(elapsed, unit, step=None):
+    """Stamps minus the origin (float64, in unit) as seconds, each rounded once: divided by a unit's
+    whole fraction of a second, cycle counts by cycle_times."""
+    if unit == "cycles":
+        whole = np.rint(elapsed)
+        if np.array_equal(whole, elapsed):
+            return cycle_times(whole.astype(np.int64), step)
+        return elapsed * step
+    if unit in TIME_DIVISORS:
+        return elapsed / TIME_DIVISORS[unit]
+    return elapsed * TIME_FACTORS[unit]
+
+
+def cycle_times(index, step):
+    """The times index * step of whole cycles, each the double nearest the exact decimal product when
+    the step is a short decimal (p / q): (index * p) / q, one rounding, so cycle 42 of 0.0001 s is
+    0.0042, not 0.004200000000000001; index * step where that cannot be exact."""
+    index = np.asarray(index)
+    numerator, denominator = Fraction(repr(float(step))).as_integer_ratio()
+    largest = int(np.abs(index).max()) if len(index) else 0
+    if denominator > 1 << 53 or largest * abs(numerator) > 1 << 53:
+        return index * step
+    return (index * numerator).astype(np.float64) / float(denominator)
+
+
+def nominal(time, cycle, step):
+    """A sample's time (seconds) as a message shows it: its cycle's time from the whole cycle when it
+    is on that cycle (the arithmetic of reading it adds no noise then: 0.0042, not
+    0.004200000000000001), else as read (as_read)."""
+    exact = float(cycle_times(np.array([cycle]), step)[0])
+    return exact if abs(time - exact) <= OFF_CYCLE * step else as_read(time)
+
+
+def as_read(time):
+    """A time read from a stamp (seconds) without the few ulps its conversion added (10.0004 ms is
+    0.010000400000000001 s divided, 0.0100004 s as written): 15 significant digits, which every
+    decimal of 15 digits survives."""
+    return float(f"{float(time):.15g}")
 
 
 def too_long(span):

@@ -59,6 +59,20 @@ def sniff(text):
     return why if found is None else None
 
 
+def _padded(key, cells, name_cells, key_columns):
+    """A property row that leaves out its trailing empty cells (Scope View
+    does with 'For each sampletime': 'SymbolComment', then nothing for the
+    last channels) filled up to the Name row, when its keys stand where
+    the Name row's do; any other row as it is."""
+    keys = [j for j, c in enumerate(cells) if c == key]
+    if len(cells) >= len(name_cells) or keys != key_columns[: len(keys)]:
+        return cells
+    filled = cells + [""] * (len(name_cells) - len(cells))
+    for j in key_columns:
+        filled[j] = key
+    return filled
+
+
 def _realigned(text, line, key, cells, name_row, separator):
     """A property row with more cells than the Name row: Scope View writes
     a decimal comma in SampleTime[ms] even with ',' as the separator
@@ -110,6 +124,7 @@ def read(text):
     key_columns = [j for j, c in enumerate(name_cells) if c == "Name"]
     for key, (line, cells) in list(header.items()):
         if len(cells) != len(name_cells):
+            cells = _padded(key, cells, name_cells, key_columns)
             header[key] = (line, _realigned(text, line, key, cells, (name_cells, key_columns), separator))
     rows, lines = grids.body(text, index, separator if separator != " " else " ")
     if not rows:
@@ -167,6 +182,7 @@ def read(text):
                     decimal_comma,
                 )
                 channel.symbol = prop("SymbolName", j)
+                channel.sample_time = ms * 1e-3
                 channels.append(channel)
             continue
         cells = table[:, time_column]
@@ -189,6 +205,8 @@ def read(text):
                 text, table[:, j], grids.Rows(lines, stamps, stamp_present), j + 1, prop("Name", j), decimal_comma
             )
             channel.symbol = prop("SymbolName", j)
+            declared = texts.cell_value(prop("SampleTime[ms]", j) or prop("SampleTime", j))
+            channel.sample_time = declared * 1e-3 if declared else None
             channels.append(channel)
     unit = "FILETIME" if filetime else "ms"
     source = (

@@ -11,9 +11,10 @@ WinCC data log (WinCC flexible / WinCC Advanced / Unified Comfort CSV
 logs): header VarName, TimeString, VarValue, Validity, Time_ms; one row
 per tag and time stamp. Time_ms is the time as OLE days (since 30 Dec
 1899) times 1e6, good to a few microseconds; TimeString the same to the
-second. Rows whose VarName is a marker ($RT_OFF$ runtime stopped,
-$RT_DIS$ logging disabled, $RT_COUNT$) and rows of Validity 0 are no
-samples. Separator ',' or ';' (then a decimal comma).
+second, the time where Time_ms is damaged (a PC whose locale wrote a tab
+for its decimal mark). Rows whose VarName is a marker ($RT_OFF$ runtime
+stopped, $RT_DIS$ logging disabled, $RT_COUNT$ with fewer cells) and
+rows of Validity 0 are no samples. Separator ',' or ';' (then a decimal comma).
 
 Niagara (history table 'Export', CSV): one history (point) per file,
 columns Timestamp, Trend Flags, Status, Value (the value column may carry
@@ -27,6 +28,7 @@ import os
 
 import numpy as np
 
+from .._errors import TraceError
 from .._traces import split_cells
 from . import _grid as grids
 from . import _text as texts
@@ -125,20 +127,14 @@ def read_wincc(text):
             notes.append(f"{int(invalid.sum())} samples of Validity 0 skipped (the first at line {int(lines[first])})")
         keep &= ~invalid
     decimal_comma = separator != ","
-    if "Time_ms" in column:
-        j = column["Time_ms"]
-        stamps = texts.values(table[:, j], True, text, lambda i: int(lines[i]), j + 1, "Time_ms")
-        unit, source = "OLE days", "WinCC's Time_ms"
-    else:
-        j = column["TimeString"]
-        stamps = timebase.dates(table[:, j], text, lambda i: int(lines[i]), j + 1, "TimeString")
-        unit, source = "date", "WinCC's TimeString"
+    samples = np.flatnonzero(keep)
+    j, stamps, unit, source = _wincc_stamps(text, table[samples], lines[samples], column, notes)
     value_column = column["VarValue"]
     channels = []
     order = dict.fromkeys(tags[keep].tolist())
     for tag in order:
         rows_of = np.flatnonzero(keep & (tags == tag))
-        tag_stamps = stamps[rows_of]
+        tag_stamps = stamps[np.searchsorted(samples, rows_of)]
         grids.check_increasing(text, tag_stamps, lines[rows_of], j + 1, f"time of {tag}")
         values = texts.values(
             table[rows_of, value_column],
@@ -167,6 +163,31 @@ def read_wincc(text):
         encoding=text.encoding,
         notes=notes,
     )
+
+
+def _wincc_stamps(text, table, lines, column, notes):
+    """(column, stamps, unit, source) of a WinCC log's sample rows: Time_ms,
+    else TimeString (to the second) where Time_ms is missing or damaged (a
+    PC whose locale wrote a tab for its decimal mark), with a note naming
+    the first damaged cell."""
+    if "Time_ms" in column:
+        j = column["Time_ms"]
+        try:
+            stamps = texts.values(table[:, j], True, text, lambda i: int(lines[i]), j + 1, "Time_ms")
+            return j, stamps, "OLE days", "WinCC's Time_ms"
+        except TraceError as error:
+            damaged = error
+    j = column["TimeString"]
+    try:
+        stamps = timebase.dates(table[:, j], text, lambda i: int(lines[i]), j + 1, "TimeString")
+    except TraceError:
+        if "Time_ms" in column:
+            raise damaged from None
+        raise
+    if "Time_ms" in column:
+        notes.append(f"{damaged}: the time is TimeString's instead")
+        return j, stamps, "date", "WinCC's TimeString: its Time_ms is damaged"
+    return j, stamps, "date", "WinCC's TimeString"
 
 
 # -- Niagara -------------------------------------------------------------------------
