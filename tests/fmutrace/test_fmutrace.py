@@ -230,7 +230,9 @@ def test_tube_fails_where_the_result_leaves_it_and_says_by_how_much(tmp_path):
     # at t = 0.1, x = 5 (1 - e^-0.1); the window [0, 0.2] of the reference's
     # polyline rises from 0 at t = 0 towards its sample at 0.25: its top is
     # at 0.2, four fifths of that sample
-    first = json.loads((tmp_path / "report" / "results.json").read_text())["cases"][0]["signals"][0]
+    case = json.loads((tmp_path / "report" / "results.json").read_text())["cases"][0]
+    assert "plot_data" in case and not any(m.startswith("no plot") for m in case["messages"])  # (its page's plots)
+    first = case["signals"][0]
     assert first["name"] == "x" and not first["passed"]
     upper = round(5 * (1 - math.exp(-0.125)), 4) * 0.2 / 0.25 + 0.001
     x = 5 * (1 - math.exp(-0.1))

@@ -458,6 +458,22 @@ class _Comparer:
         (times, lower), (_, upper) = self.envelopes[("lower", name)].line(), self.envelopes[("upper", name)].line()
         return (times, lower, upper) if len(times) else None
 
+    def page_scripts(self, case: ChunkedCase, figure: Figure, label, criteria):
+        """The case page's plot data as a script, and a long case's finer level as DETAIL scripts (or none)."""
+        envelopes, outputs = self.envelopes, self.outputs
+        data = page_data(figure, label, criteria)
+        tiles = []
+        if needs_tiles(envelopes.values()):
+            any_line = next(iter(envelopes.values()))
+            data["tiles"], data["span"] = DETAIL, [any_line.t0, any_line.t0 + any_line.span]
+            inputs = [(s, envelopes[("input", s)]) for s in case.input_names]
+            signals = [
+                (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation")))
+                for s in outputs
+            ]
+            tiles = [as_script("fmutraceTile(", page_tile(k, inputs, signals), ");") for k in range(DETAIL)]
+        return as_script("window.fmutracePlot = ", data, ";"), tiles
+
     def outcome(self, case: ChunkedCase, labels, settings):
         """The case's CaseOutcome once every reference row was compared."""
         outputs, envelopes = self.outputs, self.envelopes
@@ -483,19 +499,10 @@ class _Comparer:
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
             criteria = {s: d.criterion or outcome.criteria for s, d in zip(outputs, deviations, strict=True)}
-            data = page_data(figure, labels["fmu"], criteria)
-            if needs_tiles(envelopes.values()):
-                any_line = next(iter(envelopes.values()))
-                data["tiles"], data["span"] = DETAIL, [any_line.t0, any_line.t0 + any_line.span]
-                inputs = [(s, envelopes[("input", s)]) for s in case.input_names]
-                signals = [
-                    (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation")))
-                    for s in outputs
-                ]
-                outcome.plot_tiles = [
-                    as_script("fmutraceTile(", page_tile(k, inputs, signals), ");") for k in range(DETAIL)
-                ]
-            outcome.plot_js = as_script("window.fmutracePlot = ", data, ";")
+            try:
+                outcome.plot_js, outcome.plot_tiles = self.page_scripts(case, figure, labels["fmu"], criteria)
+            except Exception as error:  # a page's plots lost, not the verdict (as a figure below)
+                outcome.messages.append(f"no plot: its data failed ({type(error).__name__}: {error})")
             outcome.result_path = self.result.keep() or ""
             if settings.png:
                 try:

@@ -281,6 +281,11 @@ def _points(times, values, window=None) -> list:
     return [times.tolist(), values.tolist()]
 
 
+def _window(zoom_line, k):
+    """(times, line k) of a signal's zoom line at full resolution, to replace the decimated line there; or None."""
+    return None if zoom_line is None or zoom_line[k] is None else (zoom_line[0], zoom_line[k])
+
+
 def page_data(figure: Figure, label: str, criteria: dict) -> dict:
     """What a case page's interactive plots show (plain lists, NaN kept:
     the page reads them as JavaScript): per signal its reference, result,
@@ -304,12 +309,12 @@ def page_data(figure: Figure, label: str, criteria: dict) -> dict:
             {
                 "name": shown(name),
                 "criterion": shown(criteria.get(name, "")),
-                "reference": _points(ref[0], ref[1], window=z and z[5] is not None and (z[0], z[5])),
-                "reference_framed": bool(z and z[5] is not None),
-                "result": _points(result[0], result[1], window=z and (z[0], z[1])),
-                "lower": _points(band[0], band[1], window=z and (z[0], z[2])) if band is not None else None,
-                "upper": _points(band[0], band[2], window=z and (z[0], z[3])) if band is not None else None,
-                "deviation": _points(dev_t, dev_v, window=z and (z[0], z[4])),
+                "reference": _points(ref[0], ref[1], window=_window(z, 5)),
+                "reference_framed": _window(z, 5) is not None,
+                "result": _points(result[0], result[1], window=_window(z, 1)),
+                "lower": _points(band[0], band[1], window=_window(z, 2)) if band is not None else None,
+                "upper": _points(band[0], band[2], window=_window(z, 3)) if band is not None else None,
+                "deviation": _points(dev_t, dev_v, window=_window(z, 4)),
             }
         )
     return {
