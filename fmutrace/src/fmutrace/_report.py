@@ -293,7 +293,7 @@ def _case_page(o: CaseOutcome, report_dir: Path, campaign_criteria) -> str:
         f'<script src="{assets}/uPlot.iife.min.js"></script>\n'
         f'<script src="{link(o.plot_data)}"></script>\n<script src="{assets}/case.js"></script>\n'
         if o.plot_data
-        else "<p>No plot: this case was not plotted (<code>--plots</code>).</p>"
+        else "<p>No plot: the campaign plotted only some of its cases, not this one.</p>"
     )
     with _replaced(page) as out:
         out.write(_head(f"{o.status}: {text(o.case)} on {text(o.fmu)}", assets, ("uPlot.min.css", "report.css")))
