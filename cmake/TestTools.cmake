@@ -9,6 +9,7 @@
 #   qemu-user                       the aarch64 binaries and harnesses under emulation (test_aarch64)
 #   g++                             the sources compiled as C++ (test_source_fmu)
 #   clang-format-14                 the C sources' layout (ctest lint, .pre-commit-config.yaml)
+#   chromium, chromium-driver       the report's pages in a real browser (tests/fmutrace/test_report_browser.py)
 # Python packages: tests/requirements.txt (cmake/PythonEnv.cmake).
 # A tool that still cannot be had makes its tests fail and say why.
 
@@ -69,6 +70,13 @@ find_program(CLANG_FORMAT NAMES clang-format-14 clang-format)
 if(NOT CLANG_FORMAT)
   apt_install("No clang-format for the lint stage" clang-format-14)
   find_program(CLANG_FORMAT NAMES clang-format-14 clang-format)
+endif()
+
+# headless Chromium and its WebDriver: the report read in a browser, driven by selenium (tests/requirements.txt)
+find_program(CHROMIUM chromium NO_CACHE)
+find_program(CHROMEDRIVER chromedriver NO_CACHE)
+if(NOT CHROMIUM OR NOT CHROMEDRIVER)
+  apt_install("No Chromium for the report's browser tests" chromium chromium-driver)
 endif()
 
 # The standard's fmi2Functions.h, in build/fmi_headers, for the tests that

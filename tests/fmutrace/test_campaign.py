@@ -23,13 +23,17 @@ def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_pa
     fmus = [fmu_path(BUILD_DIR, model, version) for model in ("RateLimiter", "Ramp") for version in FMI_VERSIONS]
     cases = [SCENARIO_ROOT / "RateLimiter", SCENARIO_ROOT / "Ramp"]
     distributed = fmutrace.compare(
-        fmus, cases, report=tmp_path / "distributed", run=fmutrace.RunOptions(scheduler=cluster, cluster_timeout=600)
+        fmus,
+        cases,
+        report=tmp_path / "distributed",
+        run=fmutrace.RunOptions(scheduler=cluster, cluster_timeout=600),
+        plots="png",
     )
     assert distributed.where == f"Dask, 2 workers at {cluster}"
     shared = fmutrace.compare(
         fmus, cases, run=fmutrace.RunOptions(scheduler=cluster, shared_files=True, cluster_timeout=600)
     )
-    serial = fmutrace.compare(fmus, cases, report=tmp_path / "serial", run=fmutrace.RunOptions(jobs=1))
+    serial = fmutrace.compare(fmus, cases, report=tmp_path / "serial", run=fmutrace.RunOptions(jobs=1), plots="png")
     assert [(o.case, o.status) for o in shared.cases] == [(o.case, o.status) for o in serial.cases]
     assert serial.where == "1 process"
     assert len(serial.cases) == 2 * len(discover(["RateLimiter", "Ramp"]))
@@ -41,6 +45,8 @@ def test_campaign_on_a_distributed_cluster_equals_the_serial_run(cluster, tmp_pa
         for name in a.result.dtype.names:
             assert np.array_equal(a.result[name], b.result[name], equal_nan=True)
         assert a.png == b.png  # the same plot, byte for byte
+        for made in (a.plot, a.plot_data):  # (the static figure and the page's plot data)
+            assert (tmp_path / "distributed" / made).read_bytes() == (tmp_path / "serial" / made).read_bytes()
         assert (tmp_path / "distributed" / a.csv).read_bytes() == (tmp_path / "serial" / b.csv).read_bytes()
     for page in ("index.html", "summary.md", "results.json"):
         assert without_timings((tmp_path / "distributed" / page).read_text()) == without_timings(

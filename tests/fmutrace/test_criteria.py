@@ -400,8 +400,9 @@ def test_per_signal_criteria_draw_their_plot_and_report(tmp_path):
     folder, reference = own_output_case(tmp_path)
     changed(folder, reference, rampActive=late(reference["rampActive"], 2))
     criteria = fmutrace.Criteria({"y": Tube(0.1, 0.0), "rampActive": fmutrace.Discrete(1)})
-    outcome = run_folder_case(CaseFiles(folder, folder.name), fmu_target(), CaseSettings(criteria, "all"))
+    outcome = run_folder_case(CaseFiles(folder, folder.name), fmu_target(), CaseSettings(criteria, "all", png=True))
     assert outcome.status == "fail" and outcome.png.startswith(b"\x89PNG")
+    assert outcome.plot_js.startswith("window.fmutracePlot") and "tube of 0.1 s and 0" in outcome.plot_js
     campaign = fmutrace.compare(fmu_path(BUILD_DIR, "RateLimiter", 3), tmp_path, mode=criteria, report=tmp_path / "r")
     assert campaign.exit_code == 1
     summary = (tmp_path / "r" / "summary.md").read_text()

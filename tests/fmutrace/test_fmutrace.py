@@ -230,7 +230,9 @@ def test_tube_fails_where_the_result_leaves_it_and_says_by_how_much(tmp_path):
     # at t = 0.1, x = 5 (1 - e^-0.1); the window [0, 0.2] of the reference's
     # polyline rises from 0 at t = 0 towards its sample at 0.25: its top is
     # at 0.2, four fifths of that sample
-    first = json.loads((tmp_path / "report" / "results.json").read_text())["cases"][0]["signals"][0]
+    case = json.loads((tmp_path / "report" / "results.json").read_text())["cases"][0]
+    assert "plot_data" in case and not any(m.startswith("no plot") for m in case["messages"])  # (its page's plots)
+    first = case["signals"][0]
     assert first["name"] == "x" and not first["passed"]
     upper = round(5 * (1 - math.exp(-0.125)), 4) * 0.2 / 0.25 + 0.001
     x = 5 * (1 - math.exp(-0.1))
@@ -445,7 +447,17 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
     write_case(tmp_path / "cases" / "step", "PassThrough", STEP_REF, DIALECTS["comma"], STEP_OPT)
     report, junit = tmp_path / "report", tmp_path / "ci" / "junit.xml"
     done = fmutrace_cli(
-        "compare", LAG[2], LAG[3], PASS_THROUGH[3], tmp_path / "cases", "--report", report, "--junit", junit
+        "compare",
+        LAG[2],
+        LAG[3],
+        PASS_THROUGH[3],
+        tmp_path / "cases",
+        "--report",
+        report,
+        "--junit",
+        junit,
+        "--plots",
+        "png",
     )
     assert done.returncode == 1
     assert "3 of 5 cases pass, 2 differ" in done.stdout
@@ -467,7 +479,8 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
     x = next(s for s in off["signals"] if s["name"] == "x")
     assert x["time"] == 1.0 and x["excess"] == pytest.approx(0.01, rel=1e-9) and x["failed"] == 11
     html = (report / "index.html").read_text()
-    assert html.count("<tr class=") == 5 and html.count('<tr class="fail">') == 2
+    rows = re.findall(r'<tr class="(\w+)" data-status', html)
+    assert rows == ["fail", "fail", "pass", "pass", "pass"]  # one row per case, the failing ones first
     for case in results["cases"]:
         assert (report / case["plot"]).read_bytes().startswith(b"\x89PNG")
         assert fmutrace.read_trace(report / case["result_csv"]).dtype.names[0] == "time"

@@ -78,7 +78,7 @@ def journal_keys(report):
 
 def comparable(report):
     results = json.loads((report / "results.json").read_text())
-    return [(c["case"], c["fmu"], c["status"], c["messages"], c.get("plot")) for c in results["cases"]]
+    return [(c["case"], c["fmu"], c["status"], c["messages"], c.get("plot_data")) for c in results["cases"]]
 
 
 @pytest.mark.slow
@@ -128,9 +128,10 @@ def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp
     assert code == 1, out + err
     assert "499 of 501 cases pass, 2 differ" in out
     failing = ["PassThrough-fmi3/case_07", "PassThrough-fmi3/case_300"]
-    assert sorted(str(p.relative_to(report)) for p in report.rglob("*.png")) == [f"{c}.png" for c in failing]
+    plotted = sorted(str(p.relative_to(report)) for p in report.rglob("*.plot.js"))
+    assert plotted == [f"{c}.plot.js" for c in failing]
     assert sorted(str(p.relative_to(report)) for p in report.rglob("*_out.csv")) == [f"{c}_out.csv" for c in failing]
-    assert [c["case"] for c in json.loads((report / "results.json").read_text())["cases"] if "plot" in c] == [
+    assert [c["case"] for c in json.loads((report / "results.json").read_text())["cases"] if "plot_data" in c] == [
         "case_07",
         "case_300",
     ]
@@ -197,7 +198,8 @@ def test_resume_refuses_a_journal_of_another_campaign(tmp_path):
 def test_a_second_campaign_into_the_same_report_folder_is_refused(tmp_path):
     cases = pass_through_cases(tmp_path / "cases", 30)
     report = tmp_path / "report"
-    first = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "all"])
+    # (drawn as PNG: 30 cases that last seconds)
+    first = start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1, "--plots", "png"])
     wait_for(lambda: (report / "results.jsonl").exists() and journal_keys(report), "the first campaign's start")
     code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", report, "--jobs", 1]))
     assert code == 2, out + err
@@ -321,12 +323,12 @@ def test_spawned_workers_give_what_this_process_gives(tmp_path, monkeypatch):
     ]
 
 
-@pytest.mark.parametrize("plots,count,workers", [("none", 6, 1), ("all", 24, 2)])
+@pytest.mark.parametrize("plots,count,workers", [("none", 6, 1), ("png", 24, 2)])
 def test_the_default_starts_the_workers_the_work_pays_for(plots, count, workers, tmp_path):
     """By default a second worker starts only when the work left pays for
     its start-up, measured: 6 cases of a millisecond or so run in one (a
-    start-up loads the FMU: tens of milliseconds), 24 cases drawn (a tenth
-    of a second each) in two, where there are two cores. (The command:
+    start-up loads the FMU: tens of milliseconds), 24 cases drawn as PNG (a
+    tenth of a second each) in two, where there are two cores. (The command:
     its workers are forked, as users get them on Linux.)"""
     cases = pass_through_cases(tmp_path / "cases", count)
     code, out, err = finish(start(["compare", PASS_THROUGH, cases, "--report", tmp_path / "report", "--plots", plots]))

@@ -252,7 +252,7 @@ def test_tex_like_text_in_a_name_or_readme_is_drawn_as_text(tmp_path):
     mathtext: the plot is drawn (a broken formula used to abort the whole
     campaign) and the case passes."""
     write_case(tmp_path / "cases" / "cost $x^$ and $", readme="# unit price in $\\frac{$ per $m^2\n")
-    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", tmp_path / "report")
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", tmp_path / "report", "--plots", "png")
     no_traceback(done)
     assert done.returncode == 0, output(done)
     pngs = list((tmp_path / "report").rglob("*.png"))
@@ -275,6 +275,11 @@ def test_markdown_and_html_show_a_name_as_text(tmp_path):
     assert "<b>" not in summary and "](javascript" not in summary, summary
     page = (tmp_path / "report" / "index.html").read_text()
     assert "<b>bold" not in page and "&lt;b&gt;bold" in page
+    [case_page] = [p for p in (tmp_path / "report").rglob("*.html") if p.name != "index.html"]
+    page = case_page.read_text()
+    assert "<b>bold" not in page and "&lt;b&gt;bold" in page
+    data = case_page.with_name(case_page.name.removesuffix(".html") + ".plot.js").read_text()
+    assert "<" not in data and "\\u003cb>bold" in data  # (JSON's escape: the name itself once read)
 
 
 def test_control_characters_in_names_leave_junit_xml_valid(tmp_path):
@@ -326,7 +331,7 @@ def test_a_250_byte_name_becomes_a_file_name_shortened_with_a_hash(tmp_path):
     long = ["é" * 124 + "ab", "é" * 124 + "ac"]  # 250 bytes each
     for name in long:
         write_case(tmp_path / "cases" / name)
-    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", tmp_path / "report")
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", tmp_path / "report", "--plots", "png")
     no_traceback(done)
     assert done.returncode == 0, output(done)
     results = json.loads((tmp_path / "report" / "results.json").read_text())
@@ -334,9 +339,11 @@ def test_a_250_byte_name_becomes_a_file_name_shortened_with_a_hash(tmp_path):
     csvs = [c["result_csv"] for c in results["cases"]]
     assert len(set(csvs)) == 2
     for case in results["cases"]:
-        for key in ("result_csv", "plot"):
+        for key in ("result_csv", "plot", "plot_data"):
             path = tmp_path / "report" / case[key]
             assert path.is_file() and len(os.fsencode(path.name)) <= 255
+        page = tmp_path / "report" / (case["plot_data"].removesuffix(".plot.js") + ".html")  # the case's page
+        assert page.is_file() and len(os.fsencode(page.name)) <= 255
     rows = (tmp_path / "report" / csvs[0]).read_text().splitlines()[1:]
     assert [float(row.split(",")[1]) for row in rows] == [0, 1, 1, 3, 3, 3]
 
@@ -804,7 +811,9 @@ def test_a_plot_that_cannot_be_drawn_costs_the_figure_not_the_verdict(tmp_path, 
     monkeypatch.setattr(_pipeline, "draw", broken)
     write_case(tmp_path / "cases" / "differs", ref=REF.replace("0.3,3", "0.3,2"))
     write_case(tmp_path / "cases" / "same")
-    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report", run=RunOptions(jobs=1))
+    campaign = compare(
+        [PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report", plots="png", run=RunOptions(jobs=1)
+    )
     by_name = {c.case: c for c in campaign.cases}
     assert (by_name["differs"].status, by_name["same"].status) == ("fail", "pass")
     for c in by_name.values():

@@ -100,9 +100,12 @@ def test_a_long_failing_case_plots_a_zoom_and_keeps_its_result(spill, tmp_path, 
     labels = {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"}
     settings = {"keep_result": True, "steps_per_chunk": 2, "chunk_bytes": 16}
     long = run_folder_case(
-        CaseFiles(folder, "ulp"), Target(runner, fmu, labels), CaseSettings(Exact(), "failed"), Streaming(**settings)
+        CaseFiles(folder, "ulp"),
+        Target(runner, fmu, labels),
+        CaseSettings(Exact(), "failed", png=True),
+        Streaming(**settings),
     )
-    assert not long.passed and long.png.startswith(b"\x89PNG")
+    assert not long.passed and long.png.startswith(b"\x89PNG") and long.plot_js.startswith("window.fmutracePlot")
     whole = on_the_whole(folder, runner, fmu, Exact())
     write_trace(tmp_path / "whole.csv", whole[3])
     out = Path(long.result_path)

@@ -65,7 +65,8 @@ def compare(
     junit       file for JUnit XML
     plots       which cases get a plot and a result CSV in the report:
                 'all', 'failed' or 'none'; None: all for up to 500 cases,
-                else the failed ones
+                else the failed ones; 'png': as None, each plot with a
+                static PNG figure too
     resume      take the cases the report's journal (results.jsonl) holds
                 from it, run the others (after a campaign was stopped)
     progress    the stream of the progress bar (default: standard error;
@@ -106,7 +107,8 @@ def compare(
         )
     loaded = [Fmu(path) for path in fmu_paths]
     cases_of = index_cases(loaded, case_paths)
-    plots = (plots or default_plots(len(cases_of))) if report else "none"
+    png = plots == "png"  # (the default's cases, each with a PNG figure too)
+    plots = ((None if png else plots) or default_plots(len(cases_of))) if report else "none"
     folders = _report_folders(loaded)
     work = Work(
         fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
@@ -114,10 +116,10 @@ def compare(
             f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]})
             for f in loaded
         },
-        settings=CaseSettings(mode, plots, recording, run.case_timeout),
+        settings=CaseSettings(mode, plots, recording, run.case_timeout, png),
     )
     executor = executor_for(run)
-    key = campaign_key(work.fmu_bytes, mode, plots, recording.settings() if has_recordings else None)
+    key = campaign_key(work.fmu_bytes, mode, plots + " png" * png, recording.settings() if has_recordings else None)
     started = time.perf_counter()
     lock = ReportLock(report) if report else None
     try:  # the report folder stays locked until its last file is written

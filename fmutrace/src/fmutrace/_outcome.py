@@ -44,10 +44,14 @@ class CaseOutcome:
     deviations: list = field(default_factory=list)  # Deviation of the failing signals
     seconds: float = 0.0
     result: np.ndarray | None = None  # structured array
-    png: bytes = b""
+    png: bytes = b""  # the static figure (plots "png")
+    plot_js: str = ""  # the case page's plot data, a script (report.py writes it beside the page)
+    plot_tiles: list = field(default_factory=list)  # a long case's finer level, a script per part of its span
     result_path: str = ""  # a long case's result, in a file of its own (the report moves it in)
     csv: str = ""  # paths in the report folder
     plot: str = ""
+    plot_data: str = ""
+    criteria: str = ""  # what the case is judged by (its own criteria before the campaign's)
     streamed: bool = False  # read, run and compared in chunks (a long case), not in memory
 
     @property
@@ -68,6 +72,10 @@ class CaseOutcome:
             entry["result_csv"] = self.csv
         if self.plot:
             entry["plot"] = self.plot
+        if self.plot_data:
+            entry["plot_data"] = self.plot_data
+        if self.criteria:
+            entry["criteria"] = self.criteria
         if self.streamed:
             entry["streamed"] = True
         return entry
@@ -86,6 +94,8 @@ class CaseOutcome:
             seconds=entry["seconds"],
             csv=entry.get("result_csv", ""),
             plot=entry.get("plot", ""),
+            plot_data=entry.get("plot_data", ""),
+            criteria=entry.get("criteria", ""),
             streamed=entry.get("streamed", False),
         )
 

@@ -35,7 +35,7 @@ from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned
 from ._errors import InputError, SimulationError
 from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
-from ._plot import ZOOM_SAMPLES, Envelope, Figure, draw
+from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, as_script, draw, needs_tiles, page_data, page_tile
 from ._progress import SampleProgress
 from ._runner import STEPS_PER_CHUNK
 from ._traces import CHUNK_BYTES, NotPlain, TraceWriter, last_time, read_text, trace_chunks
@@ -270,6 +270,7 @@ class _Comparer:
         }
         self.zoom_at: float | None = None  # the first failing sample's time, the zoom's lines around it
         self.zoom_lines: list | None = None
+        self.expected: dict[str, np.ndarray] = {}  # name -> the reference at the samples of its band being added
         self.recent: dict[str, tuple] = {}  # name -> the last ZOOM_SAMPLES compared samples (times, values, lower,
         # upper, deviation)
         # reference times without a result sample: their count and the first's time, of the first table with any
@@ -345,7 +346,7 @@ class _Comparer:
         assert isinstance(self.mode, Pointwise)  # (stream_case gives a tube's rows to tube_rows)
         picked, compared_times, bands = result[index[use]], times[use], {}
         for s in names:
-            expected = rows[s][use].astype(np.float64)
+            expected = self.expected[s] = rows[s][use].astype(np.float64)
             values = picked[s].astype(np.float64)
             lower, upper, ok = self.mode.bounds(values, expected)
             with np.errstate(invalid="ignore", over="ignore"):
@@ -437,17 +438,18 @@ class _Comparer:
                 self.envelopes[("upper", s)].add(band.times, band.upper)
             if self.zoom_lines is None and verdict.failed > before and verdict.time is not None:
                 failing_now.append(verdict.time)
-            self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation)
+            expected = self.expected.pop(s, None)  # (known on a pointwise comparison's rows)
+            self.recent[s] = (band.times, band.values, band.lower, band.upper, band.deviation, expected)
         if failing_now and self.zoom_lines is None:
             at = min(failing_now)
             self.zoom_at, self.zoom_lines = at, []
             for s in self.outputs:
                 if s not in self.recent:
                     continue
-                t, v, lo, up, dev = self.recent[s]
+                t, v, lo, up, dev, ref = self.recent[s]
                 k = int(np.searchsorted(t, at))
                 w = slice(max(k - ZOOM_SAMPLES, 0), k + ZOOM_SAMPLES + 1)
-                self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w]))
+                self.zoom_lines.append((s, t[w], v[w], lo[w], up[w], dev[w], None if ref is None else ref[w]))
 
     def band(self, name):
         """The band's edges to draw, (times, lower, upper), or None."""
@@ -455,6 +457,22 @@ class _Comparer:
             return None
         (times, lower), (_, upper) = self.envelopes[("lower", name)].line(), self.envelopes[("upper", name)].line()
         return (times, lower, upper) if len(times) else None
+
+    def page_scripts(self, case: ChunkedCase, figure: Figure, label, criteria):
+        """The case page's plot data as a script, and a long case's finer level as DETAIL scripts (or none)."""
+        envelopes, outputs = self.envelopes, self.outputs
+        data = page_data(figure, label, criteria)
+        tiles = []
+        if needs_tiles(envelopes.values()):
+            any_line = next(iter(envelopes.values()))
+            data["tiles"], data["span"] = DETAIL, [any_line.t0, any_line.t0 + any_line.span]
+            inputs = [(s, envelopes[("input", s)]) for s in case.input_names]
+            signals = [
+                (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation")))
+                for s in outputs
+            ]
+            tiles = [as_script("fmutraceTile(", page_tile(k, inputs, signals), ");") for k in range(DETAIL)]
+        return as_script("window.fmutracePlot = ", data, ";"), tiles
 
     def outcome(self, case: ChunkedCase, labels, settings):
         """The case's CaseOutcome once every reference row was compared."""
@@ -471,6 +489,7 @@ class _Comparer:
         outcome.messages += [d.describe() for d in deviations if d.passed and d.allowance]  # (per-signal criteria)
         if case.more_messages is not None:
             outcome.messages += case.more_messages(passed, outcome.deviations)
+        outcome.criteria = self.mode.describe()
         if settings.plots == "all" or (settings.plots == "failed" and not passed):
             figure = Figure(
                 case.title,
@@ -479,11 +498,17 @@ class _Comparer:
                 [(s, *envelopes[("deviation", s)].line()) for s in outputs],
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
             )
+            criteria = {s: d.criterion or outcome.criteria for s, d in zip(outputs, deviations, strict=True)}
             try:
-                outcome.png = draw(figure, self.mode, labels["fmu"])
-                outcome.result_path = self.result.keep() or ""
-            except Exception as error:  # (matplotlib's errors are many) a figure lost, not the verdict
-                outcome.messages.append(f"no plot: drawing it failed ({type(error).__name__}: {error})")
+                outcome.plot_js, outcome.plot_tiles = self.page_scripts(case, figure, labels["fmu"], criteria)
+            except Exception as error:  # a page's plots lost, not the verdict (as a figure below)
+                outcome.messages.append(f"no plot: its data failed ({type(error).__name__}: {error})")
+            outcome.result_path = self.result.keep() or ""
+            if settings.png:
+                try:
+                    outcome.png = draw(figure, self.mode, labels["fmu"])
+                except Exception as error:  # (matplotlib's errors are many) a figure lost, not the verdict
+                    outcome.messages.append(f"no plot: drawing it failed ({type(error).__name__}: {error})")
         outcome.seconds = time.perf_counter() - case.started
         return outcome
 

@@ -1,7 +1,8 @@
 """A case's figure for the report: its inputs, each compared signal
 (reference, result, and the band where the mode draws one) and the
-deviation, as PNG bytes; for a failing case beside it the same zoomed on
-the first deviation.
+deviation, as the data of its page's interactive plots (page_data, and
+page_tile for a long case's finer level) and, when asked, as PNG bytes;
+for a failing case beside it the same zoomed on the first deviation.
 
 A line of millions of samples is drawn decimated to what the figure can
 show: per pixel column the first and last sample and the smallest and
@@ -10,7 +11,9 @@ not grow with the length. A long case fills its envelopes chunk by chunk."""
 
 import importlib
 import io
+import json
 import threading
+import warnings
 
 import numpy as np
 
@@ -22,6 +25,7 @@ COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
 ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
 
 
+DETAIL = 16  # an envelope's columns per figure column: a case page's finer level, sent in tiles of COLUMNS
 FOLD_SAMPLES = 1 << 16  # samples an envelope holds before it folds them into its columns
 
 
@@ -33,10 +37,11 @@ class Envelope:
     the columns once FOLD_SAMPLES of them wait, or when the line is drawn:
     a short case that gets no figure never pays for its envelopes."""
 
-    def __init__(self, t0: float, t1: float, columns: int = COLUMNS):
+    def __init__(self, t0: float, t1: float, columns: int = COLUMNS * DETAIL):
         self.t0, self.span, self.columns = float(t0), max(float(t1) - float(t0), 1e-300), columns
         self.waiting: list[tuple[np.ndarray, np.ndarray]] = []
         self.waiting_samples = 0
+        self.samples = 0  # added in all
         self.folded = False  # the columns below hold samples (they are made then)
         self.first_t = self.first_v = self.last_t = self.last_v = self.low = self.high = np.full(0, np.nan)
 
@@ -46,6 +51,7 @@ class Envelope:
             return
         self.waiting.append((times, values))
         self.waiting_samples += len(times)
+        self.samples += len(times)
         if self.waiting_samples >= FOLD_SAMPLES:
             self._fold()
 
@@ -75,24 +81,55 @@ class Envelope:
         self.last_t[c], self.last_v[c] = times[ends], values[ends]
         self.low[c], self.high[c] = np.fmin(self.low[c], low), np.fmax(self.high[c], high)
 
-    def line(self):
-        """(times, values) to draw: per filled column its first sample, its
-        range at its middle, its last sample."""
+    def line(self, factor: int = DETAIL):
+        """(times, values) to draw: per column (of columns / factor, each
+        joining factor of the envelope's) its first sample, its range at
+        its middle, its last sample."""
         self._fold()
         if not self.folded:
             return np.empty(0), np.empty(0)
-        filled = ~np.isnan(self.first_t)
-        middle = (self.first_t + self.last_t) / 2
-        times = np.stack([self.first_t, middle, middle, self.last_t], axis=1)[filled].ravel()
-        values = np.stack([self.first_v, self.low, self.high, self.last_v], axis=1)[filled].ravel()
-        return times, values
+        return _line(*_joined(self._arrays(), factor))
+
+    def tile(self, k: int, per: int = COLUMNS):
+        """(times, values) of the envelope's own columns k * per .. (k + 1) * per, at its full detail."""
+        self._fold()
+        if not self.folded:
+            return np.empty(0), np.empty(0)
+        return _line(*(a[k * per : (k + 1) * per] for a in self._arrays()))
+
+    def _arrays(self):
+        return self.first_t, self.first_v, self.last_t, self.last_v, self.low, self.high
+
+
+def _joined(arrays, factor):
+    """An envelope's columns (first_t, first_v, last_t, last_v, low, high) joined factor at a time."""
+    if factor == 1:
+        return arrays
+    first_t, first_v, last_t, last_v, low, high = (a.reshape(-1, factor) for a in arrays)
+    filled = ~np.isnan(first_t)
+    first = np.argmax(filled, axis=1)  # the first filled column of each group, the last below
+    last = factor - 1 - np.argmax(filled[:, ::-1], axis=1)
+    rows = np.arange(len(first_t))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # (a group of empty columns: NaN, as it should)
+        lowest, highest = np.nanmin(low, axis=1), np.nanmax(high, axis=1)
+    return first_t[rows, first], first_v[rows, first], last_t[rows, last], last_v[rows, last], lowest, highest
+
+
+def _line(first_t, first_v, last_t, last_v, low, high):
+    filled = ~np.isnan(first_t)
+    middle = (first_t + last_t) / 2
+    times = np.stack([first_t, middle, middle, last_t], axis=1)[filled].ravel()
+    values = np.stack([first_v, low, high, last_v], axis=1)[filled].ravel()
+    return times, values
 
 
 class Figure:
     """What a case's figure shows, each line already decimated:
     inputs [(name, times, values)], signals [(name, (ref times, values),
     (result times, values), band or None)], deviations [(name, times,
-    values)], and zoom: None, or the same three around the first
+    values)], and zoom: None, or (its time, [(name, times, values,
+    lower, upper, deviation[, reference or None])]) around the first
     deviation (full resolution)."""
 
     def __init__(self, title, inputs, signals, deviations, zoom=None):
@@ -158,7 +195,7 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         at, lines = figure.zoom
         zoom_axes = list(grid[has_inputs:, 1])
         zoom_deviation = zoom_axes.pop()
-        for ax, (name, times, values, lower, upper, deviation) in zip(zoom_axes, lines, strict=False):
+        for ax, (name, times, values, lower, upper, deviation, *_) in zip(zoom_axes, lines, strict=False):
             ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
             ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=_plain(name))
             ax.axvline(at, color="C3", linewidth=0.8)
@@ -229,3 +266,103 @@ def _clear(ax):
     # the limits of a new axis: an axis left empty shows 0..1, a drawn one autoscales when it is drawn
     ax.set_xlim(0, 1, auto=True)
     ax.set_ylim(0, 1, auto=True)
+
+
+def _points(times, values, window=None) -> list:
+    """[times, values] of a line as lists for a page; window (times,
+    values at full resolution) replaces the line's points in its span."""
+    times, values = np.asarray(times, dtype=np.float64), np.asarray(values, dtype=np.float64)
+    if window is not None and len(window[0]):
+        w_t, w_v = np.asarray(window[0], dtype=np.float64), np.asarray(window[1], dtype=np.float64)
+        outside = (times < w_t[0]) | (times > w_t[-1])
+        k = int(np.searchsorted(times[outside], w_t[0]))
+        times = np.concatenate((times[outside][:k], w_t, times[outside][k:]))
+        values = np.concatenate((values[outside][:k], w_v, values[outside][k:]))
+    return [times.tolist(), values.tolist()]
+
+
+def _window(zoom_line, k):
+    """(times, line k) of a signal's zoom line at full resolution, to replace the decimated line there; or None."""
+    return None if zoom_line is None or zoom_line[k] is None else (zoom_line[0], zoom_line[k])
+
+
+def page_data(figure: Figure, label: str, criteria: dict) -> dict:
+    """What a case page's interactive plots show (plain lists, NaN kept:
+    the page reads them as JavaScript): per signal its reference, result,
+    band and deviation, decimated as the figure's, with the samples around
+    the first deviation at full resolution; the inputs; where the first
+    deviation is and the span to frame on open. criteria: signal -> the
+    criterion it is judged by."""
+    zoom = {}
+    frame = None
+    if figure.zoom:
+        at, lines = figure.zoom
+        for name, times, values, lower, upper, deviation, *reference in lines:
+            zoom[name] = (times, values, lower, upper, deviation, reference[0] if reference else None)
+            if len(times):
+                low, high = float(times[0]), float(times[-1])
+                frame = [min(frame[0], low), max(frame[1], high)] if frame else [low, high]
+    signals = []
+    for (name, ref, result, band), (_, dev_t, dev_v) in zip(figure.signals, figure.deviations, strict=True):
+        z = zoom.get(name)
+        signals.append(
+            {
+                "name": shown(name),
+                "criterion": shown(criteria.get(name, "")),
+                "reference": _points(ref[0], ref[1], window=_window(z, 5)),
+                "reference_framed": _window(z, 5) is not None,
+                "result": _points(result[0], result[1], window=_window(z, 1)),
+                "lower": _points(band[0], band[1], window=_window(z, 2)) if band is not None else None,
+                "upper": _points(band[0], band[2], window=_window(z, 3)) if band is not None else None,
+                "deviation": _points(dev_t, dev_v, window=_window(z, 4)),
+            }
+        )
+    return {
+        "title": shown(figure.title),
+        "label": shown(label),
+        "inputs": [{"name": shown(name), "line": _points(t, v)} for name, t, v in figure.inputs],
+        "signals": signals,
+        "first_deviation": figure.zoom[0] if figure.zoom else None,
+        "frame": frame,
+    }
+
+
+def needs_tiles(envelopes) -> bool:
+    """Whether a page gains by the finer level: a line has more samples than the figure's columns show."""
+    return any(e.samples > 2 * COLUMNS for e in envelopes)
+
+
+def page_tile(k: int, inputs, signals) -> dict:
+    """Tile k of DETAIL of a case page's finer level: the lines' own
+    envelope columns over the k-th part of the time span. inputs: [(name,
+    Envelope)]; signals: [(name, reference, result, lower or None, upper
+    or None, deviation)], Envelopes."""
+    first = next(e for _, *lines in signals for e in lines if e is not None) if signals else inputs[0][1]
+    part = first.span / DETAIL
+
+    def points(envelope):
+        return None if envelope is None else [a.tolist() for a in envelope.tile(k)]
+
+    return {
+        "k": k,
+        "from": first.t0 + k * part,
+        "to": first.t0 + (k + 1) * part,
+        "inputs": [points(e) for _, e in inputs],
+        "signals": [
+            {
+                "reference": points(ref),
+                "result": points(result),
+                "lower": points(lower),
+                "upper": points(upper),
+                "deviation": points(deviation),
+            }
+            for _, ref, result, lower, upper, deviation in signals
+        ],
+    }
+
+
+def as_script(head: str, data, tail: str) -> str:
+    """head + data as JSON + tail: a script line; NaN and infinities as
+    JavaScript's, and no '<' (names from users' files as text even where
+    a page would hold the script inline)."""
+    return head + json.dumps(data).replace("<", "\\u003c") + tail + "\n"

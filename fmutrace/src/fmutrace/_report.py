@@ -1,6 +1,10 @@
-"""The report of a campaign: index.html (pass/fail table, one plot per
-case), summary.md, results.json and, when asked, JUnit XML; and each
-case's result as <case>_out.csv."""
+"""The report of a campaign: index.html (the summary, then a row per
+case, the failing ones first, with a filter and a sort), a page per case
+(<case>.html: its verdict, messages, criteria and interactive plots, their
+data in <case>.plot.js), summary.md, results.json and, when asked, JUnit
+XML; and each case's result as <case>_out.csv. The pages' scripts and the
+plotting library (uPlot, in _static) are copied into ASSETS: the report
+reads offline, from file:// too."""
 
 import contextlib
 import hashlib
@@ -19,22 +23,14 @@ from ._traces import shown, write_trace
 
 RESULTS_FORMAT = 1
 
-STYLE = (
-    "<style>body{font-family:sans-serif;margin:1em 2em}"
-    "table{border-collapse:collapse;width:100%;table-layout:fixed}\n"
-    "td,th{border:1px solid #ccc;padding:.3em .6em;vertical-align:top;overflow-wrap:anywhere}"
-    "tr.pass td:nth-child(3){color:#176617}\n"
-    "tr.fail td:nth-child(3),tr.error td:nth-child(3),tr.invalid td:nth-child(3){color:#b00;font-weight:bold}"
-    "img{max-width:100%;height:auto}</style>"
-)
-COLUMNS = "<colgroup>" + "".join(f'<col style="width:{w}%">' for w in (16, 10, 28, 6, 40)) + "</colgroup>"
-
-
 # not shown as they are: what XML 1.0 forbids (control characters, surrogates, U+FFFE/U+FFFF)
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 # not in a file name: separators, what Windows forbids, control characters
 _NOT_IN_FILE_NAMES = re.compile('[/\\\\:*?"<>|\x00-\x1f\x7f]')
 _MARKDOWN = re.compile(r"([\\`*_{}\[\]<>()#+!|~$])")
+PLOT_DATA = ".plot.js"  # a case's plot data beside its page
+ASSETS = "_fmutrace_assets"  # the report folder's scripts and styles
+STATIC = Path(__file__).parent / "_static"
 FILE_NAME_BYTES = 200  # a name's part of a file name (255 at most) before its suffix, _out.csv
 
 
@@ -78,15 +74,15 @@ def check_inside(report_dir, path):
 
 
 def write_case_files(outcome: CaseOutcome, report_dir):
-    """<fmu folder>/<case>_out.csv and .png; their paths into outcome. A
-    case's name with '/' makes folders."""
-    if outcome.result is None and not outcome.png and not outcome.result_path:
+    """<fmu folder>/<case>_out.csv, .png, .plot.js and its tiles; their
+    paths into outcome. A case's name with '/' makes folders."""
+    if outcome.result is None and not outcome.png and not outcome.result_path and not outcome.plot_js:
         return
     stem = report_path(report_dir, outcome.fmu_folder, *outcome.case.split("/"))
     check_inside(report_dir, stem.parent)
     stem.parent.mkdir(parents=True, exist_ok=True)
     check_inside(report_dir, stem.parent)
-    for made in (f"{stem}_out.csv", f"{stem}.png"):
+    for made in (f"{stem}_out.csv", f"{stem}.png", f"{stem}{PLOT_DATA}"):
         if os.path.islink(made):  # written through, it would write where it points
             os.unlink(made)
     if outcome.result is not None:
@@ -98,6 +94,19 @@ def write_case_files(outcome: CaseOutcome, report_dir):
     if outcome.png:
         Path(f"{stem}.png").write_bytes(outcome.png)
         outcome.plot = os.path.relpath(f"{stem}.png", report_dir)
+    if outcome.plot_js:
+        Path(f"{stem}{PLOT_DATA}").write_text(outcome.plot_js, encoding="utf-8")
+        outcome.plot_data = os.path.relpath(f"{stem}{PLOT_DATA}", report_dir)
+    for k, tile in enumerate(outcome.plot_tiles):
+        made = _tile(stem, k)
+        if os.path.islink(made):
+            os.unlink(made)
+        Path(made).write_text(tile, encoding="utf-8")
+
+
+def _tile(stem, k) -> str:
+    """The file of a case's plot data tile k (the page loads it by this name as the reader zooms)."""
+    return f"{stem}{PLOT_DATA.removesuffix('.js')}.{k}.js"
 
 
 @contextlib.contextmanager
@@ -194,51 +203,203 @@ def _verdict(o):
     return "pass" if o.passed else f"{o.status.upper()}: " + "; ".join(o.messages[:3])
 
 
+_FMI = re.compile(r" \(FMI \d+\)$")
+
+
+def model_of(fmu_label) -> str:
+    """The model of an FMU's label ("RateLimiter (FMI 3)" -> "RateLimiter")."""
+    return _FMI.sub("", fmu_label)
+
+
+def _attribute(value) -> str:
+    return html.escape(text(value), quote=True)
+
+
+def _head(title, assets, styles=("report.css",)) -> str:
+    """A page's head: its title, the style sheets (assets: the link to ASSETS from the page)."""
+    return (
+        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+        f'<meta name="viewport" content="width=device-width, initial-scale=1">'
+        f"<title>{html.escape(text(title))}</title>\n"
+        + "".join(f'<link rel="stylesheet" href="{assets}/{name}">\n' for name in styles)
+        + "</head><body>\n"
+    )
+
+
+def copy_assets(report_dir):
+    """The pages' scripts, style and the plotting library into report_dir/ASSETS."""
+    target = Path(report_dir) / ASSETS
+    check_inside(report_dir, target.parent)
+    if target.is_symlink():
+        target.unlink()
+    target.mkdir(exist_ok=True)
+    check_inside(report_dir, target)
+    for source in sorted(STATIC.iterdir()):
+        made = target / source.name
+        if made.is_symlink():
+            made.unlink()
+        shutil.copyfile(source, made)
+
+
+class _Tally:
+    """Counts by status, overall and per FMU and per model, a case at a time."""
+
+    def __init__(self):
+        self.fmus: dict[str, dict] = {}
+        self.models: dict[str, dict] = {}
+        self.own_criteria = 0
+
+    def add(self, o: CaseOutcome, campaign_criteria):
+        for key, table in ((text(o.fmu), self.fmus), (text(model_of(o.fmu)), self.models)):
+            table.setdefault(key, dict.fromkeys(Status, 0))[o.status] += 1
+        self.own_criteria += bool(o.criteria) and o.criteria != campaign_criteria
+
+
+def _count_table(title, rows) -> str:
+    head = "".join(f"<th>{s}</th>" for s in Status)
+    body = "".join(
+        f'<tr><th scope="row">{html.escape(name)}</th>'
+        + "".join(f'<td class="{s}{" some" if n[s] else ""}">{n[s]}</td>' for s in Status)
+        + "</tr>"
+        for name, n in rows.items()
+    )
+    return f'<table class="counts"><caption>{title}</caption><tr><th></th>{head}</tr>{body}</table>'
+
+
+def _case_page(o: CaseOutcome, report_dir: Path, campaign_criteria) -> str:
+    """The case's page beside its files; its path in the report folder."""
+    stem = report_path(report_dir, o.fmu_folder, *o.case.split("/"))
+    check_inside(report_dir, stem.parent)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    check_inside(report_dir, stem.parent)
+    page = Path(f"{stem}.html")
+    if page.is_symlink():
+        page.unlink()
+
+    def link(path):
+        return _link(os.path.relpath(report_dir / path, stem.parent))
+
+    assets = link(ASSETS)
+    messages = "".join(f"<li>{html.escape(text(m))}</li>" for m in o.messages) or "<li>no difference</li>"
+    signals = "".join(
+        f"<li>{html.escape(text(d.name))}: {html.escape(text(d.criterion or o.criteria or campaign_criteria))}</li>"
+        for d in o.deviations
+    )
+    files = [f'<a href="{link(o.csv)}">result CSV</a>'] if o.csv else []
+    files += [f'<a href="{link(o.plot)}">static figure (PNG)</a>'] if o.plot else []
+    tiles = html.escape(quote(stem.name + PLOT_DATA.removesuffix("js")))  # its tiles' names before k.js
+    plots = (
+        f'<div id="plots" class="plots" data-tiles="{tiles}"></div>\n'
+        f'<script src="{assets}/uPlot.iife.min.js"></script>\n'
+        f'<script src="{link(o.plot_data)}"></script>\n<script src="{assets}/case.js"></script>\n'
+        if o.plot_data
+        else "<p>No plot: the campaign plotted only some of its cases, not this one.</p>"
+    )
+    with _replaced(page) as out:
+        out.write(_head(f"{o.status}: {text(o.case)} on {text(o.fmu)}", assets, ("uPlot.min.css", "report.css")))
+        out.write(
+            f'<p class="nav"><a href="{link("index.html")}">&larr; all cases</a></p>\n'
+            f'<h1><span class="badge {o.status}">{o.status.upper()}</span> {html.escape(text(o.case))}</h1>\n'
+            f"<p>on {html.escape(text(o.fmu))} ({html.escape(text(o.fmu_file))}), {o.seconds:.2f} s</p>\n"
+            f'<h2>Messages</h2><ul class="messages">{messages}</ul>\n'
+            f"<h2>Criteria</h2><p>{html.escape(text(o.criteria or campaign_criteria))}</p>"
+            + (f"<ul>{signals}</ul>" if signals else "")
+            + (f"<p>{' · '.join(files)}</p>" if files else "")
+            + f"\n<h2>Plots</h2>\n{plots}</body></html>\n"
+        )
+    return os.path.relpath(page, report_dir)
+
+
 def write_report(campaign: CampaignResult, report_dir):
-    """index.html, summary.md and results.json into report_dir, a case at
-    a time (the case files are written as the cases finish)."""
+    """index.html, a page per case, summary.md and results.json into
+    report_dir, a case at a time (the case files are written as the cases
+    finish): one pass over the cases writes their pages, summary.md's rows
+    and index.html's rows into two files (failing, the rest), joined after
+    the summary that the pass counted."""
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
+    copy_assets(report_dir)
     headline = campaign.headline()
-    with (
-        _replaced(report_dir / "summary.md") as summary,
-        _replaced(report_dir / "index.html") as page,
-    ):
-        summary.write(
-            "\n".join(
-                [
-                    "# fmutrace",
-                    "",
-                    headline,
-                    "",
-                    f"Comparison: {campaign.mode.describe()}.",
-                    "",
-                    "| case | FMU | result | seconds | plot |",
-                    "|---|---|---|---|---|",
-                ]
-            )
-            + "\n"
-        )
-        page.write(f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>fmutrace report</title>
-{STYLE}
-</head><body>
-<h1>fmutrace report</h1><p>{html.escape(headline)}</p><p>Comparison: {html.escape(campaign.mode.describe())}.</p>
-<table>{COLUMNS}
-<tr><th>case</th><th>FMU</th><th>result</th><th>seconds</th><th>plot</th></tr>
-""")
-        for o in campaign.cases.light():
-            verdict = _verdict(o)
+    criteria = campaign.mode.describe()
+    tally = _Tally()
+    rows = {failing: report_dir / f".index-{failing}.{os.getpid()}.rows" for failing in (True, False)}
+    try:
+        with (
+            _replaced(report_dir / "summary.md") as summary,
+            open(rows[True], "w", encoding="utf-8") as failing_rows,
+            open(rows[False], "w", encoding="utf-8") as other_rows,
+        ):
             summary.write(
-                f"| {markdown(o.case)} | {markdown(o.fmu)} | {markdown(verdict)} | {o.seconds:.2f} | "
-                + (f"[png]({_link(o.plot)})" if o.plot else "")
-                + " |\n"
+                "\n".join(
+                    [
+                        "# fmutrace",
+                        "",
+                        headline,
+                        "",
+                        f"Comparison: {criteria}.",
+                        "",
+                        "| case | FMU | result | seconds | plot |",
+                        "|---|---|---|---|---|",
+                    ]
+                )
+                + "\n"
             )
-            image = f'<a href="{_link(o.plot)}"><img src="{_link(o.plot)}" loading="lazy"></a>' if o.plot else ""
-            csv = f'<br><a href="{_link(o.csv)}">result CSV</a>' if o.csv else ""
-            page.write(
-                f'<tr class="{o.status}"><td>{html.escape(text(o.case))}</td><td>{html.escape(text(o.fmu))}</td>'
-                f"<td>{html.escape(text(verdict))}{csv}</td><td>{o.seconds:.2f}</td><td>{image}</td></tr>\n"
-            )
-        page.write("</table></body></html>\n")
+            for o in campaign.cases.light():
+                tally.add(o, criteria)
+                verdict = _verdict(o)
+                summary.write(
+                    f"| {markdown(o.case)} | {markdown(o.fmu)} | {markdown(verdict)} | {o.seconds:.2f} | "
+                    + (f"[png]({_link(o.plot)})" if o.plot else "")
+                    + " |\n"
+                )
+                page = _case_page(o, report_dir, criteria)
+                message = o.messages[0] if o.messages and not o.passed else ""
+                (other_rows if o.passed else failing_rows).write(
+                    f'<tr class="{o.status}" data-status="{o.status}" data-fmu="{_attribute(o.fmu)}" '
+                    f'data-model="{_attribute(model_of(o.fmu))}">'
+                    f'<td class="status">{o.status}</td>'
+                    f'<td><a href="{_link(page)}">{html.escape(text(o.case))}</a></td>'
+                    f"<td>{html.escape(text(o.fmu))}</td><td>{html.escape(text(message))}</td>"
+                    f'<td class="seconds">{o.seconds:.2f}</td></tr>\n'
+                )
+        with _replaced(report_dir / "index.html") as index:
+            index.write(_index_head(campaign, headline, criteria, tally))
+            for failing in (True, False):
+                with open(rows[failing], encoding="utf-8") as part:
+                    shutil.copyfileobj(part, index)
+            index.write(f'</tbody></table>\n<script src="{ASSETS}/report.js"></script>\n</body></html>\n')
+    finally:
+        for path in rows.values():
+            path.unlink(missing_ok=True)
     write_results_json(campaign, report_dir / "results.json")
+
+
+def _index_head(campaign: CampaignResult, headline, criteria, tally: _Tally) -> str:
+    """index.html up to its table's rows: the summary, the filter, the table's head."""
+    counts = campaign.counts()
+    numbers = "".join(f'<div class="number {s}"><span id="count-{s}">{counts[s]}</span> {s}</div>' for s in Status)
+    own = f" {tally.own_criteria} cases with criteria of their own (on their pages)." if tally.own_criteria else ""
+    options = "".join(f"<option>{html.escape(name)}</option>" for name in tally.fmus)
+    models = "".join(f"<option>{html.escape(name)}</option>" for name in tally.models)
+    statuses = "".join(f'<option value="{s}">{s}</option>' for s in Status)
+    return (
+        _head("fmutrace report", ASSETS)
+        + f'<h1>fmutrace report</h1>\n<p class="headline">{html.escape(headline)}</p>\n'
+        f'<section class="summary"><div class="numbers"><div class="number total">'
+        f'<span id="count-total">{len(campaign.cases)}</span> cases</div>{numbers}'
+        f'<div class="number time">{campaign.seconds:.1f} s on {html.escape(text(campaign.where))}</div></div>\n'
+        f"<p>Comparison: {html.escape(text(criteria))}.{own}</p>\n"
+        f'<div class="tables">{_count_table("per FMU", tally.fmus)}{_count_table("per model", tally.models)}</div>'
+        "</section>\n"
+        '<form class="filter" id="filter" onsubmit="return false">'
+        f'<label>status <select id="f-status"><option value="">all</option><option value="!pass">not pass</option>'
+        f"{statuses}</select></label> "
+        f'<label>FMU <select id="f-fmu"><option value="">all</option>{options}</select></label> '
+        f'<label>model <select id="f-model"><option value="">all</option>{models}</select></label> '
+        '<label>text <input id="f-text" type="search" placeholder="case or message"></label> '
+        '<span id="shown"></span></form>\n'
+        '<table id="cases" class="cases"><colgroup><col class="c-status"><col class="c-case"><col class="c-fmu">'
+        '<col class="c-message"><col class="c-seconds"></colgroup>\n<thead><tr>'
+        '<th data-sort="text">status</th><th data-sort="text">case</th><th data-sort="text">FMU</th>'
+        '<th data-sort="text">first message</th><th data-sort="number">seconds</th></tr></thead><tbody>\n'
+    )

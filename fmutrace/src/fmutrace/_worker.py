@@ -15,7 +15,8 @@ from .recordings import is_recording
 from .recordings._options import RecordingOptions
 from ._runner import Runner
 
-PLOTS = ("all", "failed", "none")  # which cases get a plot and a result CSV
+PLOTS = ("all", "failed", "none", "png")  # which cases get a plot and a result CSV; png: as the default, and
+# a static PNG figure beside each interactive plot
 PLOT_ALL_UP_TO = 500  # the default: all for campaigns up to so many cases, else the failed ones
 
 
@@ -31,6 +32,7 @@ class CaseSettings:
     plots: str = "none"  # which cases get a plot and a result CSV: PLOTS
     recording: RecordingOptions = field(default_factory=RecordingOptions)  # how recordings are read
     case_timeout: float | None = None  # seconds a case may run in a child process (None: no bound)
+    png: bool = False  # a plotted case gets a static PNG figure too (matplotlib), beside its interactive plot
 
 
 @dataclass(frozen=True)
@@ -80,7 +82,9 @@ def plotting_first(settings: CaseSettings) -> bool:
     """Load the plotting packages before the first case: every case is
     drawn, or a case's timeout counts from its start and must not pay for
     the import (else the first figure loads them, if any is drawn)."""
-    return settings.plots == "all" or (settings.plots == "failed" and settings.case_timeout is not None)
+    return settings.png and (
+        settings.plots == "all" or (settings.plots == "failed" and settings.case_timeout is not None)
+    )
 
 
 def run_cases(items, fmu_bytes: bytes, fmu: FmuFile, settings: CaseSettings, on_start=None):

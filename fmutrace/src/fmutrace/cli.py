@@ -184,7 +184,8 @@ def parser():
         "--plots",
         choices=PLOTS,
         help="which cases get a plot and a result CSV in the report "
-        f"(default: all for up to {PLOT_ALL_UP_TO} cases, else the failed ones)",
+        f"(default: all for up to {PLOT_ALL_UP_TO} cases, else the failed ones; png: as the default, with a static "
+        "PNG figure beside each interactive plot)",
     )
     cmp.add_argument(
         "--case-timeout",
