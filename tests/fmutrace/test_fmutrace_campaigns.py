@@ -118,7 +118,8 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
 def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp_path):
     """The command's default is the documented one: a plot and a result CSV
     for every case up to 500 (test_fmutrace.py's report test: every case
-    plotted), the failing ones beyond. Two of 501 cases differ at t = 0.4."""
+    plotted), the failing ones beyond, and a page for a case with more to
+    show than its row. Two of 501 cases differ at t = 0.4."""
     cases = pass_through_cases(tmp_path / "cases", 501)
     for k in (7, 300):
         reference = cases / f"case_{k:02d}" / "PassThrough_ref.csv"
@@ -135,6 +136,11 @@ def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp
         "case_07",
         "case_300",
     ]
+    # a page for each case with more to show than its row (the failing ones); the index links to them alone
+    pages = sorted(str(p.relative_to(report)) for p in report.rglob("*.html") if p.name != "index.html")
+    assert pages == [f"{c}.html" for c in failing]
+    index = (report / "index.html").read_text()
+    assert index.count('href="PassThrough-fmi3/') == 2 and ">case_08</td>" in index
 
 
 def test_a_journal_line_cut_short_is_run_again_and_the_next_entries_read(tmp_path):
