@@ -652,34 +652,21 @@ def test_no_copy_of_the_tests_fmus_is_left_in_the_temporary_folder(tmp_path):
     assert not list(shared.iterdir())
 
 
-def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(tmp_path):
-    """An MDF 4.10 file marked not finalized, its blocks garbage: asammdf
-    copies it into the temporary folder to finalize it and fails. The case
-    is invalid (exit 2), the copy gone, no traceback of asammdf's clean-up."""
+@pytest.mark.parametrize("identification,version,name", [(b"MDF     ", 410, "damaged"), (b"UnFinMF ", 411, "logger")])
+def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(identification, version, name, tmp_path):
+    """An MDF 4 file marked not finalized (as a CAN logger leaves its file, 'UnFinMF ', too), its
+    blocks garbage: asammdf copies it into the temporary folder to finalize it and fails. The case
+    is invalid (exit 2, one line), the copy gone, no traceback of asammdf's clean-up."""
     shared = tmp_path / "tmp"
     shared.mkdir()
-    identification = b"MDF     4.10    fmutrace" + bytes(4) + (410).to_bytes(2, "little") + bytes(30)
-    identification += (1).to_bytes(2, "little") + bytes(2)  # unfinalized standard flags: 1
-    (tmp_path / "damaged.mf4").write_bytes(identification + b"##HD" + b"\xff" * 200)
-    done = fmutrace("compare", PASS_THROUGH, tmp_path / "damaged.mf4", env=dict(os.environ, TMPDIR=str(shared)))
+    text = f"{version // 100}.{version % 100}    ".encode()
+    header = identification + text + b"fmutrace" + bytes(4) + version.to_bytes(2, "little") + bytes(30)
+    header += (1).to_bytes(2, "little") + bytes(2)  # unfinalized standard flags: 1
+    (tmp_path / f"{name}.mf4").write_bytes(header + b"##HD" + b"\xff" * 200)
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / f"{name}.mf4", env=dict(os.environ, TMPDIR=str(shared)))
     no_traceback(done)
     assert done.returncode == 2, output(done)
-    assert "damaged.mf4: not a readable MDF file" in done.stderr, done.stderr
-    assert not list(shared.iterdir())
-
-
-def test_a_damaged_unfinalized_mdf_file_leaves_no_copy_and_no_traceback(tmp_path):
-    """As above, identified as a CAN logger leaves its file ('UnFinMF '): read as MDF now, so damaged it
-    is invalid the same way: exit 2, one line, the copy gone."""
-    shared = tmp_path / "tmp"
-    shared.mkdir()
-    identification = b"UnFinMF 4.11    fmutrace" + bytes(4) + (411).to_bytes(2, "little") + bytes(30)
-    identification += (1).to_bytes(2, "little") + bytes(2)
-    (tmp_path / "logger.mf4").write_bytes(identification + b"##HD" + b"\xff" * 200)
-    done = fmutrace("compare", PASS_THROUGH, tmp_path / "logger.mf4", env=dict(os.environ, TMPDIR=str(shared)))
-    no_traceback(done)
-    assert done.returncode == 2, output(done)
-    assert "logger.mf4: not a readable MDF file" in done.stderr, done.stderr
+    assert f"{name}.mf4: not a readable MDF file" in done.stderr, done.stderr
     assert not list(shared.iterdir())
 
 

@@ -290,7 +290,6 @@ class Pool:
         self.fmus, self.settings = fmus, settings
         self.most = jobs if jobs is not None else cores()
         self.chosen = jobs is None
-        self.started = 0  # workers started in all (a lost one's replacement included)
         self.peak = 0  # workers at once
         self.lost = 0  # workers that died or were stopped with a case (a crash, a timeout)
         self.start_up: float | None = None  # seconds from the first worker's start to its first case
@@ -342,7 +341,6 @@ class Pool:
         self.workers[worker.from_worker] = worker
         os.set_blocking(worker.from_worker, False)
         self.selector.register(worker.from_worker, selectors.EVENT_READ, worker)
-        self.started += 1
         self.peak = max(self.peak, len(self.workers))
         return worker
 
