@@ -67,6 +67,19 @@ if(FUZZ_CLANG)
       set_tests_properties(fuzz_${target}${suffix} PROPERTIES TIMEOUT 300 LABELS fuzz)
     endforeach()
   endforeach()
+  # fmutrace's reader of plain CSV rows, against strtod (no model: built once)
+  set(binary ${CMAKE_BINARY_DIR}/fuzz/fuzz_rows)
+  set(rows_source ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_rows.c)
+  add_custom_command(
+    OUTPUT ${binary}
+    COMMAND ${FUZZ_CLANG} -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -ffp-contract=off
+            -I${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_rows.c -o ${binary}
+    DEPENDS ${CMAKE_SOURCE_DIR}/tests/fuzz/fuzz_rows.c ${rows_source}
+    COMMENT "Building the fuzzer fuzz_rows")
+  list(APPEND fuzz_binaries ${binary})
+  add_test(NAME fuzz_rows
+           COMMAND sh -c "mkdir -p '${CMAKE_BINARY_DIR}/fuzz/corpus_rows' && '${binary}' -max_total_time=${FUZZ_SECONDS} -max_len=256 -seed=1 -print_final_stats=1 '${CMAKE_BINARY_DIR}/fuzz/corpus_rows' '${CMAKE_SOURCE_DIR}/tests/fuzz/corpus/rows'")
+  set_tests_properties(fuzz_rows PROPERTIES TIMEOUT 300 LABELS fuzz)
   add_custom_target(fuzzers ALL DEPENDS ${fuzz_binaries})
   add_dependencies(fuzzers ${fuzz_descriptions})
 else()

@@ -12,12 +12,14 @@ set(REQUIREMENTS ${CMAKE_SOURCE_DIR}/fmutrace/requirements.txt)
 if(RL_TESTS)
   list(APPEND REQUIREMENTS ${CMAKE_SOURCE_DIR}/tests/requirements.txt)
 endif()
+# fmutrace's C extensions (the step loop, the reader of plain CSV rows)
+set(FMUTRACE_C_SOURCES ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_steps.c ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_rows.c)
 set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${REQUIREMENTS} ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml
-             ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_steps.c)
+             ${FMUTRACE_C_SOURCES})
 
 file(READ ${CMAKE_SOURCE_DIR}/fmutrace/pyproject.toml requirements_text)
-# fmutrace's step loop in C is compiled by its install: a changed source installs it again
-foreach(file IN LISTS REQUIREMENTS ITEMS ${CMAKE_SOURCE_DIR}/fmutrace/src/fmutrace/_steps.c)
+# fmutrace's C extensions are compiled by its install: a changed source installs it again
+foreach(file IN LISTS REQUIREMENTS FMUTRACE_C_SOURCES)
   file(READ ${file} text)
   string(APPEND requirements_text "${text}")
 endforeach()
@@ -49,11 +51,11 @@ if(NOT EXISTS ${venv_stamp})
     message(FATAL_ERROR "pip install ${pip_args} failed")
   endif()
   # the trace tool, editable: the venv runs the source tree's fmutrace; its
-  # step loop in C (fmutrace/_steps.c) compiles against the Python headers
+  # C extensions compile against the Python headers
   execute_process(COMMAND ${VENV_PYTHON} -c "import sysconfig; print(sysconfig.get_path('include'))"
                   OUTPUT_VARIABLE python_include OUTPUT_STRIP_TRAILING_WHITESPACE)
   if(NOT EXISTS ${python_include}/Python.h)
-    apt_install("No Python headers for fmutrace's step loop in C" python3-dev)
+    apt_install("No Python headers for fmutrace's C extensions" python3-dev)
   endif()
   execute_process(COMMAND ${VENV_PYTHON} -m pip install --disable-pip-version-check -q --no-deps
                           --no-build-isolation -e ${CMAKE_SOURCE_DIR}/fmutrace
@@ -61,17 +63,17 @@ if(NOT EXISTS ${venv_stamp})
   if(pip_failed)
     message(FATAL_ERROR "pip install -e fmutrace failed")
   endif()
-  # the step loop's build is optional (pip -q hides a failed compile): say so,
+  # the extensions' build is optional (pip -q hides a failed compile): say so,
   # and leave the stamp unwritten so that the next configure tries again
-  execute_process(COMMAND ${VENV_PYTHON} -c "import fmutrace._steps" RESULT_VARIABLE steps_failed
+  execute_process(COMMAND ${VENV_PYTHON} -c "import fmutrace._steps, fmutrace._rows" RESULT_VARIABLE c_failed
                   OUTPUT_QUIET ERROR_QUIET)
   file(GLOB old_stamps ${VENV_DIR}/requirements-*.stamp)
   if(old_stamps)
     file(REMOVE ${old_stamps})
   endif()
-  if(steps_failed)
-    message(WARNING "fmutrace's step loop in C (fmutrace/_steps.c) was not built: fmutrace steps in Python, "
-                    "several times slower. It needs a C compiler and the Python headers (on Debian: "
+  if(c_failed)
+    message(WARNING "fmutrace's C extensions (fmutrace/_steps.c, _rows.c) were not built: fmutrace steps in "
+                    "Python, several times slower, and reads CSV rows with pyarrow only. They need a C compiler and the Python headers (on Debian: "
                     "apt-get install python3-dev); the next configure tries again.")
   else()
     file(TOUCH ${venv_stamp})

@@ -9,8 +9,10 @@
 - the Runner's chunked loop (run_chunks: a long run chunk by chunk, its
   inputs read in chunks) against its whole-trace loop, on every reference
   scenario and on random traces, in chunks of a few steps and rows;
-- NumPy's reader of plain CSV bodies and pyarrow's chunked reader
-  (trace_chunks) against the cell-by-cell reader, on random texts.
+- NumPy's reader of plain CSV bodies and the chunked reader (trace_chunks:
+  _rows.c's rows, pyarrow's where it stops or is not built) against the
+  cell-by-cell reader, on random texts; _rows.c's numbers against
+  Python's float, on random and hard decimal texts.
 """
 
 import math
@@ -371,14 +373,17 @@ TOKENS = [
 ]
 
 
-@settings(max_examples=400, deadline=None)
+@pytest.mark.parametrize("rows_in_c", [True, False], ids=["rows in C", "pyarrow only"])
+@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     rows=st.lists(st.lists(st.sampled_from(TOKENS), min_size=2, max_size=2), min_size=0, max_size=5),
     times=st.lists(st.sampled_from(["0", "1", "2", "0.5", "nan", "-1"]), min_size=5, max_size=5),
     ending=st.sampled_from(["\n", "\r\n", ""]),
     blank=st.booleans(),
 )
-def test_plain_reader_equals_the_general_reader(rows, times, ending, blank, tmp_path_factory):
+def test_plain_reader_equals_the_general_reader(rows_in_c, rows, times, ending, blank, tmp_path_factory, monkeypatch):
+    if not rows_in_c:
+        monkeypatch.setattr(trace_module, "C_ROWS", None)
     lines = ["time,a,b"] + [",".join([t] + r) for t, r in zip(times, rows, strict=False)]  # as many rows as drawn
     if blank and len(lines) > 2:
         lines.insert(2, "")
@@ -398,6 +403,113 @@ def test_plain_reader_equals_the_general_reader(rows, times, ending, blank, tmp_
             continue
         assert isinstance(general, np.ndarray), (text, chunks)
         assert same_bits(np.concatenate(chunks), general)
+
+
+def c_rows(text: bytes, columns: int):
+    """(rows as an (n, columns) array, where _rows.c stopped) of text's lines."""
+    table = np.full((text.count(b"\n") + 1, columns), -1.0)
+    ffi, stopped = trace_module._ROWS_FFI, trace_module._ROWS_FFI.new("size_t *")
+    field_of = ffi.new("size_t[]", list(range(columns)))
+    values = ffi.cast("double *", table.ctypes.data)
+    read = trace_module.C_ROWS(text, len(text), columns, field_of, values, len(table), stopped)
+    return table[:read], stopped[0]
+
+
+def test_the_row_reader_in_c_is_built():
+    """The project's set-up compiles it: a short case's reading costs pyarrow's 0.2 ms a file without it."""
+    assert trace_module.C_ROWS is not None
+
+
+# hard decimal texts: halfway between two doubles, at the ends of the range,
+# more digits than a double holds, the fast path's edges (15 digits, 10^22)
+HARD_NUMBERS = [
+    "9007199254740993",  # 2^53 + 1: halfway, rounds to even
+    "9007199254740995",
+    "2.2250738585072011e-308",  # just below the least normal double
+    "2.2250738585072014e-308",
+    "4.9406564584124654e-324",  # the least subnormal
+    "2.4703282292062327e-324",  # half of it: rounds to zero
+    "2.4703282292062328e-324",  # just above half: rounds up
+    "1.7976931348623157e308",
+    "1.7976931348623159e308",  # rounds to infinity
+    "1e23",  # not exact: the fast path ends at 10^22
+    "1e22",
+    "123456789012345e-22",
+    "1234567890123456e-22",
+    "0.1",
+    "0.30000000000000004",
+    "-0",
+    "-0.0e5",
+    "0e999",  # zero times a power beyond the table
+    "0.000e-40",
+    "000000000000000000000000000001.5",
+    "1.00000000000000011102230246251565404236316680908203125",  # 1 + 2^-53 exactly: halfway, to even
+    "1.00000000000000011102230246251565404236316680908203126",  # just above: rounds up
+    "7.038531e-26",
+    "8.533e+68",
+    "0." + "0" * 400 + "1e400",
+    "1" + "0" * 400 + "e-400",
+    "1e-99999",
+    "1e99999",
+]
+
+
+@pytest.mark.parametrize("text", HARD_NUMBERS)
+def test_the_row_reader_in_c_rounds_hard_numbers_as_python_does(text):
+    table, stopped = c_rows(f"{text},{text}\n".encode(), 2)
+    assert stopped == len(text) * 2 + 2 and len(table) == 1
+    expected = np.float64(float(text))
+    assert table[0].tobytes() == np.array([expected, expected]).tobytes(), (text, table[0])
+
+
+FINITE_REPRS = st.floats(allow_nan=False, allow_infinity=False).map(repr)
+DECIMALS = st.from_regex(r"\A[+-]?([0-9]{1,25}(\.[0-9]{0,25})?|\.[0-9]{1,25})([eE][+-]?[0-9]{1,3})?\Z")
+
+
+@settings(max_examples=2000, deadline=None)
+@given(texts=st.lists(st.one_of(DECIMALS, FINITE_REPRS), min_size=1, max_size=6))
+def test_the_row_reader_in_c_reads_every_decimal_as_python_does(texts):
+    """Every cell of the common form is read (none left to pyarrow), each
+    to float()'s bits; the repr of doubles is the usual cell."""
+    text = ",".join(texts).encode()
+    table, stopped = c_rows(text, len(texts))
+    assert stopped == len(text) and len(table) == 1
+    assert table[0].tobytes() == np.array([float(t) for t in texts]).tobytes(), texts
+
+
+@pytest.mark.parametrize(
+    "text, rows, stopped",
+    [
+        (b"1,2\n3,4\n", 2, 8),
+        (b"1,2\r\n\r\n\n3,4", 2, 11),  # empty lines skipped, the last line without its break
+        (b"1,2\n3,4,5\n6,7\n", 1, 4),  # a cell too many: the line is left
+        (b"1,2\n3\n", 1, 4),  # a cell too few
+        (b"1,2\n3,\n", 1, 4),  # an empty cell
+        (b"1,2\n 3,4\n", 1, 4),  # a space
+        (b"1,2\nnan,4\n", 1, 4),  # not a decimal: pyarrow's or read_trace's to read
+        (b"1,2\n3\r4,5\n", 1, 4),  # a carriage return inside a line (a line break to pyarrow)
+        (b"1,2\n1_0,4\n", 1, 4),
+        (b"1,2\n3,4\x00\n", 1, 4),
+        (b"1,2\n.,4\n", 1, 4),
+        (b"1,2\n1e,4\n", 1, 4),
+        (b"1,2\n+,4\n", 1, 4),
+        (b"", 0, 0),
+    ],
+)
+def test_the_row_reader_in_c_stops_at_the_first_line_it_does_not_take(text, rows, stopped):
+    table, at = c_rows(text, 2)
+    assert (len(table), at) == (rows, stopped)
+    assert table.tolist() == [[1.0, 2.0], [3.0, 4.0]][:rows]
+
+
+def test_a_block_read_partly_in_c_is_read_on_by_pyarrow(tmp_path):
+    """Where _rows.c stops (an 'inf' here, the 5th row), pyarrow reads the block's rest: one chunk, every row."""
+    lines = ["time,b,a"] + [f"{k},{k * 0.1!r},{'inf' if k == 4 else k}" for k in range(9)]
+    path = tmp_path / "trace.csv"
+    path.write_text("\n".join(lines) + "\n")
+    (chunk,) = trace_chunks(path)
+    assert same_bits(chunk, read_trace(path))
+    assert chunk["a"][4] == math.inf and chunk["b"][8] == 8 * 0.1
 
 
 def _attempt(function):

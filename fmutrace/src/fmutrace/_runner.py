@@ -35,7 +35,6 @@ scenario and on random traces.
 """
 
 import contextlib
-import importlib.util
 import io
 import itertools
 import math
@@ -53,6 +52,7 @@ from fmpy.simulation import (
 
 from ._fmu import REAL_TYPES, unpacked
 from ._fmpy import Experiment, Signals, held_to, run_fmpy
+from ._native import native_function
 
 # per FMI type: the C type's dtype (fmpy's Input tables and getters) and the
 # recorded column's dtype (fmpy's Recorder)
@@ -140,20 +140,7 @@ FFI.cdef(
 )
 
 
-def _load_c_steps():
-    """fmutrace_steps from the compiled _steps extension (found, not
-    imported: it is a plain library to cffi); None if it was not built (the
-    Python loop then)."""
-    spec = importlib.util.find_spec(f"{__package__}._steps")
-    if spec is None or spec.origin is None:
-        return None
-    try:
-        return FFI.dlopen(spec.origin).fmutrace_steps
-    except (OSError, AttributeError):
-        return None
-
-
-C_STEPS = _load_c_steps()
+C_STEPS = native_function("_steps", FFI, "fmutrace_steps")  # (None: not built, the Python loop then)
 
 STEPS_PER_CHUNK = 1 << 17  # steps run between two result chunks (a long run's memory: its pointers, its rows)
 KEPT_SHAPES = 8  # grids and output arrays kept for traces of so many shapes (memory stays flat)
