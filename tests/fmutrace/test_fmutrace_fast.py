@@ -16,6 +16,7 @@
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,7 +25,7 @@ from hypothesis import strategies as st
 
 from fmutrace import read_trace, write_trace
 from fmutrace import _runner as runner_module
-from fmutrace._runner import FastLoopFailed, Runner, discrete_rows
+from fmutrace._runner import FastLoopFailed, Runner, discrete_rows, input_events
 from fmutrace._fmpy import Experiment, Signals, run_fmpy
 from fmutrace import _traces as trace_module
 from fmutrace._fmpy import held_to
@@ -160,6 +161,29 @@ def test_random_traces_take_the_fast_loop_mostly():
     fast = sum(r.fast_runs - before.get(k, (0, 0))[0] for k, r in RUNNERS.items())
     slow = sum(r.fmpy_runs - before.get(k, (0, 0))[1] for k, r in RUNNERS.items())
     assert fast > slow > 0, (fast, slow)
+
+
+def test_a_runner_unpacks_what_the_fmu_runs_with_and_runs(tmp_path):
+    """The description, the binaries and resources/ (the instance is given
+    that folder) are unpacked; sources, documentation and extra/ (a hundred
+    FMI-LS-REF files here, most of a start-up's time) are not."""
+    import zipfile
+
+    fmu = tmp_path / "RateLimiter.fmu"
+    with zipfile.ZipFile(fmu_path(BUILD_DIR, "RateLimiter", 3)) as built, zipfile.ZipFile(fmu, "w") as copy:
+        names = built.namelist()
+        for name in names:
+            copy.writestr(name, built.read(name))
+        copy.writestr("resources/table.txt", "1 2 3\n")
+    assert any(n.startswith("extra/") for n in names) and any(n.startswith("sources/") for n in names)
+    r = Runner(fmu.read_bytes())
+    unpacked = {p.relative_to(r.folder).as_posix() for p in Path(r.folder).rglob("*") if p.is_file()}
+    expected = {n for n in names if n == "modelDescription.xml" or n.startswith("binaries/")}
+    assert unpacked == expected | {"resources/table.txt"}
+    inputs = np.array([(0.0, 0.0), (0.2, 5.0)], dtype=[("time", float), ("u", float)])
+    experiment, signals = Experiment(0.0, 0.5, 0.1), Signals(inputs, {"rateUpPar": 10.0}, ["y"])
+    result = r.run(experiment, signals)
+    assert same_bits(result, run_fmpy(str(fmu), None, experiment, signals)) and result["y"][-1] > 0
 
 
 def test_an_instance_that_failed_is_replaced_and_the_next_trace_is_right():
@@ -336,6 +360,22 @@ def test_input_rows_as_fmpy_interpolates_them(t, times, after_event):
     for time, row in zip(times, rows, strict=True):
         values, _ = Input.interpolate(time, t, table, discrete=True, after_event=after_event)
         assert values[0] == row
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    steps=st.lists(st.sampled_from([0.0, 0.1, 0.25]), min_size=0, max_size=12),
+    values=st.lists(st.sampled_from([0.0, 1.0, -1.0, math.nan]), min_size=13, max_size=13),
+)
+def test_input_events_are_fmpys(steps, values):
+    """The time events of a table of discrete columns, as fmpy's
+    Input.findEvents finds them (its set of times, less its infinity)."""
+    r = runner("RateLimiter", 3)
+    t = np.cumsum([0.0] + steps)
+    inputs = np.zeros(len(t), dtype=[("time", float), ("u", float), ("bypass", float)])
+    inputs["time"], inputs["u"], inputs["bypass"] = t, values[: len(t)], values[::-1][: len(t)]
+    expected = Input.findEvents(inputs, r.md)
+    assert input_events(inputs).tolist() == expected[expected < math.inf].tolist()
 
 
 # ---- the CSV reader's two paths ---------------------------------------------

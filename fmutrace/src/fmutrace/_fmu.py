@@ -244,24 +244,33 @@ def _remove_abandoned():
         shutil.rmtree(folder, ignore_errors=True)
 
 
+# what an FMU needs to run: its description, its binaries, the resources its instance is given (an FMU
+# carries more: sources, documentation, layered standards' extra/ files, a hundred files in ours)
+RUN_FILES = ("modelDescription.xml", "binaries/", "resources/")
+
+
 def unpacked(fmu_bytes):
-    """(folder, model description) of an FMU given as bytes, unzipped once
-    per process into a folder of its own: made fresh (mkdtemp, mode 0700,
-    never found again by a name another user could plant) and removed at
-    the process's exit."""
+    """(folder, model description) of an FMU given as bytes, its RUN_FILES
+    unzipped once per process into a folder of its own: made fresh
+    (mkdtemp, mode 0700, never found again by a name another user could
+    plant) and removed at the process's exit."""
     key = hashlib.sha256(fmu_bytes).hexdigest()
     known = _unpacked.get(key)
     if known is None or known[2] != os.getpid():  # (a forked child makes its own: the parent removes its one)
         folder = tempfile.mkdtemp(prefix="fmu-", dir=unpack_root())
         atexit.register(_remove, folder, os.getpid())
         try:
-            extract(io.BytesIO(fmu_bytes), unzipdir=folder)
+            extract(io.BytesIO(fmu_bytes), unzipdir=folder, include=_runs_with)
             known = (folder, read_model_description(folder), os.getpid())
         except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
             _remove(folder, os.getpid())
             raise InputError(f"the FMU cannot be unpacked ({error})") from None
         _unpacked[key] = known
     return known[:2]
+
+
+def _runs_with(name: str) -> bool:
+    return name == RUN_FILES[0] or name.startswith(RUN_FILES[1:])
 
 
 def _remove(folder, owner):
