@@ -636,3 +636,7 @@ def test_find_cases_names_each_case_folder_once(tmp_path):
     ]
     assert found[-1] == (two / "b", "two/b") and found[2:4] == [(one / "a" / "deep", "a/deep"), (one / "b", "b")]
     assert len(fmutrace.find_cases([tmp_path / "other"], "M")) == 0
+    # c below two was found first through one's link: it takes no name, and three's c is plain c
+    three = tmp_path / "three"
+    case(three / "c")
+    assert fmutrace.find_cases([one, two, three], "M")[-2:] == [(three / "c", "c"), (two / "b", "two/b")]

@@ -207,40 +207,77 @@ def find_cases(paths: Sequence[str | PathLike], model: str) -> CaseList:
     too, each folder once), sorted by name: the folder's path below the one
     searched (its own name for a case folder given itself). A CaseList."""
     target = f"{model}_ref.csv"
-    seen: set[tuple[int, int]] = set()
-    names: list[str] = []
-    root_of, folders, roots = array("H"), {}, []
-    # names: only folders searched together can give one twice
-    taken: set[str] | None = set() if len(paths) > 1 else None
+    seen: set[int] = set()
+    found: list[str] = []  # each case's path below its root ('' for a root that is a case folder)
+    found_in, roots = array("H"), []
+    leaves = np.zeros(0, dtype=_LEAF)  # (grown as needed)
     for path in paths:
         root = os.fspath(path)
         if not os.path.isdir(root):
             raise InputError(f"{path}: no such folder")
-        root_name = os.path.basename(os.path.realpath(root))
         roots.append(root)
-        for relative in _walk(root, "", target, seen):
-            name = relative or root_name
-            if taken is not None:
-                if name in taken:  # the same name below two folders given
-                    name = f"{root_name}/{name}"
-                taken.add(name)
-            if name != relative:  # its folder is not root/name
-                folders[len(names)] = os.path.join(root, relative) if relative else root
-            names.append(name)
-            root_of.append(len(roots) - 1)
+        for relative, leaf in _walk(root, "", target, seen):
+            if len(found) == len(leaves):
+                leaves = np.resize(leaves, max(1 << 16, 2 * len(leaves)))
+            leaves[len(found)] = leaf
+            found.append(relative)
+            found_in.append(len(roots) - 1)
+    del seen
+    kept = _first_of_each_leaf(leaves[: len(found)])
+    del leaves
+    if kept is not None:
+        found, found_in = [found[i] for i in kept], array("H", (found_in[i] for i in kept))
+    names, folders = found, {}  # (the paths below the roots are the names, as a rule)
+    root_names = [os.path.basename(os.path.realpath(root)) for root in roots]
+    # names: only folders searched together can give one twice
+    taken: set[str] | None = set() if len(paths) > 1 else None
+    for i, relative in enumerate(found):
+        name = relative or root_names[found_in[i]]
+        if taken is not None:
+            if name in taken:  # the same name below two folders given
+                name = f"{root_names[found_in[i]]}/{name}"
+            taken.add(name)
+        if name != relative:  # its folder is not root/name
+            folders[i] = os.path.join(roots[found_in[i]], relative) if relative else roots[found_in[i]]
+            names[i] = name
+    del taken
+    if all(names[i] <= names[i + 1] for i in range(len(names) - 1)):  # (the walk's order mostly is)
+        return CaseList(roots, names, found_in, folders)
     order = sorted(range(len(names)), key=names.__getitem__)
     return CaseList(
         roots,
         [names[i] for i in order],
-        array("H", (root_of[i] for i in order)),
+        array("H", (found_in[i] for i in order)),
         {new: folders[old] for new, old in enumerate(order) if old in folders},
     )
 
 
+_LEAF = np.dtype([("device", np.uint64), ("inode", np.uint64)])  # a folder without subfolders (0, 0: another)
+
+
+def _first_of_each_leaf(leaves):
+    """The cases to keep, in order, where a folder without subfolders was
+    found twice (through a link, or a bind mount): its first; None where
+    none was."""
+    found = np.sort(leaves[leaves["inode"] != 0])  # (np.unique would import numpy.ma: 16 ms)
+    if not (found[1:] == found[:-1]).any():
+        return None
+    kept_leaves, keep = set(), []
+    for i, leaf in enumerate(leaves.tolist()):
+        if leaf[1] == 0 or leaf not in kept_leaves:
+            keep.append(i)
+            kept_leaves.add(leaf)
+    return keep
+
+
 def _walk(folder, relative, file_name, seen):
-    """The paths below the root (relative) of the folders from folder on
-    that hold file_name, each folder once (seen: their identities), by the
-    first path to it in sorted order. Depth first, holding the names of one
+    """(the path below the root (relative), its identity where the folder
+    has no subfolders, else (0, 0)) of the folders from folder on that hold
+    file_name. A folder with subfolders is walked once (seen: their
+    identities), by the first path to it in sorted order, so that no link
+    loops; a folder without, found twice, gives two (find_cases keeps the
+    first): the set of identities grows with the folders that hold
+    others, not with the cases. Depth first, holding the names of one
     folder's subfolders per level: memory grows with the depth and the
     widest folder's names, not with the whole tree."""
     try:
@@ -252,9 +289,10 @@ def _walk(folder, relative, file_name, seen):
             subfolders = sorted(e.name for e in entries if e.name != file_name and _is_folder(e))
     except OSError:
         return
-    seen.add(identity)
+    if subfolders:
+        seen.add(identity)
     if os.path.isfile(os.path.join(folder, file_name)):
-        yield relative
+        yield relative, (0, 0) if subfolders else (status.st_dev, status.st_ino)
     for name in subfolders:
         yield from _walk(os.path.join(folder, name), f"{relative}/{name}" if relative else name, file_name, seen)
 
