@@ -94,18 +94,23 @@ class CaseFiles:
 def run_folder_case(files: CaseFiles, target, settings, streaming: Streaming = Streaming()) -> CaseOutcome:
     """The CaseOutcome of the case in files.folder on target (a _worker.Target)."""
     started = time.perf_counter()
-    for whole in [True] if files.texts is not None else [False, True]:  # texts travelled: read them whole
+
+    def run(whole):
+        case = _read_folder_case(files, target, streaming, whole)
+        case.started = started
+        return run_chunked_case(case, target, settings, streaming)
+
+    if files.texts is None:  # (texts travelled: read them whole)
         try:
-            case = _read_folder_case(files, target, streaming, whole)
-            case.started = started
-            return run_chunked_case(case, target, settings, streaming)
-        except (NotPlain, InputError) as error:
-            if whole:  # (read whole, a file is read or explained: NotPlain does not come from there)
-                outcome = CaseOutcome(files.name, **target.labels, status=Status.INVALID, messages=[str(error)])
-                outcome.seconds = time.perf_counter() - started
-                return outcome
-            # else a file the chunk reader does not take: read_trace reads or explains it, whole
-    raise AssertionError("unreachable")
+            return run(whole=False)
+        except (NotPlain, InputError):
+            pass  # a file the chunk reader does not take: read_trace reads or explains it, whole
+    try:
+        return run(whole=True)
+    except (NotPlain, InputError) as error:
+        outcome = CaseOutcome(files.name, **target.labels, status=Status.INVALID, messages=[str(error)])
+        outcome.seconds = time.perf_counter() - started
+        return outcome
 
 
 def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: bool) -> ChunkedCase:

@@ -410,11 +410,11 @@ class _BlockReader:
             raise NotPlain(str(error)) from None
         chunk = np.empty(table.num_rows, dtype=self.dtype)
         for (field, _), name in zip(self.dtype, self.order, strict=True):
-            chunk[field] = _float64_values(table.column(name))
+            chunk[field] = float64_values(table.column(name))
         return chunk
 
 
-def _float64_values(column) -> np.ndarray:
+def float64_values(column) -> np.ndarray:
     """A float64 column without nulls (null_values=[]: none) as one array,
     from its buffers: pyarrow's to_numpy imports pandas where it is
     installed, a third of a second of a short campaign."""

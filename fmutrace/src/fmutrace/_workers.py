@@ -156,7 +156,11 @@ def _package_root():
 
 
 def _send(fd, message):
-    data = pickle.dumps(message)
+    _write_record(fd, pickle.dumps(message))
+
+
+def _write_record(fd, data: bytes):
+    """One length-prefixed record, whole (a pipe may take it in parts)."""
     view = memoryview(HEADER.pack(len(data)) + data)
     while view:
         view = view[os.write(fd, view) :]
@@ -187,13 +191,8 @@ def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
 
     def started():
         if first[0] or settings.case_timeout is not None:
-            write(STARTED)
+            _write_record(to_parent, STARTED)
         first[0] = False
-
-    def write(data: bytes):
-        view = memoryview(HEADER.pack(len(data)) + data)
-        while view:
-            view = view[os.write(to_parent, view) :]
 
     while True:
         header = _read_exactly(from_parent, HEADER.size)
@@ -209,7 +208,7 @@ def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
         if data is not None:
             fmus[path] = data
         for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
-            write(pickle.dumps(outcome))
+            _send(to_parent, outcome)
 
 
 def _die_with_parent():

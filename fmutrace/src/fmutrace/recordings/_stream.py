@@ -34,7 +34,7 @@ import pyarrow as pa
 import pyarrow.csv as pcsv
 
 from .._errors import TraceError
-from .._traces import UNUSUAL_LINE_BREAKS, NotPlain
+from .._traces import UNUSUAL_LINE_BREAKS, NotPlain, float64_values
 from . import TEXT_FORMATS, _mdf as mdf, _tables as tables
 from . import _grid as grids
 from . import _text as texts
@@ -154,7 +154,7 @@ class Table:
             )
         except pa.ArrowInvalid:
             return None
-        columns = {j: table.column(names[j]).to_numpy() for j in read}
+        columns = {j: float64_values(table.column(names[j])) for j in read}
         stamps = columns[self.time_column]
         if any(np.isnan(c).any() for c in columns.values()) or (np.abs(stamps) >= 1e15).any():
             return None
