@@ -14,6 +14,7 @@ import os
 import re
 import shutil
 from pathlib import Path
+from typing import NamedTuple
 from urllib.parse import quote
 from xml.sax.saxutils import escape, quoteattr
 
@@ -125,8 +126,8 @@ def _replaced(path):
             new.unlink()
 
 
-def write_results_json(campaign: CampaignResult, path):
-    """results.json, a case at a time (a campaign's cases may not fit in memory at once)."""
+def _results_json_head(campaign: CampaignResult) -> str:
+    """results.json up to its first case (its cases follow, a line each, as write_report reads them)."""
     head = {
         "format": RESULTS_FORMAT,
         "mode": campaign.mode.name,
@@ -136,11 +137,7 @@ def write_results_json(campaign: CampaignResult, path):
         "where": campaign.where,
         "seconds": round(campaign.seconds, 3),
     }
-    with _replaced(path) as out:
-        out.write(json.dumps(head)[:-1] + ', "cases": [')
-        for n, o in enumerate(campaign.cases.light()):
-            out.write(("," if n else "") + "\n" + json.dumps(_shown_entry(o.to_json())))
-        out.write("\n]}\n")
+    return json.dumps(head)[:-1] + ', "cases": ['
 
 
 def _shown_entry(entry):
@@ -321,9 +318,9 @@ def _case_page(o: CaseOutcome, report_dir: Path, campaign_criteria) -> str:
 def write_report(campaign: CampaignResult, report_dir):
     """index.html, a page per case, summary.md and results.json into
     report_dir, a case at a time (the case files are written as the cases
-    finish): one pass over the cases writes their pages, summary.md's rows
-    and index.html's rows into two files (failing, the rest), joined after
-    the summary that the pass counted."""
+    finish): one pass over the cases writes their pages, summary.md's and
+    results.json's rows and index.html's rows into two files (failing, the
+    rest), joined after the summary that the pass counted."""
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     copy_assets(report_dir)
@@ -331,12 +328,15 @@ def write_report(campaign: CampaignResult, report_dir):
     criteria = campaign.mode.describe()
     tally = _Tally()
     rows = {failing: report_dir / f".index-{failing}.{os.getpid()}.rows" for failing in (True, False)}
+    fmu_cells = _FmuCells()
     try:
         with (
             _replaced(report_dir / "summary.md") as summary,
+            _replaced(report_dir / "results.json") as results,
             open(rows[True], "w", encoding="utf-8") as failing_rows,
             open(rows[False], "w", encoding="utf-8") as other_rows,
         ):
+            results.write(_results_json_head(campaign))
             summary.write(
                 "\n".join(
                     [
@@ -352,11 +352,13 @@ def write_report(campaign: CampaignResult, report_dir):
                 )
                 + "\n"
             )
-            for o in campaign.cases.light():
+            for n, o in enumerate(campaign.cases.light()):
+                results.write(("," if n else "") + "\n" + json.dumps(_shown_entry(o.to_json())))
                 tally.add(o, criteria)
                 verdict = _verdict(o)
+                fmu = fmu_cells[o.fmu]
                 summary.write(
-                    f"| {markdown(o.case)} | {markdown(o.fmu)} | {markdown(verdict)} | {o.seconds:.2f} | "
+                    f"| {markdown(o.case)} | {fmu.markdown} | {markdown(verdict)} | {o.seconds:.2f} | "
                     + (f"[png]({_link(o.plot)})" if o.plot else "")
                     + " |\n"
                 )
@@ -365,13 +367,13 @@ def write_report(campaign: CampaignResult, report_dir):
                     name = f'<a href="{_link(_case_page(o, report_dir, criteria))}">{name}</a>'
                 message = o.messages[0] if o.messages and not o.passed else ""
                 (other_rows if o.passed else failing_rows).write(
-                    f'<tr class="{o.status}" data-status="{o.status}" data-fmu="{_attribute(o.fmu)}" '
-                    f'data-model="{_attribute(model_of(o.fmu))}">'
+                    f'<tr class="{o.status}" data-status="{o.status}" {fmu.attributes}>'
                     f'<td class="status">{o.status}</td>'
                     f"<td>{name}</td>"
-                    f"<td>{html.escape(text(o.fmu))}</td><td>{html.escape(text(message))}</td>"
+                    f"<td>{fmu.html}</td><td>{html.escape(text(message))}</td>"
                     f'<td class="seconds">{o.seconds:.2f}</td></tr>\n'
                 )
+            results.write("\n]}\n")
         with _replaced(report_dir / "index.html") as index:
             index.write(_index_head(campaign, headline, criteria, tally))
             for failing in (True, False):
@@ -381,7 +383,24 @@ def write_report(campaign: CampaignResult, report_dir):
     finally:
         for path in rows.values():
             path.unlink(missing_ok=True)
-    write_results_json(campaign, report_dir / "results.json")
+
+
+class _Cells(NamedTuple):
+    markdown: str  # in summary.md's row
+    html: str  # in index.html's row
+    attributes: str  # of index.html's row
+
+
+class _FmuCells(dict):
+    """An FMU label's cells in a case's rows, made once per FMU (a campaign's cases share a few)."""
+
+    def __missing__(self, fmu) -> _Cells:
+        cells = self[fmu] = _Cells(
+            markdown(fmu),
+            html.escape(text(fmu)),
+            f'data-fmu="{_attribute(fmu)}" data-model="{_attribute(model_of(fmu))}"',
+        )
+        return cells
 
 
 def _index_head(campaign: CampaignResult, headline, criteria, tally: _Tally) -> str:
