@@ -596,6 +596,31 @@ def test_a_folder_of_links_to_case_folders_is_a_folder_of_cases(tmp_path):
     assert "1 of 1 cases pass" in done.stdout
 
 
+@pytest.mark.parametrize("identity", ["128-bit inode", "negative device"])
+def test_find_cases_takes_folder_identities_of_any_size(tmp_path, monkeypatch, identity):
+    """Windows' ReFS gives 128-bit inode numbers, macOS a signed device:
+    a case folder found twice (a link) is still found once."""
+    import os
+    from types import SimpleNamespace
+
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "M_ref.csv").write_text("time,y\n0,0\n")
+    (tmp_path / "z").mkdir()
+    (tmp_path / "z" / "link_to_b").symlink_to(tmp_path / "b")
+    real_stat = os.stat
+
+    def wide(path, *args, **kwargs):
+        status = real_stat(path, *args, **kwargs)
+        if identity == "128-bit inode":
+            return SimpleNamespace(st_dev=status.st_dev, st_ino=status.st_ino + (1 << 100), st_mode=status.st_mode)
+        return SimpleNamespace(st_dev=-1 - status.st_dev, st_ino=status.st_ino, st_mode=status.st_mode)
+
+    with monkeypatch.context() as patched:
+        patched.setattr(os, "stat", wide)
+        found = fmutrace.find_cases([tmp_path], "M")
+    assert found[:] == [(tmp_path / "b", "b")]
+
+
 def test_find_cases_names_each_case_folder_once(tmp_path):
     """Names are the paths below the folder searched, sorted; a case folder
     given itself takes its own name; a name found below two folders given
@@ -640,3 +665,25 @@ def test_find_cases_names_each_case_folder_once(tmp_path):
     three = tmp_path / "three"
     case(three / "c")
     assert fmutrace.find_cases([one, two, three], "M")[-2:] == [(three / "c", "c"), (two / "b", "two/b")]
+
+
+def test_a_report_that_fails_to_be_written_leaves_the_last_one_whole(tmp_path, monkeypatch):
+    """index.html, summary.md and results.json are replaced together: a
+    failure while the index is written leaves the three of the last
+    campaign as they were."""
+    from fmutrace import _report
+
+    cases = shutil.copytree(SCENARIO_ROOT / "RateLimiter" / "bypass", tmp_path / "cases" / "bypass")
+    report = tmp_path / "report"
+    fmutrace.compare(RATE_LIMITER[3], cases.parent, report=report, run=fmutrace.RunOptions(jobs=1))
+    files = ("index.html", "summary.md", "results.json")
+    before = {name: (report / name).read_bytes() for name in files}
+
+    def failing_head(*args):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(_report, "_index_head", failing_head)
+    (cases / "RateLimiter_ref.csv").write_text((cases / "RateLimiter_ref.csv").read_text().replace(",0\n", ",7\n", 1))
+    with pytest.raises(OSError, match="No space left"):
+        fmutrace.compare(RATE_LIMITER[3], cases.parent, report=report, run=fmutrace.RunOptions(jobs=1))
+    assert {name: (report / name).read_bytes() for name in files} == before

@@ -23,7 +23,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fmutrace import read_trace, write_trace
+from fmutrace import TraceError, read_trace, write_trace
 from fmutrace import _runner as runner_module
 from fmutrace._runner import FastLoopFailed, Runner, discrete_rows, input_events
 from fmutrace._fmpy import Experiment, Signals, run_fmpy
@@ -550,6 +550,18 @@ def test_a_block_read_partly_in_c_is_read_on_by_pyarrow(tmp_path):
     (chunk,) = trace_chunks(path)
     assert same_bits(chunk, read_trace(path))
     assert chunk["a"][4] == math.inf and chunk["b"][8] == 8 * 0.1
+
+
+def test_a_byte_order_mark_inside_a_file_is_left_to_read_trace(tmp_path):
+    """pyarrow skips a byte-order mark at the start of what it reads: where
+    _rows.c stops at one inside the file, the file is not plain, and
+    read_trace names its cell."""
+    path = tmp_path / "trace.csv"
+    path.write_bytes(b"time,u\n1,2\n\xef\xbb\xbf3,4\n")
+    with pytest.raises(NotPlain):
+        list(trace_chunks(path))
+    with pytest.raises(TraceError, match="line 3"):
+        read_trace(path)
 
 
 def _attempt(function):

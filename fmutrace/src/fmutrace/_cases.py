@@ -277,7 +277,8 @@ def _walk(folder, relative, file_name, seen):
     identities), by the first path to it in sorted order, so that no link
     loops; a folder without, found twice, gives two (find_cases keeps the
     first): the set of identities grows with the folders that hold
-    others, not with the cases. Depth first, holding the names of one
+    others, not with the cases (and with those whose identity _LEAF does
+    not hold: a 128-bit inode, a negative device). Depth first, holding the names of one
     folder's subfolders per level: memory grows with the depth and the
     widest folder's names, not with the whole tree."""
     try:
@@ -289,10 +290,12 @@ def _walk(folder, relative, file_name, seen):
             subfolders = sorted(e.name for e in entries if e.name != file_name and _is_folder(e))
     except OSError:
         return
-    if subfolders:
+    leaf = (status.st_dev, status.st_ino)
+    if subfolders or not (0 <= leaf[0] < 1 << 64 and 0 < leaf[1] < 1 << 64):  # (_LEAF's range; else remembered)
         seen.add(identity)
+        leaf = (0, 0)
     if os.path.isfile(os.path.join(folder, file_name)):
-        yield relative, (0, 0) if subfolders else (status.st_dev, status.st_ino)
+        yield relative, leaf
     for name in subfolders:
         yield from _walk(os.path.join(folder, name), f"{relative}/{name}" if relative else name, file_name, seen)
 

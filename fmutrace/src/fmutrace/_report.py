@@ -374,12 +374,15 @@ def write_report(campaign: CampaignResult, report_dir):
                     f'<td class="seconds">{o.seconds:.2f}</td></tr>\n'
                 )
             results.write("\n]}\n")
-        with _replaced(report_dir / "index.html") as index:
-            index.write(_index_head(campaign, headline, criteria, tally))
-            for failing in (True, False):
-                with open(rows[failing], encoding="utf-8") as part:
-                    shutil.copyfileobj(part, index)
-            index.write(f'</tbody></table>\n<script src="{ASSETS}/report.js"></script>\n</body></html>\n')
+            failing_rows.flush()
+            other_rows.flush()
+            # (inside: summary.md and results.json replace theirs only once index.html is written)
+            with _replaced(report_dir / "index.html") as index:
+                index.write(_index_head(campaign, headline, criteria, tally))
+                for failing in (True, False):
+                    with open(rows[failing], encoding="utf-8") as part:
+                        shutil.copyfileobj(part, index)
+                index.write(f'</tbody></table>\n<script src="{ASSETS}/report.js"></script>\n</body></html>\n')
     finally:
         for path in rows.values():
             path.unlink(missing_ok=True)

@@ -50,10 +50,11 @@ static int cell_value(const char *text, const char *end, double *value) {
     const char *p = text;
     int negative = 0;
     if (p < end && (*p == '+' || *p == '-')) negative = *p++ == '-';
-    uint64_t digits = 0; /* the significant digits, while they are at most 19 */
-    int significant = 0; /* how many: leading zeros do not count */
-    int shift = 0;       /* the power of ten of the digits' last one */
-    int seen = 0;        /* digits before or after the point */
+    /* (counts in 64 bits: a cell may be longer than an int counts) */
+    uint64_t digits = 0;     /* the significant digits, while they are at most 19 */
+    int64_t significant = 0; /* how many: leading zeros do not count */
+    int64_t shift = 0;       /* the power of ten of the digits' last one */
+    int64_t seen = 0;        /* digits before or after the point */
     for (; p < end && is_digit(*p); p++, seen++) {
         if (significant || *p != '0') {
             if (++significant <= 19) digits = digits * 10 + (uint64_t)(*p - '0');
@@ -73,7 +74,8 @@ static int cell_value(const char *text, const char *end, double *value) {
         }
     }
     if (!seen) return 0;
-    int exponent = 0, exponent_digits = 0;
+    int exponent = 0;
+    int64_t exponent_digits = 0;
     if (p < end && (*p == 'e' || *p == 'E')) {
         p++;
         int exponent_negative = 0;
@@ -86,7 +88,7 @@ static int cell_value(const char *text, const char *end, double *value) {
     if (p != end) return 0;
     /* exact digits times an exact power of ten: one rounding, correctly rounded */
     if (EXACT_DOUBLES && significant <= 15 && exponent_digits <= 6) {
-        int power = digits ? shift + exponent : 0; /* (zero times any power is zero) */
+        int64_t power = digits ? shift + exponent : 0; /* (zero times any power is zero) */
         if (power >= -22 && power <= 22) {
             double magnitude = (double)digits;
             if (power > 0) magnitude *= exact_powers[power];

@@ -19,6 +19,7 @@ Anything else raises a TraceError, which names the file, the line and
 the column.
 """
 
+import codecs
 import io
 import os
 import math
@@ -395,6 +396,8 @@ class _BlockReader:
             if stopped[0] == len(block):
                 return chunk[:read]
             block = block[stopped[0] :]
+            if block.startswith(codecs.BOM_UTF8):  # (pyarrow skips one at the start of what it is given)
+                raise NotPlain("a byte-order mark inside the file")
         rest = self._arrow(block)
         return np.concatenate([chunk[:read], rest]) if read else rest
 
