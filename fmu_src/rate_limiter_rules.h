@@ -258,8 +258,11 @@ static FMU_NOINLINE FMU_MAYBE_UNUSED RL_NUM RL_NAME(rl_accel_step)(RL_NUM y, RL_
     if (islessequal(fabs((double)RL_NAME(rl_sum)(step, -distance)), (double)arrival)) {
         return uc;
     }
-    /* at uc already, with the speed the rounding of the landing step left above b: at rest */
-    if (distance == 0 && isgreater(step, 0) && islessequal((double)step, 4.0 * (double)RL_NAME(rl_ulp)(moving))) {
+    /* at uc already, with the speed the rounding of the landing step left above b: at rest. The
+     * landing planned up to 4 ulp(yp, uc) past b and snapped as much again; P, its difference, one
+     * ulp more: 8 ulp(uc) + 4 ulp(P), within the bounds' allowance for the braking it takes */
+    if (distance == 0 && isgreater(step, 0) &&
+        islessequal((double)step, 4.0 * (double)RL_NAME(rl_ulp)(moving) + 8.0 * (double)RL_NAME(rl_ulp)(uc))) {
         return uc;
     }
     const RL_NUM next = RL_NAME(rl_advance)(y, up ? step : -step);
