@@ -16,16 +16,19 @@
   with its value reference as subFunctionStatus, the output held.
 
 More scenarios than CI runs: `python -m support.accel_campaign` (from tests/).
+A scenario one of them once failed on is kept in accel_regressions/ and
+replayed on every run.
 """
 
 import math
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from support.accel_properties import LREAL, REAL
-from support.accel_scenarios import HypothesisChooser, replay, run_random, violations
+from support.accel_scenarios import HypothesisChooser, loads, replay, run_random, violations
 from support.fmu_driver import Instance
 from support.oracle import oracle_for, output_names
 
@@ -44,6 +47,18 @@ def agree(a, b):
 
 def report(scenario, found):
     return "\n".join([str(v) for v in found[:10]] + ["scenario: " + scenario.dumps()])
+
+
+# scenarios the random tests once failed on, as they printed them: every run replays them
+REGRESSIONS = sorted((Path(__file__).parent / "accel_regressions").glob("*.json"))
+
+
+@pytest.mark.parametrize("model_exchange", [False, True], ids=["CS", "ME"])
+@pytest.mark.parametrize("path", REGRESSIONS, ids=[p.stem for p in REGRESSIONS])
+def test_scenarios_once_failed_hold_every_property(path, model_exchange):
+    scenario = loads(path.read_text())
+    found = violations(scenario, replay(scenario, model_exchange=model_exchange))
+    assert not found, report(scenario, found)
 
 
 @pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
