@@ -340,12 +340,16 @@ def test_a_folder_of_several_recordings_is_each_of_them(tmp_path):
 
 @pytest.mark.parametrize("read", ["streamed", "whole"])
 def test_a_channel_that_drives_and_is_compared_is_noted_off_its_cycle_once(tmp_path, read):
-    """u drives PassThrough's u and is compared with its y; its stamps jitter by 0.15 of a cycle."""
-    rows = [f"{k * 10 + (1.5 if k % 2 else 0)},{k}" for k in range(20)]
+    """u drives PassThrough's u and is compared with its y; its 21 stamps jitter by 0.3 of a cycle, every
+    other one late. The grid of cycles they fit, worked by hand: 10 ms per cycle (the late ones lie
+    evenly about the middle), from their mean offset, 3 ms * 10 / 21; so the 11 on time are 1/7 of a
+    cycle early, the 10 late ones 11/70 of a cycle late: every stamp more than a tenth off."""
+    rows = [f"{k * 10 + (3 if k % 2 else 0)},{k}" for k in range(21)]
     if read == "whole":
         rows.insert(10, "")
     path = tmp_path / "jitter.csv"
     path.write_text("time [ms],u\n" + "\n".join(rows) + "\n")
     done = compare(PASS_THROUGH, path, "--map", "u=u", "--map", "y=u", "--step-size", "0.01")
     assert done.returncode == 0, done.stdout + done.stderr
-    assert done.stdout.count("u: 10 of its 20 time stamps are more than 0.1 of a cycle (0.001 s) off") == 1
+    assert done.stdout.count("u: 21 of its 21 time stamps are more than 0.1 of a cycle (0.001 s) off") == 1
+    assert "jitter up to 15.7 % of a cycle (typical 14.3 %)" in done.stdout

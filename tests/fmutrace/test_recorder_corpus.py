@@ -6,6 +6,7 @@ structure reads them, support/scope_view.py; the MDF files as asammdf
 does), channel by channel: names, sample counts, time stamps, values;
 or refuses it for the one correct reason."""
 
+import json
 import gzip
 import hashlib
 import sys
@@ -170,9 +171,11 @@ def test_a_map_to_a_can_logger_channel_without_samples_says_so():
 def test_decoded_can_signals_take_the_step_of_the_channels_mapped(tmp_path):
     """FCBF0606 decoded with its DBC (asammdf, canmatrix): EngineSpeed every 0.1 s and
     WheelBasedVehicleSpeed about every 1 s, each message with its own stamps. The speed mapped alone
-    (PassThrough's u and y) takes a 1 s step, not the 0.1 s of the unmapped engine speed; its stamps
-    are matched to the nearest cycle from its first, and those more than a tenth of a cycle off (its
-    sender's 100 ms task slips now and then) are counted as this test counts them."""
+    (PassThrough's u and y) takes a 1 s step, not the 0.1 s of the unmapped engine speed. The sender's
+    100 ms task slips now and then (an interval of 1.1 s), so the stamps sit on no exact grid: fmutrace
+    lays them on the grid of cycles they fit, each on its own cycle, says how far they are from it
+    (the jitter), and names those more than a tenth of a cycle off; this test counts them on the grid
+    results.json reports, numbering each stamp on its nearest cycle as the grid's definition says."""
     from asammdf import MDF
 
     raw = MDF(str(CORPUS / "canedge" / "FCBF0606_00000001-60B621D9.MF4"))
@@ -182,12 +185,20 @@ def test_decoded_can_signals_take_the_step_of_the_channels_mapped(tmp_path):
     stamps = decoded.get("WheelBasedVehicleSpeed").timestamps
     raw.close()
     decoded.close()
-    cycles = (stamps - stamps[0]) / 1.0
-    off = int((np.abs(cycles - np.rint(cycles)) > 0.1).sum())
+    report = tmp_path / "report"
     command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(PASS_THROUGH), str(path)]
-    maps = ["--map", "u=WheelBasedVehicleSpeed", "--map", "y=WheelBasedVehicleSpeed"]
+    maps = ["--map", "u=WheelBasedVehicleSpeed", "--map", "y=WheelBasedVehicleSpeed", "--report", str(report)]
     done = run_bounded(command + maps, timeout=600, what="fmutrace compare")
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"{len(stamps)} samples" in done.stdout and "step 1 s (the finest interval" in done.stdout
+    [case] = json.loads((report / "results.json").read_text())["cases"]
+    clock = case["clock"]
+    cycles = (stamps - stamps[0] - clock["phase_s"]) / clock["cycle_s"]
+    numbers = np.rint(cycles)
+    assert (np.diff(numbers) > 0).all()  # each stamp on a cycle of its own
+    distance = np.abs(cycles - numbers)
+    assert clock["largest_percent"] == pytest.approx(100 * distance.max(), abs=1e-3) and distance.max() < 0.5
+    off = int((distance > 0.1).sum())
     assert done.stdout.count(f"WheelBasedVehicleSpeed: {off} of its {len(stamps)} time stamps are more") == 1
+    assert f"jitter up to {100 * distance.max():.1f} % of a cycle" in done.stdout
     assert "ignored: EngineSpeed" in done.stdout

@@ -301,6 +301,12 @@ def test_stamps_of_a_column_without_a_unit_are_known_by_their_size(tmp_path):
 
 
 def test_a_stamp_off_its_cycle_is_reported_and_two_on_one_cycle_refused(tmp_path):
+    """The grid of the four stamps, worked by hand: the least-squares line of 0, 10.0004, 23 and 30 ms
+    over cycles 0 to 3 is 10.29996 ms per cycle from 0.30006 ms (slope 51.4998 / 5, the mean 15.7501 less
+    1.5 slopes), which puts them -0.029, -0.058, +0.204 and -0.117 cycles off their cycles: two more than
+    a tenth, the first at line 4 (23 ms). With a step of 20 ms, the narrowest arc of a 20 ms circle
+    that holds them runs from 0 to 10.0004 ms: cycle 0 (from 5.0002 ms less half a cycle) holds the
+    first two, which the line of 21.5 ms per cycle keeps together: refused at the second, line 3."""
     path = tmp_path / "jitter.csv"
     path.write_text("time [ms];u;y\n0;1;1\n10.0004;1;1\n23;1;1\n30;1;1\n")
     recording = normalise(read_recording(path)[0])
@@ -308,13 +314,15 @@ def test_a_stamp_off_its_cycle_is_reported_and_two_on_one_cycle_refused(tmp_path
     variables = variables_of(u="input", y="output")
     aligned = align(recording, plan(recording, variables, "M"))
     assert any(
-        "u: 1 of its 4 time stamps are more than 0.1 of a cycle" in n and "line 4: t=0.023" in n for n in aligned.notes
-    )
+        "u: 2 of its 4 time stamps are more than 0.1 of a cycle" in n
+        and "line 4: t=0.023 s, +0.204 cycles from cycle 2" in n
+        for n in aligned.notes
+    ), aligned.notes
+    assert aligned.grid.period == pytest.approx(0.01029996, rel=1e-9)
     recording = normalise(read_recording(path)[0], step_size=0.02)
     with pytest.raises(
         InputError,
-        match=r"line 4: samples of u at t=0.0100004 s and t=0.023 s fall on the same "
-        r"cycle of 0.02 s",
+        match=r"line 3: samples of u at t=0 s and t=0.0100004 s fall on the same cycle of 0.02 s",
     ):
         align(recording, plan(recording, variables, "M"))
 

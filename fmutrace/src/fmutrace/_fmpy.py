@@ -21,6 +21,10 @@ class Experiment:
     stop: float
     step: float
     relative_tolerance: float | None = None
+    # recorded cycle lengths: (points, sizes) of each of the (stop - start) / step steps, which doStep is called
+    # with instead of the grid's (a size of 0: no doStep, the outputs held); the results still stand at the
+    # grid's times. Only the Runner's own loop takes it (fmpy steps on a grid).
+    replay: tuple | None = None
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ API_NAMES = {
     "step_size": "RecordingOptions.step_size",
     "time_unit": "RecordingOptions.time_unit",
     "timing": "RecordingOptions.timing",
+    "cycle_lengths": "RecordingOptions.cycle_lengths",
     "maps": "RecordingOptions.maps",
     "start_values": "RecordingOptions.start_values",
     "rel_tol": "Tolerance.rel_tol",

@@ -53,6 +53,7 @@ class CaseOutcome:
     plot_data: str = ""
     criteria: str = ""  # what the case is judged by (its own criteria before the campaign's)
     streamed: bool = False  # read, run and compared in chunks (a long case), not in memory
+    clock: dict = field(default_factory=dict)  # a recording's cycle fit: its cycle, jitter, missing cycles
 
     @property
     def passed(self) -> bool:
@@ -78,6 +79,8 @@ class CaseOutcome:
             entry["criteria"] = self.criteria
         if self.streamed:
             entry["streamed"] = True
+        if self.clock:
+            entry["clock"] = self.clock
         return entry
 
     @classmethod
@@ -97,6 +100,7 @@ class CaseOutcome:
             plot_data=entry.get("plot_data", ""),
             criteria=entry.get("criteria", ""),
             streamed=entry.get("streamed", False),
+            clock=entry.get("clock", {}),
         )
 
 

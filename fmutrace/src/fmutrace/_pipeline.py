@@ -79,6 +79,8 @@ class ChunkedCase:
     more_messages: Callable | None = None
     started: float = field(default_factory=time.perf_counter)
     criteria: tuple = ()  # the case's own per-signal criteria: ((pattern, Mode), ...)
+    replay: tuple | None = None  # recorded cycle lengths: Experiment.replay
+    clock: dict = field(default_factory=dict)  # a recording's cycle fit: CaseOutcome.clock
 
 
 @dataclass(frozen=True)
@@ -219,7 +221,7 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
                 state.envelopes[("input", s)].add(np.array([case.t_end]), last[s])
 
     results = target.runner.run_chunks(
-        Experiment(start, stop, step, options["RelTol"]),
+        Experiment(start, stop, step, options["RelTol"], case.replay),
         Signals(inputs if case.inputs is not None else None, case.start_values, outputs),
         input_names,
         streaming.steps_per_chunk,
@@ -484,6 +486,7 @@ class _Comparer:
         outputs, envelopes = self.outputs, self.envelopes
         deviations = [self.signals[s].deviation for s in outputs]
         outcome = CaseOutcome(case.name, **labels)
+        outcome.clock = case.clock
         problem = ""
         if self.absent:
             problem = f"the result has no sample at t={self.first_absent!r} ({self.absent} reference times without one)"

@@ -27,6 +27,9 @@ class RecordedCase(Case):
     notes: list = field(default_factory=list)  # what was assumed, ignored or found
     coarse: str = ""  # why an exact comparison cannot hold
     shift: int = 1  # steps from a row's time to its output's (timing)
+    cycles: dict = field(default_factory=dict)  # compared variable -> the cycle of each of its samples
+    clock: dict = field(default_factory=dict)  # the cycle fit's figures (results.json's "clock")
+    replay: tuple | None = None  # cycle_lengths "recorded": (points, sizes) of every step
 
     def explain(self, deviations) -> list:
         """What a failing comparison's reader needs beside the deviations:
@@ -38,7 +41,7 @@ class RecordedCase(Case):
             if deviation.passed or channel is None or deviation.time is None:
                 continue
             cycle = int(round(deviation.time / step)) - self.shift
-            at = np.flatnonzero(np.rint(channel.times / step).astype(np.int64) == cycle)
+            at = np.flatnonzero(self.cycles[deviation.name] == cycle)
             if len(at):
                 i = int(at[0])
                 messages.append(
@@ -73,14 +76,15 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
     matched = plan(recording, fmu.variables, fmu.label, options.maps, options.names)
     used = [c for _, c in matched.drives + matched.compares]  # the time base: what is compared, nothing else
     normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names, used or None)
-    aligned = align(recording, matched, options.timing, fmu.label, options.names)
+    aligned = align(recording, matched, options.timing, fmu.label, options.names, options.cycle_lengths)
     start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     names = [v for reference in aligned.references for v in reference.dtype.names[1:]]
     unit = UNIT_NAMES.get(recording.time_unit, recording.time_unit)
     samples = max(len(c.values) for c in used or recording.channels)  # of the channels compared or driven
     description = (
         f"{recording.format}: {samples} samples, time as {unit} ({recording.time_source}), "
-        f"step {shortest(recording.step_size)} s ({recording.step_source})"
+        f"step {shortest(recording.step_size)} s ({recording.step_source}), {aligned.description}"
+        + (", cycle lengths as recorded" if aligned.replay is not None else "")
     )
     return RecordedCase(
         name=name,
@@ -101,6 +105,9 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
         notes=aligned.notes + matched.describe(),
         coarse=aligned.coarse,
         shift=1 if options.timing == "cycle" else 0,
+        cycles={v: aligned.grid.index(c.times) for v, c in matched.compares} if aligned.grid else {},
+        clock=aligned.clock,
+        replay=aligned.replay,
     )
 
 

@@ -16,8 +16,9 @@ from ._pipeline import ChunkedCase, Streaming, run_chunked_case
 from ._outcome import CaseOutcome, Status
 from ._recorded import first_differs, recorded_case
 from ._traces import NotPlain
-from .recordings import _stream as stream, _timebase as timebase
-from .recordings._align import off_cycle_note
+from .recordings import _clock as clock, _stream as stream, _timebase as timebase
+from .recordings._align import clock_figures, off_cycle_note
+from .recordings._timebase import OFF_CYCLE
 from .recordings._matching import plan
 
 
@@ -76,6 +77,8 @@ def run_recording(path, name, target, settings, streaming: Streaming = Streaming
         max(recorded.options["StopTime"], float(recorded.reference["time"][-1])),
         more_messages,
         started,
+        replay=recorded.replay,
+        clock=recorded.clock,
     )
     return run_chunked_case(case, target, settings, streaming)
 
@@ -93,6 +96,8 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
             return None
         step = recording.step_size
         shift = 1 if options.timing == "cycle" else 0
+        if options.cycle_lengths != "nominal":
+            return None  # (the in-memory path replays the recorded cycle lengths)
         cycles = stream.time_column_pass(table, step, block_bytes)
         start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     except (NotPlain, InputError, OSError, ValueError):
@@ -101,6 +106,8 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
     stop = float(timebase.cycle_times(np.array([max(cycles.last + shift, 1)]), step)[0])
     pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": []}
     row = 0  # the next block's first row, which is its cycle (stream.time_column_pass)
+    jitter = clock.Jitter()  # of every row on the grid, as the blocks are read
+    off: list = [0, None]  # rows more than OFF_CYCLE off their cycle, and (line, seconds, cycle) of the first
 
     def parse():
         """Reads the next block into both queues; False at the end."""
@@ -111,6 +118,14 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         _, cells, line_numbers, times = block
         index = np.arange(row, row + len(times))
         row += len(times)
+        distance = cycles.grid.distance(times, index)
+        if not np.all(np.abs(distance) < 0.5):
+            raise NotPlain("a row nearer another cycle than its own")  # (the in-memory path numbers it so)
+        jitter.add(distance)
+        late = np.flatnonzero(np.abs(distance) > OFF_CYCLE)
+        if len(late) and off[1] is None:
+            off[1] = (int(line_numbers[late[0]]), float(times[late[0]]), int(index[late[0]]))
+        off[0] += len(late)
         if drives:
             chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
             chunk["time"] = timebase.cycle_times(index, step)
@@ -134,14 +149,17 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
                 return
 
     blocks = table.blocks(block_bytes)
+    figures: dict = {}  # the clock's figures, made with the last messages (the outcome takes the dict)
 
     def more_messages(passed, deviations):
         notes = []
-        if cycles.off:
-            line, time = cycles.first_off
+        if off[0]:
+            line, time, cycle = off[1]
             notes = list(
                 dict.fromkeys(  # a channel that drives and is compared is said once, as read whole
-                    off_cycle_note(channel.name, cycles.off, cycles.rows, f"{table.path}, line {line}", time, step)
+                    off_cycle_note(
+                        channel.name, off[0], cycles.rows, (f"{table.path}, line {line}", time, cycle), cycles.grid
+                    )
                     for _, channel in drives + compares
                 )
             )
@@ -149,8 +167,9 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
         description = (
             f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
-            f"step {shortest(step)} s ({recording.step_source})"
+            f"step {shortest(step)} s ({recording.step_source}), jitter {jitter.describe()}"
         )
+        figures.update(clock_figures(cycles.grid, jitter, 1, 0, []))
         if passed:
             return [description] + notes
         return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
@@ -167,6 +186,7 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         [v for v, _ in compares],
         stop,
         more_messages,
+        clock=figures,
     )
     try:
         outcome = run_chunked_case(case, target, settings, streaming)

@@ -50,6 +50,7 @@ from fmpy.simulation import (
     settable_in_instantiated,
 )
 
+from ._errors import InputError, SimulationError
 from ._fmu import REAL_TYPES, unpacked
 from ._fmpy import Experiment, Signals, held_to, run_fmpy
 from ._native import native_function
@@ -361,7 +362,7 @@ def _steps_python(instance: _Instance, times, sizes, set_at, setters, getters):
     for t, h, row, k in zip(times.tolist(), sizes.tolist(), set_at.tolist(), itertools.count()):
         if row >= 0 and _set_row(set_calls, row) > 1:
             return False
-        status = step(t, h)
+        status = step(t, h) if h != 0 else 0  # (a size of 0: a cycle that did not run, Experiment.replay)
         for get, rows in get_calls:
             status |= get(rows[k])
         if status > 1:
@@ -530,7 +531,12 @@ class Runner:
             kept = list(inputs)
             inputs = lambda: iter(kept)  # noqa: E731 (a table given as an iterator: read once)
         given = -math.inf  # the time of the last row given
-        if self.static_problem(experiment, input_names, signals.outputs) is None:
+        problem = self.static_problem(experiment, input_names, signals.outputs)
+        if problem is not None and experiment.replay is not None:
+            raise InputError(
+                f"recorded cycle lengths run on fmutrace's own step loop, which cannot take this: {problem}"
+            )
+        if problem is None:
             table = None if inputs is None else _held_to(inputs(), experiment.stop)
             try:
                 for chunk in self._fast(
@@ -540,10 +546,15 @@ class Runner:
                     yield chunk
                 self.fast_runs += 1
                 return
-            except InputsNeedFmpy:
-                pass
-            except FastLoopFailed:
+            except InputsNeedFmpy as error:
+                if experiment.replay is not None:
+                    raise InputError(
+                        f"recorded cycle lengths run on fmutrace's own step loop, which cannot take this: {error}"
+                    ) from None
+            except FastLoopFailed as error:
                 self._drop_instance()  # a call failed: fmpy tells the story on an instance of its own
+                if experiment.replay is not None:  # (fmpy steps on a grid: not the recorded steps)
+                    raise SimulationError(f"the FMU failed on the recorded cycle lengths: {error}") from None
         self.fmpy_runs += 1
         table = None if inputs is None else np.concatenate(list(inputs()))
         result = run_fmpy(self.folder, self.md, experiment, Signals(table, signals.start_values, signals.outputs))
@@ -598,6 +609,8 @@ class Runner:
         n = round((stop - start) / step)
         size = min(n, steps_per_chunk)
         component, calls = self._component, self.calls
+        replay = experiment.replay
+        end = stop if replay is None else max(stop, float(replay[0][-1] + replay[1][-1]))  # the FMU's last time
 
         # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
         getters: list[tuple] = []
@@ -625,9 +638,9 @@ class Runner:
             try:
                 if self.fmi3:
                     remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
-                    fmu.enterInitializationMode(tolerance=tolerance, startTime=start, stopTime=stop)
+                    fmu.enterInitializationMode(tolerance=tolerance, startTime=start, stopTime=end)
                 else:
-                    fmu.setupExperiment(tolerance=tolerance, startTime=start, stopTime=stop)
+                    fmu.setupExperiment(tolerance=tolerance, startTime=start, stopTime=end)
                     remaining = apply_start_values(fmu, self.md, start_values, settable=settable_in_instantiated)
                     fmu.enterInitializationMode()
                 remaining = apply_start_values(fmu, self.md, remaining, settable=settable_in_initialization_mode)
@@ -648,6 +661,8 @@ class Runner:
         for k in range(0, n, size):
             m = min(size, n - k)
             times, step_times, step_sizes = self._grid(start, step, k, m)
+            if replay is not None:  # the steps as recorded, their results at the grid's times
+                step_times, step_sizes = replay[0][k : k + m], replay[1][k : k + m]
             with _quiet():
                 if inputs is not None:
                     set_at, setters = inputs.steps(times[:-1])

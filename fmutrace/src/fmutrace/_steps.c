@@ -73,7 +73,7 @@ typedef int (*step_call)(any_function, void *, double, double, step_flags *);
 
 /* Runs steps from times[k] by sizes[k]: before step k, if set_at[k] >= 0,
  * every setter with its row set_at[k]; then doStep; then every getter into
- * its row k. Statuses are OR-ed per step as the Python loop does; a status
+ * its row k (a size of 0: no doStep). Statuses are OR-ed per step as the Python loop does; a status
  * above Warning stops the loop. Returns the number of steps done (steps if
  * all were). */
 ALWAYS_INLINE size_t run_steps(values_call values, step_call step, any_function do_step, void *component,
@@ -88,7 +88,8 @@ ALWAYS_INLINE size_t run_steps(values_call values, step_call step, any_function 
                 status |= values(&setters[i], component, setters[i].rows + (ptrdiff_t)set_at[k] * setters[i].row_bytes);
             if (status > 1) return k;
         }
-        status = step(do_step, component, times[k], sizes[k], &flags);
+        /* a size of 0 is a cycle that did not run (recorded cycle lengths): no doStep, the outputs held */
+        status = sizes[k] != 0 ? step(do_step, component, times[k], sizes[k], &flags) : 0;
         for (size_t i = 0; i < n_getters; i++)
             status |= values(&getters[i], component, getters[i].rows + (ptrdiff_t)k * getters[i].row_bytes);
         if (status > 1) return k;

@@ -26,7 +26,7 @@ from ._simulation import SimulationOptions, simulate_chunks
 from ._outcome import Status
 from ._report import text
 from .recordings import is_recording
-from .recordings._align import TIMINGS
+from .recordings._align import CYCLE_LENGTHS, TIMINGS
 from .recordings._options import TIME_UNITS, RecordingOptions
 from ._traces import TraceWriter
 from ._worker import PLOT_ALL_UP_TO, PLOTS
@@ -45,6 +45,7 @@ FLAGS = {
     "step_size": "--step-size",
     "time_unit": "--time-unit",
     "timing": "--timing",
+    "cycle_lengths": "--cycle-lengths",
     "maps": "--map",
     "start_values": "--set",
     "rel_tol": "--rel-tol",
@@ -240,6 +241,14 @@ def parser():
         "cycle read and the output it produced, as recorders write it; fmi: a row's output is the "
         "output at its time, as fmpy and FMI cross-check files write it",
     )
+    rec.add_argument(
+        FLAGS["cycle_lengths"],
+        choices=CYCLE_LENGTHS,
+        default="nominal",
+        help="nominal (default): every step is --step-size long, the stamps' jitter only places the samples; "
+        "recorded: each recorded execution of the OB is one step as long as the recorded interval since the one "
+        "before, a cycle without a sample no step (blocks that measure elapsed time see the jitter)",
+    )
     return main
 
 
@@ -291,7 +300,9 @@ def compare_command(args, out):
     # the recordings group's flags read recordings; with case folders alone the command leaves them unused, as
     # it did, and says so
     recording = (
-        RecordingOptions(args.step_size, args.time_unit, args.timing, args.map, args.set, names=FLAGS)
+        RecordingOptions(
+            args.step_size, args.time_unit, args.timing, args.map, args.set, args.cycle_lengths, names=FLAGS
+        )
         if recordings
         else RecordingOptions(names=FLAGS)
     )
@@ -303,6 +314,7 @@ def compare_command(args, out):
             ("--set", args.set),
             ("--time-unit", args.time_unit is not None),
             ("--timing", args.timing != "cycle"),
+            ("--cycle-lengths", args.cycle_lengths != "nominal"),
         )
         if given and not recordings
     ]

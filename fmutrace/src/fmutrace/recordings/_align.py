@@ -27,9 +27,14 @@ import numpy as np
 
 from .._errors import InputError
 from .._names import Names, name_of, shortest
-from ._timebase import OFF_CYCLE, as_read, cycle_times, cycles, finest_interval
+from . import _clock as clock
+from ._model import TIME_DIVISORS, TIME_FACTORS
+from ._timebase import FINEST, OFF_CYCLE, _minus, as_read, cycle_times, finest_interval
 
 TIMINGS = ("cycle", "fmi")
+CYCLE_LENGTHS = ("nominal", "recorded")
+MOST_NAMED = 10  # missing cycles named in a note (the rest counted)
+WHOLE = 1e-3  # of a tick: a stamp this close to a whole number of ticks is one (its decimals read back)
 
 
 @dataclass
@@ -41,16 +46,55 @@ class Aligned:
     step_size: float
     notes: list = field(default_factory=list)  # what was assumed, skipped or found
     coarse: str = ""  # why an exact comparison cannot hold (inputs sampled coarser than the step)
+    grid: clock.Grid | None = None  # the cycles the samples were laid on (recorder's clock)
+    clock: dict = field(default_factory=dict)  # the figures of the fit: results.json's "clock"
+    description: str = ""  # the fit in words: jitter, missing cycles
+    replay: tuple | None = None  # cycle_lengths "recorded": (points, sizes) of every step (size 0: no doStep)
 
 
-def _cycles_of(channel, step, notes, names):
-    index, off = cycles(channel.times, step)
+def fitted_grid(recording, channels, names: Names = ()):
+    """The clock.Grid that the samples of channels (those compared or
+    driven) sit on, near the recording's step; InputError where they fit
+    none (the best cycle found, and how far the samples are from it)."""
+    step = recording.step_size
+    times = np.unique(np.concatenate([c.times for c in channels]))
+    grid = clock.fit(times, step)
+    if recording.step_source == FINEST and clock.restep(grid, step) != step:
+        # jitter and skipped cycles pulled the median interval off the cycle the samples sit on
+        recording.step_size, recording.step_source = clock.restep(grid, step), "the cycle its time stamps fit"
+    distance = grid.distance(times, grid.index(times))
+    if clock.fits(distance):
+        return grid
+    jitter = clock.Jitter()
+    jitter.add(distance)
+    own = finest_interval(channels)
+    best = f"a cycle of {grid.period:.6g} s leaves them {jitter.describe()} off"
+    if own is not None and own != step:
+        nearer = clock.fit(times, own)
+        found = clock.Jitter()
+        found.add(nearer.distance(times, nearer.index(times)))
+        if found.typical < jitter.typical and found.largest < 0.5:
+            best = f"their own intervals give a cycle of {nearer.period:.6g} s, {found.describe()} off it"
+    raise InputError(
+        f"{recording.label}: the samples of {', '.join(c.name for c in channels)} fit no grid of cycles of "
+        f"{shortest(step)} s ({recording.step_source}): {best} (jitter is less than half a cycle); give the "
+        f"recorder's cycle with {name_of(names, 'step_size')}"
+    )
+
+
+def _cycles_of(channel, grid, step, notes, names):
+    index = grid.index(channel.times)
+    off = np.flatnonzero(np.abs(grid.distance(channel.times, index)) > OFF_CYCLE)
     if len(off):
         i = int(off[0])
-        note = off_cycle_note(channel.name, len(off), len(index), channel.where(i), float(channel.times[i]), step)
+        note = off_cycle_note(
+            channel.name, len(off), len(index), (channel.where(i), float(channel.times[i]), int(index[i])), grid
+        )
         own = finest_interval([channel])
-        if own is not None and cycles(channel.times, own)[1].size == 0 and own != step:
-            note += f" Its own stamps fit a step of {shortest(own)} s ({name_of(names, step_size=own)})."
+        if own is not None and own != step:
+            own_grid = clock.fit(channel.times, own)
+            if not (np.abs(own_grid.distance(channel.times, own_grid.index(channel.times))) > OFF_CYCLE).any():
+                note += f". Its own stamps fit a step of {shortest(own)} s ({name_of(names, step_size=own)})."
         if note not in notes:  # a channel that drives and is compared is said once
             notes.append(note)
     repeated = np.flatnonzero(np.diff(index) == 0)
@@ -58,19 +102,169 @@ def _cycles_of(channel, step, notes, names):
         i = int(repeated[0])
         raise InputError(
             f"{channel.where(i + 1)}: samples of {channel.name} at t={shortest(as_read(channel.times[i]))} s and "
-            f"t={shortest(as_read(channel.times[i + 1]))} s fall on the same cycle of {shortest(step)} s: the step is "
-            f"coarser than the recording (give the recorder's cycle with {name_of(names, 'step_size')})"
+            f"t={shortest(as_read(channel.times[i + 1]))} s fall on the same cycle of {shortest(step)} s, jitter of "
+            f"up to half a cycle allowed: the step is coarser than the recording (give the recorder's cycle with "
+            f"{name_of(names, 'step_size')})"
         )
     return index
 
 
-def off_cycle_note(name, off, samples, where, time, step):
-    """What a channel with off time stamps gets: how many of its samples,
-    the first (where: its file and line, time: seconds)."""
+def off_cycle_note(name, off, samples, first, grid):
+    """What a channel with stamps off their cycles gets: how many of its
+    samples, the first (first: where, its file and line; its time,
+    seconds; its cycle on grid)."""
+    where, time, cycle = first
     return (
         f"{name}: {off} of its {samples} time stamps are more than {OFF_CYCLE:g} of a cycle "
-        f"({shortest(OFF_CYCLE * step)} s) off a cycle end, matched to the nearest one; the first at {where}: "
-        f"t={shortest(as_read(time))} s, {time / step:.3f} cycles: is the step size the recorder's cycle?"
+        f"({OFF_CYCLE * grid.period:.6g} s) off their cycle, each on its nearest; the first at {where}: "
+        f"t={shortest(as_read(time))} s, {float(grid.distance(time, cycle)):+.3f} cycles from cycle {int(cycle)}"
+    )
+
+
+def align(recording, plan, timing="cycle", label="the FMU", names: Names = (), cycle_lengths="nominal"):
+    """The Aligned of a normalised recording and its Plan; names: the
+    caller's words for the settings (RecordingOptions.names);
+    cycle_lengths: 'nominal' (every step the step size) or 'recorded'
+    (every step the recorded interval between its cycle's execution and
+    the one before, Aligned.replay)."""
+    if timing not in TIMINGS:
+        raise InputError(f"timing must be one of {', '.join(TIMINGS)}, not {timing!r}")
+    if cycle_lengths not in CYCLE_LENGTHS:
+        raise InputError(f"cycle_lengths must be one of {', '.join(CYCLE_LENGTHS)}, not {cycle_lengths!r}")
+    if not plan.compares:
+        raise InputError(
+            f"{recording.label}: no channel is an output of {label}: nothing to compare (channels: "
+            f"{', '.join(c.name for c in recording.channels)}; map one with "
+            f"{name_of(names, maps=('VARIABLE', 'CHANNEL'))})"
+        )
+    step = recording.step_size
+    notes = list(recording.notes)
+    shift = 1 if timing == "cycle" else 0
+    used = list({id(c): c for _, c in plan.drives + plan.compares}.values())  # (a channel may drive and be compared)
+    grid = fitted_grid(recording, [c for c in used if len(c.times)], names)
+    step = recording.step_size  # (the fit may have found the cycle the median interval missed)
+    index_of = {id(c): _cycles_of(c, grid, step, notes, names) for c in used}
+    # inputs: every driven channel held on the union of their sample cycles
+    inputs = None
+    coarse = []
+    if plan.drives:
+        indices = [index_of[id(channel)] for _, channel in plan.drives]
+        cycles = np.unique(np.concatenate(indices))
+        inputs = np.empty(len(cycles), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in plan.drives])
+        inputs["time"] = cycle_times(cycles, step)
+        for (variable, channel), index in zip(plan.drives, indices, strict=True):
+            where = np.searchsorted(index, cycles, side="right") - 1
+            inputs[variable] = channel.values[np.maximum(where, 0)]
+            every = _interval(index)
+            if every > 1:
+                coarse.append((variable, every))
+    references = []
+    last = 0
+    groups: dict[bytes, tuple[np.ndarray, list]] = {}  # the cycles' bytes -> (cycles, [(variable, channel)])
+    for variable, channel in plan.compares:
+        index = index_of[id(channel)]
+        last = max(last, int(index[-1]) if len(index) else 0)
+        groups.setdefault(index.tobytes(), (index, []))[1].append((variable, channel))
+    for index, members in groups.values():
+        reference = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in members])
+        reference["time"] = cycle_times(index + shift, step)
+        for variable, channel in members:
+            reference[variable] = channel.values
+        references.append(reference)
+    if inputs is not None:
+        last = max(last, int(cycles[-1]))
+    stop = float(cycle_times(np.array([max(last + shift, 1)]), step)[0])
+    aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step, notes=notes)
+    if coarse:
+        aligned.coarse = _coarse_note(coarse, plan, index_of, step, names)
+    executed = np.unique(np.concatenate([index_of[id(c)] for c in used]))
+    _describe_clock(aligned, recording, used, index_of, grid, executed)
+    if cycle_lengths == "recorded":
+        aligned.replay = _replay(recording, used, index_of, np.arange(round(stop / step)) + 1 - shift, names)
+    return aligned
+
+
+def _describe_clock(aligned, recording, used, index_of, grid, executed):
+    """The fit's figures (Aligned.clock) and words (Aligned.description, a
+    note naming the missing cycles of a recording that samples every cycle)."""
+    jitter = clock.Jitter()
+    for channel in used:
+        jitter.add(grid.distance(channel.times, index_of[id(channel)]))
+    every = _interval(executed)
+    count, first = clock.missing(executed, MOST_NAMED) if every == 1 else (0, [])
+    aligned.grid = grid
+    aligned.clock = clock_figures(grid, jitter, every, count, first)
+    aligned.description = f"jitter {jitter.describe()}"
+    if count:
+        named = ", ".join(str(c) for c in first) + (f" and {count - len(first)} more" if count > len(first) else "")
+        aligned.notes.append(
+            f"{count} of {int(executed[-1] - executed[0]) + 1} cycles have no sample (cycles {named} from the first "
+            "sample's): the OB did not run them (an overrun), or the recorder missed them"
+        )
+
+
+def clock_figures(grid, jitter, every, missing, first_missing):
+    """results.json's "clock" of a recording: the cycle in the recorder's clock and the time of cycle 0
+    (seconds from the first sample), the jitter, the cycles
+    between samples, the missing cycles' count and the first of them."""
+    return {
+        "cycle_s": grid.period,
+        "phase_s": grid.phase,
+        **jitter.settings(),
+        "sampled_every": every,
+        "missing_cycles": missing,
+        "first_missing": first_missing,
+    }
+
+
+def _replay(recording, used, index_of, cycles, names):
+    """(points, sizes) of every step for cycle_lengths 'recorded': step k runs
+    the execution of cycles[k] (k + 1 - shift) for the recorded interval since the
+    execution before it, at the recorder's resolution (whole ticks of its
+    time stamps, each interval one rounding: a TIME in ms is whole ms); the
+    first execution runs a nominal step (nothing before it is recorded); a
+    cycle without a sample gets no doStep (size 0)."""
+    executed = np.unique(np.concatenate([index_of[id(c)] for c in used]))
+    if _interval(executed) > 1:
+        raise InputError(
+            f"{recording.label}: {name_of(names, cycle_lengths='recorded')} replays every execution of the OB, but "
+            f"the recording samples only every {_interval(executed)} cycles: compare with the nominal cycle lengths"
+        )
+    ticks, per_second = _ticks(recording, used)
+    none = np.iinfo(np.int64).max
+    execution = np.full(int(executed[-1]) + 1, none, dtype=np.int64)  # cycle -> its earliest sample's tick
+    for channel in used:
+        np.minimum.at(execution, index_of[id(channel)], ticks[id(channel)])
+    ran = np.flatnonzero((cycles <= executed[-1]) & (execution[np.minimum(cycles, len(execution) - 1)] != none))
+    stamps = execution[cycles[ran]]
+    sizes = np.zeros(len(cycles), dtype=np.float64)
+    if len(ran):
+        sizes[ran[0]] = recording.step_size
+        sizes[ran[1:]] = np.diff(stamps) / per_second
+    if (sizes < 0).any():
+        raise InputError(f"{recording.label}: the recorded executions go back in time")
+    points = np.concatenate([[0.0], np.cumsum(sizes)[:-1]])
+    return points, sizes
+
+
+def _ticks(recording, channels):
+    """({id(channel): its stamps from the recording's origin as whole ticks}, ticks per second): the
+    recorder's resolution, the coarsest power of ten of its unit that makes every stamp whole."""
+    unit = recording.time_unit
+    if unit == "OLE days":  # WinCC stamps in whole ms; OLE days to four decimals of 1e-6 are within 9 us of them
+        return {id(c): np.rint(c.times * 1000).astype(np.int64) for c in channels}, 1000.0
+    elapsed = {id(c): _minus(c.stamps, recording.origin) for c in channels}
+    if unit == "cycles":
+        return {k: np.rint(v).astype(np.int64) for k, v in elapsed.items()}, 1 / recording.step_size
+    per_unit = 1.0 if unit == "s" else TIME_DIVISORS.get(unit) or 1 / TIME_FACTORS[unit]
+    values = np.concatenate(list(elapsed.values()))
+    for digits in range(10):
+        scaled = values * 10.0**digits
+        if np.abs(scaled).max() < 2**53 and np.all(np.abs(scaled - np.rint(scaled)) <= WHOLE):
+            return {k: np.rint(v * 10.0**digits).astype(np.int64) for k, v in elapsed.items()}, per_unit * 10**digits
+    raise InputError(
+        f"{recording.label}: its time stamps have no resolution of a whole power of ten of their unit: the recorded "
+        "cycle lengths cannot be read from them"
     )
 
 
@@ -81,65 +275,14 @@ def _interval(index):
     return int(np.median(np.diff(index)))
 
 
-def align(recording, plan, timing="cycle", label="the FMU", names: Names = ()):
-    """The Aligned of a normalised recording and its Plan; names: the
-    caller's words for the settings (RecordingOptions.names)."""
-    if timing not in TIMINGS:
-        raise InputError(f"timing must be one of {', '.join(TIMINGS)}, not {timing!r}")
-    if not plan.compares:
-        raise InputError(
-            f"{recording.label}: no channel is an output of {label}: nothing to compare (channels: "
-            f"{', '.join(c.name for c in recording.channels)}; map one with "
-            f"{name_of(names, maps=('VARIABLE', 'CHANNEL'))})"
-        )
-    step = recording.step_size
-    notes = list(recording.notes)
-    shift = 1 if timing == "cycle" else 0
-    # inputs: every driven channel held on the union of their sample cycles
-    inputs = None
-    coarse = []
-    if plan.drives:
-        indices = [_cycles_of(channel, step, notes, names) for _, channel in plan.drives]
-        grid = np.unique(np.concatenate(indices))
-        inputs = np.empty(len(grid), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in plan.drives])
-        inputs["time"] = cycle_times(grid, step)
-        for (variable, channel), index in zip(plan.drives, indices, strict=True):
-            where = np.searchsorted(index, grid, side="right") - 1
-            inputs[variable] = channel.values[np.maximum(where, 0)]
-            every = _interval(index)
-            if every > 1:
-                coarse.append((variable, every))
-    references = []
-    last = 0
-    groups: dict[bytes, tuple[np.ndarray, list]] = {}  # the cycles' bytes -> (cycles, [(variable, channel)])
-    for variable, channel in plan.compares:
-        index = _cycles_of(channel, step, notes, names)
-        last = max(last, int(index[-1]) if len(index) else 0)
-        groups.setdefault(index.tobytes(), (index, []))[1].append((variable, channel))
-    for index, members in groups.values():
-        reference = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in members])
-        reference["time"] = cycle_times(index + shift, step)
-        for variable, channel in members:
-            reference[variable] = channel.values
-        references.append(reference)
-    if inputs is not None:
-        last = max(last, int(np.rint(inputs["time"][-1] / step)))
-    stop = float(cycle_times(np.array([max(last + shift, 1)]), step)[0])
-    aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step, notes=notes)
-    if coarse:
-        aligned.coarse = _coarse_note(coarse, plan, step, names)
-    return aligned
-
-
-def _coarse_note(coarse, plan, step, names):
+def _coarse_note(coarse, plan, index_of, step, names):
     """What inputs sampled every N cycles mean, and a tolerance that is."""
     every = max(n for _, n in coarse)
     sampled = ", ".join(f"{v} every {n} cycles" for v, n in coarse)
     lag = float(cycle_times(np.array([every - 1]), step)[0])
     spans = []
     for variable, channel in plan.compares:
-        index = np.rint(channel.times / step)
-        gaps = np.diff(index)
+        gaps = np.diff(index_of[id(channel)])
         moves = np.abs(np.diff(channel.values))
         ok = (gaps > 0) & np.isfinite(moves)
         if ok.any():

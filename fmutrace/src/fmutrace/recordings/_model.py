@@ -39,6 +39,7 @@ class Recording:
     step_size: float | None = None  # set by normalise()
     step_source: str = ""
     unit_given: bool = False  # the caller gave the time unit (set by normalise())
+    origin: object = None  # the stamp that is time 0 (set by normalise())
 
     @property
     def label(self):

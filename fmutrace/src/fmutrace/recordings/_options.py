@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 from .._errors import InputError
 from .._names import Names, name_of
-from ._align import TIMINGS
+from ._align import CYCLE_LENGTHS, TIMINGS
 
 TIME_UNITS = ("s", "ms", "us", "ns", "cycles", "filetime")
 
@@ -29,6 +29,11 @@ class RecordingOptions:
     timing        'cycle': a row is the input a cycle read and the output it
                   produced, as recorders write it; 'fmi': a row's output is
                   the output at its time, as fmpy writes it
+    cycle_lengths 'nominal': every step is step_size long, whatever the
+                  stamps' jitter; 'recorded': each recorded execution of
+                  the OB is one step as long as the recorded interval since
+                  the one before (blocks that measure elapsed time see the
+                  jitter), a cycle without a sample no step
     maps          {VARIABLE: CHANNEL} (or pairs): the channel that is the
                   FMU's variable
     start_values  {name: value} (or pairs): start values of the FMU
@@ -44,6 +49,7 @@ class RecordingOptions:
     timing: str = "cycle"
     maps: tuple = ()
     start_values: tuple = ()
+    cycle_lengths: str = "nominal"
     names: Names = field(default=(), compare=False)  # stored as pairs
 
     def __post_init__(self):
@@ -58,6 +64,11 @@ class RecordingOptions:
             raise InputError(
                 f"{name_of(self.names, 'timing')} must be one of {', '.join(TIMINGS)}, not {self.timing!r}"
             )
+        if self.cycle_lengths not in CYCLE_LENGTHS:
+            raise InputError(
+                f"{name_of(self.names, 'cycle_lengths')} must be one of {', '.join(CYCLE_LENGTHS)}, "
+                f"not {self.cycle_lengths!r}"
+            )
         if self.step_size is not None and not self.step_size > 0:
             raise InputError(f"{name_of(self.names, 'step_size')} must be greater than 0, not {self.step_size!r}")
 
@@ -71,6 +82,7 @@ class RecordingOptions:
             "step_size": self.step_size,
             "time_unit": self.time_unit,
             "timing": self.timing,
+            "cycle_lengths": self.cycle_lengths,
             "maps": [list(m) for m in self.maps],
             "start_values": [list(s) for s in self.start_values],
         }

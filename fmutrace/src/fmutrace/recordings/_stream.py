@@ -38,6 +38,7 @@ from .._traces import UNUSUAL_LINE_BREAKS, NotPlain, float64_values
 from . import TEXT_FORMATS, _mdf as mdf, _tables as tables
 from . import _grid as grids
 from . import _text as texts
+from . import _clock as clock
 from . import _timebase as timebase
 
 HEAD_BYTES = 1 << 20  # read as the in-memory path reads a whole file
@@ -78,9 +79,7 @@ class Table:
         timebase.normalise(recording, options.timebase_unit, options.step_size, fmu.default_step, options.names)
         self.recording = recording
         self.origin = float(recording.channels[0].stamps[0])
-        self.step_given = (
-            recording.time_unit == "cycles" or recording.step_source != "the finest interval between its time stamps"
-        )
+        self.step_given = recording.time_unit == "cycles" or recording.step_source != timebase.FINEST
         # the body starts after the header's line (index: 0-based), counted in bytes of the head
         start = 0
         for _ in range(index + 1):
@@ -217,8 +216,7 @@ class Cycles:
 
     rows: int
     last: int  # the last row's cycle
-    off: int  # rows stamped more than OFF_CYCLE of a cycle off its end
-    first_off: tuple | None  # (line, seconds) of the first of them, or None
+    grid: clock.Grid  # the cycles the rows sit on (the recorder's clock): row k is cycle k
 
 
 def time_column_pass(table, step, block_bytes=None):
@@ -226,18 +224,26 @@ def time_column_pass(table, step, block_bytes=None):
     its cells converted), by the rules normalise applies to a whole
     recording: the step its intervals give (unless one was given) is the
     head's, its length is no misread unit; and by the stream's own: every
-    row the cycle after the one before. NotPlain otherwise."""
+    row the cycle after the one before, on the grid of cycles the rows
+    before it fit (clock.Line: the in-memory path's fit, on a recording
+    of a row per cycle; the run checks each row on the whole file's grid,
+    the pass each block on its rows' once they are SEARCH_WINDOW).
+    NotPlain otherwise."""
     recording = table.recording
     intervals = timebase.Intervals()
-    rows, expected, off, first_off, span = 0, 0, 0, None, 0.0
-    for _, _, line_numbers, times in table.blocks(block_bytes, time_only=True):
-        index, late = timebase.cycles(times, step)
-        if index[0] != expected or (np.diff(index) != 1).any():
-            raise NotPlain("a repeated or skipped cycle")
-        expected = int(index[-1]) + 1
-        if len(late) and first_off is None:
-            first_off = (int(line_numbers[late[0]]), float(times[late[0]]))
-        off += len(late)
+    line = clock.Line()
+    rows, span = 0, 0.0
+    first: list[np.ndarray] = []  # the first SEARCH_WINDOW rows' times: checked once their line is known
+    for _, _, _, times in table.blocks(block_bytes, time_only=True):
+        index = np.arange(rows, rows + len(times))
+        if line.count >= clock.SEARCH_WINDOW:
+            _on_their_cycles(line.grid(step), index, times)
+        else:
+            first.append(times)
+        line.add(index, times)
+        if first and line.count >= clock.SEARCH_WINDOW:
+            _on_their_cycles(line.grid(step), np.arange(line.count), np.concatenate(first))
+            first = []
         rows, span = rows + len(times), float(times[-1])
         if not table.step_given:
             intervals.add(times)
@@ -247,4 +253,16 @@ def time_column_pass(table, step, block_bytes=None):
         raise NotPlain("the whole file's interval is another step than its head's")
     if timebase.too_long(span) or timebase.too_many_steps(span / step, rows, recording.unit_given):
         raise NotPlain("the in-memory path refuses the length")
-    return Cycles(rows, expected - 1, off, first_off)
+    grid = line.grid(step)
+    if first:
+        _on_their_cycles(grid, np.arange(line.count), np.concatenate(first))
+    if clock.restep(grid, step) != step:
+        raise NotPlain("the rows fit another step than their finest interval (the in-memory path says)")
+    return Cycles(rows, rows - 1, grid)
+
+
+def _on_their_cycles(grid, index, times):
+    """NotPlain unless each row's nearest cycle on grid is its own: a
+    repeated or skipped cycle, time going back."""
+    if not np.array_equal(grid.index(times), index):
+        raise NotPlain("a repeated or skipped cycle")

@@ -28,6 +28,7 @@ from ._model import TIME_DIVISORS, TIME_FACTORS
 OFF_CYCLE = 0.1  # a stamp more than this fraction of a cycle from a cycle end is reported
 MAX_SPARSE = 100  # and so are samples this many steps apart on average (unless the caller gave the unit)
 MAX_SPAN = 366 * 86400.0  # and so is a recording over a year long
+FINEST = "the finest interval between its time stamps"  # a step's source: the channels' median intervals
 SNAP = 1e-3  # an interval between stamps this close to a shorter decimal is that decimal
 UNIT_WORDS = {
     "s": "s",
@@ -208,6 +209,7 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
             else "the FMU's default step size"
         )
     origin = min(c.stamps[0] for c in channels)
+    recording.origin = origin
     for channel in recording.channels:
         channel.times = seconds(_minus(channel.stamps, origin), unit, recording.step_size)
     span = max(float(c.times[-1]) for c in channels)
@@ -238,7 +240,7 @@ def normalise(recording, time_unit=None, step_size=None, default_step=None, name
                     )
                 step, source = default_step, "the FMU's default step size"
             else:
-                source = "the finest interval between its time stamps"
+                source = FINEST
             recording.step_size, recording.step_source = step, source
     steps = span / recording.step_size
     samples = max(len(c.times) for c in channels)
