@@ -226,6 +226,46 @@ def plain_space():
     return "\n".join(lines) + "\n"
 
 
+def modbusscope():
+    """ModbusScope's data file (File > Export Data...), as its DataFileExporter writes it (the
+    jgeudens/ModbusScope repository at 3.2.1, src/importexport/datafileexporter.cpp, read for its
+    layout): comment lines '//' of the log's settings (one TCP connection), an empty '//' line, the
+    rows Property, Register Address, Color, Expression and ConnectionId, '//', the notes (none: an
+    empty line), '//', then the label row 'Time (ms)' and a line per poll: the time in whole ms since
+    logging started, the values to at most three decimals. The locale's decimal mark is ',', so the
+    separator is ';'. Register 40001 (the PLC writes y * 100 into it) is plotted three times, each
+    with the default label 'Register 40001' and its own expression: the raw count, y and y in per
+    minute; Register 40002 is u * 100, shown as u. The poll interval is the PLC's cycle, polled 12 ms
+    after logging started, each poll in step with the PLC. Written on Windows (CR LF)."""
+    y, u = RATE_LIMITER["y"], RATE_LIMITER["u"]
+    lines = [
+        "//ModbusScope version;3.2.1",
+        "//Start time;20-11-2026 14:00:00",
+        "//End time;20-11-2026 14:00:04",
+        "//Settings (Connection ID 1);192.168.0.10:502",
+        "//Slave ID (Connection ID 1);1",
+        "//Time-out (Connection ID 1);1000",
+        "//Consecutive max (Connection ID 1);125",
+        "//Poll interval;250",
+        f"//Communication success;{len(y)}",
+        "//Communication errors;0",
+        "//",
+        "//Property;Register 40001;Register 40001;Register 40001;Register 40002",
+        "//Register Address;40001;40001;40001;40002",
+        "//Color;#000000;#0000ff;#00ffff;#00ff00",
+        '//Expression;"VAL";"VAL/100";"VAL*60/100";"VAL/100"',
+        "//ConnectionId;0;0;0;0",
+        "//",
+        "",
+        "//",
+        "Time (ms);Register 40001;Register 40001;Register 40001;Register 40002",
+    ]
+    for k in range(len(y)):
+        cells = [y[k] * 100, y[k], y[k] * 60, u[k]]
+        lines.append(f"{12 + k * 250};" + ";".join(_num(c, True) for c in cells))
+    return "\r\n".join(lines) + "\r\n"  # a Windows PC's: the exporter's text mode writes CR LF
+
+
 SAMPLES = {
     # file: (text, encoding)
     "twincat_siemens.csv": (twincat_every_cycle, "utf-8"),
@@ -239,6 +279,7 @@ SAMPLES = {
     "niagara_siemens/history_3.csv": (lambda: niagara("delayedValue"), "utf-8"),
     "plain_ratelimiter.tsv": (plain_tab, "utf-8"),
     "plain_ratelimiter_spaces.txt": (plain_space, "utf-8"),
+    "modbusscope_ratelimiter.csv": (modbusscope, "utf-8"),
 }
 
 
