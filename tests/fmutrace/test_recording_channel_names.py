@@ -6,6 +6,7 @@ ModbusScope sample (tests/recordings/samples.py: modbusscope, written from
 ModbusScope's data file exporter's layout), on small files written here
 and on an MDF 2 file of asammdf's own writer."""
 
+import json
 import sys
 from pathlib import Path
 from types import SimpleNamespace
@@ -25,7 +26,7 @@ sys.path.insert(0, str(SAMPLES))
 import samples  # noqa: E402  (the generator beside the samples)
 
 MODBUSSCOPE = SAMPLES / "modbusscope_ratelimiter.csv"
-RATE_LIMITER = BUILD_DIR / "fmi3" / "RateLimiter.fmu"
+RATE_LIMITER = {v: BUILD_DIR / f"fmi{v}" / "RateLimiter.fmu" for v in (2, 3)}
 FMUTRACE = Path(sys.executable).parent / "fmutrace"
 SHARED = "Register 40001"
 
@@ -118,16 +119,20 @@ def test_a_bad_cell_of_a_same_named_column_names_its_file_line_and_column(tmp_pa
     assert "'1.0.0'" in str(error.value) and SHARED in str(error.value)
 
 
-def test_the_modbusscope_sample_compares_its_chosen_column_exactly(tmp_path):
-    """End to end: y is the column that holds y (3); the raw count in column 2 fails at cycle 1."""
-    done = compare(RATE_LIMITER, MODBUSSCOPE, "--map", "y=#3", "--map", "u=Register 40002")
+@pytest.mark.parametrize("version", [2, 3])
+def test_the_modbusscope_sample_compares_its_chosen_column_exactly(version, tmp_path):
+    """End to end: y is the column that holds y (3); the raw count in column 2 fails at cycle 1. The
+    file is read in blocks (streamed), whose columns are found by the channels' names."""
+    fmu = RATE_LIMITER[version]
+    done = compare(fmu, MODBUSSCOPE, "--map", "y=#3", "--map", "u=Register 40002", "--report", tmp_path)
     assert done.returncode == 0, done.stdout + done.stderr
+    assert json.loads((tmp_path / "results.json").read_text())["cases"][0]["streamed"] is True
     assert "ModbusScope data file" in done.stdout and "y <- Register 40001#3" in done.stdout
-    done = compare(RATE_LIMITER, MODBUSSCOPE, "--map", "y=Register 40001#2", "--map", "u=Register 40002")
+    done = compare(fmu, MODBUSSCOPE, "--map", "y=Register 40001#2", "--map", "u=Register 40002")
     assert done.returncode == 1, done.stdout + done.stderr
     assert "y <- Register 40001#2" in done.stdout
     assert f"y first differs at the recording's sample of cycle 1 ({MODBUSSCOPE}, line 22" in done.stdout
-    done = compare(RATE_LIMITER, MODBUSSCOPE, "--map", f"y={SHARED}", "--map", "u=Register 40002")
+    done = compare(fmu, MODBUSSCOPE, "--map", f"y={SHARED}", "--map", "u=Register 40002")
     assert done.returncode == 2 and "--map y=Register 40001: 3 channels of" in done.stdout + done.stderr
 
 
