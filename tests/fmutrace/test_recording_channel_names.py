@@ -71,9 +71,9 @@ def test_a_map_by_the_shared_name_is_refused_with_every_candidate_and_how_to_cho
     with pytest.raises(InputError) as error:
         plan(recording, RATE_LIMITER_VARIABLES, "RateLimiter", [("y", SHARED)], names=FLAGS)
     assert str(error.value) == (
-        f"--map y=Register 40001: 3 channels of {MODBUSSCOPE} are 'Register 40001': 'Register 40001#2' "
+        f"--map \"y=Register 40001\": 3 channels of {MODBUSSCOPE} are 'Register 40001': 'Register 40001#2' "
         "(column 2); 'Register 40001#3' (column 3); 'Register 40001#4' (column 4); "
-        "map one by its name, e.g. --map y=Register 40001#2, or by its column, e.g. --map y=#2"
+        'map one by its name, e.g. --map "y=Register 40001#2", or by its column, e.g. --map y=#2'
     )
     with pytest.raises(InputError) as error:  # a Python caller's words
         plan(recording, RATE_LIMITER_VARIABLES, "RateLimiter", [("y", SHARED)])
@@ -133,7 +133,7 @@ def test_the_modbusscope_sample_compares_its_chosen_column_exactly(version, tmp_
     assert "y <- Register 40001#2" in done.stdout
     assert f"y first differs at the recording's sample of cycle 1 ({MODBUSSCOPE}, line 22" in done.stdout
     done = compare(fmu, MODBUSSCOPE, "--map", f"y={SHARED}", "--map", "u=Register 40002")
-    assert done.returncode == 2 and "--map y=Register 40001: 3 channels of" in done.stdout + done.stderr
+    assert done.returncode == 2 and '--map "y=Register 40001": 3 channels of' in done.stdout + done.stderr
 
 
 # -- the same rule for every reader ------------------------------------------------------
