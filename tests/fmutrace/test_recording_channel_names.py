@@ -98,7 +98,7 @@ def test_a_same_named_column_is_chosen_by_its_column_or_its_name_made_unique(cho
 
 def test_a_map_to_a_column_that_holds_no_channel_names_the_columns_there_are():
     recording = read_one(MODBUSSCOPE)
-    for column in ("#1", "#6"):  # the time column; past the last
+    for column in ("#0", "#1", "#6"):  # before the first; the time column; past the last
         with pytest.raises(InputError) as error:
             plan(recording, RATE_LIMITER_VARIABLES, "RateLimiter", [("y", column)], names=FLAGS)
         assert str(error.value) == (
@@ -226,8 +226,9 @@ def test_mdf_channels_of_one_name_in_several_groups_are_each_kept_and_chosen_by_
     )
     result = plan(recording, RATE_LIMITER_VARIABLES, "M", [("y", "y#2")])
     assert [(v, c.values.tolist()) for v, c in result.compares] == [("y", [5.0, 6.0])]
-    with pytest.raises(InputError, match=r"has no channel in column 2 \(its channels have no columns \(MDF\)"):
-        plan(recording, RATE_LIMITER_VARIABLES, "M", [("y", "#2")])
+    for column in ("#0", "#2"):
+        with pytest.raises(InputError, match=r"has no channel in column \d \(its channels have no columns \(MDF\)"):
+            plan(recording, RATE_LIMITER_VARIABLES, "M", [("y", column)])
 
 
 def test_a_modbusscope_file_with_absolute_times_reads_its_day_first_dates(tmp_path):

@@ -90,7 +90,7 @@ def _candidates(recording, wanted):
         return exact
     column = _at_column(wanted)
     if column is not None:
-        return [c for c in recording.channels if c.column == column]
+        return [c for c in recording.channels if c.column and c.column == column]  # (MDF's are 0: none)
     return [c for c in recording.channels if wanted in _last_components(c)]
 
 
