@@ -61,8 +61,8 @@ def test_a_modbusscope_data_file_keeps_its_three_same_named_columns():
     y, u = samples.RATE_LIMITER["y"], samples.RATE_LIMITER["u"]
     raw, value, per_minute, drive = (c.values.tolist() for c in recording.channels)
     assert raw == [v * 100 for v in y] and value == y and per_minute == [v * 60 for v in y] and drive == u
-    # the label row is line 20 (after the comments, an empty notes line and '//'): samples from line 21
-    assert all(c.lines.tolist() == list(range(21, 21 + len(y))) for c in recording.channels)
+    # the label row is line 19 (after the comments, a note and '//'): samples from line 20
+    assert all(c.lines.tolist() == list(range(20, 20 + len(y))) for c in recording.channels)
     assert recording.channels[0].stamps.tolist() == [12 + 250 * k for k in range(len(y))]
 
 
@@ -109,13 +109,13 @@ def test_a_map_to_a_column_that_holds_no_channel_names_the_columns_there_are():
 
 def test_a_bad_cell_of_a_same_named_column_names_its_file_line_and_column(tmp_path):
     lines = MODBUSSCOPE.read_text().splitlines()
-    assert lines[24] == "1012;100;1;60;2"
-    lines[24] = "1012;100;1.0.0;60;2"
+    assert lines[23] == "1012;100;1;60;2"
+    lines[23] = "1012;100;1.0.0;60;2"
     path = tmp_path / "bad.csv"
     path.write_text("\r\n".join(lines) + "\r\n")
     with pytest.raises(TraceError) as error:
         read_recording(path)
-    assert (error.value.path, error.value.line, error.value.column) == (str(path), 25, 3)
+    assert (error.value.path, error.value.line, error.value.column) == (str(path), 24, 3)
     assert "'1.0.0'" in str(error.value) and SHARED in str(error.value)
 
 
@@ -131,7 +131,7 @@ def test_the_modbusscope_sample_compares_its_chosen_column_exactly(version, tmp_
     done = compare(fmu, MODBUSSCOPE, "--map", "y=Register 40001#2", "--map", "u=Register 40002")
     assert done.returncode == 1, done.stdout + done.stderr
     assert "y <- Register 40001#2" in done.stdout
-    assert f"y first differs at the recording's sample of cycle 1 ({MODBUSSCOPE}, line 22" in done.stdout
+    assert f"y first differs at the recording's sample of cycle 1 ({MODBUSSCOPE}, line 21" in done.stdout
     done = compare(fmu, MODBUSSCOPE, "--map", f"y={SHARED}", "--map", "u=Register 40002")
     assert done.returncode == 2 and '--map "y=Register 40001": 3 channels of' in done.stdout + done.stderr
 
@@ -236,7 +236,7 @@ def test_a_modbusscope_file_with_absolute_times_reads_its_day_first_dates(tmp_pa
     the ms (its FormatDateTime) in the column still labelled 'Time (ms)'."""
     path = tmp_path / "absolute.csv"
     path.write_text(
-        "//ModbusScope version;3.2.1\r\n//\r\nTime (ms);Register 40001;Register 40001\r\n"
+        "//ModbusScope version;3.6.0\r\n//\r\nTime (ms);Register 40001;Register 40001\r\n"
         "01/02/2026 23:59:59,900;0;0\r\n02/02/2026 00:00:00,150;25;0,25\r\n"
     )
     recording = normalise(read_one(path))
