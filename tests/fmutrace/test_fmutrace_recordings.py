@@ -161,7 +161,7 @@ def bad(tmp_path, name, text, *options, encoding="utf-8"):
 
 def test_a_file_of_no_known_format_says_which_formats_were_tried(tmp_path):
     said = bad(tmp_path, "notes.txt", "Commissioning notes\nthe ramp looked fine\n")
-    assert "notes.txt: no known recording format; tried ASAM MDF (3 or 4): not MDF" in said
+    assert "notes.txt: no known recording format; tried ASAM MDF (2, 3 or 4): not MDF" in said
     for name in (
         "Beckhoff TwinCAT Scope View CSV: no channel header block",
         "WinCC data log CSV: no header",

@@ -142,7 +142,7 @@ PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"  # y is u, 
 def test_a_scope_view_export_through_the_command_on_the_channels_mapped(tmp_path):
     """The default export: var_REAL32 sampled every 1 ms, func_OS (unmapped) every 0.2 ms. Mapped to
     PassThrough's u and y it passes with the 1 ms step of the mapped channel; its symbol, which nine
-    channels share, is refused, each of them named."""
+    channels share, is refused, each of them named, and one of them is chosen by its column."""
     path = _unpacked("pytcs/tc3_scope_3_4_3145_3-default.csv.gz", tmp_path)
 
     def compare(*maps):
@@ -156,7 +156,12 @@ def test_a_scope_view_export_through_the_command_on_the_channels_mapped(tmp_path
     assert done.returncode == 2, done.stdout + done.stderr
     assert "--map y=MAIN.var_REAL: 9 channels of" in done.stderr
     assert "'func_scaled' (symbol 'MAIN.var_REAL', column 26)" in done.stderr
-    assert done.stderr.rstrip().endswith("map one by its name, e.g. --map y=var_REAL32")
+    assert done.stderr.rstrip().endswith(
+        "map one by its name, e.g. --map y=var_REAL32, or by its column, e.g. --map y=#20"
+    )
+    done = compare("u=#20", "y=var_REAL32")  # var_REAL32 by its column
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "u <- var_REAL32" in done.stdout
 
 
 def test_a_map_to_a_can_logger_channel_without_samples_says_so():

@@ -334,7 +334,7 @@ def test_a_file_of_no_known_format_says_what_was_tried_and_why_not(tmp_path):
     with pytest.raises(TraceError) as error:
         read_file(path)
     message = str(error.value)
-    assert message.startswith(f"{path}: no known recording format; tried ASAM MDF (3 or 4): not MDF")
+    assert message.startswith(f"{path}: no known recording format; tried ASAM MDF (2, 3 or 4): not MDF")
     for name in FORMAT_NAMES:
         assert f"{name}: " in message
     assert "no channel header block" in message and "VarName, TimeString" in message
@@ -651,7 +651,7 @@ def test_a_map_to_a_symbol_several_channels_share_is_refused_naming_each(tmp_pat
     assert str(error.value) == (
         f"--map y=MAIN.var_REAL: 2 channels of {path} are 'MAIN.var_REAL': 'var_REAL32' (symbol "
         "'MAIN.var_REAL', column 2); 'func_scaled' (symbol 'MAIN.var_REAL', column 4); map one by its name, "
-        "e.g. --map y=var_REAL32"
+        "e.g. --map y=var_REAL32, or by its column, e.g. --map y=#2"
     )
     chosen = plan(recording, variables, "M", [("y", "func_scaled")])
     assert [(v, c.name) for v, c in chosen.compares] == [("y", "func_scaled")]

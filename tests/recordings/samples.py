@@ -226,6 +226,47 @@ def plain_space():
     return "\n".join(lines) + "\n"
 
 
+def modbusscope():
+    """ModbusScope's data file (File > Export Data...), as its DataFileExporter writes it from version
+    3.6.0 on (the ModbusScope/ModbusScope repository at tag 3.6.0,
+    src/importexport/datafileexporter.cpp, read for its layout): comment lines '//' of the log's
+    settings (one TCP connection), '//', the rows Property, Color, Expression and Axis (0 the left
+    value axis, 1 the right), '//', the notes with a '//' after them, then the label row 'Time (ms)'
+    and a line per poll: the time in whole ms since logging started, the values to at most three
+    decimals. The locale's decimal mark is ',', so the separator is ';'; written on Windows (the
+    exporter's text mode: CR LF). Register 40001 (the PLC writes y * 100 into it) is plotted three
+    times, each labelled 'Register 40001' with its own expression and axis: the raw count, y, and y
+    per minute on the right axis (the label row is line 19, as in the export the issue saw refused);
+    Register 40002 is u * 100, shown as u. The poll interval is the PLC's cycle, polled 12 ms after
+    logging started, each poll in step with the PLC."""
+    y, u = RATE_LIMITER["y"], RATE_LIMITER["u"]
+    lines = [
+        "//ModbusScope version;3.6.0",
+        "//Start time;20-11-2026 14:00:00",
+        "//End time;20-11-2026 14:00:04",
+        "//Settings (Connection ID 1);192.168.0.10:502",
+        "//Slave ID (Connection ID 1);1",
+        "//Time-out (Connection ID 1);1000",
+        "//Consecutive max (Connection ID 1);125",
+        "//Poll interval;250",
+        f"//Communication success;{len(y)}",
+        "//Communication errors;0",
+        "//",
+        "//Property;Register 40001;Register 40001;Register 40001;Register 40002",
+        "//Color;#000000;#0000ff;#00ffff;#00ff00",
+        '//Expression;"${40001}";"${40001}/100";"${40001}*60/100";"${40002}/100"',
+        "//Axis;0;0;1;0",
+        "//",
+        '//Note;2012;2;"y reaches u"',
+        "//",
+        "Time (ms);Register 40001;Register 40001;Register 40001;Register 40002",
+    ]
+    for k in range(len(y)):
+        cells = [y[k] * 100, y[k], y[k] * 60, u[k]]
+        lines.append(f"{12 + k * 250};" + ";".join(_num(c, True) for c in cells))
+    return "\r\n".join(lines) + "\r\n"
+
+
 SAMPLES = {
     # file: (text, encoding)
     "twincat_siemens.csv": (twincat_every_cycle, "utf-8"),
@@ -239,6 +280,7 @@ SAMPLES = {
     "niagara_siemens/history_3.csv": (lambda: niagara("delayedValue"), "utf-8"),
     "plain_ratelimiter.tsv": (plain_tab, "utf-8"),
     "plain_ratelimiter_spaces.txt": (plain_space, "utf-8"),
+    "modbusscope_ratelimiter.csv": (modbusscope, "utf-8"),
 }
 
 

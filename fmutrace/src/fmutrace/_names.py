@@ -66,5 +66,9 @@ def _text(value, flag):
         return shortest(value)
     if isinstance(value, tuple):
         name, setting = value
-        return f"{name}={setting}" if flag else f"{{{name!r}: {setting!r}}}"
+        if not flag:
+            return f"{{{name!r}: {setting!r}}}"
+        pair = f"{name}={setting}"
+        # quoted where blanks would split it: as a shell (bash, cmd, PowerShell) takes it back
+        return f'"{pair}"' if any(c.isspace() for c in pair) else pair
     return str(value) if flag else repr(value)

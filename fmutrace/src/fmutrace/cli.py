@@ -216,8 +216,8 @@ def parser():
         action="append",
         type=_assignment,
         default=[],
-        help="the channel that is the FMU's variable (repeatable; default: the channel whose name's "
-        "last component is the variable's name)",
+        help="the channel that is the FMU's variable: its name, or #N for the one in column N "
+        "(repeatable; default: the channel whose name's last component is the variable's name)",
     )
     rec.add_argument(
         FLAGS["start_values"],

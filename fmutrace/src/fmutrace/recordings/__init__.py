@@ -4,12 +4,12 @@ normalised, columnar Recording (recordings._model) whatever the recorder.
 The format is recognised from the content, in this order (the first that
 fits reads the file):
 
-  ASAM MDF 4 and 3                       mdf.py
+  ASAM MDF 4, 3 and 2                    mdf.py
   Beckhoff TwinCAT Scope View CSV        twincat.py
   WinCC data log CSV                     vendors.py
   Niagara history export (one point)     vendors.py
   CODESYS 2.3 trace (ASCII file)         vendors.py
-  tables: TIA Portal trace CSV, CODESYS V3 export, plain CSV/TSV   tables.py
+  tables: TIA Portal trace CSV, CODESYS V3 export, ModbusScope data file, plain CSV/TSV   tables.py
 
 A file none of them fits is a TraceError that says, for each, why not.
 """
@@ -31,7 +31,7 @@ TEXT_FORMATS = (
     ("CODESYS 2.3 trace (ASCII file)", vendors.sniff_codesys23, vendors.read_codesys23),
     ("table (TIA Portal trace CSV, CODESYS V3 export, CSV/TSV)", tables.sniff, tables.read),
 )
-FORMAT_NAMES = ("ASAM MDF (3 or 4)",) + tuple(name for name, _, _ in TEXT_FORMATS)
+FORMAT_NAMES = ("ASAM MDF (2, 3 or 4)",) + tuple(name for name, _, _ in TEXT_FORMATS)
 
 __all__ = [
     "Channel",

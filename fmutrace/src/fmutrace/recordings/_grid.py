@@ -4,6 +4,7 @@ an empty cell is no sample of that channel (recorders leave cells empty
 where a channel sampled less often)."""
 
 import operator
+from collections import Counter
 from typing import NamedTuple
 
 import numpy as np
@@ -117,3 +118,28 @@ def channel_from(text, cells, table_rows: Rows, column, name, decimal_comma):
     rows = np.flatnonzero(has)
     values = texts.values(cells[rows], decimal_comma, text, lambda i: int(lines[rows[i]]), column, name)
     return Channel(name=name, stamps=stamps[rows], values=values, file=text.path, column=column, lines=lines[rows])
+
+
+def unique_names(channels):
+    """The channels of one file, those that share a name each named by its
+    position too: NAME#COLUMN in a text file, NAME#K (the K-th of that
+    name) where there are no columns (MDF); the name as written is kept
+    in written. A recorder writes a name twice where one variable is
+    recorded twice (ModbusScope: a register plotted on three axes, each
+    with its own expression): every one of them is kept, and a map or a
+    report names one alone. A made name that another channel has already
+    gets its position again."""
+    counts = Counter(c.name for c in channels)
+    taken = set(counts)
+    seen: Counter = Counter()
+    for channel in channels:
+        if counts[channel.name] < 2:
+            continue
+        seen[channel.name] += 1
+        position = channel.column or seen[channel.name]
+        unique = f"{channel.name}#{position}"
+        while unique in taken:
+            unique += f"#{position}"
+        taken.add(unique)
+        channel.written, channel.name = channel.name, unique
+    return channels

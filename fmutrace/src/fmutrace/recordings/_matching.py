@@ -5,9 +5,12 @@ MAIN.fbRamp.delayedValue, "DB_Ramp".delayedValue and
 Application.PLC_PRG.fbRamp.delayedValue all mean delayedValue (the same
 name in another case too, when that is the only such variable). A map
 (RecordingOptions.maps; the command's --map VARIABLE=CHANNEL) says it
-where the names differ. A channel of an input or a tunable parameter
-drives the FMU, one of an output is compared, any other is listed as
-ignored with the reason."""
+where the names differ: CHANNEL is a channel's name (channels of a file
+that share a name are NAME#COLUMN, _grid.unique_names), its name as
+written or symbol, or #N, the channel in column N. A CHANNEL that means
+several channels is refused with each of them and how to name one. A
+channel of an input or a tunable parameter drives the FMU, one of an
+output is compared, any other is listed as ignored with the reason."""
 
 from dataclasses import dataclass, field
 
@@ -69,32 +72,63 @@ def _role(variable):
     return None, f"a {variable.variability} {variable.causality} of the FMU: it can neither drive nor be compared"
 
 
+def _at_column(wanted):
+    """N of a map's CHANNEL written #N (the channel in column N), else None."""
+    return int(wanted[1:]) if wanted[:1] == "#" and wanted[1:].isdigit() else None
+
+
 def _candidates(recording, wanted):
     """The channels a map's CHANNEL may mean: the one of that name, else
-    those of that symbol, else those whose name's or symbol's last
-    component it is; more than one is ambiguous."""
+    those of that name as written or symbol, else the one in column N for
+    #N, else those whose name's or symbol's last component it is; more
+    than one is ambiguous."""
     named = [c for c in recording.channels if c.name == wanted]
     if len(named) == 1:
         return named
-    exact = [c for c in recording.channels if wanted in (c.name, c.symbol)]
+    exact = [c for c in recording.channels if wanted in (c.name, c.symbol, c.written)]
     if exact:
         return exact
-    return [c for c in recording.channels if wanted in (last_component(c.name), last_component(c.symbol or c.name))]
+    column = _at_column(wanted)
+    if column is not None:
+        return [c for c in recording.channels if c.column and c.column == column]  # (MDF's are 0: none)
+    return [c for c in recording.channels if wanted in _last_components(c)]
+
+
+def _last_components(channel):
+    """The last components of a channel's symbol, name as written and name: the variable each may mean."""
+    names = (channel.symbol, channel.written, channel.name)
+    return list(dict.fromkeys(last_component(n) for n in names if n))
+
+
+def _where(recording, channel):
+    """A candidate's symbol and column (of its file where the recording has several), or its file."""
+    said = [f"symbol {channel.symbol!r}"] if channel.symbol else []
+    if not channel.column:
+        return ", ".join(said + [f"in {channel.file}"])
+    of = f" of {channel.file}" if len(recording.paths) > 1 else ""
+    return ", ".join(said + [f"column {channel.column}{of}"])
+
+
+def _means_only(recording, wanted, channel):
+    """Whether a map's CHANNEL wanted means that channel alone."""
+    found = _candidates(recording, wanted)
+    return len(found) == 1 and found[0] is channel
 
 
 def _ambiguous(recording, mapping, candidates, names):
     """The refusal of a map that means several channels: each of them, and how to name one."""
     variable, wanted = mapping
-    listed = "; ".join(
-        f"{c.name!r} ("
-        + (f"symbol {c.symbol!r}, " if c.symbol else "")
-        + (f"column {c.column})" if c.column else f"in {c.file})")
-        for c in candidates
-    )
-    unique = [c for c in candidates if sum(o.name == c.name for o in recording.channels) == 1]
+    listed = "; ".join(f"{c.name!r} ({_where(recording, c)})" for c in candidates)
+    alone = [c for c in candidates if _means_only(recording, c.name, c)]
+    at_column = [c for c in candidates if c.column and _means_only(recording, f"#{c.column}", c)]
+    ways = []
+    if alone:
+        ways.append(f"by its name, e.g. {name_of(names, maps=(variable, alone[0].name))}")
+    if at_column:
+        ways.append(f"by its column, e.g. {name_of(names, maps=(variable, f'#{at_column[0].column}'))}")
     how = (
-        f"map one by its name, e.g. {name_of(names, maps=(variable, unique[0].name))}"
-        if unique
+        "map one " + ", or ".join(ways)
+        if ways
         else "their names are not unique either: export them under names of their own"
     )
     return InputError(
@@ -115,6 +149,19 @@ def _all_mean(recording, variable, found, names):
     )
 
 
+def _missing(recording, mapping, names):
+    """The refusal of a map whose CHANNEL means no channel: the channels there are (with their columns for #N)."""
+    wanted = mapping[1]
+    if _at_column(wanted) is None:
+        there = ", ".join(c.name for c in recording.channels)
+        missing = f"no channel {wanted!r} (its channels: {there})"
+    else:
+        columns = [f"{c.name} (column {c.column})" for c in recording.channels if c.column]
+        there = ", ".join(columns) if columns else "its channels have no columns (MDF): name one"
+        missing = f"no channel in column {wanted[1:]} ({there})"
+    return InputError(f"{name_of(names, maps=mapping)}: {recording.label} has {missing}")
+
+
 def plan(recording, variables, label, maps=(), names: Names = ()):
     """The Plan of a recording for an FMU whose variables (name ->
     fmpy ScalarVariable) are given; maps: (VARIABLE, CHANNEL) pairs;
@@ -125,10 +172,7 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
             raise InputError(f"{name_of(names, maps=(variable, wanted))}: {label} has no variable {variable!r}")
         candidates = _candidates(recording, wanted)
         if not candidates:
-            raise InputError(
-                f"{name_of(names, maps=(variable, wanted))}: {recording.label} has no channel {wanted!r} "
-                f"(its channels: {', '.join(c.name for c in recording.channels)})"
-            )
+            raise _missing(recording, (variable, wanted), names)
         if len(candidates) > 1:
             raise _ambiguous(recording, (variable, wanted), candidates, names)
         taken[variable] = candidates[0]
@@ -145,11 +189,7 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
             result.ignored.append((channel, "no samples"))
             continue
         variable = None
-        for candidate in dict.fromkeys(
-            (last_component(channel.symbol) if channel.symbol else None, last_component(channel.name))
-        ):
-            if candidate is None:
-                continue
+        for candidate in _last_components(channel):
             if candidate in variables:
                 variable = candidate
             elif len(folded.get(candidate.lower(), [])) == 1:
@@ -157,9 +197,7 @@ def plan(recording, variables, label, maps=(), names: Names = ()):
             if variable:
                 break
         if variable is None:
-            result.ignored.append(
-                (channel, f"no variable of {label} is named {last_component(channel.symbol or channel.name)!r}")
-            )
+            result.ignored.append((channel, f"no variable of {label} is named {_last_components(channel)[0]!r}"))
             continue
         matches.setdefault(variable, []).append(channel)
     for variable, found in matches.items():

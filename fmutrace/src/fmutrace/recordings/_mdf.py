@@ -1,12 +1,14 @@
-"""ASAM MDF 4 (.mf4) and MDF 3 (.mdf) through asammdf: every channel with
-the time base of its channel group, as recorded (nothing is resampled onto
-a common time base, so no value is invented). Master (time) channels are
-the stamps, in seconds; channels of text or byte arrays are listed as
-ignored. A file its writer has not finalized (identified 'UnFinMF ', as
-CAN loggers leave it until it is closed) is read as asammdf reads it: it
-finalizes a copy. A channel group that declares more samples than the
-step bound allows is refused before its samples are read (a small
-compressed file can hold hundreds of millions)."""
+"""ASAM MDF 4 (.mf4), MDF 3 and MDF 2 (.mdf) through asammdf: every
+channel with the time base of its channel group, as recorded (nothing is
+resampled onto a common time base, so no value is invented). Master
+(time) channels are the stamps, in seconds; channels of text or byte
+arrays are listed as ignored; channels of one name in several groups are
+each kept (_grid.unique_names). A file its writer has not finalized
+(identified 'UnFinMF ', as CAN loggers leave it until it is closed) is
+read as asammdf reads it: it finalizes a copy. A channel group that
+declares more samples than the step bound allows is refused before its
+samples are read (a small compressed file can hold hundreds of
+millions)."""
 
 import sys
 import tempfile
@@ -16,6 +18,7 @@ import numpy as np
 
 from .._errors import TraceError
 from .._traces import samples_problem
+from ._grid import unique_names
 from ._model import Channel, Recording
 
 MAGIC = b"MDF     "
@@ -46,8 +49,9 @@ def sniff(head):
 
 
 def format_name(version):
-    """The format as users call it, from asammdf's version ('3.30', '4.10')."""
-    return "ASAM MDF 3" if str(version).startswith("3") else "ASAM MDF4"
+    """The format as users call it, from asammdf's version ('2.00', '3.30', '4.10')."""
+    major = str(version)[:1]
+    return f"ASAM MDF {major}" if major in ("2", "3") else "ASAM MDF4"
 
 
 def read(path):
@@ -100,7 +104,7 @@ def _read(path, scratch):
     return Recording(
         paths=[str(path)],
         format=format_name(version),
-        channels=channels,
+        channels=unique_names(channels),
         time_unit="s",
         time_source="MDF's time channels are in seconds",
         notes=notes,

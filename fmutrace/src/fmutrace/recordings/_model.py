@@ -9,7 +9,7 @@ import numpy as np
 
 @dataclass
 class Channel:
-    name: str  # as the recorder wrote it, e.g. "DB_Ramp".value
+    name: str  # as the recorder wrote it, e.g. "DB_Ramp".value; made unique where its file has it twice (written)
     stamps: np.ndarray  # as recorded: float64, int64 (FILETIME ticks) or datetime64[ns]
     values: np.ndarray  # float64
     file: str
@@ -18,6 +18,7 @@ class Channel:
     symbol: str = ""  # a fuller name the recorder gives too (TwinCAT's SymbolName)
     times: np.ndarray | None = None  # seconds from the recording's first sample (normalise())
     sample_time: float | None = None  # its sample interval in seconds, when the file declares it (TwinCAT)
+    written: str = ""  # its name as written where other channels of its file share it: name is then NAME#POSITION
 
     def where(self, index):
         """'file, line L' of sample index (or the file and channel)."""

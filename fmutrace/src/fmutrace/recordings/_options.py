@@ -35,7 +35,9 @@ class RecordingOptions:
                   the one before (blocks that measure elapsed time see the
                   jitter), a cycle without a sample no step
     maps          {VARIABLE: CHANNEL} (or pairs): the channel that is the
-                  FMU's variable
+                  FMU's variable: its name ('Register 40001#3' where
+                  columns share a name: the one in column 3), its
+                  symbol, or '#3': the channel in column 3
     start_values  {name: value} (or pairs): start values of the FMU
     names         {setting: how the caller writes it} (or pairs): the
                   words messages name the settings in (default: the

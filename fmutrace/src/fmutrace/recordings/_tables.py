@@ -1,9 +1,12 @@
 """Tables with a header line: plain CSV/TSV (separator ',' ';' tab or
-blanks), the Siemens TIA Portal trace CSV export and the CODESYS V3
-trace text/CSV export. Metadata lines may come before the table (TIA
-Portal and CODESYS write the trace's name, device, trigger...): the table
-is found by its header, the first line of names followed by a line of
-values with as many cells.
+blanks), the Siemens TIA Portal trace CSV export, the CODESYS V3 trace
+text/CSV export and ModbusScope's data file. Metadata lines may come
+before the table (TIA Portal and CODESYS write the trace's name, device,
+trigger...; ModbusScope its settings and each register's properties as
+'//' comments): the table is found by its header, the first line of
+names followed by a line of values with as many cells. Columns may share
+a name (ModbusScope labels a register plotted twice the same): each is a
+channel, named by its column too (_grid.unique_names).
 
 Columns: a time column (time, t, Time, Zeit, Timestamp, Zeitstempel; a
 unit in its name: 'Time [ms]', 'Zeit (ms)', 'time_us'; or date strings),
@@ -136,13 +139,9 @@ def read(text):
     index, separator, names, time_columns, index_columns = layout(text)
     header_line = index + 1
     preamble = [line for line in text.lines[:index] if line.strip()]
-    seen: dict[str, int] = {}
     for i, name in enumerate(names):
         if not name:
             raise text.error(header_line, i + 1, "a column without a name")
-        if name in seen:
-            raise text.error(header_line, i + 1, f"column {name!r} again (first in column {seen[name] + 1})")
-        seen[name] = i
     fast = grids.uniform_table(text, index + 1, separator, len(names))
     if fast:
         table, lines = fast
@@ -185,11 +184,13 @@ def read(text):
     grids.check_increasing(text, stamps, lines, time_column + 1, time_name)
     skip = {time_column} | set(index_columns)
     rows = grids.Rows(lines, stamps, stamp_present)
-    channels = [
-        grids.channel_from(text, table[:, j], rows, j + 1, names[j], decimal_comma)
-        for j in range(len(names))
-        if j not in skip
-    ]
+    channels = grids.unique_names(
+        [
+            grids.channel_from(text, table[:, j], rows, j + 1, names[j], decimal_comma)
+            for j in range(len(names))
+            if j not in skip
+        ]
+    )
     return Recording(
         paths=[text.path],
         format=_label(preamble, names, time_name, index_columns),
@@ -202,6 +203,8 @@ def read(text):
 
 def _label(preamble, names, time_name, index_columns):
     said = " ".join(preamble).lower()
+    if said.startswith("//modbusscope"):
+        return "ModbusScope data file"
     if "codesys" in said or any(n.startswith("Application.") for n in names):
         return "CODESYS V3 trace export"
     if preamble and (index_columns or "tia" in said or "s7-" in said or any(n.startswith('"') for n in names)):

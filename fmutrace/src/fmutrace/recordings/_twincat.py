@@ -217,7 +217,7 @@ def read(text):
     return Recording(
         paths=[text.path],
         format="Beckhoff TwinCAT Scope View CSV export",
-        channels=channels,
+        channels=grids.unique_names(channels),
         time_unit=unit,
         time_source=source,
         encoding=text.encoding,

@@ -71,10 +71,12 @@ def read_codesys23(text):
     grids.check_increasing(text, stamps, lines, 1, names[0])
     cycles = bare_name(names[0]) in CYCLE_WORDS
     everywhere = np.ones(len(rows), dtype=bool)
-    channels = [
-        grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, everywhere), j + 1, names[j], True)
-        for j in range(1, len(names))
-    ]
+    channels = grids.unique_names(
+        [
+            grids.channel_from(text, table[:, j], grids.Rows(lines, stamps, everywhere), j + 1, names[j], True)
+            for j in range(1, len(names))
+        ]
+    )
     return Recording(
         paths=[text.path],
         format="CODESYS 2.3 trace (ASCII file)",
