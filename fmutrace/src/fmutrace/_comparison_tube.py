@@ -1,0 +1,148 @@
+"""The tube: the reference drawn as a polyline (a repeated time is a
+vertical jump), widened by tube_time in time and tube_value in value, as
+the Modelica Association's csv-compare draws it: a result sample passes
+when some point of the reference lies within tube_time of its time and
+tube_value of its value (the samples inside the reference's time range
+are checked). For traces sampled at other instants than the FMU's steps.
+"""
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from ._comparison_modes import Mode, check_widths, time_slack
+from ._comparison_verdicts import Band
+
+
+@dataclass(frozen=True)
+class Tube(Mode):
+    time: float
+    value: float
+
+    name: ClassVar[str] = "tube"
+    fills_band = True
+    reference_line = {"color": "0.5", "linewidth": 1}
+    deviation_label = "outside the tube"
+
+    def __post_init__(self):
+        check_widths({"tube_time": self.time, "tube_value": self.value})
+
+    def settings(self):
+        return {"tube_time": self.time, "tube_value": self.value}
+
+    def describe(self):
+        return f"tube of {self.time:g} s and {self.value:g}"
+
+    def spec(self):
+        return f"tube:time={self.time!r},value={self.value!r}"
+
+    def time_used(self, result, reference, name):
+        """(seconds, at): the largest time, over the result's samples inside
+        the tube, to the nearest point of the reference's polyline within
+        the tube's value of the sample, and that sample's time: how much of
+        the tube's time a sample needed (a time allowance that hides a value
+        error uses all of it). (0, None) if none is inside."""
+        times, values = reference["time"], reference[name].astype(np.float64)
+        most, at = 0.0, None
+        for t, v in zip(result["time"], result[name].astype(np.float64), strict=True):
+            if not times[0] <= t <= times[-1]:
+                continue
+            need = _distance_to_polyline(times, values, float(t), float(v), self.value, self.time + time_slack(t))
+            need = 0.0 if need <= time_slack(t) else need  # (the same instant, up to the times' rounding)
+            if need <= self.time + time_slack(t) and (at is None or need > most):
+                most, at = min(need, self.time), float(t)
+        return most, at
+
+    def bands(self, result, reference, names):
+        return {name: self.band(result, reference, name) for name in names}, ""
+
+    def band(self, result, reference, name, span=None):
+        """The Band of the result's samples of signal name in the tube
+        around the reference; span: the whole reference's (first, last)
+        time where reference is a window of it (None: its own)."""
+        lower, upper = tube_bounds(
+            reference["time"], reference[name].astype(np.float64), result["time"], (self.time, self.value), span
+        )
+        inside = ~np.isnan(lower)  # the samples inside the reference's time range
+        values, lower, upper = result[name].astype(np.float64)[inside], lower[inside], upper[inside]
+        with np.errstate(invalid="ignore"):
+            ok = (values >= lower) & (values <= upper)
+            outside = np.where(values > upper, values - upper, np.where(values < lower, values - lower, 0.0))
+        return Band(result["time"][inside], values, lower, upper, ok, outside)
+
+
+def _distance_to_polyline(times, values, t, v, width, reach):
+    """The smallest |tau - t| (at most reach; inf if none) at which the
+    polyline (times, values) lies within width of v."""
+    lo = int(np.searchsorted(times, t - reach, "left"))
+    hi = int(np.searchsorted(times, t + reach, "right"))
+    best = math.inf
+    for k in range(max(lo - 1, 0), min(hi + 1, len(times))):
+        t0, p0 = times[k], values[k]
+        if abs(p0 - v) <= width:
+            best = min(best, abs(t0 - t))
+        if k + 1 >= len(times):
+            continue
+        t1, p1 = times[k + 1], values[k + 1]
+        if math.isnan(p0) or math.isnan(p1) or t1 == t0:  # (a jump is reached at its time)
+            if t1 == t0 and min(p0, p1) - width <= v <= max(p0, p1) + width:
+                best = min(best, abs(t0 - t))
+            continue
+        if p1 == p0:
+            a, b = (0.0, 1.0) if abs(p0 - v) <= width else (1.0, 0.0)
+        else:
+            a, b = sorted(((v - width - p0) / (p1 - p0), (v + width - p0) / (p1 - p0)))
+        a, b = max(a, 0.0), min(b, 1.0)
+        if a > b:
+            continue
+        start, end = t0 + a * (t1 - t0), t0 + b * (t1 - t0)
+        best = min(best, 0.0 if start <= t <= end else min(abs(start - t), abs(end - t)))
+    return best
+
+
+def _polyline_at(times, values, at):
+    """The reference polyline at time at (inside its time range)."""
+    k = int(np.searchsorted(times, at, side="right")) - 1
+    if k >= len(times) - 1:
+        return float(values[-1])
+    t0, t1 = times[k], times[k + 1]
+    if t1 == t0:
+        return float(values[k + 1])
+    with np.errstate(invalid="ignore"):  # a NaN sample gives NaN, which the window's nanmin and nanmax leave out
+        return float(values[k] + (values[k + 1] - values[k]) * (at - t0) / (t1 - t0))
+
+
+def tube_bounds(reference_time, reference_values, times, widths, span=None):
+    """The tube's lower and upper bound at each of times (NaN outside the
+    reference's time range: there the reference says nothing); widths:
+    (time, value); a reference sample at the window's edge counts (up to
+    the rounding of its time). span: the whole reference's (first, last) time where
+    reference_time is a window of it that holds every sample within the
+    tube's time of each of times and one more on either side (None: its
+    own)."""
+    tube_time, tube_value = widths
+    lower = np.full(len(times), np.nan)
+    upper = np.full(len(times), np.nan)
+    t_first, t_last = span if span is not None else (reference_time[0], reference_time[-1])
+    for i, t in enumerate(times):
+        if not t_first <= t <= t_last:
+            continue
+        start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
+        slack = time_slack(t)  # a sample exactly at the allowed time counts, however t - tube_time rounds
+        inside = reference_values[
+            np.searchsorted(reference_time, start - slack, "left") : np.searchsorted(
+                reference_time, end + slack, "right"
+            )
+        ]
+        edges = [
+            _polyline_at(reference_time, reference_values, start),
+            _polyline_at(reference_time, reference_values, end),
+        ]
+        window = np.concatenate([inside, edges])
+        if np.isnan(window).all():
+            continue
+        lower[i] = np.nanmin(window) - tube_value
+        upper[i] = np.nanmax(window) + tube_value
+    return lower, upper
