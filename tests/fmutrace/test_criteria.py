@@ -126,7 +126,10 @@ def test_ramp_active_one_cycle_late_passes_a_one_cycle_tube_of_value_0(tmp_path,
     assert outcome.status == "pass", outcome.messages
     changed(folder, reference, rampActive=shift(ramp, 2))
     outcome = run_folder_case(CaseFiles(folder, folder.name), target, settings, Streaming(*chunks))
-    assert outcome.status == "fail" and outcome.messages[0].startswith("rampActive leaves the band"), outcome.messages
+    assert outcome.status == "fail", outcome.messages
+    # two cycles off: a trace's change lies outside the tube around the other (which first: late or early)
+    first = outcome.messages[0]
+    assert first.startswith("rampActive: the ") and " leaves the tube around the " in first, outcome.messages
 
 
 # ---- 2. discrete signals: exact in value, changes within k cycles --------------
@@ -157,9 +160,12 @@ def test_a_status_word_flipped_for_one_cycle_fails_whatever_the_time_allowance()
     flipped[9] = 0x8201
     for cycles in (0, 1, 5):
         comparison = discrete(status, flipped, cycles)
-        assert not comparison.passed and "a change the reference lacks" in comparison.messages()[0], cycles
-    # the reference's one-cycle flip missing from the result fails too
-    assert not discrete(flipped, status, 3).passed
+        assert not comparison.passed, cycles
+        assert comparison.messages()[0] == "b: changes to 33281 at t=0.9 and back at t=1.0, a pulse the reference lacks"
+    # the reference's one-cycle flip missing from the result fails too: a pulse missing, at its time
+    comparison = discrete(flipped, status, 3)
+    assert not comparison.passed
+    assert comparison.messages()[0] == "b: the reference's pulse to 33281 at t=0.9 (1 cycle) is missing from the result"
 
 
 def test_a_change_to_another_value_fails_where_a_tube_would_interpolate():
@@ -293,29 +299,40 @@ def test_a_status_word_is_recognised_from_the_fmu_and_never_interpolated(tmp_pat
     status = reference["status"].copy()
     status[40] = 0x8200
     changed(folder, reference, status=status)
-    assert run_case(folder, Tube(0.1, 0.0)).status == "pass"  # the old judgement, unchanged
+    assert run_case(folder, Tube(0.1, 0.0, sides=1)).status == "pass"  # the old, one-sided judgement, unchanged
+    # both ways, the flip in the reference lies outside the tube around the result (status is 0 there)
+    flipped = run_case(folder, Tube(0.1, 0.0))
+    assert flipped.status == "fail" and flipped.messages[0].startswith(
+        "status: the reference leaves the tube around the result first at t=4.0: 33280.0, the tube there 0.0, off by"
+    ), flipped.messages
     outcome = run_case(folder, fmutrace.Criteria({"*": Tube(0.1, 0.0)}))
     assert outcome.status == "fail", outcome.messages
     assert outcome.messages[0] == (
         "status (exact, up to 1 cycle early or late): "
-        "the reference's change to 33280 at t=4.0 is missing from the result"
+        "the reference's pulse to 33280 at t=4.0 (1 cycle) is missing from the result"
     )
 
 
 def test_a_time_tolerance_hiding_a_value_error_shows_its_use(tmp_path):
-    """A +10 glitch of y at one sample passes a one-cycle tube (its neighbours
-    are in the window); the verdict says the sample needed nearly the whole
-    time: y rises 0.2 a cycle there, so the reference's polyline from the
-    sample before (y - 0.2) to the glitch (y + 10.2) passes y at 10/10.2 of
-    the cycle before."""
+    """A +10 glitch of y at one sample of the reference passes a one-sided
+    one-cycle tube (its neighbours are in the window); the verdict says the
+    sample needed nearly the whole time: y rises 0.2 a cycle there, so the
+    reference's polyline from the sample before (y - 0.2) to the glitch
+    (y + 10.2) passes y at 10/10.2 of the cycle before. The tube both ways
+    fails it: the glitch lies outside the tube around the result."""
     folder, reference = own_output_case(tmp_path)
     y = reference["y"].copy()
     y[20] += 10
     changed(folder, reference, y=y)
-    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0)}))
+    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0, sides=1)}))
     assert outcome.status == "pass"
     assert f"time allowance used: {0.1 * 10 / 10.2:.6g} of 0.1 s (98%) at t=2.0" in outcome.messages[0]
-    assert outcome.messages[0].startswith("y (tube of 0.1 s and 0): ")
+    assert outcome.messages[0].startswith("y (tube of 0.1 s and 0, one-sided): ")
+    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0)}))
+    assert outcome.status == "fail"
+    assert outcome.messages[0].startswith(
+        "y (tube of 0.1 s and 0): the reference leaves the tube around the result first at t=2.0: "
+    ), outcome.messages
 
 
 def test_a_case_folder_carries_its_criteria(tmp_path):

@@ -63,22 +63,29 @@ def varied(tmp_path, how):
     elif how == "repeated":
         ref = np.concatenate([ref[:4], ref[3:4], ref[4:]])
         ref["y"][3] = 99.0  # an event: the polyline jumps there
+    elif how == "spike":
+        ref["y"][9] = ref["y"][9] + 10.0  # t = 4.5: a one-sample spike in the reference
     elif how == "shorter":
         ref = ref[2:-3]  # result samples before and after the reference: outside its time range
     write_trace(folder / "RateLimiter_ref.csv", ref)
     return folder
 
 
-@pytest.mark.parametrize("how", ["off", "repeated", "shorter"])
+@pytest.mark.parametrize("how", ["off", "repeated", "shorter", "spike"])
 @pytest.mark.parametrize("mode", TUBES, ids=["narrow", "few-steps", "wide"])
 def test_varied_references_in_a_tube_chunked_as_in_memory(how, mode, tmp_path):
     folder = varied(tmp_path, how)
     for steps, chunk_bytes in [(1, 8), (3, 30), (100, 1 << 20)]:
         whole, long = outcomes(folder, "RateLimiter", mode, steps, chunk_bytes)
         same(whole, long)
-    # the result is the original reference: an added sample only widens the tube, fewer samples narrow its
-    # range; the ramp reaches 10 at t = 6, the last sample, there made 3: every window around t = 6 tops at
-    # 9 (t = 5.5) + 0.25 at the most
+    # the result is the original reference: an added sample only widens the tube (and on the second side, the
+    # value up to an instant is not a sample), fewer samples narrow its range; the ramp reaches 10 at t = 6, the
+    # last sample, there made 3: every window around t = 6 tops at 9 (t = 5.5) + 0.25 at the most
+    if how == "spike":  # outside the tube around the result, where the run holds its whole window (t <= 3 s before)
+        assert whole[0] == ("pass" if mode.time > 1.5 else "fail"), whole[1]
+        # (a tube narrower than the cycle: the spike is the whole window around the result's sample, too)
+        assert mode.time > 1.5 or "the reference leaves the tube around the result" in whole[1][0], whole[1]
+        return
     assert (whole[0] == "pass") == (how != "off")
 
 

@@ -175,7 +175,7 @@ def test_a_failing_campaign(browser, tmp_path):
         )
     )
     assert 25 < low <= 30 <= high < 35, (low, high)
-    assert "y leaves the band first at t=30.0" in browser.find_element("tag name", "body").text
+    assert "y differs first at t=30.0" in browser.find_element("tag name", "body").text
     no_horizontal_scrolling(browser, "failing_case.png")
     assert console_errors(browser) == []
 

@@ -135,12 +135,13 @@ def signal_criteria(assignments, default: Mode, names: Names = ()) -> Mode:
     return Criteria(tuple(pairs), default)
 
 
-MODE_WORDS = "exact, tol:abs=A,rel=R, tube:time=S,value=V, discrete[:cycles=K], ulps:N[,binary32|binary64]"
+MODE_WORDS = "exact, tol:abs=A,rel=R, tube:time=S,value=V[,sides=1], discrete[:cycles=K], ulps:N[,binary32|binary64]"
 
 
 def parse_mode(text: str) -> Mode:
     """A mode from its words (Mode.spec's): exact, tol:abs=1e-6,rel=0,
-    tube:time=0.01,value=0, discrete:cycles=1, ulps:4,binary32.
+    tube:time=0.01,value=0 (sides=1: one-sided), discrete:cycles=1,
+    ulps:4,binary32.
     InputError if text is none of them."""
     kind, _, rest = text.strip().partition(":")
     kind = kind.strip().lower()
@@ -167,10 +168,12 @@ def parse_mode(text: str) -> Mode:
         given = numbers(("abs", "rel"))
         return Tolerance(given.get("rel", 0.0), given.get("abs", 0.0))
     if kind == "tube":
-        given = numbers(("time", "value"))
-        if len(given) != 2:
+        given = numbers(("time", "value", "sides"), whole=("sides",))
+        if "time" not in given or "value" not in given:
             raise InputError(f"mode {text!r}: a tube needs both time= and value=")
-        return Tube(given["time"], given["value"])
+        if given.get("sides", 2) not in (1, 2):
+            raise InputError(f"mode {text!r}: a tube's sides are 1 or 2")
+        return Tube(given["time"], given["value"], given.get("sides", 2))
     if kind == "discrete":
         return Discrete(numbers(("cycles",), whole=("cycles",)).get("cycles", 0))
     if kind == "ulps" and 1 <= len(items) <= 2:
@@ -189,10 +192,12 @@ def comparison_mode(
     tube_time: float | None = None,
     tube_value: float | None = None,
     *,
+    tube_sides: int = 2,
     names: Names = (),
 ) -> Mode:
     """The mode the command's options (and compare's arguments of the same
-    names) choose: a tube, a tolerance, else exact. InputError if they do
+    names) choose: a tube (tube_sides: 2, both ways; 1, the result's samples
+    only), a tolerance, else exact. InputError if they do
     not make one, naming the settings in names (the caller's words, as
     RecordingOptions.names; default the API's)."""
     if (tube_time is None) != (tube_value is None):
@@ -200,10 +205,12 @@ def comparison_mode(
             "a tube needs both its time and its value tolerance "
             f"({name_of(names, 'tube_time')} and {name_of(names, 'tube_value')})"
         )
+    if tube_sides != 2 and tube_time is None:
+        raise InputError(f"{name_of(names, 'tube_sides')} is a tube's: give the tube too")
     if tube_time is not None and tube_value is not None:
         if rel_tol or abs_tol:
             raise InputError("choose a tube or a relative/absolute tolerance, not both")
         check_widths({"tube_time": tube_time, "tube_value": tube_value}, names)
-        return Tube(tube_time, tube_value)
+        return Tube(tube_time, tube_value, tube_sides)
     check_widths({"rel_tol": rel_tol, "abs_tol": abs_tol}, names)
     return Tolerance(rel_tol, abs_tol) if (rel_tol or abs_tol) else EXACT

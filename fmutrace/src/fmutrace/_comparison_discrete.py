@@ -87,57 +87,173 @@ class Discrete(Mode):
         deviation = Deviation(name, True)
         if not len(cycle):
             return deviation, ok
-        k = self.cycles
-        ref_at = _changed(expected)  # reference rows that change
-        # the result's changes that its samples at the reference's rows show (between two rows the reference
-        # says nothing), each at the last cycle it changed in that interval
         first = int(cycle[0])
-        res_at = [self._last_change(x, int(cycle[s - 1]), int(cycle[s])) for s in _changed(x[cycle])]
-        problem, shift_most, shift_at = "", 0, None
         if not _same(x[first], expected[0]):
-            problem = f"starts at {shown(x[first])}, expected {shown(expected[0])} at t={float(rt[first])!r}"
             ok[0] = False
-        for m in range(max(len(ref_at), len(res_at))):
-            if problem:
-                break
-            if m >= len(ref_at):
-                j = int(res_at[m])
-                problem = f"changes to {shown(x[j])} at t={float(rt[j])!r}, a change the reference lacks"
-                ok[min(int(np.searchsorted(cycle, j)), len(ok) - 1)] = False
-                break
-            row = int(ref_at[m])
-            earliest, latest = int(cycle[row - 1]) + 1, int(cycle[row])
-            if m >= len(res_at):
-                problem = (
-                    f"the reference's change to {shown(expected[row])} at t={float(rt[latest])!r} "
-                    "is missing from the result"
-                )
+            note = f"starts at {shown(x[first])}, expected {shown(expected[0])} at t={float(rt[first])!r}"
+            return self._failed(deviation, ok, note, 1, (rt, x, cycle, expected)), ok
+        seen = x[cycle]
+        # the reference's changes, each somewhere in the cycles after its row's predecessor up to its row; the
+        # result's that its samples at the reference's rows show (between two rows the reference says nothing),
+        # each at the last cycle it changed in that interval
+        wanted = [
+            Change(int(cycle[row - 1]) + 1, int(cycle[row]), row, float(expected[row - 1]), float(expected[row]))
+            for row in _changed(expected)
+        ]
+        made = []
+        for row in _changed(seen):
+            j = self._last_change(x, int(cycle[row - 1]), int(cycle[row]))
+            made.append(Change(j, j, row, float(seen[row - 1]), float(seen[row])))
+        pairs = pair_changes(wanted, made, self.cycles)
+        problems = unpaired(wanted, made, pairs, self.cycles, rt)
+        if problems:
+            for _, row, _ in problems:
                 ok[row] = False
-                break
-            j = int(res_at[m])
-            shift = max(earliest - j, j - latest, 0)
-            if not _same(x[j], expected[row]):
-                problem = (
-                    f"changes to {shown(x[j])} at t={float(rt[j])!r} where the reference's next change is "
-                    f"to {shown(expected[row])} at t={float(rt[latest])!r}"
-                )
-            elif shift > k:
-                when = "late" if j > latest else "early"
-                problem = (
-                    f"the reference's change to {shown(expected[row])} at t={float(rt[latest])!r} comes "
-                    f"{cycles_text(shift)} {when} (t={float(rt[j])!r}), more than the {k} allowed"
-                )
-            if problem:
-                ok[row] = False
-                break
-            if shift_at is None or shift > shift_most:
-                shift_most, shift_at = shift, float(rt[j])
-        if problem:
-            bad = int(np.argmin(ok))
-            deviation.passed, deviation.failed, deviation.note = False, 1, problem
-            deviation.time, deviation.value = float(rt[cycle[bad]]), float(x[cycle[bad]])
-            deviation.lower = deviation.upper = float(expected[bad])
-        elif k and shift_at is not None:
-            where = f" at t={shift_at!r}" if shift_most else ""
-            deviation.allowance = f"time allowance used: {shift_most} of {cycles_text(k)}{where}"
+            return self._failed(deviation, ok, explain(problems), len(problems), (rt, x, cycle, expected)), ok
+        shifts = [(wanted[m].shift(made[n].first), made[n].first) for m, n in pairs.items()]
+        if self.cycles and shifts:
+            most, at = max(shifts, key=lambda s: s[0])  # (the first of the largest)
+            where = f" at t={float(rt[at])!r}" if most else ""
+            deviation.allowance = f"time allowance used: {most} of {cycles_text(self.cycles)}{where}"
         return deviation, ok
+
+    @staticmethod
+    def _failed(deviation, ok, note, failed, traces):
+        """deviation failed at the first reference sample not ok, with note."""
+        rt, x, cycle, expected = traces
+        bad = int(np.argmin(ok))
+        deviation.passed, deviation.failed, deviation.note = False, failed, note
+        deviation.time, deviation.value = float(rt[cycle[bad]]), float(x[cycle[bad]])
+        deviation.lower = deviation.upper = float(expected[bad])
+        return deviation
+
+
+@dataclass(frozen=True)
+class Change:
+    """A change of a discrete signal from before to after, made in one of
+    the cycles first to last (a reference row says only that it happened
+    since the row before); row: the reference row that shows it."""
+
+    first: int
+    last: int
+    row: int
+    before: float
+    after: float
+
+    def same_as(self, other: "Change") -> bool:
+        """The same change (from the same value to the same value; NaN is NaN)."""
+        return bool(_same(np.float64(self.before), other.before) and _same(np.float64(self.after), other.after))
+
+    def shift(self, at: int) -> int:
+        """How many cycles a change made at cycle at lies outside this one's cycles."""
+        return max(self.first - at, at - self.last, 0)
+
+
+def pair_changes(wanted, made, cycles) -> dict:
+    """{index in wanted: index in made}: each of the reference's changes
+    paired with the result's nearest change of the same values within
+    cycles, as an engineer pairs them (the closest pairs first, a change in
+    one pair only); a missing or added change leaves the others' pairs as
+    they are."""
+    starts = [c.first for c in made]
+    candidates = []
+    for m, change in enumerate(wanted):
+        lo = int(np.searchsorted(starts, change.first - cycles, "left"))
+        hi = int(np.searchsorted(starts, change.last + cycles, "right"))
+        for n in range(lo, hi):
+            if change.same_as(made[n]):
+                candidates.append((change.shift(made[n].first), abs(made[n].first - change.last), m, n))
+    pairs: dict = {}
+    taken = set()
+    for _, _, m, n in sorted(candidates):
+        if m not in pairs and n not in taken:
+            pairs[m] = n
+            taken.add(n)
+    return pairs
+
+
+def unpaired(wanted, made, pairs, cycles, rt) -> list:
+    """The changes left unpaired, in time order, as (cycle, reference row,
+    words; rt: the result's times, the cycles' in the words): a change of the reference with the
+    result's same change next to it in time (no other change between) comes
+    too late or too early; a change to another value next to it is one;
+    two changes of one trace there and back are a pulse; the rest are
+    missing from the result or added to it."""
+
+    def when(cycle):
+        return repr(float(rt[cycle]))
+
+    taken = set(pairs.values())
+    lost = [m for m in range(len(wanted)) if m not in pairs]
+    added = [n for n in range(len(made)) if n not in taken]
+    unpaired_at = {(0, m) for m in lost} | {(1, n) for n in added}
+    order = sorted([(c.last, 0, m) for m, c in enumerate(wanted)] + [(c.first, 1, n) for n, c in enumerate(made)])
+    place = {(side, i): k for k, (_, side, i) in enumerate(order)}
+    problems, done = [], set()
+    for m in lost:
+        change = wanted[m]
+        for k in (place[0, m] - 1, place[0, m] + 1):  # the changes of either trace just before and after it
+            if (
+                not 0 <= k < len(order)
+                or order[k][1] != 1
+                or (1, order[k][2]) not in unpaired_at
+                or (1, order[k][2]) in done
+            ):
+                continue
+            n = order[k][2]
+            other = made[n]
+            if change.same_as(other):
+                late = "late" if other.first > change.last else "early"
+                words = (
+                    f"the reference's change to {shown(change.after)} at t={when(change.last)} comes "
+                    f"{cycles_text(change.shift(other.first))} {late} (t={when(other.first)}), "
+                    f"more than the {cycles} allowed"
+                )
+            else:
+                words = (
+                    f"changes to {shown(other.after)} at t={when(other.first)} where the reference's next change is "
+                    f"to {shown(change.after)} at t={when(change.last)}"
+                )
+            problems.append((min(change.last, other.first), change.row, words))
+            done |= {(0, m), (1, n)}
+            break
+    for side, changes, left in ((0, wanted, lost), (1, made, added)):
+        for i in left:
+            if (side, i) in done:
+                continue
+            change, back = changes[i], changes[i + 1] if i + 1 < len(changes) else None
+            pulse = (
+                back is not None
+                and (side, i + 1) in unpaired_at
+                and (side, i + 1) not in done
+                and back.same_as(_reversed(change))
+            )
+            at = change.last if side == 0 else change.first
+            if pulse:
+                assert back is not None
+                until = back.last if side == 0 else back.first
+                done.add((side, i + 1))
+                words = (
+                    f"the reference's pulse to {shown(change.after)} at t={when(at)} ({cycles_text(until - at)}) "
+                    "is missing from the result"
+                    if side == 0
+                    else f"changes to {shown(change.after)} at t={when(at)} and back at t={when(until)}, "
+                    "a pulse the reference lacks"
+                )
+            elif side == 0:
+                words = f"the reference's change to {shown(change.after)} at t={when(at)} is missing from the result"
+            else:
+                words = f"changes to {shown(change.after)} at t={when(at)}, a change the reference lacks"
+            problems.append((at, change.row, words))
+            done.add((side, i))
+    return sorted(problems, key=lambda p: p[0])
+
+
+def _reversed(change: Change) -> Change:
+    return Change(change.first, change.last, change.row, change.after, change.before)
+
+
+def explain(problems) -> str:
+    """The first of the unpaired changes in words, and how many there are in all."""
+    first = problems[0][2]
+    return first if len(problems) == 1 else f"{first}; {len(problems)} changes or pulses unpaired in all"

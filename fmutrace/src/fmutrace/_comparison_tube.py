@@ -1,9 +1,16 @@
-"""The tube: the reference drawn as a polyline (a repeated time is a
-vertical jump), widened by tube_time in time and tube_value in value, as
-the Modelica Association's csv-compare draws it: a result sample passes
-when some point of the reference lies within tube_time of its time and
-tube_value of its value (the samples inside the reference's time range
-are checked). For traces sampled at other instants than the FMU's steps.
+"""The tube: a trace drawn as a polyline (a repeated time is a vertical
+jump), widened by tube_time in time and tube_value in value, as the
+Modelica Association's csv-compare draws it: a sample passes when some
+point of the polyline lies within tube_time of its time and tube_value of
+its value (the samples inside the polyline's time range are checked).
+For traces sampled at other instants than the FMU's steps.
+
+A tube is checked both ways: the result's samples within the tube around
+the reference, and the reference's within the tube around the result. A
+one-cycle spike in the reference only widens the tube around it, so
+csv-compare's one-sided check (sides=1, kept for comparisons with it)
+passes it; the other way round the spike lies outside the tube around
+the result, which no shift in time explains.
 """
 
 import math
@@ -13,13 +20,20 @@ from typing import ClassVar
 import numpy as np
 
 from ._comparison_modes import Mode, check_widths, time_slack
-from ._comparison_verdicts import Band
+from ._errors import InputError
+from ._comparison_verdicts import Band, Deviation, verdict_of
 
 
 @dataclass(frozen=True)
 class Tube(Mode):
+    """A tube of time seconds and value around each trace; sides: 2 (the
+    result within the tube around the reference and the reference within
+    the tube around the result), 1 (the result's samples only, as
+    csv-compare)."""
+
     time: float
     value: float
+    sides: int = 2
 
     name: ClassVar[str] = "tube"
     fills_band = True
@@ -28,15 +42,19 @@ class Tube(Mode):
 
     def __post_init__(self):
         check_widths({"tube_time": self.time, "tube_value": self.value})
+        if self.sides not in (1, 2):
+            raise InputError(f"Tube.sides must be 1 or 2, not {self.sides!r}")
 
     def settings(self):
-        return {"tube_time": self.time, "tube_value": self.value}
+        return {"tube_time": self.time, "tube_value": self.value, "tube_sides": self.sides}
 
     def describe(self):
-        return f"tube of {self.time:g} s and {self.value:g}"
+        one = ", one-sided" if self.sides == 1 else ""
+        return f"tube of {self.time:g} s and {self.value:g}{one}"
 
     def spec(self):
-        return f"tube:time={self.time!r},value={self.value!r}"
+        one = ",sides=1" if self.sides == 1 else ""
+        return f"tube:time={self.time!r},value={self.value!r}{one}"
 
     def time_used(self, result, reference, name):
         """(seconds, at): the largest time, over the result's samples inside
@@ -58,19 +76,67 @@ class Tube(Mode):
     def bands(self, result, reference, names):
         return {name: self.band(result, reference, name) for name in names}, ""
 
-    def band(self, result, reference, name, span=None):
-        """The Band of the result's samples of signal name in the tube
-        around the reference; span: the whole reference's (first, last)
-        time where reference is a window of it (None: its own)."""
+    def judge(self, result, reference, names):
+        bands = {name: self.band(result, reference, name) for name in names}
+        deviations = {
+            name: self.verdict(
+                verdict_of(name, band),
+                verdict_of(name, self.back_band(reference, result, name)) if self.sides == 2 else None,
+            )
+            for name, band in bands.items()
+        }
+        return deviations, bands, ""
+
+    def verdict(self, forth: Deviation, back: Deviation | None) -> Deviation:
+        """A signal's verdict from the result's samples in the tube around
+        the reference (forth) and, on a two-sided tube, the reference's in
+        the tube around the result (back): the side that fails first in
+        time, the other named if it fails too (a pass counts the result's
+        samples, as a one-sided tube's)."""
+        if back is None or (forth.passed and back.passed):
+            forth.direction = "" if forth.passed else "result"
+            return forth
+        forth.direction, back.direction = "result", "reference"
+        failing = [d for d in (forth, back) if not d.passed]
+        first = min(failing, key=lambda d: d.time if d.time is not None else math.inf)
+        other = back if first is forth else forth
+        if not other.passed:
+            first.also = f"{other.side()} too, first at t={other.time!r}"
+        return first
+
+    def band(self, inner, outer, name, span=None):
+        """The Band of inner's samples of signal name in the tube around
+        outer (Tube.band(result, reference, ...): the result's samples in
+        the tube around the reference; the other way round for the second
+        side); span: the whole outer trace's (first, last) time where outer
+        is a window of it (None: its own)."""
         lower, upper = tube_bounds(
-            reference["time"], reference[name].astype(np.float64), result["time"], (self.time, self.value), span
+            outer["time"], outer[name].astype(np.float64), inner["time"], (self.time, self.value), span
         )
-        inside = ~np.isnan(lower)  # the samples inside the reference's time range
-        values, lower, upper = result[name].astype(np.float64)[inside], lower[inside], upper[inside]
+        inside = ~np.isnan(lower)  # the samples inside outer's time range
+        values, lower, upper = inner[name].astype(np.float64)[inside], lower[inside], upper[inside]
         with np.errstate(invalid="ignore"):
             ok = (values >= lower) & (values <= upper)
             outside = np.where(values > upper, values - upper, np.where(values < lower, values - lower, 0.0))
-        return Band(result["time"][inside], values, lower, upper, ok, outside)
+        return Band(inner["time"][inside], values, lower, upper, ok, outside)
+
+    def back_band(self, reference, result, name, span=None, following=math.nan):
+        """The second side's Band: the reference's samples in the tube
+        around the result, those whose whole window of the tube's time lies
+        in the result's time range (span: its (first, last), None: its own).
+        Nearer the run's ends the first side alone judges: beyond them the
+        result says nothing, and a result one cycle late is not a spike. At
+        a repeated time the last row, the value from that instant on, is
+        the sample (as the pointwise modes compare it; the rows before it
+        are the value up to the instant, which a result sampled at
+        communication points does not hold); following: the time of the
+        row after reference's last (NaN: none)."""
+        first, last = span if span is not None else (result["time"][0], result["time"][-1])
+        t = reference["time"]
+        last_row = np.append(t[1:] != t[:-1], t[-1:] != following)
+        with np.errstate(invalid="ignore"):  # (last: inf while the run goes on)
+            whole = (t - self.time >= first - time_slack(t)) & (t + self.time <= last + time_slack(t))
+        return self.band(reference[whole & last_row], result, name, span)
 
 
 def _distance_to_polyline(times, values, t, v, width, reach):

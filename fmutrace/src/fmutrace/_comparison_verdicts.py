@@ -43,6 +43,8 @@ class Deviation:
     note: str = ""
     criterion: str = ""  # the signal's own criterion (per-signal criteria only)
     allowance: str = ""  # how much of a time allowance was used, where it came closest to failing
+    direction: str = ""  # a tube's failing side: "result" (in the tube around the reference) or "reference"
+    also: str = ""  # a two-sided tube's other side where it fails too
 
     NUMBERS: ClassVar[tuple] = ("time", "value", "lower", "upper", "excess", "largest_excess", "largest_at")
 
@@ -54,11 +56,29 @@ class Deviation:
         if self.note:
             return f"{who}: {self.note}{used}"
         band = f"{self.lower!r}" if self.lower == self.upper else f"[{self.lower!r}, {self.upper!r}]"
+        if self.direction:
+            also = f"; {self.also}" if self.also else ""
+            return (
+                f"{who}: {self.side()} first at t={self.time!r}: {self.value!r}, the tube there {band}, "
+                f"off by {self.excess:.6g}; {self.failed} of {self.compared} of its samples outside, "
+                f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}{also}{used}"
+            )
+        if self.lower == self.upper:  # (exact: no band but the expected value)
+            return (
+                f"{who} differs first at t={self.time!r}: {self.value!r}, expected {band}, "
+                f"off by {self.excess:.6g}; {self.failed} of {self.compared} samples differ, "
+                f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}{used}"
+            )
         return (
             f"{who} leaves the band first at t={self.time!r}: {self.value!r}, expected {band}, "
             f"off by {self.excess:.6g}; {self.failed} of {self.compared} samples outside, "
             f"the most by {self.largest_excess:.6g} at t={self.largest_at!r}{used}"
         )
+
+    def side(self) -> str:
+        """Which trace leaves the tube around which (direction's words)."""
+        inner, outer = ("result", "reference") if self.direction == "result" else ("reference", "result")
+        return f"the {inner} leaves the tube around the {outer}"
 
     def to_json(self) -> dict:
         """The fields that have a value; NaN and infinities as "nan", "inf", "-inf" (JSON has none)."""

@@ -12,7 +12,9 @@ comparison.aligned, the verdict accumulated by comparison.Verdict), and
 the figure's lines are envelopes filled as they go (plot.Envelope). A
 tube compares each result sample with the reference around it: the
 reference is kept from the row before that window to a row after it
-(Tube.band on that window gives the whole reference's bounds). The
+(Tube.band on that window gives the whole reference's bounds); its second
+side, each reference row with the result around it, keeps the result the
+same way. The
 verdict does not depend on where the chunks end (a test runs every
 reference scenario in chunks of one step and one row).
 """
@@ -292,12 +294,20 @@ class _Comparer:
         self.reference: np.ndarray | None = None  # a tube's: the reference rows its next samples look around
         self.t_first: float | None = None  # the reference's first time
         self.compared = 0  # a tube's: the result samples compared
+        # a two-sided tube's second side: each signal's verdict on the reference's rows in the tube around the
+        # result, the rows not yet judged, and the result from the sample before their window on
+        two_sided = isinstance(mode, Tube) and mode.sides == 2
+        self.back = {name: Verdict(name) for name in outputs} if two_sided else None
+        self.back_rows: np.ndarray | None = None
+        self.back_result: list[np.ndarray] = []
+        self.result_first: float | None = None  # the run's first time
 
     def next_reference(self):
         """The table compared is done: the next one starts at the run's start."""
         if self.absent_here and not self.absent:
             self.absent, self.first_absent = self.absent_here, self.first_absent_here
         self.absent_here, self.first_absent_here = 0, None
+        self.back_rows, self.back_result = None, [c for _, c in self.window] if self.keep_all else []
         self.reference, self.t_first, self.compared = None, None, 0
 
     def result_until(self, k):
@@ -308,6 +318,9 @@ class _Comparer:
                 return
             self.window.append((self.reached, chunk))
             self.reached += len(chunk)
+            if self.back is not None and len(chunk):
+                self.back_result.append(chunk)
+                self.result_first = float(chunk["time"][0]) if self.result_first is None else self.result_first
             for s in self.outputs:
                 self.envelopes[("result", s)].add(chunk["time"], chunk[s])
             self.result.add(chunk)
@@ -384,11 +397,20 @@ class _Comparer:
             self.signals[s].deviation = deviation
 
     def tube_rows(self, rows):
-        """A tube's comparison as Tube.bands makes it on the whole: adds
+        """A tube's comparison as Tube.judge makes it on the whole: adds
         reference rows (None: there are no more) and compares the result
         samples whose look-around window they cover, each against the
         reference from its time - the tube's time to its time + the tube's
-        time (the window: from the row before that on, to a row after it)."""
+        time (the window: from the row before that on, to a row after it);
+        on a two-sided tube the reference's rows the other way round."""
+        if self.back is not None and rows is not None and len(rows):
+            self.back_rows = rows if self.back_rows is None else np.concatenate([self.back_rows, rows])
+        self._tube_forth(rows)
+        if self.back is not None:
+            self._tube_back(done=rows is None)
+
+    def _tube_forth(self, rows):
+        """The result's samples in the tube around the reference."""
         mode = self.mode
         assert isinstance(mode, Tube)
         if rows is not None and len(rows):
@@ -427,6 +449,31 @@ class _Comparer:
         at = float(result["time"][take])
         keep = int(np.searchsorted(reference["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
         self.reference = reference[max(keep, 0) :]
+
+    def _tube_back(self, done):
+        """The reference's rows in the tube around the result: those whose
+        window the result made so far covers (all once done: the reference
+        and the run are whole), each against the result from its time - the
+        tube's time to its time + the tube's time."""
+        mode, rows, back = self.mode, self.back_rows, self.back
+        assert isinstance(mode, Tube) and back is not None
+        if rows is None or not len(rows) or not self.back_result:
+            return
+        result = self.back_result[0] if len(self.back_result) == 1 else np.concatenate(self.back_result)
+        last = float(result["time"][-1])
+        covered = np.inf if done else last - mode.time - 2 * float(time_slack(last))
+        take = int(np.searchsorted(rows["time"], covered, side="left"))
+        if not done:
+            take = min(take, len(rows) - 1)  # (the last row waits for the next: a repeated time may span chunks)
+        if take:
+            span = (self.result_first, last if done else np.inf)
+            following = float(rows["time"][take]) if take < len(rows) else math.nan
+            for s in _signal_names(rows):
+                back[s].add(mode.back_band(rows[:take], result, s, span, following))
+        # the result the next rows' windows need: from the sample before the earliest's time - the tube's time on
+        at = float(rows["time"][min(take, len(rows) - 1)])
+        keep = int(np.searchsorted(result["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
+        self.back_result, self.back_rows = [result[max(keep, 0) :]], rows[take:]
 
     def _add(self, bands):
         """Each signal's band on the compared samples; the zoom at the first failing one."""
@@ -483,6 +530,9 @@ class _Comparer:
         """The case's CaseOutcome once every reference row was compared."""
         outputs, envelopes = self.outputs, self.envelopes
         deviations = [self.signals[s].deviation for s in outputs]
+        if isinstance(self.mode, Tube):
+            back = self.back
+            deviations = [self.mode.verdict(d, back[d.name].deviation if back else None) for d in deviations]
         outcome = CaseOutcome(case.name, **labels)
         problem = ""
         if self.absent:

@@ -51,6 +51,7 @@ FLAGS = {
     "abs_tol": "--abs-tol",
     "tube_time": "--tube-time",
     "tube_value": "--tube-value",
+    "tube_sides": "--tube-sides",
     "resume": "--resume",
     "signals": "--signal",
 }
@@ -146,6 +147,14 @@ def _compare_arguments(command):
         help="tube half-width in time (with --tube-value), for traces sampled at other instants",
     )
     judge.add_argument(FLAGS["tube_value"], type=_non_negative, metavar="V", help="tube half-width in value")
+    judge.add_argument(
+        FLAGS["tube_sides"],
+        type=int,
+        choices=(1, 2),
+        default=2,
+        help="2 (default): the result within the tube around the reference and the reference within the tube "
+        "around the result; 1: the result's samples only, as csv-compare checks",
+    )
     judge.add_argument(
         FLAGS["signals"],
         type=_assignment,
@@ -347,7 +356,9 @@ def compare_command(args, out):
     result = campaign(
         mode=signal_criteria(
             args.signal,
-            comparison_mode(args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, names=FLAGS),
+            comparison_mode(
+                args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, tube_sides=args.tube_sides, names=FLAGS
+            ),
             FLAGS,
         ),
         report=args.report,
