@@ -513,7 +513,7 @@ class _Comparer:
     def page_scripts(self, case: ChunkedCase, figure: Figure, label, criteria):
         """The case page's plot data as a script, and a long case's finer level as DETAIL scripts (or none)."""
         envelopes, outputs = self.envelopes, self.outputs
-        data = page_data(figure, label, criteria)
+        data = page_data(figure, label, criteria, self.mode.deviation_label)
         tiles = []
         if needs_tiles(envelopes.values()):
             any_line = next(iter(envelopes.values()))

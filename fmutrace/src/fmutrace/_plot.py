@@ -175,7 +175,7 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
     for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals, strict=False):
         if band is not None and mode.fills_band:
             ax.fill_between(band[0], band[1], band[2], color="0.85", label=_plain(mode.name))
-        ax.plot(ref_t, ref_v, **mode.reference_line, label=_plain(f"{name} reference"))
+        ax.plot(ref_t, ref_v, **_held(mode.reference_line), label=_plain(f"{name} reference"))
         ax.step(
             res_t,
             res_v,
@@ -196,7 +196,10 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         zoom_axes = list(grid[has_inputs:, 1])
         zoom_deviation = zoom_axes.pop()
         for ax, (name, times, values, lower, upper, deviation, *_) in zip(zoom_axes, lines, strict=False):
-            ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
+            if mode.fills_band:
+                ax.fill_between(times, lower, upper, step="post", color="0.8", label=_plain(mode.name))
+            else:  # (lower = upper: the expected values)
+                ax.plot(times, lower, **_held(mode.reference_line), label="reference")
             ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=_plain(name))
             ax.axvline(at, color="C3", linewidth=0.8)
             zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=_plain(name))
@@ -207,6 +210,11 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
     stream = io.BytesIO()
     fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
     return stream.getvalue()
+
+
+def _held(line: dict) -> dict:
+    """The mode's reference line drawn as the result is: each value held until the next sample."""
+    return {**line, "drawstyle": "steps-post"}
 
 
 def _plain(text):
@@ -286,13 +294,14 @@ def _window(zoom_line, k):
     return None if zoom_line is None or zoom_line[k] is None else (zoom_line[0], zoom_line[k])
 
 
-def page_data(figure: Figure, label: str, criteria: dict) -> dict:
+def page_data(figure: Figure, label: str, criteria: dict, deviation_label: str = "result - ref") -> dict:
     """What a case page's interactive plots show (plain lists, NaN kept:
     the page reads them as JavaScript): per signal its reference, result,
     band and deviation, decimated as the figure's, with the samples around
     the first deviation at full resolution; the inputs; where the first
     deviation is and the span to frame on open. criteria: signal -> the
-    criterion it is judged by."""
+    criterion it is judged by; deviation_label: what the deviation is (the
+    mode's, its plots' scale's label)."""
     zoom = {}
     frame = None
     if figure.zoom:
@@ -320,6 +329,7 @@ def page_data(figure: Figure, label: str, criteria: dict) -> dict:
     return {
         "title": shown(figure.title),
         "label": shown(label),
+        "deviation_label": deviation_label,
         "inputs": [{"name": shown(name), "line": _points(t, v)} for name, t, v in figure.inputs],
         "signals": signals,
         "first_deviation": figure.zoom[0] if figure.zoom else None,
