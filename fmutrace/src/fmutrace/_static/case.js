@@ -147,7 +147,11 @@
 
   // a tick's text that keeps the scale however small or large the numbers (not the locale's 3 decimals)
   function ticks(u, splits) {
-    return splits.map(function (v) { return v === null ? "" : String(Number(v.toPrecision(6))); });
+    return splits.map(function (v) {
+      if (v === null) { return ""; }
+      var x = Number(v.toPrecision(6));
+      return x !== 0 && (Math.abs(x) < 1e-3 || Math.abs(x) >= 1e6) ? x.toExponential() : String(x);
+    });
   }
 
   // a legend's value as it is (the shortest text that reads back to it), not rounded to the locale's 3 decimals
