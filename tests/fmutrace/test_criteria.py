@@ -168,6 +168,41 @@ def test_a_status_word_flipped_for_one_cycle_fails_whatever_the_time_allowance()
     assert comparison.messages()[0] == "b: the reference's pulse to 33281 at t=0.9 (1 cycle) is missing from the result"
 
 
+def test_a_pulse_missing_from_the_result_is_that_pulse_not_every_later_change_late():
+    """The issue's case: the reference's one-cycle pulse at t = 0.5 that
+    the result lacks, the signal's later changes (t = 1.0 and 1.5) in
+    both: changes pair nearest first, so the pulse is missing at its time;
+    paired in order, the change at 0.5 came 5 cycles late."""
+    later = np.where((np.arange(20) >= 10) & (np.arange(20) < 15), 1, 0)
+    spurious = later.copy()
+    spurious[5] = 1
+    for cycles in (1, 3, 4):
+        comparison = discrete(spurious, later, cycles)
+        assert comparison.messages() == [
+            "b: the reference's pulse to 1 at t=0.5 (1 cycle) is missing from the result"
+        ], cycles
+    # within the cycles allowed of the later rise (5 cycles), the pulse's rise pairs with it: the rest is unpaired
+    assert not discrete(spurious, later, 5).passed
+
+
+def test_changes_pair_nearest_first_and_a_change_too_late_names_both_times():
+    """A pulse 2 cycles late within 2 allowed pairs; a rise 4 cycles late,
+    with nothing between it and the reference's rise, is that rise late,
+    named with both times."""
+    reference = np.zeros(20)
+    reference[[3, 4, 5]] = 1  # a rise at 0.3, a fall at 0.6
+    reference[12:] = 1  # a rise at 1.2
+    result = np.zeros(20)
+    result[[5, 6, 7]] = 1  # the first pulse 2 cycles late
+    result[16:] = 1  # the rise at 1.2 four cycles late: unpaired with 2 allowed
+    comparison = discrete(reference, result, 2)
+    assert comparison.messages() == [
+        f"b: the reference's change to 1 at t={float(GRID[12])!r} comes 4 cycles late (t={float(GRID[16])!r}), "
+        "more than the 2 allowed"
+    ]
+    assert discrete(reference, result, 4).passed
+
+
 def test_a_change_to_another_value_fails_where_a_tube_would_interpolate():
     """16#8200 -> 16#8201 is not 16#8200 -> 16#8202, however close the numbers."""
     comparison = discrete(step_at(5, 0x8200, 0x8201), step_at(5, 0x8200, 0x8202), 2)

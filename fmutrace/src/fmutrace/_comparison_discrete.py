@@ -155,7 +155,7 @@ def pair_changes(wanted, made, cycles) -> dict:
     cycles, as an engineer pairs them (the closest pairs first, a change in
     one pair only); a missing or added change leaves the others' pairs as
     they are."""
-    starts = [c.first for c in made]
+    starts = np.array([c.first for c in made], dtype=np.int64)
     candidates = []
     for m, change in enumerate(wanted):
         lo = int(np.searchsorted(starts, change.first - cycles, "left"))
