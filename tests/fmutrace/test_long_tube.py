@@ -11,6 +11,7 @@ import shutil
 import numpy as np
 import pytest
 
+import fmutrace
 from fmutrace import Tube, read_trace, write_trace
 from fmutrace._pipeline import CaseFiles, Streaming, run_folder_case
 from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
@@ -133,3 +134,27 @@ def test_table_exports_in_a_tube_streamed_as_in_memory(name, model, mode, monkey
         same(whole, streamed)
     if name == "perturbed" and mode == TUBES[0]:
         assert not whole.passed and any("line 17" in m for m in whole.messages), whole.messages
+
+
+@pytest.mark.parametrize("criteria", [False, True], ids=["tube", "per-signal criteria"])
+def test_the_second_sides_deviation_is_plotted(criteria, tmp_path):
+    """A spike of the reference fails on the tube's second side: its page's
+    plot data hold that side's deviation (the reference outside the tube
+    around the result) with the spike's excess at its time, streamed and
+    judged whole alike; the first side's deviation is 0 there."""
+    import json
+
+    folder = varied(tmp_path, "spike")
+    tube = Tube(0.5, 1e-9)
+    mode = fmutrace.Criteria({"y": tube}) if criteria else tube
+    path = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    runner, fmu = worker_fmu(path.read_bytes(), str(path))
+    target = Target(runner, fmu, {"fmu": fmu.label, "fmu_file": str(path), "fmu_folder": "f"})
+    outcome = run_folder_case(CaseFiles(folder, folder.name), target, CaseSettings(mode, "all"), Streaming(1, 8))
+    assert outcome.status == "fail" and "the reference leaves the tube around the result" in outcome.messages[0]
+    data = json.loads(outcome.plot_js.removeprefix("window.fmutracePlot = ").rstrip().removesuffix(";"))
+    (y,) = [s for s in data["signals"] if s["name"] == "y"]
+    times, back = y["back"]
+    # 17 at t = 4.5; the result around it (t = 4 to 5) tops at 8, and the tube at 8 + 1e-9
+    assert max(back) == pytest.approx(9.0 - 1e-9) and times[back.index(max(back))] == 4.5
+    assert data["back_label"] == "the reference outside the tube around the result"

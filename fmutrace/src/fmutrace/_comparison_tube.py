@@ -14,7 +14,7 @@ the result, which no shift in time explains.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
@@ -78,11 +78,10 @@ class Tube(Mode):
 
     def judge(self, result, reference, names):
         bands = {name: self.band(result, reference, name) for name in names}
+        if self.sides == 2:  # (the second side's band rides on the first's: the report plots both)
+            bands = {name: replace(band, back=self.back_band(reference, result, name)) for name, band in bands.items()}
         deviations = {
-            name: self.verdict(
-                verdict_of(name, band),
-                verdict_of(name, self.back_band(reference, result, name)) if self.sides == 2 else None,
-            )
+            name: self.verdict(verdict_of(name, band), verdict_of(name, band.back) if band.back else None)
             for name, band in bands.items()
         }
         return deviations, bands, ""

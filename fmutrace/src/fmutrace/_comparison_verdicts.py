@@ -21,6 +21,7 @@ class Band:
     upper: np.ndarray
     ok: np.ndarray  # the sample passes
     deviation: np.ndarray  # what the report plots under the signals
+    back: "Band | None" = None  # a two-sided tube's second side: the reference's samples in the tube around the result
 
 
 @dataclass

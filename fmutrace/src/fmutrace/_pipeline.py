@@ -266,12 +266,14 @@ class _Comparer:
     def __init__(self, case: ChunkedCase, mode: Mode, bar: SampleProgress):
         options, outputs = case.options, case.outputs
         self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
+        self.t_end = case.t_end
         self.signals = {name: Verdict(name) for name in outputs}
         self.envelopes = {
             key: Envelope(self.start, case.t_end)
             for key in [("ref", s) for s in outputs]
             + [("result", s) for s in outputs]
             + [("deviation", s) for s in outputs]
+            + ([("back", s) for s in outputs] if isinstance(mode, Tube) and mode.sides == 2 else [])
             + ([(edge, s) for s in outputs for edge in ("lower", "upper")] if mode.fills_band else [])
             + [("input", s) for s in case.input_names]
         }
@@ -469,7 +471,9 @@ class _Comparer:
             span = (self.result_first, last if done else np.inf)
             following = float(rows["time"][take]) if take < len(rows) else math.nan
             for s in _signal_names(rows):
-                back[s].add(mode.back_band(rows[:take], result, s, span, following))
+                band = mode.back_band(rows[:take], result, s, span, following)
+                back[s].add(band)
+                self.envelopes[("back", s)].add(band.times, band.deviation)
         # the result the next rows' windows need: from the sample before the earliest's time - the tube's time on
         at = float(rows["time"][min(take, len(rows) - 1)])
         keep = int(np.searchsorted(result["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
@@ -485,6 +489,10 @@ class _Comparer:
             before = verdict.failed
             self.signals[s].add(band)
             self.envelopes[("deviation", s)].add(band.times, band.deviation)
+            if band.back is not None:  # (per-signal criteria: a two-sided tube's signals have one)
+                self.envelopes.setdefault(("back", s), Envelope(self.start, self.t_end)).add(
+                    band.back.times, band.back.deviation
+                )
             if self.mode.fills_band:  # (the same samples: both edges' envelopes have the same times)
                 self.envelopes[("lower", s)].add(band.times, band.lower)
                 self.envelopes[("upper", s)].add(band.times, band.upper)
@@ -520,7 +528,7 @@ class _Comparer:
             data["tiles"], data["span"] = DETAIL, [any_line.t0, any_line.t0 + any_line.span]
             inputs = [(s, envelopes[("input", s)]) for s in case.input_names]
             signals = [
-                (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation")))
+                (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation", "back")))
                 for s in outputs
             ]
             tiles = [as_script("fmutraceTile(", page_tile(k, inputs, signals), ");") for k in range(DETAIL)]
@@ -552,6 +560,7 @@ class _Comparer:
                 [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), self.band(s)) for s in outputs],
                 [(s, *envelopes[("deviation", s)].line()) for s in outputs],
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
+                {s: envelopes[("back", s)].line() for s in outputs if ("back", s) in envelopes},
             )
             criteria = {s: d.criterion or outcome.criteria for s, d in zip(outputs, deviations, strict=True)}
             try:

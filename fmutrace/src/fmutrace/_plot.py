@@ -25,6 +25,7 @@ COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
 ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
 
 
+BACK = "the reference outside the tube around the result"  # a two-sided tube's second side, in the plots
 DETAIL = 16  # an envelope's columns per figure column: a case page's finer level, sent in tiles of COLUMNS
 FOLD_SAMPLES = 1 << 16  # samples an envelope holds before it folds them into its columns
 
@@ -130,10 +131,12 @@ class Figure:
     (result times, values), band or None)], deviations [(name, times,
     values)], and zoom: None, or (its time, [(name, times, values,
     lower, upper, deviation[, reference or None])]) around the first
-    deviation (full resolution)."""
+    deviation (full resolution); back: a two-sided tube's second side,
+    {name: (times, the reference outside the tube around the result)}."""
 
-    def __init__(self, title, inputs, signals, deviations, zoom=None):
+    def __init__(self, title, inputs, signals, deviations, zoom=None, back=None):
         self.title, self.inputs, self.signals, self.deviations, self.zoom = title, inputs, signals, deviations, zoom
+        self.back = back or {}
 
 
 _reused = threading.local()  # a figure is drawn by one thread at a time
@@ -189,6 +192,8 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         ax.legend(loc="best", fontsize=7)
     for name, times, values in figure.deviations:
         deviation_axis.plot(times, values, drawstyle="steps-post", label=_plain(name))
+        if name in figure.back:
+            deviation_axis.plot(*figure.back[name], drawstyle="steps-post", label=_plain(f"{name}, {BACK}"))
     deviation_axis.set_ylabel(mode.deviation_label, fontsize=7)
     deviation_axis.legend(loc="best", fontsize=7)
     if figure.zoom:
@@ -324,12 +329,14 @@ def page_data(figure: Figure, label: str, criteria: dict, deviation_label: str =
                 "lower": _points(band[0], band[1], window=_window(z, 2)) if band is not None else None,
                 "upper": _points(band[0], band[2], window=_window(z, 3)) if band is not None else None,
                 "deviation": _points(dev_t, dev_v, window=_window(z, 4)),
+                "back": _points(*figure.back[name]) if name in figure.back else None,
             }
         )
     return {
         "title": shown(figure.title),
         "label": shown(label),
         "deviation_label": deviation_label,
+        "back_label": BACK,
         "inputs": [{"name": shown(name), "line": _points(t, v)} for name, t, v in figure.inputs],
         "signals": signals,
         "first_deviation": figure.zoom[0] if figure.zoom else None,
@@ -346,7 +353,7 @@ def page_tile(k: int, inputs, signals) -> dict:
     """Tile k of DETAIL of a case page's finer level: the lines' own
     envelope columns over the k-th part of the time span. inputs: [(name,
     Envelope)]; signals: [(name, reference, result, lower or None, upper
-    or None, deviation)], Envelopes."""
+    or None, deviation, back or None)], Envelopes."""
     first = next(e for _, *lines in signals for e in lines if e is not None) if signals else inputs[0][1]
     part = first.span / DETAIL
 
@@ -365,8 +372,9 @@ def page_tile(k: int, inputs, signals) -> dict:
                 "lower": points(lower),
                 "upper": points(upper),
                 "deviation": points(deviation),
+                "back": points(back),
             }
-            for _, ref, result, lower, upper, deviation in signals
+            for _, ref, result, lower, upper, deviation, back in signals
         ],
     }
 

@@ -282,7 +282,8 @@
     }
     var title = s.name + (s.criterion ? " (" + s.criterion + ")" : "");
     chart(title, names, styles, lines, 230).root.parentNode.dataset.signal = s.name;
-    var none = s.deviation[1].every(function (v) { return v === 0; });
+    function zero(line) { return !line || line[1].every(function (v) { return v === 0; }); }
+    var none = zero(s.deviation) && zero(s.back);
     if (none) {
       var box = document.createElement("div");
       box.className = "plot deviation-none";
@@ -296,8 +297,14 @@
       root.appendChild(box);
       return;
     }
-    chart(s.name + ": deviation", [s.name + " deviation"], [held({ stroke: "#d62728" })],
-      [["signals", n, "deviation"]], 170, data.deviation_label).root.parentNode.dataset.signal = s.name;
+    var deviations = [s.name + " deviation"], strokes = [held({ stroke: "#d62728" })], sources = [["signals", n, "deviation"]];
+    if (s.back) {  // a two-sided tube: the reference outside the tube around the result too
+      deviations.push(s.name + ": " + data.back_label);
+      strokes.push(held({ stroke: "#9467bd", dash: [5, 3] }));
+      sources.push(["signals", n, "back"]);
+    }
+    chart(s.name + ": deviation", deviations, strokes, sources, 170, data.deviation_label)
+      .root.parentNode.dataset.signal = s.name;
   });
   if (data.frame) { frame(); } else if (charts.length) { root.dataset.xmin = charts[0].scales.x.min; root.dataset.xmax = charts[0].scales.x.max; }
   window.addEventListener("resize", function () {
