@@ -394,6 +394,23 @@ def command(*args):
     return status, out.getvalue(), err.getvalue()
 
 
+def test_the_command_checks_a_tube_both_ways_unless_told_one_side(tmp_path):
+    """A +10 glitch of the reference's y: --tube-time 0.1 --tube-value 0
+    fails it, naming the side; --tube-sides 1 passes it, as csv-compare;
+    the sides without a tube are refused, naming the flag."""
+    folder, reference = own_output_case(tmp_path)
+    y = reference["y"].copy()
+    y[20] += 10
+    changed(folder, reference, y=y)
+    tube = ("--tube-time", 0.1, "--tube-value", 0)
+    status, out, _ = command(tmp_path, *tube)
+    assert status == 1 and "y: the reference leaves the tube around the result first at t=2.0: " in out, out
+    status, out, _ = command(tmp_path, *tube, "--tube-sides", 1)
+    assert status == 0, out
+    status, _, err = command(tmp_path, "--tube-sides", 1)
+    assert status == 2 and "--tube-sides is a tube's: give the tube too" in err, err
+
+
 def test_the_command_states_each_signals_criterion(tmp_path):
     folder, reference = own_output_case(tmp_path)
     changed(folder, reference, y=reference["y"] + 0.5e-6, rampActive=late(reference["rampActive"], 1))
