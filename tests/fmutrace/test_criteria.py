@@ -479,7 +479,7 @@ def test_per_signal_criteria_draw_their_plot_and_report(tmp_path):
         "per signal: y: tube of 0.1 s and 0; rampActive: exact, up to 1 cycle early or late; the rest: exact" in summary
     )
     assert r"rampActive \(exact, up to 1 cycle early or late\): the reference's change" in summary  # (Markdown)
-    assert r"y \(tube of 0.1 s and 0\): 81 samples within the band; time allowance used: 0 of 0.1 s \(0%\) |" in summary
+    assert r"y \(tube of 0.1 s and 0\): 81 samples pass; time allowance used: 0 of 0.1 s \(0%\) |" in summary
 
 
 def test_one_discrete_or_ulps_mode_for_every_signal(tmp_path):

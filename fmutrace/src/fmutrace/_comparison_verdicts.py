@@ -53,7 +53,7 @@ class Deviation:
         who = f"{self.name} ({self.criterion})" if self.criterion else self.name
         used = f"; {self.allowance}" if self.allowance else ""
         if self.passed:
-            return f"{who}: {self.compared} samples within the band{used}"
+            return f"{who}: {self.compared} samples pass{used}"
         if self.note:
             return f"{who}: {self.note}{used}"
         band = f"{self.lower!r}" if self.lower == self.upper else f"[{self.lower!r}, {self.upper!r}]"
