@@ -158,3 +158,61 @@ def test_the_second_sides_deviation_is_plotted(criteria, tmp_path):
     # 17 at t = 4.5; the result around it (t = 4 to 5) tops at 8, and the tube at 8 + 1e-9
     assert max(back) == pytest.approx(9.0 - 1e-9) and times[back.index(max(back))] == 4.5
     assert data["back_label"] == "the reference outside the tube around the result"
+
+
+def tube_bounds_one_by_one(reference_time, reference_values, times, widths, span=None):
+    """The tube's bounds as csv-compare's definition reads, one sample at a
+    time (the oracle of the vectorized comparison._comparison_tube.tube_bounds):
+    the extremes of the reference's samples within the window (its edges
+    up to the times' rounding) and of its polyline at the window's ends."""
+
+    def polyline_at(at):
+        k = int(np.searchsorted(reference_time, at, side="right")) - 1
+        if k >= len(reference_time) - 1:
+            return float(reference_values[-1])
+        t0, t1 = reference_time[k], reference_time[k + 1]
+        if t1 == t0:
+            return float(reference_values[k + 1])
+        return float(reference_values[k] + (reference_values[k + 1] - reference_values[k]) * (at - t0) / (t1 - t0))
+
+    tube_time, tube_value = widths
+    lower, upper = np.full(len(times), np.nan), np.full(len(times), np.nan)
+    t_first, t_last = span if span is not None else (reference_time[0], reference_time[-1])
+    for i, t in enumerate(times):
+        if not t_first <= t <= t_last:
+            continue
+        start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
+        slack = 1e-9 * max(1.0, abs(t))
+        lo = np.searchsorted(reference_time, start - slack, "left")
+        hi = np.searchsorted(reference_time, end + slack, "right")
+        with np.errstate(invalid="ignore"):
+            window = np.concatenate([reference_values[lo:hi], [polyline_at(start), polyline_at(end)]])
+        if not np.isnan(window).all():
+            lower[i], upper[i] = np.nanmin(window) - tube_value, np.nanmax(window) + tube_value
+    return lower, upper
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_tubes_bounds_at_once_are_the_bounds_one_sample_at_a_time(seed):
+    """Random references (repeated times, NaN samples, steps of several
+    sizes), the result's times on and off them, tubes from none to wider
+    than the trace, with and without a span: the same bounds."""
+    from fmutrace._comparison_tube import QUERIES, tube_bounds
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 3 * QUERIES if seed % 4 == 0 else 200))
+    steps = rng.choice([0.0, 0.01, 0.1, 0.25], size=n - 1, p=[0.05, 0.55, 0.3, 0.1])
+    times = np.round(np.concatenate([[rng.uniform(-1, 1)], rng.uniform(-1, 1) + np.cumsum(steps)]), 6)
+    values = rng.normal(size=n).round(2)
+    values[rng.random(n) < 0.05] = np.nan
+    result_times = np.sort(np.concatenate([times, rng.uniform(times[0] - 1, times[-1] + 1, size=n // 2)]))
+    span = None if seed % 3 else (times[0] - 0.5 * rng.random(), times[-1] + 0.5 * rng.random())
+    for tube_time in (0.0, 0.01, 0.1, 0.35, 2.0, 1e3):
+        widths = (tube_time, float(rng.choice([0.0, 1e-6, 0.5])))
+        at_once = tube_bounds(times, values, result_times, widths, span)
+        one_by_one = tube_bounds_one_by_one(times, values, result_times, widths, span)
+        for got, want in zip(at_once, one_by_one, strict=True):
+            assert np.array_equal(got, want, equal_nan=True), (
+                tube_time,
+                np.flatnonzero(~((got == want) | (np.isnan(got) & np.isnan(want)))),
+            )

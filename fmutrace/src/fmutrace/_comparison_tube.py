@@ -168,15 +168,49 @@ def _distance_to_polyline(times, values, t, v, width, reach):
 
 
 def _polyline_at(times, values, at):
-    """The reference polyline at time at (inside its time range)."""
-    k = int(np.searchsorted(times, at, side="right")) - 1
-    if k >= len(times) - 1:
-        return float(values[-1])
-    t0, t1 = times[k], times[k + 1]
-    if t1 == t0:
-        return float(values[k + 1])
-    with np.errstate(invalid="ignore"):  # a NaN sample gives NaN, which the window's nanmin and nanmax leave out
-        return float(values[k] + (values[k + 1] - values[k]) * (at - t0) / (t1 - t0))
+    """The reference polyline at each time of at (inside its time range)."""
+    k = np.searchsorted(times, at, side="right") - 1
+    last = k >= len(times) - 1
+    k = np.minimum(k, len(times) - 2)
+    t0, t1, v0, v1 = times[k], times[k + 1], values[k], values[k + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):  # a NaN sample gives NaN, which the window's fmin leaves out
+        between = v0 + (v1 - v0) * (at - t0) / (t1 - t0)
+    return np.where(last, values[-1], np.where(t1 == t0, v1, between))
+
+
+QUERIES = 4096  # tube windows whose extremes one sparse table answers (its memory: their span of samples, log2 deep)
+
+
+def _window_extremes(values, lo, hi):
+    """(smallest, largest) of values[lo[i]:hi[i]] for each i, NaN left out
+    (NaN where a window is empty or all NaN); lo and hi ascending: a
+    sparse table of the span of each QUERIES windows answers them."""
+    smallest, largest = np.full(len(lo), np.nan), np.full(len(lo), np.nan)
+    for first in range(0, len(lo), QUERIES):
+        part = slice(first, first + QUERIES)
+        a, b = lo[part], hi[part]
+        filled = b > a
+        if not filled.any():
+            continue
+        base = int(a[filled].min())
+        a, b = a[filled] - base, b[filled] - base
+        size = b - a
+        depth = int(size.max()).bit_length() - 1  # the largest power of 2 at most the widest window: 2^depth
+        level = np.floor(np.log2(size)).astype(np.int64)
+        low = high = values[base : base + int(b.max())]
+        got_low, got_high = np.full(len(a), np.nan), np.full(len(a), np.nan)
+        for j in range(depth + 1):
+            if j:
+                half = 1 << (j - 1)
+                low, high = np.fmin(low[:-half], low[half:]), np.fmax(high[:-half], high[half:])
+            at = level == j
+            if at.any():
+                reach = b[at] - (1 << j)
+                got_low[at] = np.fmin(low[a[at]], low[reach])
+                got_high[at] = np.fmax(high[a[at]], high[reach])
+        smallest[np.flatnonzero(filled) + first] = got_low
+        largest[np.flatnonzero(filled) + first] = got_high
+    return smallest, largest
 
 
 def tube_bounds(reference_time, reference_values, times, widths, span=None):
@@ -191,23 +225,18 @@ def tube_bounds(reference_time, reference_values, times, widths, span=None):
     lower = np.full(len(times), np.nan)
     upper = np.full(len(times), np.nan)
     t_first, t_last = span if span is not None else (reference_time[0], reference_time[-1])
-    for i, t in enumerate(times):
-        if not t_first <= t <= t_last:
-            continue
-        start, end = max(t - tube_time, t_first), min(t + tube_time, t_last)
-        slack = time_slack(t)  # a sample exactly at the allowed time counts, however t - tube_time rounds
-        inside = reference_values[
-            np.searchsorted(reference_time, start - slack, "left") : np.searchsorted(
-                reference_time, end + slack, "right"
-            )
-        ]
-        edges = [
-            _polyline_at(reference_time, reference_values, start),
-            _polyline_at(reference_time, reference_values, end),
-        ]
-        window = np.concatenate([inside, edges])
-        if np.isnan(window).all():
-            continue
-        lower[i] = np.nanmin(window) - tube_value
-        upper[i] = np.nanmax(window) + tube_value
+    inside = np.flatnonzero((times >= t_first) & (times <= t_last))
+    if not len(inside):
+        return lower, upper
+    t = times[inside]
+    start, end = np.maximum(t - tube_time, t_first), np.minimum(t + tube_time, t_last)
+    slack = time_slack(t)  # a sample exactly at the allowed time counts, however t - tube_time rounds
+    smallest, largest = _window_extremes(
+        reference_values,
+        np.searchsorted(reference_time, start - slack, "left"),
+        np.searchsorted(reference_time, end + slack, "right"),
+    )
+    edges = (_polyline_at(reference_time, reference_values, start), _polyline_at(reference_time, reference_values, end))
+    smallest, largest = np.fmin(smallest, np.fmin(*edges)), np.fmax(largest, np.fmax(*edges))
+    lower[inside], upper[inside] = smallest - tube_value, largest + tube_value  # (NaN where the window is all NaN)
     return lower, upper
