@@ -126,7 +126,10 @@ def test_ramp_active_one_cycle_late_passes_a_one_cycle_tube_of_value_0(tmp_path,
     assert outcome.status == "pass", outcome.messages
     changed(folder, reference, rampActive=shift(ramp, 2))
     outcome = run_folder_case(CaseFiles(folder, folder.name), target, settings, Streaming(*chunks))
-    assert outcome.status == "fail" and outcome.messages[0].startswith("rampActive leaves the band"), outcome.messages
+    assert outcome.status == "fail", outcome.messages
+    # two cycles off: a trace's change lies outside the tube around the other (which first: late or early)
+    first = outcome.messages[0]
+    assert first.startswith("rampActive: the ") and " leaves the tube around the " in first, outcome.messages
 
 
 # ---- 2. discrete signals: exact in value, changes within k cycles --------------
@@ -157,9 +160,47 @@ def test_a_status_word_flipped_for_one_cycle_fails_whatever_the_time_allowance()
     flipped[9] = 0x8201
     for cycles in (0, 1, 5):
         comparison = discrete(status, flipped, cycles)
-        assert not comparison.passed and "a change the reference lacks" in comparison.messages()[0], cycles
-    # the reference's one-cycle flip missing from the result fails too
-    assert not discrete(flipped, status, 3).passed
+        assert not comparison.passed, cycles
+        assert comparison.messages()[0] == "b: changes to 33281 at t=0.9 and back at t=1.0, a pulse the reference lacks"
+    # the reference's one-cycle flip missing from the result fails too: a pulse missing, at its time
+    comparison = discrete(flipped, status, 3)
+    assert not comparison.passed
+    assert comparison.messages()[0] == "b: the reference's pulse to 33281 at t=0.9 (1 cycle) is missing from the result"
+
+
+def test_a_pulse_missing_from_the_result_is_that_pulse_not_every_later_change_late():
+    """The issue's case: the reference's one-cycle pulse at t = 0.5 that
+    the result lacks, the signal's later changes (t = 1.0 and 1.5) in
+    both: changes pair nearest first, so the pulse is missing at its time;
+    paired in order, the change at 0.5 came 5 cycles late."""
+    later = np.where((np.arange(20) >= 10) & (np.arange(20) < 15), 1, 0)
+    spurious = later.copy()
+    spurious[5] = 1
+    for cycles in (1, 3, 4):
+        comparison = discrete(spurious, later, cycles)
+        assert comparison.messages() == [
+            "b: the reference's pulse to 1 at t=0.5 (1 cycle) is missing from the result"
+        ], cycles
+    # within the cycles allowed of the later rise (5 cycles), the pulse's rise pairs with it: the rest is unpaired
+    assert not discrete(spurious, later, 5).passed
+
+
+def test_changes_pair_nearest_first_and_a_change_too_late_names_both_times():
+    """A pulse 2 cycles late within 2 allowed pairs; a rise 4 cycles late,
+    with nothing between it and the reference's rise, is that rise late,
+    named with both times."""
+    reference = np.zeros(20)
+    reference[[3, 4, 5]] = 1  # a rise at 0.3, a fall at 0.6
+    reference[12:] = 1  # a rise at 1.2
+    result = np.zeros(20)
+    result[[5, 6, 7]] = 1  # the first pulse 2 cycles late
+    result[16:] = 1  # the rise at 1.2 four cycles late: unpaired with 2 allowed
+    comparison = discrete(reference, result, 2)
+    assert comparison.messages() == [
+        f"b: the reference's change to 1 at t={float(GRID[12])!r} comes 4 cycles late (t={float(GRID[16])!r}), "
+        "more than the 2 allowed"
+    ]
+    assert discrete(reference, result, 4).passed
 
 
 def test_a_change_to_another_value_fails_where_a_tube_would_interpolate():
@@ -293,29 +334,40 @@ def test_a_status_word_is_recognised_from_the_fmu_and_never_interpolated(tmp_pat
     status = reference["status"].copy()
     status[40] = 0x8200
     changed(folder, reference, status=status)
-    assert run_case(folder, Tube(0.1, 0.0)).status == "pass"  # the old judgement, unchanged
+    assert run_case(folder, Tube(0.1, 0.0, sides=1)).status == "pass"  # the old, one-sided judgement, unchanged
+    # both ways, the flip in the reference lies outside the tube around the result (status is 0 there)
+    flipped = run_case(folder, Tube(0.1, 0.0))
+    assert flipped.status == "fail" and flipped.messages[0].startswith(
+        "status: the reference leaves the tube around the result first at t=4.0: 33280.0, the tube there 0.0, off by"
+    ), flipped.messages
     outcome = run_case(folder, fmutrace.Criteria({"*": Tube(0.1, 0.0)}))
     assert outcome.status == "fail", outcome.messages
     assert outcome.messages[0] == (
         "status (exact, up to 1 cycle early or late): "
-        "the reference's change to 33280 at t=4.0 is missing from the result"
+        "the reference's pulse to 33280 at t=4.0 (1 cycle) is missing from the result"
     )
 
 
 def test_a_time_tolerance_hiding_a_value_error_shows_its_use(tmp_path):
-    """A +10 glitch of y at one sample passes a one-cycle tube (its neighbours
-    are in the window); the verdict says the sample needed nearly the whole
-    time: y rises 0.2 a cycle there, so the reference's polyline from the
-    sample before (y - 0.2) to the glitch (y + 10.2) passes y at 10/10.2 of
-    the cycle before."""
+    """A +10 glitch of y at one sample of the reference passes a one-sided
+    one-cycle tube (its neighbours are in the window); the verdict says the
+    sample needed nearly the whole time: y rises 0.2 a cycle there, so the
+    reference's polyline from the sample before (y - 0.2) to the glitch
+    (y + 10.2) passes y at 10/10.2 of the cycle before. The tube both ways
+    fails it: the glitch lies outside the tube around the result."""
     folder, reference = own_output_case(tmp_path)
     y = reference["y"].copy()
     y[20] += 10
     changed(folder, reference, y=y)
-    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0)}))
+    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0, sides=1)}))
     assert outcome.status == "pass"
     assert f"time allowance used: {0.1 * 10 / 10.2:.6g} of 0.1 s (98%) at t=2.0" in outcome.messages[0]
-    assert outcome.messages[0].startswith("y (tube of 0.1 s and 0): ")
+    assert outcome.messages[0].startswith("y (tube of 0.1 s and 0, one-sided): ")
+    outcome = run_case(folder, fmutrace.Criteria({"y": Tube(0.1, 0.0)}))
+    assert outcome.status == "fail"
+    assert outcome.messages[0].startswith(
+        "y (tube of 0.1 s and 0): the reference leaves the tube around the result first at t=2.0: "
+    ), outcome.messages
 
 
 def test_a_case_folder_carries_its_criteria(tmp_path):
@@ -340,6 +392,23 @@ def command(*args):
     with contextlib.redirect_stderr(io.StringIO()) as err:
         status = cli.main(["compare", str(fmu_path(BUILD_DIR, "RateLimiter", 3)), *map(str, args)], out=out)
     return status, out.getvalue(), err.getvalue()
+
+
+def test_the_command_checks_a_tube_both_ways_unless_told_one_side(tmp_path):
+    """A +10 glitch of the reference's y: --tube-time 0.1 --tube-value 0
+    fails it, naming the side; --tube-sides 1 passes it, as csv-compare;
+    the sides without a tube are refused, naming the flag."""
+    folder, reference = own_output_case(tmp_path)
+    y = reference["y"].copy()
+    y[20] += 10
+    changed(folder, reference, y=y)
+    tube = ("--tube-time", 0.1, "--tube-value", 0)
+    status, out, _ = command(tmp_path, *tube)
+    assert status == 1 and "y: the reference leaves the tube around the result first at t=2.0: " in out, out
+    status, out, _ = command(tmp_path, *tube, "--tube-sides", 1)
+    assert status == 0, out
+    status, _, err = command(tmp_path, "--tube-sides", 1)
+    assert status == 2 and "--tube-sides is a tube's: give the tube too" in err, err
 
 
 def test_the_command_states_each_signals_criterion(tmp_path):
@@ -410,7 +479,7 @@ def test_per_signal_criteria_draw_their_plot_and_report(tmp_path):
         "per signal: y: tube of 0.1 s and 0; rampActive: exact, up to 1 cycle early or late; the rest: exact" in summary
     )
     assert r"rampActive \(exact, up to 1 cycle early or late\): the reference's change" in summary  # (Markdown)
-    assert r"y \(tube of 0.1 s and 0\): 81 samples within the band; time allowance used: 0 of 0.1 s \(0%\) |" in summary
+    assert r"y \(tube of 0.1 s and 0\): 81 samples pass; time allowance used: 0 of 0.1 s \(0%\) |" in summary
 
 
 def test_one_discrete_or_ulps_mode_for_every_signal(tmp_path):

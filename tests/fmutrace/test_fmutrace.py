@@ -90,7 +90,7 @@ def test_an_event_row_changes_the_value_at_that_instant(tmp_path):
     write_case(tmp_path / "event", "PassThrough", STEP_REF.replace("0.3,3", "0.3,1"))
     done = fmutrace_cli("compare", PASS_THROUGH[3], tmp_path)
     assert done.returncode == 1
-    assert "y leaves the band first at t=0.3: 3.0, expected 1.0" in done.stdout
+    assert "y differs first at t=0.3: 3.0, expected 1.0" in done.stdout
 
 
 def test_an_event_row_in_a_reference(tmp_path):
@@ -170,8 +170,8 @@ def test_exact_mode_passes_bit_for_bit_and_fails_on_one_ulp(version, tmp_path):
     lag_case(tmp_path / "lag", lambda t, x: math.nextafter(x, math.inf) if abs(t - 1.5) < 1e-9 else x)
     done = fmutrace_cli("compare", LAG[version], tmp_path)
     assert done.returncode == 1
-    assert "x leaves the band first at t=1.5" in done.stdout
-    assert "1 of 21 samples outside" in done.stdout
+    assert "x differs first at t=1.5" in done.stdout
+    assert "1 of 21 samples differ" in done.stdout
 
 
 @pytest.mark.parametrize(
@@ -240,7 +240,11 @@ def test_tube_fails_where_the_result_leaves_it_and_says_by_how_much(tmp_path):
     assert first["value"] == pytest.approx(x, rel=1e-12)
     assert first["upper"] == pytest.approx(upper, rel=1e-12) and first["lower"] == pytest.approx(-0.001, abs=1e-12)
     assert first["excess"] == pytest.approx(x - upper, rel=1e-9)
-    assert f"x leaves the band first at t={first['time']!r}: {first['value']!r}, expected [" in done.stdout
+    assert first["direction"] == "result"  # (the result's sample leaves the tube around the reference first)
+    assert (
+        f"x: the result leaves the tube around the reference first at t={first['time']!r}: {first['value']!r}, "
+        "the tube there [" in done.stdout
+    )
 
 
 def test_the_tube_needs_both_widths_and_no_tolerance_beside_it(tmp_path):
@@ -470,7 +474,7 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
     lag2 = {case.name: case for case in suites["FirstOrderLag (FMI 2)"]}
     assert lag2["lag_exact"].is_passed
     failure = lag2["lag_off"].result[0]
-    assert failure.message.startswith("x leaves the band first at t=1.0")
+    assert failure.message.startswith("x differs first at t=1.0")
 
     results = json.loads((report / "results.json").read_text())
     assert results["mode"] == "exact" and results["passed"] is False

@@ -21,7 +21,20 @@ PACKAGE = Path(__file__).resolve().parents[2] / "fmutrace" / "src" / "fmutrace"
 LAYERS = [
     ("base", {"fmutrace._errors", "fmutrace._names", "fmutrace._progress", "fmutrace._native"}),
     ("readers", {"fmutrace._traces", "fmutrace.recordings", "fmutrace.recordings.*"}),
-    ("model", {"fmutrace._fmu", "fmutrace._comparison", "fmutrace._fmpy", "fmutrace._outcome"}),
+    (
+        "model",
+        {
+            "fmutrace._fmu",
+            "fmutrace._comparison",
+            "fmutrace._comparison_verdicts",
+            "fmutrace._comparison_modes",
+            "fmutrace._comparison_tube",
+            "fmutrace._comparison_discrete",
+            "fmutrace._comparison_criteria",
+            "fmutrace._fmpy",
+            "fmutrace._outcome",
+        },
+    ),
     (
         "runs",
         {

@@ -185,7 +185,7 @@ def test_the_stop_time_is_read_from_a_last_line_of_any_length(width, tmp_path):
 
 @pytest.mark.parametrize("parts", [1, 2, 7])
 def test_a_verdict_given_in_chunks_is_the_verdict_on_the_whole(parts):
-    from fmutrace._comparison import Band, Verdict, _verdict
+    from fmutrace._comparison import Band, Verdict, verdict_of
 
     rng = np.random.default_rng(parts)
     times = np.arange(50) * 0.1
@@ -199,5 +199,5 @@ def test_a_verdict_given_in_chunks_is_the_verdict_on_the_whole(parts):
         verdict = Verdict("y")
         for piece in np.array_split(np.arange(50), parts):
             verdict.add(Band(*(a[piece] for a in (times, values, lower, upper, ok, values - expected))))
-        assert verdict.deviation.to_json() == _verdict("y", band).to_json()
+        assert verdict.deviation.to_json() == verdict_of("y", band).to_json()
         assert verdict.deviation.largest_at == times[40] and verdict.deviation.time == times[4]

@@ -33,6 +33,7 @@ REF = "time,y\n0,0\n0.1,1\n0.2,1\n0.3,3\n0.4,3\n0.5,3\n"
 LONGER_OPT = OPT.replace("StopTime,0.5", "StopTime,50")
 LONGER_REF = REF + "".join(f"{k / 10:g},{2 if k == 300 else 3}\n" for k in range(6, 501))
 HOSTILE = "<img src=x onerror=window.hurt=1> & <b>bold</b>"
+RED = "rgba(187, 0, 0, 1)"  # report.css's #b00: a status that is not a pass
 
 
 def write_case(folder, ref=REF, inputs=INPUT, opt=OPT):
@@ -126,6 +127,13 @@ def test_a_passing_campaign(browser, tmp_path):
     assert campaign.passed
     open_page(browser, tmp_path / "report" / "index.html")
     assert (number(browser, "total"), number(browser, "pass"), number(browser, "fail")) == (6, 6, 0)
+    verdict = browser.find_element("id", "verdict")
+    assert verdict.get_attribute("data-verdict") == "pass" and verdict.text.startswith("PASS 6 of 6 cases pass")
+    for status in ("fail", "error", "invalid"):  # none: not an alarm
+        count = browser.find_element("id", f"count-{status}")
+        assert count.value_of_css_property("color") != RED and int(count.value_of_css_property("font-weight")) < 700
+    summary = (tmp_path / "report" / "summary.md").read_text()
+    assert summary.startswith("# fmutrace: PASS\n") and "| case | FMU | result | seconds |\n" in summary  # no plot
     per_fmu, per_model = (t.text.splitlines() for t in browser.find_elements("css selector", "table.counts"))
     assert per_fmu[2:] == ["PassThrough (FMI 2) 3 0 0 0", "PassThrough (FMI 3) 3 0 0 0"], per_fmu
     assert per_model[2:] == ["PassThrough 6 0 0 0"], per_model
@@ -139,7 +147,10 @@ def test_a_passing_campaign(browser, tmp_path):
     assert console_errors(browser) == []
     browser.find_element("link text", "two").click()
     wait_for(browser, "return document.getElementById('plots').dataset.xmax")
-    assert len(browser.execute_script("return window.fmutraceCharts")) == 3  # inputs, y, y's deviation
+    assert len(browser.execute_script("return window.fmutraceCharts")) == 2  # inputs, y; y's deviation said:
+    assert browser.find_element("css selector", ".deviation-none").text == (
+        "y: deviation\nnone: result - ref is 0 at every compared sample"
+    )
     assert console_errors(browser) == []
 
 
@@ -155,6 +166,14 @@ def test_a_failing_campaign(browser, tmp_path):
     assert campaign.counts()["fail"] == 1
     open_page(browser, tmp_path / "report" / "index.html")
     assert (number(browser, "total"), number(browser, "pass"), number(browser, "fail")) == (4, 3, 1)
+    verdict = browser.find_element("id", "verdict")
+    assert verdict.get_attribute("data-verdict") == "fail" and verdict.text.startswith("FAIL ")
+    count = browser.find_element("id", "count-fail")
+    assert count.value_of_css_property("color") == RED and int(count.value_of_css_property("font-weight")) >= 700
+    summary = (tmp_path / "report" / "summary.md").read_text()
+    rows = [line for line in summary.splitlines() if line.startswith("| ") and "PassThrough" in line]
+    assert summary.startswith("# fmutrace: FAIL\n") and rows[0].startswith("| differs |"), summary  # failures first
+    assert all(row.count(" | ") == 3 for row in rows), rows  # case, FMU, result, seconds: no empty plot column
     assert visible_rows(browser) == ["fail", "pass", "pass", "pass"]
     assert HOSTILE in browser.find_element("id", "cases").text  # as text, not markup
     assert browser.execute_script("return document.images.length === 0 && window.hurt === undefined")
@@ -175,7 +194,7 @@ def test_a_failing_campaign(browser, tmp_path):
         )
     )
     assert 25 < low <= 30 <= high < 35, (low, high)
-    assert "y leaves the band first at t=30.0" in browser.find_element("tag name", "body").text
+    assert "y differs first at t=30.0" in browser.find_element("tag name", "body").text
     no_horizontal_scrolling(browser, "failing_case.png")
     assert console_errors(browser) == []
 
@@ -237,4 +256,71 @@ def test_a_long_trace_opens_framed_and_refines_as_it_is_zoomed(browser, tmp_path
     assert browser.execute_script("return window.fmutraceCharts[1].data[0].length") > before
     assert in_view > 100, in_view  # the overview has about 4 points per 6 s column there: 60 or so
     no_horizontal_scrolling(browser, "long_case_zoomed.png")
+    assert console_errors(browser) == []
+
+
+# each curve of y's plot (series 1: the reference, 2: the result) as uPlot drew it (its path in canvas pixels),
+# stroked alone in black on a canvas of the plot's size: its pixels
+CURVE_PIXELS = """
+var u = window.fmutraceCharts[1], k = arguments[0], canvas = document.createElement("canvas");
+canvas.width = u.ctx.canvas.width;
+canvas.height = u.ctx.canvas.height;
+var ctx = canvas.getContext("2d");
+ctx.lineWidth = u.series[k].width * uPlot.pxRatio;
+ctx.strokeStyle = "#000";
+ctx.stroke(u.series[k]._paths.stroke);
+return Array.from(ctx.getImageData(0, 0, canvas.width, canvas.height).data.filter((_, i) => i % 4 === 3));
+"""
+
+
+def legend_values(browser, chart):
+    return browser.execute_script(
+        "return Array.from(window.fmutraceCharts[arguments[0]].root.querySelectorAll('.u-value'))"
+        ".map(function (v) { return v.textContent; })",
+        chart,
+    )
+
+
+def test_a_bit_for_bit_pass_draws_reference_and_result_as_one_curve(browser, tmp_path):
+    """Reference and result are the same samples: both drawn as values held
+    until the next sample, their curves' pixels are the same; the legend
+    shows values before the cursor is over the plot; the deviation, 0
+    throughout, is said, not drawn on an axis without a scale."""
+    write_case(tmp_path / "cases" / "same")
+    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report", run=RunOptions(jobs=1))
+    assert campaign.passed
+    open_page(browser, tmp_path / "report" / "index.html")
+    browser.find_element("link text", "same").click()
+    wait_for(browser, "return document.getElementById('plots').dataset.xmax")
+    reference, result = (np.array(browser.execute_script(CURVE_PIXELS, k)) for k in (1, 2))
+    assert (reference > 0).sum() > 500  # (a curve across the plot)
+    assert np.array_equal(reference, result)
+    values = legend_values(browser, 1)  # t, y reference, y result
+    assert len(values) == 3 and "--" not in values and values[1] == values[2], values
+    assert browser.find_elements("css selector", ".deviation-none")
+    no_horizontal_scrolling(browser, "passing_case.png")
+    assert console_errors(browser) == []
+
+
+def test_a_failing_deviation_plot_has_a_labelled_scale(browser, tmp_path):
+    """y is 3 from t = 0.3 on; the reference says 3.000001 at t = 0.4: the
+    deviation of -1e-6 there has ticks that tell its size (not '0' alone)
+    and its axis says what it is; the legend shows the values at the first
+    deviation."""
+    write_case(tmp_path / "cases" / "off", ref=REF.replace("0.4,3\n", "0.4,3.000001\n"))
+    campaign = compare([PASS_THROUGH], [tmp_path / "cases"], report=tmp_path / "report", run=RunOptions(jobs=1))
+    assert campaign.counts()["fail"] == 1
+    open_page(browser, tmp_path / "report" / "index.html")
+    browser.find_element("link text", "off").click()
+    wait_for(browser, "return document.getElementById('plots').dataset.xmax")
+    label, ticks = browser.execute_script(
+        "var a = window.fmutraceCharts[2].axes[1]; return [a.label, a._values]"  # (2: y's deviation)
+    )
+    assert label == "result - ref"
+    numbers = [float(t) for t in ticks if t]
+    assert len(set(numbers)) >= 2 and any(abs(v) >= 1e-7 for v in numbers), ticks
+    assert all(abs(v) <= 1e-5 for v in numbers), ticks  # (the scale of the deviation, not 0 to 100)
+    values = legend_values(browser, 1)
+    assert values[1:] == ["3.000001", "3"], values  # (at t = 0.4)
+    no_horizontal_scrolling(browser, "failing_deviation.png")
     assert console_errors(browser) == []

@@ -21,7 +21,15 @@ Real). A label follows from the fault and the criterion's definition
   more than 1e-6 (checked here, in exact rational arithmetic);
 - a one-sample glitch (+10 on a REAL, the other value on a Boolean, a bit
   on a status word, at a sample whose neighbours hold its value): fails
-  "tol:abs=1e-6" and "discrete:cycles=1";
+  "tol:abs=1e-6" and "discrete:cycles=1"; on a REAL it fails a one-cycle
+  tube of value 1e-6 too where it rises above its neighbours by more
+  than 1e-6 (the tube is checked both ways: a glitch in the reference
+  fails as one in the result); on a Boolean in the reference it is a
+  pulse missing from the result;
+- a REAL one cycle late: passes a one-cycle tube of value 1e-6 (each
+  sample is its reference's sample one cycle before, which the tube's
+  time reaches; one way only: one cycle early, the last sample's value
+  is one the reference reaches after its end);
 - an event shifted by half a cycle (the reference's row of a discrete
   change stamped half a cycle late, as a recorder on another clock might):
   within one cycle: passes "discrete:cycles=1";
@@ -174,6 +182,10 @@ def scenario_pairs(folder):
                 yield pair("event half a cycle late", values, "discrete:cycles=1", one_cycle, "pass", ref_times=shifted)
         else:
             tolerance = {"atolx": 0.0, "atoly": RAMP_TOLERANCE}
+            one_cycle_tube, tube_allowances = (
+                f"tube:time={step!r},value={RAMP_TOLERANCE}",
+                {"atolx": step, "atoly": RAMP_TOLERANCE},
+            )
             yield pair("none", values, f"tol:abs={RAMP_TOLERANCE}", tolerance, "pass")
             finite = np.isfinite(values)
             if finite[middle]:
@@ -185,6 +197,12 @@ def scenario_pairs(folder):
                 glitched = values.copy()
                 glitched[middle] += GLITCH
                 yield pair("one-sample glitch", glitched, f"tol:abs={RAMP_TOLERANCE}", tolerance, "fail")
+            if finite.all():  # (a NaN sample is outside any tube)
+                # under a one-cycle tube: the glitch fails where it leaves the window of its neighbours
+                neighbours = values[max(middle - 1, 0) : middle + 2]
+                spike = "fail" if glitched[middle] > neighbours.max() + RAMP_TOLERANCE else "pass"
+                yield pair("one-sample glitch", glitched, one_cycle_tube, tube_allowances, spike)
+                yield pair("late by 1 cycle", late(values, 1), one_cycle_tube, tube_allowances, "pass")
             if finite.all() and len(changes(values)):
                 slow, moved = stretched_moves(times, values, 1.01)
                 label = "fail" if moved else "pass"
@@ -233,7 +251,8 @@ def hard_cases():
         )
 
 
-ONE_WAY = ("none", "signal missing", "event half a cycle late")  # (the fault is where it is said to be)
+# the faults that are where they are said to be (a REAL one cycle early is not one cycle late: see above)
+ONE_WAY = ("none", "signal missing", "event half a cycle late", "late by 1 cycle")
 
 
 def corpus():

@@ -57,7 +57,7 @@ def compare(
                 cases) is a recording as a recorder exports it
                 (docs/recordings.md): it is run on every FMU
     mode        a comparison mode: fmutrace.Exact() (bit for bit),
-                Tolerance(rel_tol, abs_tol), Tube(time, value); or, instead
+                Tolerance(rel_tol, abs_tol), Tube(time, value[, sides]); or, instead
                 of mode, rel_tol/abs_tol or tube_time/tube_value; none of
                 them: exact
     report      folder for index.html, summary.md, results.json, the

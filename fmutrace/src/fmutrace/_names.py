@@ -19,6 +19,7 @@ API_NAMES = {
     "abs_tol": "Tolerance.abs_tol",
     "tube_time": "Tube.time",
     "tube_value": "Tube.value",
+    "tube_sides": "Tube.sides",
     "resume": "compare.resume",
     "signals": "Criteria.signals",
 }

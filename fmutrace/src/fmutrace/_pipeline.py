@@ -12,7 +12,9 @@ comparison.aligned, the verdict accumulated by comparison.Verdict), and
 the figure's lines are envelopes filled as they go (plot.Envelope). A
 tube compares each result sample with the reference around it: the
 reference is kept from the row before that window to a row after it
-(Tube.band on that window gives the whole reference's bounds). The
+(Tube.band on that window gives the whole reference's bounds); its second
+side, each reference row with the result around it, keeps the result the
+same way. The
 verdict does not depend on where the chunks end (a test runs every
 reference scenario in chunks of one step and one row).
 """
@@ -266,12 +268,14 @@ class _Comparer:
     def __init__(self, case: ChunkedCase, mode: Mode, bar: SampleProgress):
         options, outputs = case.options, case.outputs
         self.mode, self.outputs, self.start, self.step = mode, outputs, options["StartTime"], options["StepSize"]
+        self.t_end = case.t_end
         self.signals = {name: Verdict(name) for name in outputs}
         self.envelopes = {
             key: Envelope(self.start, case.t_end)
             for key in [("ref", s) for s in outputs]
             + [("result", s) for s in outputs]
             + [("deviation", s) for s in outputs]
+            + ([("back", s) for s in outputs] if isinstance(mode, Tube) and mode.sides == 2 else [])
             + ([(edge, s) for s in outputs for edge in ("lower", "upper")] if mode.fills_band else [])
             + [("input", s) for s in case.input_names]
         }
@@ -294,12 +298,20 @@ class _Comparer:
         self.reference: np.ndarray | None = None  # a tube's: the reference rows its next samples look around
         self.t_first: float | None = None  # the reference's first time
         self.compared = 0  # a tube's: the result samples compared
+        # a two-sided tube's second side: each signal's verdict on the reference's rows in the tube around the
+        # result, the rows not yet judged, and the result from the sample before their window on
+        two_sided = isinstance(mode, Tube) and mode.sides == 2
+        self.back = {name: Verdict(name) for name in outputs} if two_sided else None
+        self.back_rows: np.ndarray | None = None
+        self.back_result: list[np.ndarray] = []
+        self.result_first: float | None = None  # the run's first time
 
     def next_reference(self):
         """The table compared is done: the next one starts at the run's start."""
         if self.absent_here and not self.absent:
             self.absent, self.first_absent = self.absent_here, self.first_absent_here
         self.absent_here, self.first_absent_here = 0, None
+        self.back_rows, self.back_result = None, [c for _, c in self.window] if self.keep_all else []
         self.reference, self.t_first, self.compared = None, None, 0
 
     def result_until(self, k):
@@ -310,6 +322,9 @@ class _Comparer:
                 return
             self.window.append((self.reached, chunk))
             self.reached += len(chunk)
+            if self.back is not None and len(chunk):
+                self.back_result.append(chunk)
+                self.result_first = float(chunk["time"][0]) if self.result_first is None else self.result_first
             for s in self.outputs:
                 self.envelopes[("result", s)].add(chunk["time"], chunk[s])
             self.result.add(chunk)
@@ -386,11 +401,20 @@ class _Comparer:
             self.signals[s].deviation = deviation
 
     def tube_rows(self, rows):
-        """A tube's comparison as Tube.bands makes it on the whole: adds
+        """A tube's comparison as Tube.judge makes it on the whole: adds
         reference rows (None: there are no more) and compares the result
         samples whose look-around window they cover, each against the
         reference from its time - the tube's time to its time + the tube's
-        time (the window: from the row before that on, to a row after it)."""
+        time (the window: from the row before that on, to a row after it);
+        on a two-sided tube the reference's rows the other way round."""
+        if self.back is not None and rows is not None and len(rows):
+            self.back_rows = rows if self.back_rows is None else np.concatenate([self.back_rows, rows])
+        self._tube_forth(rows)
+        if self.back is not None:
+            self._tube_back(done=rows is None)
+
+    def _tube_forth(self, rows):
+        """The result's samples in the tube around the reference."""
         mode = self.mode
         assert isinstance(mode, Tube)
         if rows is not None and len(rows):
@@ -430,6 +454,33 @@ class _Comparer:
         keep = int(np.searchsorted(reference["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
         self.reference = reference[max(keep, 0) :]
 
+    def _tube_back(self, done):
+        """The reference's rows in the tube around the result: those whose
+        window the result made so far covers (all once done: the reference
+        and the run are whole), each against the result from its time - the
+        tube's time to its time + the tube's time."""
+        mode, rows, back = self.mode, self.back_rows, self.back
+        assert isinstance(mode, Tube) and back is not None
+        if rows is None or not len(rows) or not self.back_result:
+            return
+        result = self.back_result[0] if len(self.back_result) == 1 else np.concatenate(self.back_result)
+        last = float(result["time"][-1])
+        covered = np.inf if done else last - mode.time - 2 * float(time_slack(last))
+        take = int(np.searchsorted(rows["time"], covered, side="left"))
+        if not done:
+            take = min(take, len(rows) - 1)  # (the last row waits for the next: a repeated time may span chunks)
+        if take:
+            span = (self.result_first, last if done else np.inf)
+            following = float(rows["time"][take]) if take < len(rows) else math.nan
+            for s in _signal_names(rows):
+                band = mode.back_band(rows[:take], result, s, span, following)
+                back[s].add(band)
+                self.envelopes[("back", s)].add(band.times, band.deviation)
+        # the result the next rows' windows need: from the sample before the earliest's time - the tube's time on
+        at = float(rows["time"][min(take, len(rows) - 1)])
+        keep = int(np.searchsorted(result["time"], at - mode.time - float(time_slack(at)), side="left")) - 1
+        self.back_result, self.back_rows = [result[max(keep, 0) :]], rows[take:]
+
     def _add(self, bands):
         """Each signal's band on the compared samples; the zoom at the first failing one."""
         failing_now = []
@@ -440,6 +491,10 @@ class _Comparer:
             before = verdict.failed
             self.signals[s].add(band)
             self.envelopes[("deviation", s)].add(band.times, band.deviation)
+            if band.back is not None:  # (per-signal criteria: a two-sided tube's signals have one)
+                self.envelopes.setdefault(("back", s), Envelope(self.start, self.t_end)).add(
+                    band.back.times, band.back.deviation
+                )
             if self.mode.fills_band:  # (the same samples: both edges' envelopes have the same times)
                 self.envelopes[("lower", s)].add(band.times, band.lower)
                 self.envelopes[("upper", s)].add(band.times, band.upper)
@@ -468,14 +523,14 @@ class _Comparer:
     def page_scripts(self, case: ChunkedCase, figure: Figure, label, criteria):
         """The case page's plot data as a script, and a long case's finer level as DETAIL scripts (or none)."""
         envelopes, outputs = self.envelopes, self.outputs
-        data = page_data(figure, label, criteria)
+        data = page_data(figure, label, criteria, self.mode.deviation_label)
         tiles = []
         if needs_tiles(envelopes.values()):
             any_line = next(iter(envelopes.values()))
             data["tiles"], data["span"] = DETAIL, [any_line.t0, any_line.t0 + any_line.span]
             inputs = [(s, envelopes[("input", s)]) for s in case.input_names]
             signals = [
-                (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation")))
+                (s, *(envelopes.get((line, s)) for line in ("ref", "result", "lower", "upper", "deviation", "back")))
                 for s in outputs
             ]
             tiles = [as_script("fmutraceTile(", page_tile(k, inputs, signals), ");") for k in range(DETAIL)]
@@ -485,6 +540,9 @@ class _Comparer:
         """The case's CaseOutcome once every reference row was compared."""
         outputs, envelopes = self.outputs, self.envelopes
         deviations = [self.signals[s].deviation for s in outputs]
+        if isinstance(self.mode, Tube):
+            back = self.back
+            deviations = [self.mode.verdict(d, back[d.name].deviation if back else None) for d in deviations]
         outcome = CaseOutcome(case.name, **labels)
         outcome.clock = case.clock
         problem = ""
@@ -505,6 +563,7 @@ class _Comparer:
                 [(s, envelopes[("ref", s)].line(), envelopes[("result", s)].line(), self.band(s)) for s in outputs],
                 [(s, *envelopes[("deviation", s)].line()) for s in outputs],
                 (self.zoom_at, self.zoom_lines) if self.zoom_lines else None,
+                {s: envelopes[("back", s)].line() for s in outputs if ("back", s) in envelopes},
             )
             criteria = {s: d.criterion or outcome.criteria for s, d in zip(outputs, deviations, strict=True)}
             try:

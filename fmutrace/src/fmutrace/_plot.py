@@ -25,6 +25,7 @@ COLUMNS = 600  # pixel columns of an axis (the figure is 640 pixels wide)
 ZOOM_SAMPLES = 40  # compared samples each side of the first deviation in the zoom
 
 
+BACK = "the reference outside the tube around the result"  # a two-sided tube's second side, in the plots
 DETAIL = 16  # an envelope's columns per figure column: a case page's finer level, sent in tiles of COLUMNS
 FOLD_SAMPLES = 1 << 16  # samples an envelope holds before it folds them into its columns
 
@@ -130,10 +131,12 @@ class Figure:
     (result times, values), band or None)], deviations [(name, times,
     values)], and zoom: None, or (its time, [(name, times, values,
     lower, upper, deviation[, reference or None])]) around the first
-    deviation (full resolution)."""
+    deviation (full resolution); back: a two-sided tube's second side,
+    {name: (times, the reference outside the tube around the result)}."""
 
-    def __init__(self, title, inputs, signals, deviations, zoom=None):
+    def __init__(self, title, inputs, signals, deviations, zoom=None, back=None):
         self.title, self.inputs, self.signals, self.deviations, self.zoom = title, inputs, signals, deviations, zoom
+        self.back = back or {}
 
 
 _reused = threading.local()  # a figure is drawn by one thread at a time
@@ -175,7 +178,7 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
     for ax, (name, (ref_t, ref_v), (res_t, res_v), band) in zip(axes, figure.signals, strict=False):
         if band is not None and mode.fills_band:
             ax.fill_between(band[0], band[1], band[2], color="0.85", label=_plain(mode.name))
-        ax.plot(ref_t, ref_v, **mode.reference_line, label=_plain(f"{name} reference"))
+        ax.plot(ref_t, ref_v, **_held(mode.reference_line), label=_plain(f"{name} reference"))
         ax.step(
             res_t,
             res_v,
@@ -189,6 +192,8 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         ax.legend(loc="best", fontsize=7)
     for name, times, values in figure.deviations:
         deviation_axis.plot(times, values, drawstyle="steps-post", label=_plain(name))
+        if name in figure.back:
+            deviation_axis.plot(*figure.back[name], drawstyle="steps-post", label=_plain(f"{name}, {BACK}"))
     deviation_axis.set_ylabel(mode.deviation_label, fontsize=7)
     deviation_axis.legend(loc="best", fontsize=7)
     if figure.zoom:
@@ -196,7 +201,10 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
         zoom_axes = list(grid[has_inputs:, 1])
         zoom_deviation = zoom_axes.pop()
         for ax, (name, times, values, lower, upper, deviation, *_) in zip(zoom_axes, lines, strict=False):
-            ax.fill_between(times, lower, upper, step="post", color="0.8", label="band")
+            if mode.fills_band:
+                ax.fill_between(times, lower, upper, step="post", color="0.8", label=_plain(mode.name))
+            else:  # (lower = upper: the expected values)
+                ax.plot(times, lower, **_held(mode.reference_line), label="reference")
             ax.step(times, values, where="post", color="C1", marker=".", markersize=3, label=_plain(name))
             ax.axvline(at, color="C3", linewidth=0.8)
             zoom_deviation.plot(times, deviation, drawstyle="steps-post", marker=".", markersize=3, label=_plain(name))
@@ -207,6 +215,11 @@ def draw(figure: Figure, mode: Mode, label: str, reuse: bool = True) -> bytes:
     stream = io.BytesIO()
     fig.savefig(stream, dpi=DPI, format="png", metadata={"Software": None})
     return stream.getvalue()
+
+
+def _held(line: dict) -> dict:
+    """The mode's reference line drawn as the result is: each value held until the next sample."""
+    return {**line, "drawstyle": "steps-post"}
 
 
 def _plain(text):
@@ -286,13 +299,14 @@ def _window(zoom_line, k):
     return None if zoom_line is None or zoom_line[k] is None else (zoom_line[0], zoom_line[k])
 
 
-def page_data(figure: Figure, label: str, criteria: dict) -> dict:
+def page_data(figure: Figure, label: str, criteria: dict, deviation_label: str = "result - ref") -> dict:
     """What a case page's interactive plots show (plain lists, NaN kept:
     the page reads them as JavaScript): per signal its reference, result,
     band and deviation, decimated as the figure's, with the samples around
     the first deviation at full resolution; the inputs; where the first
     deviation is and the span to frame on open. criteria: signal -> the
-    criterion it is judged by."""
+    criterion it is judged by; deviation_label: what the deviation is (the
+    mode's, its plots' scale's label)."""
     zoom = {}
     frame = None
     if figure.zoom:
@@ -315,11 +329,14 @@ def page_data(figure: Figure, label: str, criteria: dict) -> dict:
                 "lower": _points(band[0], band[1], window=_window(z, 2)) if band is not None else None,
                 "upper": _points(band[0], band[2], window=_window(z, 3)) if band is not None else None,
                 "deviation": _points(dev_t, dev_v, window=_window(z, 4)),
+                "back": _points(*figure.back[name]) if name in figure.back else None,
             }
         )
     return {
         "title": shown(figure.title),
         "label": shown(label),
+        "deviation_label": deviation_label,
+        "back_label": BACK,
         "inputs": [{"name": shown(name), "line": _points(t, v)} for name, t, v in figure.inputs],
         "signals": signals,
         "first_deviation": figure.zoom[0] if figure.zoom else None,
@@ -336,7 +353,7 @@ def page_tile(k: int, inputs, signals) -> dict:
     """Tile k of DETAIL of a case page's finer level: the lines' own
     envelope columns over the k-th part of the time span. inputs: [(name,
     Envelope)]; signals: [(name, reference, result, lower or None, upper
-    or None, deviation)], Envelopes."""
+    or None, deviation, back or None)], Envelopes."""
     first = next(e for _, *lines in signals for e in lines if e is not None) if signals else inputs[0][1]
     part = first.span / DETAIL
 
@@ -355,8 +372,9 @@ def page_tile(k: int, inputs, signals) -> dict:
                 "lower": points(lower),
                 "upper": points(upper),
                 "deviation": points(deviation),
+                "back": points(back),
             }
-            for _, ref, result, lower, upper, deviation in signals
+            for _, ref, result, lower, upper, deviation, back in signals
         ],
     }
 

@@ -328,6 +328,8 @@ def write_report(campaign: CampaignResult, report_dir):
     criteria = campaign.mode.describe()
     tally = _Tally()
     rows = {failing: report_dir / f".index-{failing}.{os.getpid()}.rows" for failing in (True, False)}
+    summary_rows = {failing: report_dir / f".summary-{failing}.{os.getpid()}.rows" for failing in (True, False)}
+    pngs = False  # a case has a PNG: summary.md has a plot column
     fmu_cells = _FmuCells()
     try:
         with (
@@ -335,32 +337,20 @@ def write_report(campaign: CampaignResult, report_dir):
             _replaced(report_dir / "results.json") as results,
             open(rows[True], "w", encoding="utf-8") as failing_rows,
             open(rows[False], "w", encoding="utf-8") as other_rows,
+            open(summary_rows[True], "w", encoding="utf-8") as failing_summary,
+            open(summary_rows[False], "w", encoding="utf-8") as other_summary,
         ):
             results.write(_results_json_head(campaign))
-            summary.write(
-                "\n".join(
-                    [
-                        "# fmutrace",
-                        "",
-                        headline,
-                        "",
-                        f"Comparison: {criteria}.",
-                        "",
-                        "| case | FMU | result | seconds | plot |",
-                        "|---|---|---|---|---|",
-                    ]
-                )
-                + "\n"
-            )
             for n, o in enumerate(campaign.cases.light()):
                 results.write(("," if n else "") + "\n" + json.dumps(_shown_entry(o.to_json())))
                 tally.add(o, criteria)
                 verdict = _verdict(o)
                 fmu = fmu_cells[o.fmu]
-                summary.write(
-                    f"| {markdown(o.case)} | {fmu.markdown} | {markdown(verdict)} | {o.seconds:.2f} | "
-                    + (f"[png]({_link(o.plot)})" if o.plot else "")
-                    + " |\n"
+                pngs = pngs or bool(o.plot)
+                (other_summary if o.passed else failing_summary).write(
+                    f"| {markdown(o.case)} | {fmu.markdown} | {markdown(verdict)} | {o.seconds:.2f} |"
+                    + (f" [png]({_link(o.plot)}) |" if o.plot else "")
+                    + "\n"
                 )
                 name = html.escape(text(o.case))
                 if _has_a_page(o):
@@ -374,8 +364,9 @@ def write_report(campaign: CampaignResult, report_dir):
                     f'<td class="seconds">{o.seconds:.2f}</td></tr>\n'
                 )
             results.write("\n]}\n")
-            failing_rows.flush()
-            other_rows.flush()
+            for part in (failing_rows, other_rows, failing_summary, other_summary):
+                part.flush()
+            _summary(summary, campaign, criteria, summary_rows, pngs)
             # (inside: summary.md and results.json replace theirs only once index.html is written)
             with _replaced(report_dir / "index.html") as index:
                 index.write(_index_head(campaign, headline, criteria, tally))
@@ -384,8 +375,24 @@ def write_report(campaign: CampaignResult, report_dir):
                         shutil.copyfileobj(part, index)
                 index.write(f'</tbody></table>\n<script src="{ASSETS}/report.js"></script>\n</body></html>\n')
     finally:
-        for path in rows.values():
+        for path in (*rows.values(), *summary_rows.values()):
             path.unlink(missing_ok=True)
+
+
+def _summary(out, campaign: CampaignResult, criteria, rows, pngs):
+    """summary.md: the verdict, the headline, the criteria, then a row per
+    case, the failing ones first (rows: failing -> the file of their rows),
+    a plot column where a case has a PNG."""
+    verdict = "PASS" if campaign.passed else "FAIL"
+    out.write(
+        f"# fmutrace: {verdict}\n\n{campaign.headline()}\n\nComparison: {criteria}.\n\n"
+        + ("| case | FMU | result | seconds | plot |\n|---|---|---|---|---|\n" if pngs else "")
+        + ("| case | FMU | result | seconds |\n|---|---|---|---|\n" if not pngs else "")
+    )
+    for failing in (True, False):
+        with open(rows[failing], encoding="utf-8") as part:
+            for line in part:  # (a row with a PNG ends in its link; the others get an empty plot cell)
+                out.write(line if not pngs or line.endswith(") |\n") else line[:-1] + "  |\n")
 
 
 class _Cells(NamedTuple):
@@ -409,14 +416,19 @@ class _FmuCells(dict):
 def _index_head(campaign: CampaignResult, headline, criteria, tally: _Tally) -> str:
     """index.html up to its table's rows: the summary, the filter, the table's head."""
     counts = campaign.counts()
-    numbers = "".join(f'<div class="number {s}"><span id="count-{s}">{counts[s]}</span> {s}</div>' for s in Status)
+    numbers = "".join(
+        f'<div class="number {s}{" some" if counts[s] else ""}"><span id="count-{s}">{counts[s]}</span> {s}</div>'
+        for s in Status
+    )
+    verdict = "pass" if campaign.passed else "fail"
     own = f" {tally.own_criteria} cases with criteria of their own (on their pages)." if tally.own_criteria else ""
     options = "".join(f"<option>{html.escape(name)}</option>" for name in tally.fmus)
     models = "".join(f"<option>{html.escape(name)}</option>" for name in tally.models)
     statuses = "".join(f'<option value="{s}">{s}</option>' for s in Status)
     return (
         _head("fmutrace report", ASSETS)
-        + f'<h1>fmutrace report</h1>\n<p class="headline">{html.escape(headline)}</p>\n'
+        + f'<h1>fmutrace report</h1>\n<p class="headline" id="verdict" data-verdict="{verdict}">'
+        f'<span class="badge {verdict}">{verdict.upper()}</span> {html.escape(headline)}</p>\n'
         f'<section class="summary"><div class="numbers"><div class="number total">'
         f'<span id="count-total">{len(campaign.cases)}</span> cases</div>{numbers}'
         f'<div class="number time">{campaign.seconds:.1f} s on {html.escape(text(campaign.where))}</div></div>\n'

@@ -52,6 +52,7 @@ FLAGS = {
     "abs_tol": "--abs-tol",
     "tube_time": "--tube-time",
     "tube_value": "--tube-value",
+    "tube_sides": "--tube-sides",
     "resume": "--resume",
     "signals": "--signal",
 }
@@ -91,71 +92,71 @@ def _positive_int(text):
     return value
 
 
-def parser():
-    main = argparse.ArgumentParser(
-        prog="fmutrace",
-        description="Replay CSV traces through FMI 2 and FMI 3 "
-        "co-simulation FMUs with fmpy and report where they differ from references.",
-        epilog=EXAMPLES,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
-    main.add_argument("--version", action="version", version=f"fmutrace {__version__}")
-    commands = main.add_subparsers(dest="command", required=True, metavar="{run,compare,check}")
+COMPARE_SUMMARY = "replay cases and recordings through FMUs and compare with their references"
+COMPARE_TEXT = (
+    "Replay every case (FMI cross-check layout: <Model>_in.csv, <Model>_ref.csv, <Model>_ref.opt, "
+    "<Model>_start.csv) through the FMUs of its model, and every recording as a controller's recorder exports it "
+    "(TwinCAT Scope View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF 4 and 3, WinCC data logs, "
+    "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. Exact (bit for bit) unless a "
+    "tolerance or a tube is given. With FMUs alone: as fmutrace check."
+)
+CHECK_SUMMARY = "run the experiments the FMUs carry (FMI-LS-REF) and compare with their references"
+CHECK_TEXT = (
+    "Run the experiments each FMU carries (FMI-LS-REF) and judge them by the criteria their references carry. "
+    "Given case folders or recordings after the FMUs: as fmutrace compare."
+)
 
-    run = commands.add_parser(
-        "run",
-        help="simulate an FMU on a CSV input and write the result",
-        description="Simulate an FMU on CSV inputs and write the result as CSV.",
-    )
-    run.add_argument("fmu", metavar="FMU")
-    run.add_argument("--input", metavar="IN.csv", help="input signals (a row holds from its time on)")
-    run.add_argument(
-        "--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[], help="a start value (repeatable)"
-    )
-    run.add_argument("--start-time", type=float, metavar="S", help="default: the input's first time")
-    run.add_argument("--stop-time", type=float, metavar="S", help="default: the input's last time")
-    run.add_argument("--step-size", type=float, metavar="H", help="communication step (default: the FMU's)")
-    run.add_argument("--output-interval", type=float, metavar="H", help="a whole multiple of the step size")
-    run.add_argument(
-        "--output", metavar="NAME", action="append", help="a variable to record (repeatable; default: the outputs)"
-    )
-    run.add_argument("-o", dest="out", metavar="OUT.csv", help="result file (default: standard output)")
 
-    cmp = commands.add_parser(
-        "compare",
-        aliases=["check"],
-        help="replay cases and recordings and compare with their references; "
-        "check (or compare with FMUs alone): the experiments the FMUs carry (FMI-LS-REF)",
-        description="Replay every case (FMI cross-check layout: <Model>_in.csv, "
-        "<Model>_ref.csv, <Model>_ref.opt, <Model>_start.csv) through the FMUs of its "
-        "model, and every recording as a controller's recorder exports it (TwinCAT Scope "
-        "View CSV, CODESYS 2.3 and V3 traces, TIA Portal trace CSV, MDF 4 and 3, WinCC data logs, "
-        "Niagara histories, CSV/TSV) through every FMU, and compare with the reference. "
-        "Exact (bit for bit) unless a tolerance or a tube is given. With FMUs alone (fmutrace "
-        "check FMU...): the experiments each FMU carries (FMI-LS-REF), by the criteria their "
-        "references carry.",
-    )
-    cmp.add_argument(
+def _compare_arguments(command):
+    """The options of compare and check, in groups: what to compare, how to
+    judge, what to write, where to run, recordings."""
+    what = command.add_argument_group("what to compare")
+    what.add_argument(
         "paths",
         nargs="+",
         metavar="FMU|CASE|RECORDING",
-        help=".fmu files, then case folders or "
-        "folders holding them (searched recursively), or recordings (files, or a folder of one "
-        "recording's files)",
+        help=".fmu files, then case folders or folders holding them (searched recursively), or recordings "
+        "(files, or a folder of one recording's files)",
     )
-    cmp.add_argument(
-        "--report", metavar="DIR", help="write index.html, summary.md, results.json, the results and plots here"
+    what.add_argument(
+        "--role",
+        choices=ROLES,
+        help="with FMUs alone: the experiments of this role (default: both, each experiment once)",
     )
-    cmp.add_argument(FLAGS["rel_tol"], type=_non_negative, default=0.0, metavar="R")
-    cmp.add_argument(FLAGS["abs_tol"], type=_non_negative, default=0.0, metavar="A")
-    cmp.add_argument(
+    what.add_argument(
+        FLAGS["resume"],
+        action="store_true",
+        help="take the cases the report's journal holds from it and "
+        "run the others (after a stopped campaign; needs --report)",
+    )
+
+    judge = command.add_argument_group("how to judge", "exact (bit for bit) unless a tolerance or a tube is given")
+    judge.add_argument(
+        FLAGS["rel_tol"],
+        type=_non_negative,
+        default=0.0,
+        metavar="R",
+        help="relative tolerance: |result - reference| <= A + R * |reference|",
+    )
+    judge.add_argument(
+        FLAGS["abs_tol"], type=_non_negative, default=0.0, metavar="A", help="absolute tolerance (with or without R)"
+    )
+    judge.add_argument(
         FLAGS["tube_time"],
         type=_non_negative,
         metavar="S",
         help="tube half-width in time (with --tube-value), for traces sampled at other instants",
     )
-    cmp.add_argument(FLAGS["tube_value"], type=_non_negative, metavar="V", help="tube half-width in value")
-    cmp.add_argument(
+    judge.add_argument(FLAGS["tube_value"], type=_non_negative, metavar="V", help="tube half-width in value")
+    judge.add_argument(
+        FLAGS["tube_sides"],
+        type=int,
+        choices=(1, 2),
+        default=2,
+        help="2 (default): the result within the tube around the reference and the reference within the tube "
+        "around the result; 1: the result's samples only, as csv-compare checks",
+    )
+    judge.add_argument(
         FLAGS["signals"],
         type=_assignment,
         action="append",
@@ -163,46 +164,48 @@ def parser():
         metavar="NAME=MODE",
         help=f"a signal's own criterion (a name or pattern, '*' for the rest; repeatable); MODE: {MODE_WORDS}",
     )
-    cmp.add_argument(
-        "--role",
-        choices=ROLES,
-        help="with FMUs alone: the experiments of this role (default: both, each experiment once)",
+
+    write = command.add_argument_group("what to write")
+    write.add_argument(
+        "--report", metavar="DIR", help="write index.html, summary.md, results.json, the results and plots here"
     )
-    cmp.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
-    cmp.add_argument(
-        "--jobs",
-        type=_positive_int,
-        metavar="N",
-        help="local worker processes (1: this process; default: as many as the work pays for, up to one per core)",
-    )
-    cmp.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
-    cmp.add_argument(
-        "--shared-files",
-        action="store_true",
-        help="the scheduler's workers see the case folders at the same paths (else they are sent the files)",
-    )
-    cmp.add_argument(
+    write.add_argument("--junit", metavar="FILE", help="write JUnit XML for CI servers")
+    write.add_argument(
         "--plots",
         choices=PLOTS,
         help="which cases get a plot and a result CSV in the report "
         f"(default: all for up to {PLOT_ALL_UP_TO} cases, else the failed ones; png: as the default, with a static "
         "PNG figure beside each interactive plot)",
     )
-    cmp.add_argument(
+
+    where = command.add_argument_group("where to run")
+    where.add_argument(
+        "--jobs",
+        type=_positive_int,
+        metavar="N",
+        help="local worker processes (1: this process; default: as many as the work pays for, up to one per core)",
+    )
+    where.add_argument("--scheduler", metavar="ADDR", help="a Dask distributed scheduler to run on")
+    where.add_argument(
+        "--shared-files",
+        action="store_true",
+        help="the scheduler's workers see the case folders at the same paths (else they are sent the files)",
+    )
+    where.add_argument(
         "--case-timeout",
         type=_non_negative,
         metavar="S",
         help="seconds a case may run: one over it is stopped and reported (--jobs 1 then runs in one worker process)",
     )
-    cmp.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
-    cmp.add_argument("--cluster-timeout", type=_non_negative, metavar="S", help="bound on the wait for a cluster")
-    cmp.add_argument(
-        FLAGS["resume"],
-        action="store_true",
-        help="take the cases the report's journal holds from it and "
-        "run the others (after a stopped campaign; needs --report)",
+    where.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
+    where.add_argument(
+        "--cluster-timeout",
+        type=_non_negative,
+        metavar="S",
+        help="seconds to wait for the Dask cluster's results (default: no bound)",
     )
-    rec = cmp.add_argument_group("recordings", "how recordings are read (docs/recordings.md)")
+
+    rec = command.add_argument_group("recordings", "how recordings are read (docs/recordings.md)")
     rec.add_argument(
         FLAGS["step_size"],
         type=_positive,
@@ -249,6 +252,43 @@ def parser():
         "recorded: each recorded execution of the OB is one step as long as the recorded interval since the one "
         "before, a cycle without a sample no step (blocks that measure elapsed time see the jitter)",
     )
+
+
+def parser():
+    main = argparse.ArgumentParser(
+        prog="fmutrace",
+        description="Replay CSV traces through FMI 2 and FMI 3 "
+        "co-simulation FMUs with fmpy and report where they differ from references.",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    main.add_argument("--version", action="version", version=f"fmutrace {__version__}")
+    commands = main.add_subparsers(dest="command", required=True, metavar="{run,compare,check}")
+
+    run = commands.add_parser(
+        "run",
+        help="simulate an FMU on a CSV input and write the result",
+        description="Simulate an FMU on CSV inputs and write the result as CSV.",
+    )
+    run.add_argument("fmu", metavar="FMU", help="the .fmu file to simulate")
+    run.add_argument("--input", metavar="IN.csv", help="input signals (a row holds from its time on)")
+    run.add_argument(
+        "--set", metavar="NAME=VALUE", action="append", type=_assignment, default=[], help="a start value (repeatable)"
+    )
+    run.add_argument("--start-time", type=float, metavar="S", help="default: the input's first time")
+    run.add_argument("--stop-time", type=float, metavar="S", help="default: the input's last time")
+    run.add_argument("--step-size", type=float, metavar="H", help="communication step (default: the FMU's)")
+    run.add_argument("--output-interval", type=float, metavar="H", help="a whole multiple of the step size")
+    run.add_argument(
+        "--output", metavar="NAME", action="append", help="a variable to record (repeatable; default: the outputs)"
+    )
+    run.add_argument("-o", dest="out", metavar="OUT.csv", help="result file (default: standard output)")
+
+    for name, summary, description in (
+        ("compare", COMPARE_SUMMARY, COMPARE_TEXT),
+        ("check", CHECK_SUMMARY, CHECK_TEXT),
+    ):
+        _compare_arguments(commands.add_parser(name, help=summary, description=description))
     return main
 
 
@@ -328,7 +368,9 @@ def compare_command(args, out):
     result = campaign(
         mode=signal_criteria(
             args.signal,
-            comparison_mode(args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, names=FLAGS),
+            comparison_mode(
+                args.rel_tol, args.abs_tol, args.tube_time, args.tube_value, tube_sides=args.tube_sides, names=FLAGS
+            ),
             FLAGS,
         ),
         report=args.report,

@@ -2,7 +2,10 @@
    signal its reference, result and band, and its deviation; the x axes
    kept in sync; framed on the first deviation on open. Data: window.fmutracePlot
    (the case's .plot.js). Zoom: drag a span, the mouse wheel or the buttons;
-   pan: shift + wheel or the buttons; double click: the whole length. */
+   pan: shift + wheel or the buttons; double click: the whole length. Reference and result are drawn the
+   same way (values held until the next sample), so that equal samples draw one curve; a deviation that is
+   0 throughout is said, not drawn; the legends show the values at the first deviation (else at the end)
+   until the cursor is over a plot. */
 (function () {
   "use strict";
   var data = window.fmutracePlot;
@@ -142,16 +145,58 @@
 
   function width() { return Math.max(280, root.clientWidth - 4); }
 
-  function chart(title, names, styles, sources, height) {
+  // a tick's text that keeps the scale however small or large the numbers (not the locale's 3 decimals)
+  function ticks(u, splits) {
+    return splits.map(function (v) {
+      if (v === null) { return ""; }
+      var x = Number(v.toPrecision(6));
+      return x !== 0 && (Math.abs(x) < 1e-3 || Math.abs(x) >= 1e6) ? x.toExponential() : String(x);
+    });
+  }
+
+  // a legend's value as it is (the shortest text that reads back to it), not rounded to the locale's 3 decimals
+  function exactly(u, v) { return v === null || v === undefined ? "--" : String(v); }
+
+  // the legend's values when the cursor is not over the plot: each line's sample nearest to the first deviation,
+  // else to the end (the lines' samples have x entries of their own: a line has none at the others')
+  function nearest(u, s, k) {
+    for (var d = 0; d < u.data[0].length; d++) {
+      if (k - d >= 0 && u.data[s][k - d] !== null) { return k - d; }
+      if (k + d < u.data[0].length && u.data[s][k + d] !== null) { return k + d; }
+    }
+    return null;
+  }
+
+  function restingIndexes(u) {
+    var xs = u.data[0], n = xs.length, at = data.first_deviation, k = n - 1;
+    if (!n) { return null; }
+    if (at !== null && at !== undefined) {
+      k = 0;
+      while (k < n - 1 && xs[k] < at) { k++; }
+    }
+    return u.series.map(function (_, s) { return s === 0 ? k : nearest(u, s, k); });
+  }
+
+  var resting = false;
+  function rest(u) {
+    if (resting || (u.legend.idx !== null && u.legend.idx !== undefined)) { return; }
+    var idxs = restingIndexes(u);
+    if (!idxs) { return; }
+    resting = true;
+    u.setLegend({ idxs: idxs });
+    resting = false;
+  }
+
+  function chart(title, names, styles, sources, height, valueLabel) {
     var box = document.createElement("div");
     box.className = "plot";
     var h = document.createElement("h3");
     h.textContent = title;
     box.appendChild(h);
     root.appendChild(box);
-    var series = [{ label: "t [s]" }];
+    var series = [{ label: "t [s]", value: exactly }];
     names.forEach(function (name, k) {
-      series.push(Object.assign({ label: name, spanGaps: true, width: 1.5 }, styles[k]));
+      series.push(Object.assign({ label: name, spanGaps: true, width: 1.5, value: exactly }, styles[k]));
     });
     var bands = styles.some(function (s) { return s.band; }) ? [{ series: [names.length, names.length - 1], fill: "rgba(0,0,0,0.09)" }] : [];
     var options = {
@@ -160,11 +205,13 @@
       series: series,
       bands: bands,
       scales: { x: { time: false } },
-      axes: [{ label: "time [s]" }, {}],
-      cursor: { sync: { key: "fmutrace" }, drag: { x: true, y: false } },
-      hooks: { setScale: [scaled], draw: [marker] }
+      axes: [{ label: "time [s]" }, { label: valueLabel || "", values: ticks, size: 72, space: 20 }],
+      // (hovered: each line's nearest sample, not the null of another line's x)
+      cursor: { sync: { key: "fmutrace" }, drag: { x: true, y: false }, hover: { skip: [null, undefined] } },
+      hooks: { setScale: [scaled], draw: [marker], setLegend: [rest] }
     };
     var u = new uPlot(options, aligned(sources.map(lineOf)), box);
+    rest(u);
     u.fmutraceSources = sources;
     u.over.addEventListener("wheel", function (e) {
       e.preventDefault();
@@ -226,7 +273,7 @@
   }
   data.signals.forEach(function (s, n) {
     var names = [s.name + " reference", s.name + " " + data.label];
-    var styles = [{ stroke: "#777" }, held({ stroke: "#e8710a" })];
+    var styles = [held({ stroke: "#777" }), held({ stroke: "#e8710a" })];
     var lines = [["signals", n, "reference"], ["signals", n, "result"]];
     if (s.lower && s.upper) {
       names.push("lower", "upper");
@@ -235,8 +282,29 @@
     }
     var title = s.name + (s.criterion ? " (" + s.criterion + ")" : "");
     chart(title, names, styles, lines, 230).root.parentNode.dataset.signal = s.name;
-    chart(s.name + ": deviation", [s.name + " deviation"], [held({ stroke: "#d62728" })],
-      [["signals", n, "deviation"]], 130).root.parentNode.dataset.signal = s.name;
+    function zero(line) { return !line || line[1].every(function (v) { return v === 0; }); }
+    var none = zero(s.deviation) && zero(s.back);
+    if (none) {
+      var box = document.createElement("div");
+      box.className = "plot deviation-none";
+      box.dataset.signal = s.name;
+      var h = document.createElement("h3");
+      h.textContent = s.name + ": deviation";
+      var p = document.createElement("p");
+      p.textContent = "none: " + data.deviation_label + " is 0 at every compared sample";
+      box.appendChild(h);
+      box.appendChild(p);
+      root.appendChild(box);
+      return;
+    }
+    var deviations = [s.name + " deviation"], strokes = [held({ stroke: "#d62728" })], sources = [["signals", n, "deviation"]];
+    if (s.back) {  // a two-sided tube: the reference outside the tube around the result too
+      deviations.push(s.name + ": " + data.back_label);
+      strokes.push(held({ stroke: "#9467bd", dash: [5, 3] }));
+      sources.push(["signals", n, "back"]);
+    }
+    chart(s.name + ": deviation", deviations, strokes, sources, 170, data.deviation_label)
+      .root.parentNode.dataset.signal = s.name;
   });
   if (data.frame) { frame(); } else if (charts.length) { root.dataset.xmin = charts[0].scales.x.min; root.dataset.xmax = charts[0].scales.x.max; }
   window.addEventListener("resize", function () {
