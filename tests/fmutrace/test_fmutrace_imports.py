@@ -39,9 +39,10 @@ LAYERS = [
     ("where cases run", {"fmutrace._workers", "fmutrace._executors"}),
     ("campaign", {"fmutrace._campaign"}),
     ("checks", {"fmutrace._check"}),
-    ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__"}),
+    ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.pytest_plugin"}),
 ]
-PUBLIC = {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.recordings"}  # the readers' package
+# the readers' package; the pytest plugin (named by the package's pytest11 entry point)
+PUBLIC = {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.recordings", "fmutrace.pytest_plugin"}
 POSIX_ONLY = {"fcntl", "termios", "pwd", "grp", "resource", "posix", "tty", "pty"}
 LOADED_ON_USE = ("dask", "distributed", "matplotlib", "asammdf", "pandas")  # campaigns on Dask, plots, MDF4
 
@@ -230,6 +231,7 @@ def test_a_campaign_of_plain_cases_loads_no_heavy_package(tmp_path):
 AS_ON_WINDOWS = """
 import sys, types
 import cffi, fmpy, fmpy.simulation, numpy, pyarrow.csv  # (before the switch: they load this platform's libraries)
+import multiprocessing.connection  # (and so does this one: _winapi on Windows)
 sys.modules["fcntl"] = None  # its import fails, as on Windows
 msvcrt = types.ModuleType("msvcrt")  # Windows' own, reduced to the lock (this is not Windows)
 msvcrt.LK_NBLCK, msvcrt.LK_UNLCK, msvcrt.locked = 2, 0, []
