@@ -106,7 +106,7 @@ def compare(
             "carries its own settings (<Model>_ref.opt, <Model>_start.csv)"
         )
     if plots == "png":
-        require_extra("matplotlib", "png", "plots='png' (a PNG figure of each plot)")
+        require_extra("matplotlib", "png", "drawing PNG figures")
     loaded = [Fmu(path) for path in fmu_paths]
     cases_of = index_cases(loaded, case_paths)
     png = plots == "png"  # (the default's cases, each with a PNG figure too)

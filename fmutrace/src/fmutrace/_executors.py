@@ -193,18 +193,13 @@ class Dask(Executor):
         batches = _batches(todo, size, ship_texts=not self.shared_files)
         in_flight = as_completed()
         submitted = {}  # future -> (fmu, batch, isolated, attempt)
-        # the scheduler runs a task whose worker died again by itself (its allowed-failures): it says so in its
-        # events, which reach this client before the task's result does
-        run_again: dict = {}  # task key -> why it ran again
 
-        def worker_removed(event):
-            _, message = event
-            if isinstance(message, dict) and message.get("action") == "remove-worker" and not message["expected"]:
-                why = f"its Dask worker {message['worker']} died while it held the case's batch"
-                for key in (*message["processing-tasks"], *message["lost-computed-tasks"]):
-                    run_again.setdefault(key, why)
-
-        client.subscribe_topic("all", worker_removed)
+        # the scheduler runs a task whose worker died again by itself (its allowed-failures), counting the deaths
+        # (TaskState.suspicious): asked as each batch finishes (its result is on a worker: its state is kept)
+        def deaths(key):
+            return client.run_on_scheduler(
+                lambda dask_scheduler: getattr(dask_scheduler.tasks.get(key), "suspicious", 0)
+            )
 
         def submit(fmu, batch, isolated, attempt, why=""):
             items = [(folder, name, texts) for _, folder, name, texts in batch]
@@ -227,7 +222,9 @@ class Dask(Executor):
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             future = next(in_flight) if remaining is None else _next_within(in_flight, remaining, timeout)
             fmu, batch, isolated, attempt, why = submitted.pop(future)
-            why = run_again.pop(future.key, why)
+            died = deaths(future.key)
+            if died:
+                why = f"its Dask worker died while it held the case's batch ({died} time{'s' if died > 1 else ''})"
             try:
                 outcomes = future.result()
             except Exception as error:  # its worker died (an FMU crashed it?), or the result was lost with a worker
