@@ -1,6 +1,7 @@
 /* PassThrough, FMI 2: the least a Co-Simulation FMU can do per step
  * (y = u). The functions it does not need are stubs (tests/fixtures/stubs.py). */
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -94,11 +95,13 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
     Instance *instance = c;
-#ifdef FIXTURE_FAULTS /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
+#ifdef FIXTURE_FAULTS /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs, u = 19 is
+                        killed (as from outside) once: when the file $FAULTY_ONCE names exists (it is removed) */
     if (instance->values[VR_u] == 13.0) raise(SIGSEGV);
     if (instance->values[VR_u] == 17.0)
         for (;;) {
         }
+    if (instance->values[VR_u] == 19.0 && getenv("FAULTY_ONCE") && remove(getenv("FAULTY_ONCE")) == 0) raise(SIGKILL);
 #endif
     instance->values[VR_y] = instance->values[VR_u];
     instance->values[VR_time] = currentCommunicationPoint + communicationStepSize;

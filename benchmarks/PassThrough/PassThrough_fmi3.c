@@ -1,6 +1,7 @@
 /* PassThrough, FMI 3: the least a Co-Simulation FMU can do per step
  * (y = u). The functions it does not need are stubs (tests/fixtures/stubs.py). */
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,11 +98,13 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     (void)noSetFMUStatePriorToCurrentPoint;
     Instance *self = instance;
-#ifdef FIXTURE_FAULTS /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs */
+#ifdef FIXTURE_FAULTS /* the Faulty fixture of the campaign tests: u = 13 crashes, u = 17 hangs, u = 19 is
+                        killed (as from outside) once: when the file $FAULTY_ONCE names exists (it is removed) */
     if (self->values[VR_u] == 13.0) raise(SIGSEGV);
     if (self->values[VR_u] == 17.0)
         for (;;) {
         }
+    if (self->values[VR_u] == 19.0 && getenv("FAULTY_ONCE") && remove(getenv("FAULTY_ONCE")) == 0) raise(SIGKILL);
 #endif
     self->values[VR_y] = self->values[VR_u];
     self->values[VR_time] = currentCommunicationPoint + communicationStepSize;

@@ -587,6 +587,29 @@ def test_the_readme_pytest_example_runs(tmp_path):
     assert re.search(r"\b[1-9]\d* passed", done.stdout)
 
 
+def test_the_readme_run_example_runs_to_a_meaningful_stop_time(tmp_path):
+    """The README's `run` lines as a user types them (its u.csv, then the
+    command): y rises at rateUpPar = 2 per second from the step at t = 1 s
+    (seen by the cycle (1, 1.1]) and holds the input's 10 from t = 6 s on."""
+    text = (REPO / "README.md").read_text()
+    lines = [
+        line
+        for block in re.findall(r"```sh\n(.*?)```", text, re.S)
+        for line in block.splitlines()
+        if line.startswith("printf ") or line.startswith("build/venv/bin/fmutrace run ")
+    ]
+    assert len(lines) == 2, lines
+    (tmp_path / "build").symlink_to(BUILD_DIR)
+    done = run_bounded(["sh", "-c", "\n".join(lines)], timeout=300, what="the README's run example", cwd=tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    result = fmutrace.read_trace(tmp_path / "y.csv")
+    t, y = result["time"], result["y"]
+    assert len(t) == 81 and t[-1] == pytest.approx(8.0)
+    expected = [min(max(2 * (k / 10 - 1), 0), 10) for k in range(81)]  # worked by hand, k: the step
+    assert y == pytest.approx(expected, abs=1e-9)
+    assert not (y == 0).all() and y[-1] == 10
+
+
 def test_a_folder_of_links_to_case_folders_is_a_folder_of_cases(tmp_path):
     """As the benchmarks give a part of their cases: links to case folders
     (and a link loop) in a folder of their own; not a recording."""

@@ -52,9 +52,10 @@ LAYERS = [
     ("where cases run", {"fmutrace._workers", "fmutrace._executors"}),
     ("campaign", {"fmutrace._campaign"}),
     ("checks", {"fmutrace._check"}),
-    ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__"}),
+    ("interfaces", {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.pytest_plugin"}),
 ]
-PUBLIC = {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.recordings"}  # the readers' package
+# the readers' package; the pytest plugin (named by the package's pytest11 entry point)
+PUBLIC = {"fmutrace", "fmutrace.cli", "fmutrace.__main__", "fmutrace.recordings", "fmutrace.pytest_plugin"}
 POSIX_ONLY = {"fcntl", "termios", "pwd", "grp", "resource", "posix", "tty", "pty"}
 LOADED_ON_USE = ("dask", "distributed", "matplotlib", "asammdf", "pandas")  # campaigns on Dask, plots, MDF4
 
@@ -243,6 +244,7 @@ def test_a_campaign_of_plain_cases_loads_no_heavy_package(tmp_path):
 AS_ON_WINDOWS = """
 import sys, types
 import cffi, fmpy, fmpy.simulation, numpy, pyarrow.csv  # (before the switch: they load this platform's libraries)
+import multiprocessing.connection  # (and so does this one: _winapi on Windows)
 sys.modules["fcntl"] = None  # its import fails, as on Windows
 msvcrt = types.ModuleType("msvcrt")  # Windows' own, reduced to the lock (this is not Windows)
 msvcrt.LK_NBLCK, msvcrt.LK_UNLCK, msvcrt.locked = 2, 0, []
@@ -301,3 +303,47 @@ def test_the_entry_points_take_their_settings_by_keyword(entry):
     parameters = list(inspect.signature(getattr(fmutrace, entry)).parameters.values())
     assert [p.kind for p in parameters[:2]] == [inspect.Parameter.POSITIONAL_OR_KEYWORD] * 2
     assert all(p.kind == inspect.Parameter.KEYWORD_ONLY for p in parameters[2:]) and len(parameters) > 2
+
+
+WITHOUT = (
+    "import sys\nsys.modules[{module!r}] = None  # not installed, as in the base install\nfrom fmutrace import cli\n"
+)
+
+
+@pytest.mark.parametrize(
+    "module,extra,args",
+    [
+        ("matplotlib", "png", ["--plots", "png", "--report", "{tmp}/report"]),
+        ("distributed", "dask", ["--scheduler", "tcp://127.0.0.1:9"]),
+        ("asammdf", "mdf", []),
+    ],
+)
+def test_a_command_that_needs_a_missing_extra_names_its_pip_install_line(module, extra, args, tmp_path):
+    """The base install leaves out matplotlib, Dask and asammdf: a command
+    that needs one ends with exit status 2 and the line that installs it,
+    no traceback (an MDF recording: reported as an invalid case)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "recordings"))
+    try:
+        import samples  # (the generator beside the recordings: asammdf's own writer)
+    finally:
+        sys.path.pop(0)
+    case = tmp_path / "cases" / "step"
+    case.mkdir(parents=True)
+    (case / "PassThrough_in.csv").write_text("time,u\n0,0\n0.2,1\n")
+    (case / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,1\n0.4,1\n")
+    (case / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    fmu = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
+    given = [str(fmu), str(case)]
+    if module == "asammdf":
+        fmu = BUILD_DIR / "fmi3" / "LGF_LimRateOfChangeCI.fmu"
+        given = [str(fmu), str(samples.write_mdf(tmp_path / "ramp.mf4"))]
+    command = ["compare", *given, *(a.format(tmp=tmp_path) for a in args)]
+    done = subprocess.run(
+        [sys.executable, "-c", WITHOUT.format(module=module) + f"sys.exit(cli.main({command!r}))"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert f'needs {module}, an optional part of fmutrace: pip install "fmutrace[{extra}]"' in done.stderr
+    assert "Traceback" not in done.stderr

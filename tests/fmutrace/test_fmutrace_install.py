@@ -67,8 +67,8 @@ def test_the_readme_commands_run_in_a_fresh_environment_from_the_declared_depend
         (work / "build" / version).symlink_to(BUILD_DIR / version)
     shutil.copytree(REPO / "tests" / "scenarios" / "RateLimiter", work / "my_traces")
     shutil.copytree(REPO / "tests" / "recordings", work / "tests" / "recordings")
-    # u.csv: u steps from 0 to 10 at t = 1 s
-    (work / "u.csv").write_text("time,u\n0,0\n1,10\n2,10\n")
+    # u.csv as the README makes it: u steps from 0 to 10 at t = 1 s
+    (work / "u.csv").write_text("time,u\n0,0\n1,10\n")
     environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     for words in commands:
         done = run([bin_dir / "fmutrace", *words[1:]], cwd=work, env=environment)
@@ -76,10 +76,10 @@ def test_the_readme_commands_run_in_a_fresh_environment_from_the_declared_depend
         assert "Traceback" not in done.stderr, done.stderr
     assert (work / "my_report" / "index.html").exists() and (work / "my_report" / "results.json").exists()
     result = (work / "y.csv").read_text().splitlines()
-    assert result[0].startswith('"time","y"') and len(result) == 1 + 21  # 0 to 2 s in steps of 0.1 s
+    assert result[0].startswith('"time","y"') and len(result) == 1 + 81  # 0 to 8 s in steps of 0.1 s
     # y holds 0 until the step at t = 1, which the cycle (1, 1.1] sees; then it rises at 2 per second
     y = [float(line.split(",")[1]) for line in result[1:]]
-    assert y[:11] == [0.0] * 11 and y[11:14] == pytest.approx([0.2, 0.4, 0.6], abs=1e-12)
+    assert y[:11] == [0.0] * 11 and y[11:14] == pytest.approx([0.2, 0.4, 0.6], abs=1e-12) and y[60:] == [10.0] * 21
 
 
 def test_every_pinned_requirement_has_a_windows_wheel(tmp_path):

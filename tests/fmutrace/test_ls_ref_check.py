@@ -155,6 +155,24 @@ def test_a_bad_manifest_is_bad_input(tmp_path):
     assert status == 2 and "carries no FMI-LS-REF experiments" in err, err
 
 
+def test_an_fmu_without_experiments_leaves_the_others_checked(tmp_path):
+    """check of several FMUs, one of them without experiments (listed first,
+    of the same model as another): the others' experiments run and pass,
+    the bare one is named, and the call ends as for bad input (2)."""
+    source = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    bare = rewritten(source, tmp_path / "bare.fmu", {}, drop=lambda name: name.startswith(FOLDER))
+    others = [source, fmu_path(BUILD_DIR, "RateLimiter", 2)]
+    status, out, err = command("check", bare, *others, "--role", "smoke-test")
+    assert status == 2, out + err
+    assert f"fmutrace: error: {bare} carries no FMI-LS-REF experiments" in err and "not checked" in err, err
+    assert "6 of 6 cases pass" in out, out  # (each FMU's 3 smoke tests)
+    result = fmutrace.check([bare, *others], role="smoke-test", run=ONE_JOB)
+    assert len(result.cases) == 6 and not result.passed and result.exit_code == 2
+    assert [p.split(":")[0] for p in result.problems] == [f"{bare} carries no FMI-LS-REF experiments (no {MANIFEST})"]
+    with pytest.raises(fmutrace.InputError, match="carries no FMI-LS-REF experiments"):
+        fmutrace.check([bare, bare], run=ONE_JOB)
+
+
 # ---- an LS-REF FMU another tool wrote ------------------------------------------------
 
 # its stimuli and reference: README's first simulation, worked by hand

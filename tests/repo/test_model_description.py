@@ -289,3 +289,37 @@ def test_generator_refuses_more_variables_than_the_core_holds(tmp_path):
     assert generator_run(tmp_path, fits).returncode == 0
     done = generator_run(tmp_path, fits + [("y", "output")])
     assert done.returncode != 0 and f"the core's table holds {limit}" in done.stderr
+
+
+def test_the_state_serialization_shows_no_expected_status_as_a_warning(tmp_path):
+    """The build serializes a state of each FMU's first scenario; the
+    advanced block's is an invalid call (16#8601 at every step, as its
+    reference expects): that status is no warning in the build's output.
+    A status the reference does not hold is still shown."""
+    from support.fmu_driver import BUILD_DIR
+
+    model = "LGF_LimRateOfChangeAdvancedCI"
+    scenarios = REPO / "tests" / "scenarios" / model
+    done = run_bounded(
+        [
+            sys.executable,
+            REPO / "modelDescription" / "state.py",
+            BUILD_DIR / "stage" / "fmi2" / model,  # (FMI 2's instance logs the status)
+            "2",
+            scenarios,
+            tmp_path / "state.bin",
+        ],
+        timeout=300,
+        what="state.py",
+    )
+    assert done.returncode == 0 and (tmp_path / "state.bin").stat().st_size > 0, done.stdout + done.stderr
+    assert "WARNING" not in done.stdout, done.stdout
+    sys.path.insert(0, str(REPO / "modelDescription"))
+    try:
+        import state
+    finally:
+        sys.path.pop(0)
+    reference = tmp_path / "ref.csv"
+    reference.write_text("time,y,status\n0,0,34305\n1,0,0\n")  # 34305: 16#8601
+    log = "[WARNING] status 16#8601: no valid call\n[WARNING] status 16#8200: bad limits\n[ERROR] other\n"
+    assert state.unexpected(log, reference) == ["[WARNING] status 16#8200: bad limits", "[ERROR] other"]

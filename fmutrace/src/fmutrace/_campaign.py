@@ -17,7 +17,7 @@ from typing import TextIO
 
 from ._cases import find_cases
 from ._comparison import Mode, comparison_mode
-from ._errors import InputError
+from ._errors import InputError, require_extra
 from ._executors import RunOptions, Work, executor_for
 from ._fmu import Fmu
 from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key, fmu_digest
@@ -105,6 +105,8 @@ def compare(
             "recording options apply to recordings, and only case folders are given: a case folder "
             "carries its own settings (<Model>_ref.opt, <Model>_start.csv)"
         )
+    if plots == "png":
+        require_extra("matplotlib", "png", "drawing PNG figures")
     loaded = [Fmu(path) for path in fmu_paths]
     cases_of = index_cases(loaded, case_paths)
     png = plots == "png"  # (the default's cases, each with a PNG figure too)
@@ -172,10 +174,12 @@ def _run(cases_of, work, executor, journal_of, progress):
         else:
             indices = range(len(cases_of))
         todo = Todo(cases_of, indices)
+        run_again = [0]  # cases run a second time (their first run's process died)
         bar = Progress(len(cases_of), progress)
 
         def finished(i, outcome):
             counts[outcome.status] += 1
+            run_again[0] += bool(outcome.retried)
             if journal:
                 write_case_files(outcome, report)
                 fmu, folder, _ = cases_of[i]
@@ -193,6 +197,8 @@ def _run(cases_of, work, executor, journal_of, progress):
         if journal:
             journal.close()
     where = executor.where if len(todo) else "the journal"
+    if run_again[0]:
+        where += f", {run_again[0]} case{'s' if run_again[0] != 1 else ''} run again"
     resumed = len(cases_of) - len(todo)
     if resumed and len(todo):
         where += f" ({resumed} cases from the journal)"

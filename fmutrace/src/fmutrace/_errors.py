@@ -2,6 +2,7 @@
 The statuses are decided here, once; a campaign's is its worst case's
 (outcome.Status)."""
 
+import importlib.util
 from enum import IntEnum
 
 
@@ -36,3 +37,10 @@ class SimulationError(RuntimeError):
     """The FMU failed (an FMI error status, a crash of the call)."""
 
     exit_code = ExitStatus.FAILURE
+
+
+def require_extra(module: str, extra: str, purpose: str):
+    """InputError naming the pip install line unless module (an optional
+    part of fmutrace: the extra's) is installed; nothing is imported."""
+    if importlib.util.find_spec(module) is None:
+        raise InputError(f'{purpose} needs {module}, an optional part of fmutrace: pip install "fmutrace[{extra}]"')

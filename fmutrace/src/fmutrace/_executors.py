@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ._cases import case_texts
-from ._errors import InputError
+from ._errors import InputError, require_extra
 from ._outcome import CaseOutcome, Status
 from ._runner import Runner
 from ._worker import CaseSettings, FmuFile, Target, run_case, run_cases
@@ -194,13 +194,19 @@ class Dask(Executor):
         in_flight = as_completed()
         submitted = {}  # future -> (fmu, batch, isolated, attempt)
 
-        def submit(fmu, batch, isolated, attempt):
-            self.submitted = True
+        # the scheduler runs a task whose worker died again by itself (its allowed-failures), counting the deaths
+        # (TaskState.suspicious): asked as each batch finishes (its result is on a worker: its state is kept)
+        def deaths(key):
+            return client.run_on_scheduler(
+                lambda dask_scheduler: getattr(dask_scheduler.tasks.get(key), "suspicious", 0)
+            )
+
+        def submit(fmu, batch, isolated, attempt, why=""):
             items = [(folder, name, texts) for _, folder, name, texts in batch]
             future = client.submit(
                 run_batch, items, shared[fmu.path], work.fmus[fmu.path], work.settings, isolated, pure=False
             )
-            submitted[future] = fmu, batch, isolated, attempt
+            submitted[future] = fmu, batch, isolated, attempt, why
             in_flight.add(future)
 
         def submit_next():
@@ -215,14 +221,18 @@ class Dask(Executor):
         while in_flight.count():
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             future = next(in_flight) if remaining is None else _next_within(in_flight, remaining, timeout)
-            fmu, batch, isolated, attempt = submitted.pop(future)
+            fmu, batch, isolated, attempt, why = submitted.pop(future)
+            died = deaths(future.key)
+            if died:
+                why = f"its Dask worker died while it held the case's batch ({died} time{'s' if died > 1 else ''})"
             try:
                 outcomes = future.result()
             except Exception as error:  # its worker died (an FMU crashed it?), or the result was lost with a worker
                 if attempt < BATCH_ATTEMPTS:
                     # the FMU's bytes again too: the copies may have gone with the workers
                     shared[fmu.path] = client.scatter(work.fmu_bytes[fmu.path], broadcast=True)
-                    submit(fmu, batch, True, attempt + 1)  # isolated: a crashing case fails alone
+                    # isolated: a crashing case fails alone
+                    submit(fmu, batch, True, attempt + 1, f"lost with its Dask worker: {type(error).__name__}: {error}")
                     continue
                 outcomes = [
                     CaseOutcome(
@@ -236,6 +246,7 @@ class Dask(Executor):
             for (i, _, _, _), outcome in zip(batch, outcomes, strict=True):
                 measured[0] += outcome.seconds
                 measured[1] += 1
+                outcome.retried = outcome.retried or why  # (a case run again in its own process says why itself)
                 finished(i, outcome)
             del outcomes
             submit_next()
@@ -245,6 +256,7 @@ class Dask(Executor):
 def executor_for(options: RunOptions) -> Executor:
     """The executor the run options choose."""
     if options.scheduler is not None:
+        require_extra("distributed", "dask", "a campaign on a Dask scheduler")
         return Dask(options)
     if options.jobs == 1 and options.case_timeout is None:
         return InProcess()

@@ -54,6 +54,7 @@ class CaseOutcome:
     criteria: str = ""  # what the case is judged by (its own criteria before the campaign's)
     streamed: bool = False  # read, run and compared in chunks (a long case), not in memory
     clock: dict = field(default_factory=dict)  # a recording's cycle fit: its cycle, jitter, missing cycles
+    retried: str = ""  # why the case ran a second time (its first run's process died), else ""
 
     @property
     def passed(self) -> bool:
@@ -81,6 +82,8 @@ class CaseOutcome:
             entry["streamed"] = True
         if self.clock:
             entry["clock"] = self.clock
+        if self.retried:
+            entry["retried"] = self.retried
         return entry
 
     @classmethod
@@ -101,7 +104,13 @@ class CaseOutcome:
             criteria=entry.get("criteria", ""),
             streamed=entry.get("streamed", False),
             clock=entry.get("clock", {}),
+            retried=entry.get("retried", ""),
         )
+
+
+def ran_again(outcome: CaseOutcome) -> str:
+    """What a case run a second time says of it (outcome.retried: why)."""
+    return f"ran a second time, on a fresh process, after its first run's process ended: {outcome.retried}"
 
 
 class Outcomes(Sequence):
@@ -134,15 +143,17 @@ class CampaignResult:
     seconds: float = 0.0
     report_dir: Path | None = None
     _counts: dict | None = field(default=None, repr=False)  # by status, when known
+    problems: list = field(default_factory=list)  # what was given and could not be run at all, each a message
 
     @property
     def passed(self) -> bool:
-        return self.counts()[Status.PASS] == len(self.cases)
+        return self.counts()[Status.PASS] == len(self.cases) and not self.problems
 
     @property
     def exit_code(self) -> ExitStatus:
         """The worst case's: 0 every case passes, 1 one differs or failed to simulate, 2 one is invalid."""
-        return max((status.exit_code for status, n in self.counts().items() if n), default=ExitStatus.SUCCESS)
+        worst = max((status.exit_code for status, n in self.counts().items() if n), default=ExitStatus.SUCCESS)
+        return max(worst, ExitStatus.BAD_INPUT) if self.problems else worst
 
     def counts(self) -> dict:
         """{status: cases}, every status."""
@@ -160,7 +171,7 @@ class CampaignResult:
     def headline(self) -> str:
         c = self.counts()
         text = f"{c[Status.PASS]} of {len(self.cases)} cases pass"
-        if not self.passed:
+        if c[Status.PASS] != len(self.cases):
             text += (
                 f", {c[Status.FAIL]} differ"
                 + (f", {c[Status.ERROR]} failed to simulate" if c[Status.ERROR] else "")
@@ -170,7 +181,7 @@ class CampaignResult:
 
     def summary(self) -> str:
         """The headline and every failing case with its messages."""
-        lines = [self.headline()]
+        lines = [self.headline()] + [f"not run: {problem}" for problem in self.problems]
         for o in self.failed(results=False):
             lines.append(f"{o.status.upper()}  {o.case} on {o.fmu}")
             lines += [f"      {m}" for m in o.messages]

@@ -19,7 +19,7 @@ from urllib.parse import quote
 from xml.sax.saxutils import escape, quoteattr
 
 from ._errors import InputError
-from ._outcome import CampaignResult, CaseOutcome, Status
+from ._outcome import CampaignResult, CaseOutcome, Status, ran_again
 from ._traces import shown, write_trace
 
 RESULTS_FORMAT = 1
@@ -197,7 +197,8 @@ def _link(path):
 
 
 def _verdict(o):
-    return "pass" if o.passed else f"{o.status.upper()}: " + "; ".join(o.messages[:3])
+    verdict = "pass" if o.passed else f"{o.status.upper()}: " + "; ".join(o.messages[:3])
+    return verdict + (f" ({ran_again(o)})" if o.retried else "")
 
 
 _FMI = re.compile(r" \(FMI \d+\)$")
@@ -268,7 +269,7 @@ def _has_a_page(o: CaseOutcome) -> bool:
     case, a plot, a result file or messages. A passing case of a campaign
     that plots only its failing ones is its row alone (creating a file
     costs about half a millisecond: 10,000 of them, seconds)."""
-    return not o.passed or bool(o.plot_data or o.csv or o.plot or o.messages)
+    return not o.passed or bool(o.plot_data or o.csv or o.plot or o.messages or o.retried)
 
 
 def _case_page(o: CaseOutcome, report_dir: Path, campaign_criteria) -> str:
@@ -286,6 +287,7 @@ def _case_page(o: CaseOutcome, report_dir: Path, campaign_criteria) -> str:
 
     assets = link(ASSETS)
     messages = "".join(f"<li>{html.escape(text(m))}</li>" for m in o.messages) or "<li>no difference</li>"
+    messages += f"<li>{html.escape(text(ran_again(o)))}</li>" if o.retried else ""
     signals = "".join(
         f"<li>{html.escape(text(d.name))}: {html.escape(text(d.criterion or o.criteria or campaign_criteria))}</li>"
         for d in o.deviations
@@ -355,7 +357,7 @@ def write_report(campaign: CampaignResult, report_dir):
                 name = html.escape(text(o.case))
                 if _has_a_page(o):
                     name = f'<a href="{_link(_case_page(o, report_dir, criteria))}">{name}</a>'
-                message = o.messages[0] if o.messages and not o.passed else ""
+                message = o.messages[0] if o.messages and not o.passed else ran_again(o) if o.retried else ""
                 (other_rows if o.passed else failing_rows).write(
                     f'<tr class="{o.status}" data-status="{o.status}" {fmu.attributes}>'
                     f'<td class="status">{o.status}</td>'

@@ -4,16 +4,23 @@ reported by itself while the others go on.
 
 A worker is a child process: forked from this one where that is safe
 (Linux, no other Python thread: it starts in milliseconds with fmutrace
-already imported), else a new Python running `main` below. It reads
-batches of cases on a pipe and writes back each case's outcome, and an
-empty record when it starts a case whose start matters (length-prefixed
-pickles; what the FMU prints goes nowhere). This process, one thread, waits on every
-worker's pipe with a deadline: a worker whose pipe closes died, and the
-case it ran gets an error naming the signal; a case over the per-case
-timeout gets its worker killed. Either way the rest of the batch goes
-back to the queue and a new worker takes over. The timeout counts from
-the case's start, so a worker's start-up (slow on a loaded machine) is
-never charged to a case.
+already imported), else a new Python running `main` below (Windows,
+macOS). It reads batches of cases on a multiprocessing Connection and
+writes back each case's outcome, and an empty message when it starts a
+case whose start matters (pickles; what the FMU prints goes nowhere).
+This process, one thread, waits on every worker's Connection with
+multiprocessing.connection.wait and a deadline (the standard library's
+portable wait: Windows' select() takes sockets only): a worker whose
+Connection closes died; a case over the per-case timeout gets its worker
+killed. Either way the rest of the batch goes back to the queue and a new
+worker takes over. The timeout counts from the case's start, so a
+worker's start-up (slow on a loaded machine) is never charged to a case.
+
+A case whose worker died (killed from outside, by the OOM killer or an
+operator, or crashed by the FMU) runs again once, alone, on a fresh
+worker, and fails only if it kills that one too: its outcome says why it
+ran again (CaseOutcome.retried). A case stopped after the per-case
+timeout is not run again (it hangs).
 
 How many: `jobs` workers if asked, else one, and more once the first
 outcomes show that the work left pays for their start-up (measured: the
@@ -26,11 +33,10 @@ import collections
 import ctypes
 import gc
 import math
+import multiprocessing.connection
 import os
 import pickle
-import selectors
 import signal
-import struct
 import subprocess
 import sys
 import tempfile
@@ -38,6 +44,8 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from multiprocessing import Pipe
+from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
 from ._fmu import UNPACK_ROOT, unpack_root
@@ -45,13 +53,17 @@ from ._outcome import CaseOutcome, Status
 from ._plot import load_plotting
 from ._worker import CaseSettings, plotting_first, run_cases
 
-HEADER = struct.Struct("!Q")
-STARTED = b""  # a worker's record that it starts its next case (an empty record)
+# the end of Pipe() a spawned worker gets by its number: a named pipe's handle on Windows, a socket's descriptor
+# elsewhere
+ParentEnd = getattr(multiprocessing.connection, "PipeConnection", Connection)
+
+STARTED = b""  # a worker's message that it starts its next case (an empty one)
 PR_SET_PDEATHSIG = 1  # prctl(2)
 PARENT = "FMUTRACE_PARENT_PID"  # in a spawned worker's environment: the process whose child it is
 CHILD = "import sys, fmutrace._workers; sys.exit(fmutrace._workers.main())"
 # the most a worker may take to start a case (a new Python's imports, the FMU unpacked) on a loaded machine
 START_SECONDS = 300.0
+STOP_SECONDS = 60.0  # the most a worker told to end may take to exit before it is killed
 BATCH_SECONDS = 0.25  # of measured work per batch: the round trip to the worker is a fraction of a millisecond
 START_PAYS = 2.0  # another worker starts once the work left per worker exceeds so many times a start-up
 
@@ -71,15 +83,40 @@ def can_fork() -> bool:
     return sys.platform.startswith("linux") and threading.active_count() == 1
 
 
-@dataclass
+class _Forked:
+    """A forked worker's process, as subprocess.Popen gives a spawned one's
+    (kill, wait, poll; only on Linux, where can_fork() forks)."""
+
+    def __init__(self, pid: int):
+        self.pid = pid
+        self.returncode: int | None = None
+
+    def poll(self) -> int | None:
+        if self.returncode is None:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                self.returncode = os.waitstatus_to_exitcode(status)
+        return self.returncode
+
+    def wait(self, timeout: float) -> int:
+        deadline = time.monotonic() + timeout
+        while (code := self.poll()) is None:
+            if time.monotonic() > deadline:
+                raise subprocess.TimeoutExpired(str(self.pid), timeout)
+            time.sleep(0.002)
+        return code
+
+    def kill(self):
+        if self.poll() is None:
+            os.kill(self.pid, signal.SIGKILL)  # (Linux alone forks)
+
+
+@dataclass(eq=False)
 class _Worker:
-    pid: int
-    to_worker: int  # pipe ends, this side's
-    from_worker: int
+    process: "_Forked | subprocess.Popen"
+    connection: Connection  # this side's
     said: object  # a file with what the worker wrote to stderr (its last words, if it dies)
-    process: subprocess.Popen | None = None  # a spawned worker's
     started: float = field(default_factory=time.monotonic)
-    received: bytearray = field(default_factory=bytearray)
     fmus: set = field(default_factory=set)  # the FMUs whose bytes it has
     batch: collections.deque = field(default_factory=collections.deque)  # its cases not finished (as in todo)
     running_since: float | None = None  # the case at batch[0] started then
@@ -87,51 +124,61 @@ class _Worker:
     last_words: str = ""  # what it wrote last to stderr, once it ended
     first_case: bool = True  # its next outcome is its first
 
-    def kill(self):
-        try:
-            os.kill(self.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-
-    def wait(self) -> int:
-        """Its exit status as subprocess gives it (negative: the signal)."""
-        if self.process is not None:
-            return self.process.wait()
-        _, status = os.waitpid(self.pid, 0)
-        return -os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status)
+    def end(self, kill: bool) -> int:
+        """Its exit status as subprocess gives it (negative: the signal),
+        once it has ended: at once (kill), or after its last batch (killed
+        if it takes longer than STOP_SECONDS)."""
+        if not kill:
+            try:
+                self.connection.send_bytes(pickle.dumps(None))
+            except OSError:
+                kill = True
+        if not kill:
+            try:
+                return self.process.wait(timeout=STOP_SECONDS)
+            except subprocess.TimeoutExpired:
+                pass
+        self.process.kill()
+        return self.process.wait(timeout=STOP_SECONDS)
 
     def close(self):
-        for fd in (self.to_worker, self.from_worker):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
+        self.connection.close()
         self.said.close()  # type: ignore[attr-defined]
 
 
 def _start_worker(settings: CaseSettings, others: list[_Worker]) -> _Worker:
     """A new worker, forked where can_fork() says it is safe, else spawned."""
     said = tempfile.TemporaryFile()
+    here, there = Pipe()
     if can_fork():
-        down_read, down_write = os.pipe()
-        up_read, up_write = os.pipe()
         pid = os.fork()
-        if pid == 0:  # the worker: nothing of this process's but the pipes, never back into its code
+        if pid == 0:  # the worker: nothing of this process's but its Connection, never back into its code
             gc.freeze()  # what it inherited stays shared: the collector's passes would copy every page of it
             code = 1
             try:
                 for worker in others:
-                    worker.close()
-                os.close(down_write)
-                os.close(up_read)
+                    worker.connection.close()
+                here.close()
                 os.dup2(said.fileno(), 2)
-                _serve(down_read, up_write, settings)
+                _serve(there, settings)
                 code = 0
             finally:
                 os._exit(code)
-        os.close(down_read)
-        os.close(up_write)
-        return _Worker(pid, down_write, up_read, said)
+        there.close()
+        return _Worker(_Forked(pid), here, said)
+    process = _spawn(there, said)
+    there.close()
+    worker = _Worker(process, here, said)
+    try:
+        here.send_bytes(pickle.dumps(settings))
+    except OSError:  # it died at once: its end shows on its Connection
+        pass
+    return worker
+
+
+def _spawn(there: Connection, said) -> subprocess.Popen:
+    """A new Python running main() with the Connection's other end (the
+    handle or descriptor number its command line gives), inherited alone."""
     environment = dict(
         os.environ,
         PYTHONPATH=os.pathsep.join(
@@ -139,15 +186,26 @@ def _start_worker(settings: CaseSettings, others: list[_Worker]) -> _Worker:
         ),
         **{UNPACK_ROOT: unpack_root(), PARENT: str(os.getpid())},
     )
-    process = subprocess.Popen(
-        [sys.executable, "-c", CHILD], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=said, env=environment
+    command = [sys.executable, "-c", CHILD, str(there.fileno())]
+    if sys.platform == "win32":
+        os.set_handle_inheritable(there.fileno(), True)
+        inherit = subprocess.STARTUPINFO(lpAttributeList={"handle_list": [there.fileno()]})
+        return subprocess.Popen(
+            command,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=said,
+            env=environment,
+            startupinfo=inherit,
+        )
+    return subprocess.Popen(
+        command,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=said,
+        env=environment,
+        pass_fds=[there.fileno()],
     )
-    assert process.stdin is not None and process.stdout is not None
-    worker = _Worker(process.pid, os.dup(process.stdin.fileno()), os.dup(process.stdout.fileno()), said, process)
-    process.stdin.close()
-    process.stdout.close()
-    _send(worker.to_worker, settings)
-    return worker
 
 
 def _package_root():
@@ -155,33 +213,11 @@ def _package_root():
     return str(Path(__file__).resolve().parent.parent)
 
 
-def _send(fd, message):
-    _write_record(fd, pickle.dumps(message))
-
-
-def _write_record(fd, data: bytes):
-    """One length-prefixed record, whole (a pipe may take it in parts)."""
-    view = memoryview(HEADER.pack(len(data)) + data)
-    while view:
-        view = view[os.write(fd, view) :]
-
-
-def _read_exactly(fd, size) -> bytes | None:
-    parts, left = [], size
-    while left:
-        part = os.read(fd, left)
-        if not part:
-            return None
-        parts.append(part)
-        left -= len(part)
-    return b"".join(parts)
-
-
-def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
+def _serve(parent: Connection, settings: CaseSettings):
     """A worker's loop: batches in, an outcome per case out, until None;
-    a STARTED record before a case where its start matters (every case
+    a STARTED message before a case where its start matters (every case
     with a per-case timeout, else the worker's first: its start-up ends
-    there). A record fewer saves the campaign's process a wake-up."""
+    there). A message fewer saves the campaign's process a wake-up."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the campaign's to handle (it stops its workers)
     _die_with_parent()
     devnull = os.open(os.devnull, os.O_WRONLY)
@@ -191,24 +227,21 @@ def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
 
     def started():
         if first[0] or settings.case_timeout is not None:
-            _write_record(to_parent, STARTED)
+            parent.send_bytes(STARTED)
         first[0] = False
 
     while True:
-        header = _read_exactly(from_parent, HEADER.size)
-        if header is None:
+        try:
+            message = pickle.loads(parent.recv_bytes())
+        except EOFError:
             return
-        body = _read_exactly(from_parent, HEADER.unpack(header)[0])
-        if body is None:
-            return
-        message = pickle.loads(body)
         if message is None:
             return
         path, data, fmu, items = message
         if data is not None:
             fmus[path] = data
         for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
-            _send(to_parent, outcome)
+            parent.send_bytes(pickle.dumps(outcome))
 
 
 def _die_with_parent():
@@ -225,14 +258,15 @@ def _die_with_parent():
 
 
 def main():
-    """A spawned worker: its settings, then batches, on standard input."""
+    """A spawned worker: its Connection's handle (or descriptor) on its
+    command line, its settings and then batches on that Connection."""
     os.environ.pop(PARENT, None)  # (its own children are not its parent's)
-    from_parent, to_parent = os.dup(0), os.dup(1)
-    header = _read_exactly(from_parent, HEADER.size)
-    body = header and _read_exactly(from_parent, HEADER.unpack(header)[0])
-    if not body:
+    parent = ParentEnd(int(sys.argv[1]))
+    try:
+        settings = pickle.loads(parent.recv_bytes())
+    except EOFError:
         return 1
-    _serve(from_parent, to_parent, pickle.loads(body))
+    _serve(parent, settings)
     return 0
 
 
@@ -241,6 +275,16 @@ def _last_words(file):
     file.seek(0)
     lines = [line.strip() for line in file.read()[-4000:].decode(errors="replace").splitlines() if line.strip()]
     return f"; it said: {lines[-1][:200]}" if lines else ""
+
+
+def _cause(code: int) -> str:
+    """How a worker's process ended, by its exit status as subprocess gives it."""
+    if code < 0:
+        try:
+            return f"killed by signal {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exited with status {code}"
 
 
 class _Queue:
@@ -291,13 +335,13 @@ class Pool:
         self.chosen = jobs is None
         self.peak = 0  # workers at once
         self.lost = 0  # workers that died or were stopped with a case (a crash, a timeout)
+        self.retried: dict[int, str] = {}  # case -> why it runs again, until its outcome comes
         self.start_up: float | None = None  # seconds from the first worker's start to its first case
         # the work's measure: seconds and count of the cases finished, each worker's first apart (it carries
         # the worker's warm-up: the FMU's first instance, lazy imports)
         self.measured = {True: [0.0, 0], False: [0.0, 0]}  # first? -> [seconds, cases]
         self.queue = _Queue((), 0)
-        self.workers: dict[int, _Worker] = {}  # by its pipe from the worker
-        self.selector = selectors.DefaultSelector()
+        self.workers: dict[Connection, _Worker] = {}  # by its Connection
         self.finished: Callable = lambda i, outcome: None
         self.announced = settings.case_timeout is not None  # every case's start is said (else the first's)
 
@@ -316,48 +360,54 @@ class Pool:
             while self.workers:
                 deadlines = [(self._deadline(w), w) for w in self.workers.values()]
                 wakes = [d for d, _ in deadlines if d is not None] + [self._worth_from() or math.inf]
-                soonest = min(wakes) if min(wakes) < math.inf else None
-                timeout = None if soonest is None else max(0.0, soonest - time.monotonic())
-                for key, _ in self.selector.select(timeout):
-                    worker: _Worker = key.data
-                    if self.workers.get(key.fd) is worker:  # (not one stopped meanwhile)
+                soonest = min(wakes)
+                timeout = None if soonest == math.inf else max(0.0, soonest - time.monotonic())
+                for connection in wait(list(self.workers), timeout):
+                    worker = self.workers.get(connection)  # type: ignore[call-overload]
+                    if worker is not None:  # (not one stopped meanwhile)
                         self._read(worker)
                 now = time.monotonic()
                 for deadline, worker in deadlines:
-                    if self.workers.get(worker.from_worker) is worker and deadline is not None and now > deadline:
-                        why = self._overdue(worker.running_since is not None)
+                    if self.workers.get(worker.connection) is worker and deadline is not None and now > deadline:
+                        running = worker.running_since is not None
                         self._stop(worker, kill=True)
-                        self._lost(worker, why)
+                        self._lost(worker, self._overdue(running), again=not running)
                 while self._pays():
                     self._give(self._start())
-        finally:
-            for worker in list(self.workers.values()):
+        except BaseException as error:
+            self._stop_all(error)
+            raise
+        self._stop_all(None)
+
+    def _stop_all(self, first: BaseException | None):
+        """Kills the workers left; an error doing it is raised, or (first:
+        the error that ended the run) noted on the first, never hiding it."""
+        problems = []
+        for worker in list(self.workers.values()):
+            try:
                 self._stop(worker, kill=True)
-            self.selector.close()
+            except Exception as problem:
+                problems.append(problem)
+        if first is not None:
+            for trouble in problems:
+                first.add_note(f"(stopping the workers then: {type(trouble).__name__}: {trouble})")
+        elif problems:
+            raise problems[0]
 
     def _start(self) -> _Worker:
         worker = _start_worker(self.settings, list(self.workers.values()))
-        self.workers[worker.from_worker] = worker
-        os.set_blocking(worker.from_worker, False)
-        self.selector.register(worker.from_worker, selectors.EVENT_READ, worker)
+        self.workers[worker.connection] = worker
         self.peak = max(self.peak, len(self.workers))
         return worker
 
     def _stop(self, worker: _Worker, kill=False) -> int:
         """Ends the worker (kill: at once, else after its last batch); its exit status."""
-        self.selector.unregister(worker.from_worker)
-        del self.workers[worker.from_worker]
-        if not kill:
-            try:
-                _send(worker.to_worker, None)
-            except OSError:
-                kill = True
-        if kill:
-            worker.kill()
-        code = worker.wait()
-        worker.last_words = _last_words(worker.said)
-        worker.close()
-        return code
+        self.workers.pop(worker.connection, None)
+        try:
+            return worker.end(kill)
+        finally:
+            worker.last_words = _last_words(worker.said)
+            worker.close()
 
     def _batch_size(self) -> int:
         """Cases for a worker's next batch: about BATCH_SECONDS of the work
@@ -369,12 +419,13 @@ class Pool:
         share = -(-len(self.queue) // (2 * max(1, len(self.workers))))
         return max(1, min(round(BATCH_SECONDS / per_case), share))
 
-    def _give(self, worker: _Worker):
-        """Its next batch of one FMU's cases, or its end when none is left."""
-        if not self.queue:
+    def _give(self, worker: _Worker, batch: list | None = None):
+        """Its next batch of one FMU's cases (batch, else from the queue),
+        or its end when none is left."""
+        if batch is None and not self.queue:
             self._stop(worker)
             return
-        worker.batch.extend(self.queue.take(self._batch_size()))
+        worker.batch.extend(batch if batch is not None else self.queue.take(self._batch_size()))
         path = worker.batch[0][1]
         data, file = self.fmus[path]
         first = path not in worker.fmus
@@ -382,9 +433,10 @@ class Pool:
         worker.sent_at = time.monotonic()
         # its next case starts now, unless it says when (with a timeout, or as a new worker's first)
         worker.running_since = None if self.announced or worker.first_case else worker.sent_at
+        message = (path, data if first else None, file, [item for _, _, item in worker.batch])
         try:
-            _send(worker.to_worker, (path, data if first else None, file, [item for _, _, item in worker.batch]))
-        except OSError:  # it died before it read the batch: its end shows on its pipe
+            worker.connection.send_bytes(pickle.dumps(message))
+        except OSError:  # it died before it read the batch: its end shows on its Connection
             pass
 
     def _deadline(self, worker: _Worker) -> float | None:
@@ -426,55 +478,54 @@ class Pool:
         return None
 
     def _read(self, worker: _Worker):
-        """What the worker wrote: its records handled; its end if its pipe closed."""
-        try:
-            data = os.read(worker.from_worker, 1 << 20)
-        except BlockingIOError:
-            return
-        except OSError:
-            data = b""
-        if not data:  # it died: a worker ends only when stopped, and is forgotten then
-            code = self._stop(worker, kill=True)
-            cause = f"killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
-            self._lost(worker, f"the simulation's process was {cause} while running this case" + worker.last_words)
-            return
-        worker.received += data
-        while len(worker.received) >= HEADER.size:
-            size = HEADER.unpack_from(worker.received)[0]
-            if len(worker.received) < HEADER.size + size:
+        """The messages the worker wrote, handled; its end if its Connection closed."""
+        while self.workers.get(worker.connection) is worker:
+            try:
+                if not worker.connection.poll():
+                    return
+                record = worker.connection.recv_bytes()
+            except (EOFError, OSError):  # it died: a worker ends only when stopped, and is forgotten then
+                why = f"the simulation's process was {_cause(self._stop(worker, kill=True))}"
+                self._lost(worker, why + " while running this case" + worker.last_words, again=True)
                 return
-            record = bytes(worker.received[HEADER.size : HEADER.size + size])
-            del worker.received[: HEADER.size + size]
             if not record:  # STARTED
                 worker.running_since = time.monotonic()
                 if self.start_up is None:
                     self.start_up = worker.running_since - worker.started
                 continue
-            outcome = pickle.loads(record)
+            outcome: CaseOutcome = pickle.loads(record)
             i = worker.batch.popleft()[0]
             worker.running_since = None if self.announced else time.monotonic()  # (the next one's start)
             measure = self.measured[worker.first_case]
             measure[0] += outcome.seconds
             measure[1] += 1
             worker.first_case = False
+            outcome.retried = self.retried.pop(i, "")
             self.finished(i, outcome)
             if not worker.batch:
                 self._give(worker)
-                return
 
-    def _lost(self, worker: _Worker, why: str):
+    def _lost(self, worker: _Worker, why: str, again: bool):
         """The worker is gone: its running case (the first of its batch)
-        fails saying why, the rest of the batch goes back to the queue,
-        and a new worker takes over if cases are left."""
+        runs again alone on a fresh worker (again, the first time), else
+        fails saying why; the rest of the batch goes back to the queue, and
+        a new worker takes over if cases are left."""
         if worker.batch:  # (else it went between two batches: no case to blame)
             self.lost += 1
-            i, path, (_, name, _) = worker.batch.popleft()
+            item = worker.batch.popleft()
             started = worker.running_since if worker.running_since is not None else worker.sent_at
             self.queue.give_back(list(worker.batch))
             worker.batch.clear()
-            labels = self.fmus[path][1].labels
-            seconds = time.monotonic() - started
-            self.finished(i, CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=seconds))
+            i, path, (_, name, _) = item
+            if again and i not in self.retried:
+                self.retried[i] = why
+                self._give(self._start(), [item])
+            else:
+                labels = self.fmus[path][1].labels
+                seconds = time.monotonic() - started
+                outcome = CaseOutcome(name, **labels, status=Status.ERROR, messages=[why], seconds=seconds)
+                outcome.retried = self.retried.pop(i, "")
+                self.finished(i, outcome)
         if self.queue and len(self.workers) < self.most:
             self._give(self._start())
 

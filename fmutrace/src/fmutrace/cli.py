@@ -23,7 +23,7 @@ from ._errors import ExitStatus, InputError, SimulationError
 from ._fmu import Fmu, is_fmu_file
 from ._lsref import ROLES
 from ._simulation import SimulationOptions, simulate_chunks
-from ._outcome import Status
+from ._outcome import Status, ran_again
 from ._report import text
 from .recordings import is_recording
 from .recordings._align import CYCLE_LENGTHS, TIMINGS
@@ -380,17 +380,21 @@ def compare_command(args, out):
         run=run,
         recording=recording,
     )
-    for o in result.failed(results=False) if not recordings else result.cases.light():
+    for o in result.cases.light():  # the failing ones, a recording's messages, and the cases run again
         if o.status == Status.INVALID:
             print(f"fmutrace: error: {text(o.messages[0])}", file=sys.stderr)
             continue
-        if o.passed and not o.messages:
+        if o.passed and not o.retried and not (recordings and o.messages):
             continue
         print(f"{o.status.upper()}  {text(o.case)} on {text(o.fmu)}", file=out)
         for message in o.messages[:SHOWN_MESSAGES]:
             print(f"      {text(message)}", file=out)
         if len(o.messages) > SHOWN_MESSAGES:
             print(f"      {_the_rest(len(o.messages) - SHOWN_MESSAGES, args.report)}", file=out)
+        if o.retried:
+            print(f"      {text(ran_again(o))}", file=out)
+    for problem in result.problems:
+        print(f"fmutrace: error: {text(problem)}", file=sys.stderr)
     print(result.headline(), file=out)
     if args.report:
         print(f"report: {text(args.report.rstrip('/'))}/index.html", file=out)

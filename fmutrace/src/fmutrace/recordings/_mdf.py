@@ -16,7 +16,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from .._errors import TraceError
+from .._errors import TraceError, require_extra
 from .._traces import samples_problem
 from ._grid import unique_names
 from ._model import Channel, Recording
@@ -63,6 +63,7 @@ def read(path):
 
 
 def _read(path, scratch):
+    require_extra("asammdf", "mdf", f"reading the MDF recording {path}")
     from asammdf import MDF  # loaded on first use: it brings pandas, seconds of import for every other command
 
     _quiet_asammdf_finalizers()
