@@ -6,6 +6,7 @@ given), run by an executor (executors.py), recorded as they finish (in
 memory, or in the report's journal) and reported at the end.
 """
 
+import os
 import time
 from array import array
 from bisect import bisect_right
@@ -23,9 +24,10 @@ from ._fmu import Fmu
 from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key, fmu_digest
 from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
+from ._reading import read_bytes
 from .recordings import is_recording, recording_paths
 from .recordings._options import RecordingOptions
-from ._report import file_name, write_case_files, write_junit, write_report
+from ._report import file_name, output_problem, write_case_files, write_junit, write_report
 from ._worker import PLOTS, CaseSettings, FmuFile, default_plots
 
 Paths = str | PathLike | Iterable[str | PathLike]  # one path, or several
@@ -93,9 +95,12 @@ def compare(
         mode = comparison_mode(rel_tol or 0.0, abs_tol or 0.0, tube_time, tube_value)
     if plots not in (None, *PLOTS):
         raise InputError(f"plots must be {', '.join(PLOTS[:-1])} or {PLOTS[-1]}, not {plots!r}")
+    if junit and output_problem(junit):
+        raise InputError(output_problem(junit))
     if resume and not report:
         raise InputError("resume continues the campaign of a report folder: give the report folder")
     fmu_paths = [fmus] if isinstance(fmus, (str, PathLike)) else list(fmus)
+    fmu_paths = list({os.path.realpath(p): p for p in reversed(fmu_paths)}.values())[::-1]  # one FMU given twice: once
     case_paths = [cases] if isinstance(cases, (str, PathLike)) else list(cases)
     if not fmu_paths or not case_paths:
         raise InputError("give at least one FMU and one case folder")
@@ -111,7 +116,7 @@ def compare(
     plots = ((None if png else plots) or default_plots(len(cases_of))) if report else "none"
     folders = _report_folders(loaded)
     work = Work(
-        fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
+        fmu_bytes={f.path: read_bytes(f.path) for f in loaded},
         fmus={
             f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]})
             for f in loaded

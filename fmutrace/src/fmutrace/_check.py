@@ -4,17 +4,21 @@ tests"). They are written out as case folders first (_lsref): into the
 report folder's experiments/ when there is one (so that --resume finds
 them again), else into a temporary folder."""
 
+import os
 import shutil
 import tempfile
 from os import PathLike
 from pathlib import Path
 
 from ._campaign import Paths, compare
-from ._fmu import Fmu
+from ._errors import InputError
+from ._journal import ReportLock
+from ._fmu import Fmu, unpack_root
 from ._lsref import write_cases
 from ._outcome import CampaignResult
 
 EXPERIMENTS = "experiments"
+MARKER = ".fmutrace-experiments"  # in experiments/: the folder is a check's, to replace
 
 
 def check(fmus: Paths, *, role: str | None = None, report: str | PathLike | None = None, **options) -> CampaignResult:
@@ -27,11 +31,34 @@ def check(fmus: Paths, *, role: str | None = None, report: str | PathLike | None
     whose SHA-256 is not the manifest's."""
     paths = [fmus] if isinstance(fmus, (str, PathLike)) else list(fmus)
     if report:
-        target = Path(report) / EXPERIMENTS
-        shutil.rmtree(target, ignore_errors=True)
-        return compare(paths, _write(paths, role, target), report=report, **options)
-    with tempfile.TemporaryDirectory(prefix="fmutrace-check-") as folder:
+        lock = ReportLock(report)  # before anything in the folder is touched (compare's own is this one)
+        try:
+            target = _experiments_folder(report)
+            return compare(paths, _write(paths, role, target), report=report, **options)
+        finally:
+            lock.release()
+    # in the command's own folder of unpacked FMUs: a check killed leaves it to the next command to remove
+    with tempfile.TemporaryDirectory(prefix="check-", dir=unpack_root()) as folder:
         return compare(paths, _write(paths, role, Path(folder)), **options)
+
+
+def _experiments_folder(report) -> Path:
+    """The report's experiments/, emptied for this check: only a folder a
+    check made (its MARKER file inside) is replaced; a link, a file, or a
+    folder of the user's is refused (InputError), nothing in it touched."""
+    target = Path(report) / EXPERIMENTS
+    if os.path.islink(target):
+        raise InputError(f"{target}: a link in the report folder; remove it or choose another folder")
+    if os.path.lexists(target):
+        if not (target.is_dir() and os.path.isfile(target / MARKER) and not os.path.islink(target / MARKER)):
+            raise InputError(
+                f"{target}: not written by fmutrace check (no {MARKER} in it), so not replaced; "
+                "move it away or choose another report folder"
+            )
+        shutil.rmtree(target)
+    target.mkdir()
+    (target / MARKER).write_text("written by fmutrace check: replaced by the next check into this report\n")
+    return target
 
 
 def _write(paths, role, target):

@@ -33,6 +33,7 @@ import numpy as np
 
 from ._errors import InputError
 from ._names import Names, name_of
+from ._traces import plain_float
 
 TIME_MATCH = 1e-9  # seconds below |t| = 1 s, relative above
 
@@ -635,7 +636,7 @@ def parse_mode(text: str) -> Mode:
             if not sep or key not in allowed or key in given:
                 raise InputError(f"mode {text!r}: expected {kind}:{','.join(k + '=...' for k in allowed)}")
             try:
-                given[key] = int(value) if key in whole else float(value)
+                given[key] = int(value) if key in whole else plain_float(value.strip())
             except ValueError:
                 raise InputError(f"mode {text!r}: {key} {value.strip()!r} is not a number") from None
             if not (given[key] >= 0 and math.isfinite(given[key])):

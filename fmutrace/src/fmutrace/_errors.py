@@ -10,6 +10,7 @@ class ExitStatus(IntEnum):
     FAILURE = 1  # a result differs from its reference, or the FMU failed
     BAD_INPUT = 2  # usage, a file, an option: nothing a simulation can mend
     INTERRUPTED = 130  # Ctrl-C (SIGINT), as shells report a command it ends
+    TERMINATED = 143  # SIGTERM, as shells report a command it ends
 
 
 class InputError(ValueError):

@@ -40,6 +40,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ._errors import InputError
 from ._fmu import UNPACK_ROOT, unpack_root
 from ._outcome import CaseOutcome, Status
 from ._plot import load_plotting
@@ -127,6 +128,8 @@ def _start_worker(settings: CaseSettings, others: list[_Worker]) -> _Worker:
                 os.dup2(said.fileno(), 2)
                 _serve(down_read, up_write, settings)
                 code = 0
+            except BaseException as error:  # (os._exit prints no traceback: its reason is its last words)
+                os.write(2, f"{type(error).__name__}: {error}\n".encode(errors="replace"))
             finally:
                 os._exit(code)
         os.close(down_read)
@@ -207,8 +210,12 @@ def _serve(from_parent: int, to_parent: int, settings: CaseSettings):
         path, data, fmu, items = message
         if data is not None:
             fmus[path] = data
-        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
-            _send(to_parent, outcome)
+        try:
+            for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
+                _send(to_parent, outcome)
+        except InputError as error:  # the FMU's, not a case's (it cannot be unpacked): the campaign's to raise
+            _send(to_parent, InputError(str(error)))  # (a TraceError's pickle would not load: its arguments)
+            return
 
 
 def _die_with_parent():
@@ -451,6 +458,8 @@ class Pool:
                     self.start_up = worker.running_since - worker.started
                 continue
             outcome = pickle.loads(record)
+            if isinstance(outcome, InputError):  # no case of the FMU can run: said once, as in this process
+                raise outcome
             i = worker.batch.popleft()[0]
             worker.running_since = None if self.announced else time.monotonic()  # (the next one's start)
             measure = self.measured[worker.first_case]
