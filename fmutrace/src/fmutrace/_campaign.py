@@ -95,8 +95,6 @@ def compare(
         mode = comparison_mode(rel_tol or 0.0, abs_tol or 0.0, tube_time, tube_value)
     if plots not in (None, *PLOTS):
         raise InputError(f"plots must be {', '.join(PLOTS[:-1])} or {PLOTS[-1]}, not {plots!r}")
-    if junit and output_problem(junit):
-        raise InputError(output_problem(junit))
     if resume and not report:
         raise InputError("resume continues the campaign of a report folder: give the report folder")
     fmu_paths = [fmus] if isinstance(fmus, (str, PathLike)) else list(fmus)
@@ -128,6 +126,8 @@ def compare(
     started = time.perf_counter()
     lock = ReportLock(report) if report else None
     try:  # the report folder stays locked until its last file is written
+        if junit and output_problem(junit):  # (checked once the report folder is made: it may hold the file)
+            raise InputError(output_problem(junit))
         outcomes, counts, where = _run(cases_of, work, executor, (report, key, resume), progress)
         kept = (
             JournaledOutcomes(

@@ -16,6 +16,7 @@ from ._journal import ReportLock
 from ._fmu import Fmu, unpack_root
 from ._lsref import write_cases
 from ._outcome import CampaignResult
+from ._report import output_problem, write_junit
 
 EXPERIMENTS = "experiments"
 MARKER = ".fmutrace-experiments"  # in experiments/: the folder is a check's, to replace
@@ -34,12 +35,22 @@ def check(fmus: Paths, *, role: str | None = None, report: str | PathLike | None
         lock = ReportLock(report)  # before anything in the folder is touched (compare's own is this one)
         try:
             target = _experiments_folder(report)
-            return compare(paths, _write(paths, role, target), report=report, **options)
+            return compare(paths, list(_write(paths, role, target)), report=report, **options)
         finally:
             lock.release()
+    junit = options.pop("junit", None)  # (written below, once the messages name what is left)
+    if junit and output_problem(junit):
+        raise InputError(output_problem(junit))
     # in the command's own folder of unpacked FMUs: a check killed leaves it to the next command to remove
     with tempfile.TemporaryDirectory(prefix="check-", dir=unpack_root()) as folder:
-        return compare(paths, _write(paths, role, Path(folder)), **options)
+        folders = _write(paths, role, Path(folder))
+        result = compare(paths, list(folders), **options)
+    for case in result.cases:  # the folder is gone: its files are named by the FMU that carries them
+        for root, fmu in folders.items():
+            case.messages = [m.replace(f"{root}{os.sep}", f"{fmu}: experiment ") for m in case.messages]
+    if junit:
+        write_junit(result, junit)
+    return result
 
 
 def _experiments_folder(report) -> Path:
@@ -62,14 +73,17 @@ def _experiments_folder(report) -> Path:
 
 
 def _write(paths, role, target):
-    """The case folders of each FMU's experiments: one folder per model
-    (its FMUs, FMI 2 and 3, share them), every FMU's manifest checked."""
+    """The case folders of each FMU's experiments, each with the FMU that
+    carries them: one folder per model (its FMUs, FMI 2 and 3, share them),
+    every FMU's manifest checked."""
     folders: dict[str, Path] = {}
+    made: dict[Path, str] = {}  # each case folder -> the FMU whose experiments it holds
     for path in paths:
         fmu = Fmu(path)
         folder = target / f"{len(folders)}-{fmu.model}" if fmu.model not in folders else None
         write_cases(path, fmu.model, str(path), role, folder or target / "checked")
         if folder:
             folders[fmu.model] = folder
+            made[folder] = str(path)
     shutil.rmtree(target / "checked", ignore_errors=True)
-    return list(folders.values())
+    return made

@@ -72,21 +72,20 @@ def data_lines(text, path=""):
     TraceError of path's."""
     number, position, end = 0, 0, len(text)
     while position < end:
-        cut = _LINE_BREAK.search(text, position)
-        line_end = cut.start() if cut else end
+        reach = min(end, position + MAX_LINE + 2)  # (a search that never looks past a line's bound)
+        cut = _LINE_BREAK.search(text, position, reach)
         number += 1
-        if line_end - position > MAX_LINE:
-            raise TraceError(path, number, 0, line_too_long(line_end - position))
-        line, position = (text[position:line_end], cut.end()) if cut else (text[position:], end)
+        if cut is None and reach < end or (cut and cut.start() - position > MAX_LINE):
+            raise TraceError(path, number, 0, line_too_long())
+        line, position = (text[position : cut.start()], cut.end()) if cut else (text[position:], end)
         if line.strip() and not line.lstrip().startswith("#"):
             yield number, line
 
 
-def line_too_long(length) -> str:
-    return (
-        f"a line of {length:,} characters: more than the bound of {MAX_LINE:,} characters "
-        "(so many columns, or no line ends?)"
-    )
+def line_too_long(length: int | None = None) -> str:
+    """Why a line is refused: longer than MAX_LINE (its length, where it is known)."""
+    what = f"a line of {length:,} characters: more than" if length else "a line longer than"
+    return f"{what} the bound of {MAX_LINE:,} characters (so many columns, or no line ends?)"
 
 
 def counts_outside_quotes(line, characters):
