@@ -5,7 +5,8 @@
   fmutrace check FMU... [--role smoke-test|validation] [--report DIR] ...
 
 Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
-simulation, 2 bad input, 130 interrupted); compare's is its worst case's.
+simulation, 2 bad input, 130 interrupted, 143 terminated); compare's is its
+worst case's.
 """
 
 import argparse
