@@ -589,3 +589,61 @@ def test_the_same_fmu_given_twice_is_one_fmu(tmp_path):
     assert "2 of 2 cases pass" in done.stdout, done.stdout
     cases = json.loads((tmp_path / "report" / "results.json").read_text())["cases"]
     assert sorted(c["case"] for c in cases) == ["one", "two"]
+
+
+# 7. The corpus: every hostile case of this file in one campaign
+
+
+def test_a_hostile_corpus_runs_with_no_traceback_no_write_outside_and_no_silent_drop(tmp_path):
+    """One campaign over a folder of hostile cases beside a good one, under
+    the memory cap, bound by files' modes: exit 2, no traceback, each bad
+    case named once, every case counted, nothing written outside the report
+    folder (and the temporary folder left as it was)."""
+    cases, shared = tmp_path / "cases", tmp_path / "tmp"
+    shared.mkdir()
+    write_case(cases / "good")
+    hostile = {}
+
+    def case(name, file, make):
+        folder = write_case(cases / name)
+        (folder / file).unlink(missing_ok=True)
+        make(folder / file)
+        hostile[name] = folder / file
+
+    case("huge_ref", "PassThrough_ref.csv", lambda p: sparse(p, 2 * GiB))
+    case("zero_readme", "README.md", lambda p: p.symlink_to("/dev/zero"))
+    case("random_input", "PassThrough_in.csv", lambda p: p.symlink_to("/dev/urandom"))
+    case("fifo_start", "PassThrough_start.csv", os.mkfifo)
+    case("fifo_ref", "PassThrough_ref.csv", os.mkfifo)
+    case("dangling_criteria", "PassThrough_criteria.csv", lambda p: p.symlink_to(tmp_path / "gone"))
+    case("long_opt", "PassThrough_ref.opt", lambda p: p.write_text("x" * 1_000_000))
+    case("underscore_mode", "PassThrough_criteria.csv", lambda p: p.write_text("y,tol:abs=1_0\n"))
+    case("closed_input", "PassThrough_in.csv", lambda p: (p.write_text(INPUT), p.chmod(0)))
+    closed = write_case(cases / "closed_folder")
+    closed.chmod(0)
+    hostile["closed_folder"] = closed
+    report = tmp_path / "report"
+    before = files_and_links(tmp_path)
+    try:
+        done = fmutrace_command(
+            "compare", PASS_THROUGH, cases, "--report", report, env=with_env(TMPDIR=str(shared)), preexec_fn=bounded
+        )
+    finally:
+        closed.chmod(0o755)
+    refused(done)
+    assert f"1 of {len(hostile) + 1} cases pass" in done.stdout, output(done)
+    for name, path in hostile.items():  # its file (the folder's reference) named, once
+        assert str(path) in done.stderr and done.stderr.count(f"{cases / name}{os.sep}") == 1, (name, done.stderr)
+    new = files_and_links(tmp_path) - before
+    outside = sorted(p for p in new if p != report and report not in p.parents)
+    assert not outside, outside
+    assert not list(shared.iterdir())
+
+
+def files_and_links(folder):
+    return {Path(root) / name for root, dirs, names in os.walk(folder) for name in names + dirs}
+
+
+def bounded():
+    capped()
+    modes_binding()
