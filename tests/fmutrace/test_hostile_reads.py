@@ -647,3 +647,13 @@ def files_and_links(folder):
 def bounded():
     capped()
     modes_binding()
+
+
+def test_a_message_quoting_a_huge_name_is_cut(tmp_path):
+    """A criteria file naming a signal of 3,000,000 characters (within the
+    line bound): the message that quotes it is cut to its first 2,000
+    characters and says how long it was (it was 3 MB on one line)."""
+    case = write_case(tmp_path / "cases" / "one")
+    (case / "PassThrough_criteria.csv").write_text("z" * 3_000_000 + ",exact\n")
+    done = fmutrace_command("compare", PASS_THROUGH, tmp_path / "cases", "--jobs", "1")
+    refused(done, "PassThrough_criteria.csv, line 1, column 1: column 'zzzz", "characters, cut)")
