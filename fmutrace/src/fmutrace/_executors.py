@@ -246,9 +246,11 @@ class Dask(Executor):
 def _check_address(address):
     """InputError for a scheduler address Dask cannot take (an unknown
     scheme, a host that does not parse), before any connection."""
-    from distributed.comm.addressing import parse_address, parse_host_port
-    from distributed.comm.registry import get_backend
-
+    try:
+        from distributed.comm.addressing import parse_address, parse_host_port
+        from distributed.comm.registry import get_backend
+    except ImportError:  # (Dask not installed: running on it says so)
+        return
     try:
         scheme, location = parse_address(address)
         get_backend(scheme)
