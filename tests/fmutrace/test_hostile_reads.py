@@ -559,22 +559,33 @@ def test_sigterm_ends_the_command_with_a_line(tmp_path):
     ]
 
 
-def test_a_checks_temporary_cases_go_where_a_killed_commands_files_are_removed(tmp_path, monkeypatch):
-    """check without a report writes its cases into the command's folder of
-    unpacked FMUs, which the next command removes when this one was killed
-    (a killed check left its folder for good)."""
-    from fmutrace import _check, _fmu
-
-    seen = []
-
-    def record(paths, folders, **options):
-        seen.extend(folders)
-        raise fmutrace.InputError("stop here")
-
-    monkeypatch.setattr(_check, "compare", record)
-    with pytest.raises(fmutrace.InputError):
-        fmutrace.check(RATE_LIMITER, role="smoke-test")
-    assert seen and all(Path(_fmu.unpack_root()) in Path(f).parents for f in seen), seen
+def test_a_killed_checks_temporary_cases_are_removed_by_the_next_command(tmp_path):
+    """check without a report, killed (SIGKILL) while its cases run: the
+    next command removes the cases it wrote (a killed check left its
+    temporary folder for good)."""
+    shared = tmp_path / "tmp"
+    shared.mkdir()
+    env = with_env(TMPDIR=str(shared))
+    check = subprocess.Popen(
+        [sys.executable, "-m", "fmutrace", "check", str(RATE_LIMITER), "--role", "validation", "--jobs", "1"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, start_new_session=True,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while not list(shared.glob("*/check-*/*")) and time.monotonic() < deadline:
+            assert check.poll() is None, "the check ended before it was killed"
+            time.sleep(0.02)
+        written = list(shared.glob("*/check-*"))
+        assert written, "no cases written"
+        check.kill()
+        check.wait(timeout=60)
+    finally:
+        kill_session(check)
+    assert written[0].is_dir(), "the killed check's cases are gone already"
+    write_case(tmp_path / "cases" / "one")
+    done = fmutrace_command("compare", PASS_THROUGH, tmp_path / "cases", env=env)
+    refused(done, status=0)
+    assert not list(shared.iterdir()), list(shared.rglob("*"))
 
 
 def test_the_same_fmu_given_twice_is_one_fmu(tmp_path):
