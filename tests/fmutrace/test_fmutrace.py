@@ -450,6 +450,7 @@ def test_report_and_junit_xml_that_a_junit_parser_reads(tmp_path):
     lag_case(tmp_path / "cases" / "lag_off", lambda t, x: x + 0.01 if t >= 1 else x)
     write_case(tmp_path / "cases" / "step", "PassThrough", STEP_REF, DIALECTS["comma"], STEP_OPT)
     report, junit = tmp_path / "report", tmp_path / "ci" / "junit.xml"
+    junit.parent.mkdir()  # (--junit makes no folder: issue 51)
     done = fmutrace_cli(
         "compare",
         LAG[2],

@@ -19,7 +19,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "fmutrace" / "src" / "fmutrace"
 
 # lowest first; a module imports from its own layer or the ones before it
 LAYERS = [
-    ("base", {"fmutrace._errors", "fmutrace._names", "fmutrace._progress", "fmutrace._native"}),
+    ("base", {"fmutrace._errors", "fmutrace._names", "fmutrace._progress", "fmutrace._native", "fmutrace._reading"}),
     ("readers", {"fmutrace._traces", "fmutrace.recordings", "fmutrace.recordings.*"}),
     (
         "model",

@@ -6,6 +6,7 @@ given), run by an executor (executors.py), recorded as they finish (in
 memory, or in the report's journal) and reported at the end.
 """
 
+import os
 import time
 from array import array
 from bisect import bisect_right
@@ -23,9 +24,10 @@ from ._fmu import Fmu
 from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key, fmu_digest
 from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
+from ._reading import read_bytes
 from .recordings import is_recording, recording_paths
 from .recordings._options import RecordingOptions
-from ._report import file_name, write_case_files, write_junit, write_report
+from ._report import file_name, output_problem, write_case_files, write_junit, write_report
 from ._worker import PLOTS, CaseSettings, FmuFile, default_plots
 
 Paths = str | PathLike | Iterable[str | PathLike]  # one path, or several
@@ -96,6 +98,7 @@ def compare(
     if resume and not report:
         raise InputError("resume continues the campaign of a report folder: give the report folder")
     fmu_paths = [fmus] if isinstance(fmus, (str, PathLike)) else list(fmus)
+    fmu_paths = list({os.path.realpath(p): p for p in reversed(fmu_paths)}.values())[::-1]  # one FMU given twice: once
     case_paths = [cases] if isinstance(cases, (str, PathLike)) else list(cases)
     if not fmu_paths or not case_paths:
         raise InputError("give at least one FMU and one case folder")
@@ -113,7 +116,7 @@ def compare(
     plots = ((None if png else plots) or default_plots(len(cases_of))) if report else "none"
     folders = _report_folders(loaded)
     work = Work(
-        fmu_bytes={f.path: f.path.read_bytes() for f in loaded},
+        fmu_bytes={f.path: read_bytes(f.path) for f in loaded},
         fmus={
             f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]})
             for f in loaded
@@ -125,6 +128,8 @@ def compare(
     started = time.perf_counter()
     lock = ReportLock(report) if report else None
     try:  # the report folder stays locked until its last file is written
+        if junit and output_problem(junit):  # (checked once the report folder is made: it may hold the file)
+            raise InputError(output_problem(junit))
         outcomes, counts, where = _run(cases_of, work, executor, (report, key, resume), progress)
         kept = (
             JournaledOutcomes(

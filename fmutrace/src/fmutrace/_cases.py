@@ -28,6 +28,7 @@ import numpy as np
 from ._comparison import Comparison, Mode, compare_traces, criteria_for, parse_mode
 from ._errors import InputError, TraceError
 from ._fmu import Fmu
+from ._reading import absent, quoted
 from ._traces import data_lines, parse_number, read_text, read_trace, split_cells, steps_problem
 
 OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
@@ -59,16 +60,16 @@ class Case:
 
 def read_options(path, text, reference, fmu):
     options = {"RelTol": 1e-6}
-    for number, line in data_lines(text or ""):
+    for number, line in data_lines(text or "", path):
         cells = split_cells(line, ",")
         if len(cells) != 2:
-            raise TraceError(path, number, 1, f"expected 'Name,value', found {line.strip()!r}")
+            raise TraceError(path, number, 1, f"expected 'Name,value', found {quoted(line.strip())}")
         key, literal = cells
         if key not in OPTIONS:
-            raise TraceError(path, number, 1, f"unknown option {key!r} (known: {', '.join(OPTIONS)})")
+            raise TraceError(path, number, 1, f"unknown option {quoted(key)} (known: {', '.join(OPTIONS)})")
         value = parse_number(literal)
         if value is None or not math.isfinite(value):
-            raise TraceError(path, number, 2, f"{key} {literal!r} is not a finite number")
+            raise TraceError(path, number, 2, f"{key} {quoted(literal)} is not a finite number")
         options[key] = value
     options.setdefault("StartTime", float(reference["time"][0]))
     options.setdefault("StopTime", float(reference["time"][-1]))
@@ -95,13 +96,13 @@ def read_start_values(path, text, fmu):
     """The start values of a "name,value" file, each checked against the
     FMU's variable (type, range)."""
     values = {}
-    for number, line in data_lines(text or ""):
+    for number, line in data_lines(text or "", path):
         cells = split_cells(line, "," if line.count(",") else ";")
         if len(cells) != 2:
-            raise TraceError(path, number, 1, f"expected 'name,value', found {line.strip()!r}")
+            raise TraceError(path, number, 1, f"expected 'name,value', found {quoted(line.strip())}")
         name, literal = cells
         if name not in fmu.variables:
-            raise TraceError(path, number, 1, f"{name!r} is not a variable of {fmu.label}")
+            raise TraceError(path, number, 1, f"{quoted(name)} is not a variable of {fmu.label}")
         try:
             values[name] = fmu.start_value(name, literal)
         except InputError as error:
@@ -113,11 +114,11 @@ def read_criteria(path, text, fmu) -> tuple:
     """The per-signal criteria of a "signal,mode" file, ((pattern, Mode), ...):
     a name without a pattern's characters must be a variable of the FMU."""
     pairs = []
-    for number, line in data_lines(text or ""):
+    for number, line in data_lines(text or "", path):
         signal, sep, words = line.partition(",")
         signal = signal.strip().strip('"')
         if not sep or not signal:
-            raise TraceError(path, number, 1, f"expected 'signal,mode', found {line.strip()!r}")
+            raise TraceError(path, number, 1, f"expected 'signal,mode', found {quoted(line.strip())}")
         if not any(c in signal for c in "*?[") and fmu.variable_problem(signal):
             raise TraceError(path, number, 1, fmu.variable_problem(signal))
         try:
@@ -129,7 +130,9 @@ def read_criteria(path, text, fmu) -> tuple:
 
 def case_texts(folder, model):
     """{file name: text} of the case's files that exist (what a worker
-    without this file system needs)."""
+    without this file system needs); a TraceError for one that is there
+    and cannot be read (a dangling link, a FIFO, no permission): never
+    taken as absent."""
     texts = {}
     for suffix in FILES:
         name = suffix if suffix == "README.md" else f"{model}{suffix}"
@@ -137,7 +140,7 @@ def case_texts(folder, model):
         try:
             texts[name] = read_text(path)
         except TraceError:
-            if os.path.exists(path):  # there but unreadable: say so
+            if not absent(path):
                 raise
     return texts
 
@@ -280,7 +283,9 @@ def _walk(folder, relative, file_name, seen):
     others, not with the cases (and with those whose identity _LEAF does
     not hold: a 128-bit inode, a negative device). Depth first, holding the names of one
     folder's subfolders per level: memory grows with the depth and the
-    widest folder's names, not with the whole tree."""
+    widest folder's names, not with the whole tree. A folder that cannot
+    be searched, and a file_name that is no regular file (a FIFO, a device,
+    a dangling link), is a case too: its reading makes it invalid, counted."""
     try:
         status = os.stat(folder)
         identity = (status.st_dev << 64) | status.st_ino
@@ -288,13 +293,14 @@ def _walk(folder, relative, file_name, seen):
             return
         with os.scandir(folder) as entries:
             subfolders = sorted(e.name for e in entries if e.name != file_name and _is_folder(e))
-    except OSError:
+    except OSError:  # a folder that cannot be searched (no permission) may hold a case: one, whose reading says why
+        yield relative, (0, 0)
         return
     leaf = (status.st_dev, status.st_ino)
     if subfolders or not (0 <= leaf[0] < 1 << 64 and 0 < leaf[1] < 1 << 64):  # (_LEAF's range; else remembered)
         seen.add(identity)
         leaf = (0, 0)
-    if os.path.isfile(os.path.join(folder, file_name)):
+    if os.path.lexists(os.path.join(folder, file_name)):  # (a FIFO, a dangling link: a case, invalid when read)
         yield relative, leaf
     for name in subfolders:
         yield from _walk(os.path.join(folder, name), f"{relative}/{name}" if relative else name, file_name, seen)

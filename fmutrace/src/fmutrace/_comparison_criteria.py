@@ -13,6 +13,7 @@ from ._comparison_modes import ARITHMETIC_TYPES, EXACT, TIME_MATCH, Exact, Mode,
 from ._comparison_tube import Tube
 from ._errors import InputError
 from ._names import Names, name_of
+from ._traces import plain_float
 
 
 @dataclass(frozen=True)
@@ -155,7 +156,7 @@ def parse_mode(text: str) -> Mode:
             if not sep or key not in allowed or key in given:
                 raise InputError(f"mode {text!r}: expected {kind}:{','.join(k + '=...' for k in allowed)}")
             try:
-                given[key] = int(value) if key in whole else float(value)
+                given[key] = int(value) if key in whole else plain_float(value.strip())
             except ValueError:
                 raise InputError(f"mode {text!r}: {key} {value.strip()!r} is not a number") from None
             if not (given[key] >= 0 and math.isfinite(given[key])):

@@ -71,8 +71,8 @@ class RunOptions:
             raise InputError(f"jobs must be a whole number of at least 1, or None, not {self.jobs!r}")
         for name in ("case_timeout", "cluster_timeout"):
             value = getattr(self, name)
-            if value is not None and not value >= 0:
-                raise InputError(f"{name} must be >= 0 seconds, or None, not {value!r}")
+            if value is not None and not value > 0:  # (0 would stop every case at once)
+                raise InputError(f"{name} must be more than 0 seconds, or None, not {value!r}")
 
 
 @dataclass(frozen=True)
@@ -160,6 +160,7 @@ class Dask(Executor):
 
     def __init__(self, options: RunOptions):
         assert options.scheduler is not None
+        _check_address(options.scheduler)
         self.scheduler, self.shared_files, self.cluster_timeout = (
             options.scheduler,
             options.shared_files,
@@ -251,6 +252,25 @@ class Dask(Executor):
             del outcomes
             submit_next()
         return workers
+
+
+def _check_address(address):
+    """InputError for a scheduler address Dask cannot take (an unknown
+    scheme, a host that does not parse), before any connection."""
+    try:
+        from distributed.comm.addressing import parse_address, parse_host_port
+        from distributed.comm.registry import get_backend
+    except ImportError:  # (Dask not installed: running on it says so)
+        return
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as error:
+        raise InputError(
+            f"scheduler {address!r}: not the address of a Dask scheduler ({error}); such as tcp://host:8786"
+        ) from None
 
 
 def executor_for(options: RunOptions) -> Executor:

@@ -18,7 +18,8 @@ from pathlib import Path
 import fmpy
 from fmpy import extract, read_model_description
 
-from ._errors import InputError
+from ._errors import InputError, TraceError
+from ._reading import check_entries, open_regular, read_limit, too_large
 from ._traces import BOOLEAN_WORDS, plain_float
 
 INTEGER_RANGES = {
@@ -45,8 +46,9 @@ class Fmu:
         (a worker has it from the unpacked FMU)."""
         self.path = Path(path)
         if model_description is None:
-            if not self.path.is_file():
+            if not os.path.lexists(self.path):
                 raise InputError(f"{path}: no such FMU file")
+            _check_size(path)
             try:
                 model_description = read_model_description(str(self.path))
             except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
@@ -175,6 +177,21 @@ class Fmu:
             raise InputError(f"{variable.name} = {text} is outside its range {bounds}")
 
 
+def _check_size(path):
+    """InputError for an FMU file that is no regular file, is larger than
+    the read bound, or whose model description inflates to more (_reading):
+    checked before fmpy reads it."""
+    with open_regular(path) as file:
+        size = os.fstat(file.fileno()).st_size
+        if size > read_limit():
+            raise TraceError(path, 0, 0, too_large(size))
+        try:
+            with zipfile.ZipFile(file) as archive:
+                check_entries(archive, path, {"modelDescription.xml"})
+        except (OSError, zipfile.BadZipFile, EOFError) as error:
+            raise InputError(f"{path}: not an FMU ({error})") from None
+
+
 def _float(value):
     if value is None or value == "":
         return None
@@ -260,8 +277,13 @@ def unpacked(fmu_bytes):
         folder = tempfile.mkdtemp(prefix="fmu-", dir=unpack_root())
         atexit.register(_remove, folder, os.getpid())
         try:
+            with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as archive:
+                check_entries(archive, "the FMU", [n for n in archive.namelist() if _runs_with(n)])
             extract(io.BytesIO(fmu_bytes), unzipdir=folder, include=_runs_with)
             known = (folder, read_model_description(folder), os.getpid())
+        except InputError:
+            _remove(folder, os.getpid())
+            raise
         except Exception as error:  # fmpy raises plain Exceptions for a bad zip or XML
             _remove(folder, os.getpid())
             raise InputError(f"the FMU cannot be unpacked ({error})") from None

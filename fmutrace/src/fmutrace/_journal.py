@@ -17,6 +17,7 @@ import os
 import re
 import sys
 from pathlib import Path
+from typing import ClassVar
 
 from ._comparison import Mode
 from ._errors import InputError
@@ -56,9 +57,15 @@ class ReportLock:
     holds it, however it ends. The holder's pid is written after the
     locked byte (Windows refuses a read of a byte another process locked)."""
 
+    _held: ClassVar[dict[str, "ReportLock"]] = {}  # real path -> this process's lock on that folder
+
     def __init__(self, folder):
         self.folder = Path(folder)
         self.path = self.folder / LOCK
+        self.key = os.path.realpath(self.folder)
+        if self.key in ReportLock._held:  # held by this process already (check, then its compare): one lock
+            self.file = None
+            return
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             self.file = open(self.path, "a+")
@@ -80,9 +87,11 @@ class ReportLock:
         self.file.truncate()
         self.file.write(f" pid {os.getpid()}\n")
         self.file.flush()
+        ReportLock._held[self.key] = self
 
     def release(self):
-        if not self.file.closed:
+        if self.file is not None and not self.file.closed:
+            ReportLock._held.pop(self.key, None)
             self.file.seek(1)
             self.file.truncate()
             _unlock(self.file)

@@ -21,6 +21,8 @@ from pathlib import Path
 from xml.etree import ElementTree
 
 from ._errors import InputError
+from ._reading import check_entries, quoted
+from ._traces import UNUSUAL_LINE_BREAKS
 from ._report import file_name
 
 FOLDER = "extra/org.fmi-standard.fmi-ls-ref/"
@@ -53,7 +55,7 @@ class Experiment:
 def manifest(fmu_zip: zipfile.ZipFile, label: str) -> list[Related]:
     """The manifest's related files; InputError if there is none or it is not one."""
     try:
-        root = ElementTree.fromstring(fmu_zip.read(MANIFEST))
+        root = ElementTree.fromstring(bounded_read(fmu_zip, label, MANIFEST))
     except KeyError:
         raise InputError(
             f"{label} carries no FMI-LS-REF experiments (no {MANIFEST}): give case folders after it"
@@ -74,7 +76,8 @@ def manifest(fmu_zip: zipfile.ZipFile, label: str) -> list[Related]:
             for entry in annotation.iterfind(f"{NS}File"):
                 related.sha256 = entry.get("sha256")
             related.criteria += [
-                (c.get("signal", ""), c.get("mode", "")) for c in annotation.iterfind(f"{NS}Criterion")
+                tuple(one_line(label, MANIFEST, f"a criterion's {key}", c.get(key, "")) for key in ("signal", "mode"))
+                for c in annotation.iterfind(f"{NS}Criterion")
             ]
         found.append(related)
     return found
@@ -94,7 +97,7 @@ def _inside(label, base, source):
 def checked(fmu_zip, label, path, digests):
     """A file's bytes, its SHA-256 checked where the manifest gives one."""
     try:
-        data = fmu_zip.read(path)
+        data = bounded_read(fmu_zip, label, path)
     except KeyError:
         raise InputError(f"{label}: {path}: named by the manifest or an experiment, and not in the FMU") from None
     expected = digests.get(path)
@@ -103,6 +106,21 @@ def checked(fmu_zip, label, path, digests):
             f"{label}: {path}: its SHA-256 is not the manifest's: the file was changed after the FMU was made"
         )
     return data
+
+
+def bounded_read(fmu_zip, label, path) -> bytes:
+    """An entry's bytes, refused before it is inflated when it would inflate
+    to more than the read bound (a zip bomb); KeyError if there is none."""
+    check_entries(fmu_zip, label, {fmu_zip.getinfo(path).filename})
+    return fmu_zip.read(path)
+
+
+def one_line(label, path, what, text: str) -> str:
+    """text, which becomes a line's cell of a case file: InputError if it
+    holds a line break (it would add a line of its own making)."""
+    if any(c in text for c in "\r\n" + UNUSUAL_LINE_BREAKS):
+        raise InputError(f"{label}: {path}: {what} {quoted(text)} holds a line break")
+    return text
 
 
 def wanted(role: str, chosen: str | None) -> bool:
@@ -147,7 +165,11 @@ def experiments(fmu_zip, label, role: str | None = None):
                     files[key] = _inside(label, base, child.get("source"))
             if "references" not in files:
                 raise InputError(f"{label}: {related.source}: experiment {name!r} has no References")
-            options = {key: element.get(attr) for attr, key in OPTIONS if element.get(attr) is not None}
+            options = {
+                key: one_line(label, related.source, f"experiment {quoted(name)}'s {attr}", element.get(attr, ""))
+                for attr, key in OPTIONS
+                if element.get(attr) is not None
+            }
             identity = (name, tuple(options.items()), tuple(sorted(files.items())))
             if identity in seen:  # the smoke test's experiments are the validation's too
                 continue
@@ -182,7 +204,8 @@ def parameter_lines(label, path, data):
         if value is None or value.get("value") is None:
             raise InputError(f"{label}: {path}: parameter {parameter.get('name')!r} has no value")
         literal = value.get("value", "")
-        rows.append(f"{parameter.get('name')},{XSD_WORDS.get(literal, literal)}\n")
+        name = one_line(label, path, "a parameter's name", parameter.get("name") or "")
+        rows.append(f"{name},{one_line(label, path, f'the value of {name}', XSD_WORDS.get(literal, literal))}\n")
     return "".join(rows)
 
 

@@ -39,6 +39,7 @@ from ._fmpy import Experiment, Signals
 from ._outcome import CaseOutcome, Status
 from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, as_script, draw, needs_tiles, page_data, page_tile
 from ._progress import SampleProgress
+from ._reading import absent
 from ._runner import STEPS_PER_CHUNK
 from ._traces import CHUNK_BYTES, NotPlain, TraceWriter, last_time, read_text, trace_chunks
 
@@ -135,12 +136,18 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
     else:
         ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
         try:
-            present = set(os.listdir(folder))  # (one look at the folder, not one per file)
+            listed = set(os.listdir(folder))  # (one look at the folder, not one per file)
         except OSError:
-            present = set()
+            listed = None
+
+        def present(file_name):  # (a name listed is there, read or not: a dangling link, a FIFO)
+            if listed is None or os.path.basename(file_name) != file_name:  # (a model's name may hold a '/')
+                return not absent(folder / file_name)
+            return file_name in listed
+
         texts = {}  # the small files' texts (the reference and the inputs are read in chunks)
         for file_name in (f"{model}_ref.opt", f"{model}_start.csv", f"{model}_criteria.csv", "README.md"):
-            if file_name in present:
+            if present(file_name):
                 texts[file_name] = read_text(folder / file_name)
         ref_chunks = trace_chunks(ref_path, fmu.variable_problem, chunk_bytes=streaming.chunk_bytes)
         try:
@@ -159,7 +166,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
         criteria = read_criteria(folder / f"{model}_criteria.csv", texts.get(f"{model}_criteria.csv"), fmu)
         input_names, table = (), None
-        if in_path.exists():
+        if present(f"{model}_in.csv"):
             in_chunks = trace_chunks(in_path, fmu.input_problem, chunk_bytes=streaming.chunk_bytes)
             first_in = next(in_chunks, None)
             if first_in is None:

@@ -126,6 +126,24 @@ def _replaced(path):
             new.unlink()
 
 
+def output_problem(path) -> str | None:
+    """Why a file the user names as an output cannot be written (None if it
+    can): its folder must be there (none is made)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        return f"{path}: no folder {folder} to write it into"
+    return None
+
+
+def _output(path):
+    """A file the user named, to write: a regular file (or a new one) is
+    replaced whole (_replaced); a link, a device or a FIFO is written into
+    as it is (the file the link leads to, the device), never replaced."""
+    if os.path.islink(path) or (os.path.exists(path) and not os.path.isfile(path)):
+        return open(path, "w", encoding="utf-8")
+    return _replaced(path)
+
+
 def _results_json_head(campaign: CampaignResult) -> str:
     """results.json up to its first case (its cases follow, a line each, as write_report reads them)."""
     head = {
@@ -151,7 +169,6 @@ def _shown_entry(entry):
 def write_junit(campaign: CampaignResult, path):
     """JUnit XML: a test suite per FMU, a test case per case; a suite's
     totals first (one pass over the cases), then its cases (one pass per FMU)."""
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
     counts = campaign.counts()
     suites: dict[str, list] = {}  # fmu -> [tests, failures, errors, seconds]
     for o in campaign.cases.light():
@@ -160,7 +177,7 @@ def write_junit(campaign: CampaignResult, path):
         totals[1] += o.status == Status.FAIL
         totals[2] += o.status in (Status.ERROR, Status.INVALID)
         totals[3] += o.seconds
-    with _replaced(path) as out:
+    with _output(path) as out:
         out.write("<?xml version='1.0' encoding='utf-8'?>\n")
         out.write(
             f'<testsuites name="fmutrace" tests="{len(campaign.cases)}" failures="{counts[Status.FAIL]}" '

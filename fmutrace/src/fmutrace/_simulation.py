@@ -18,6 +18,7 @@ from ._errors import InputError
 from ._fmpy import Experiment, Signals
 from ._fmu import Fmu
 from ._progress import SampleProgress
+from ._reading import read_bytes
 from ._runner import STEPS_PER_CHUNK, Runner
 from ._traces import CHUNK_BYTES, NotPlain, last_time, read_trace, steps_problem, trace_chunks
 
@@ -101,7 +102,7 @@ def simulate_chunks(
     experiment, signals = resolved(fmu, options, span)
     interval = options.output_interval
     every_nth(np.empty(0, dtype=[("time", np.float64)]), experiment.start, experiment.step, interval)  # checked now
-    runner = Runner(fmu.path.read_bytes())  # its own loop where it gives fmpy's result, else fmpy's
+    runner = Runner(read_bytes(fmu.path))  # its own loop where it gives fmpy's result, else fmpy's
     bar = SampleProgress(round((experiment.stop - experiment.start) / experiment.step) + 1) if progress else None
     made = 0
     try:

@@ -36,6 +36,7 @@ import pyarrow.csv as pcsv
 
 from ._errors import TraceError
 from ._native import native_function
+from ._reading import MAX_LINE, open_regular, quoted, read_bytes
 
 TIME_NAMES = ("time", "t", "Time")
 UNUSUAL_LINE_BREAKS = "\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
@@ -44,14 +45,13 @@ BOOLEAN_WORDS = {"true": 1.0, "false": 0.0}
 
 
 def read_text(path):
-    """A file's text; a TraceError if it cannot be read or is not UTF-8."""
+    """A file's text, within the read bound (_reading); a TraceError if it
+    cannot be read, is no regular file, is larger, or is not UTF-8."""
+    data = read_bytes(path)
     try:
-        with open(path, encoding="utf-8-sig") as file:
-            return file.read()
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         raise TraceError(path, 0, 0, f"not UTF-8 text ({error.reason} at byte {error.start})") from None
-    except OSError as error:
-        raise TraceError(path, 0, 0, error.strerror or str(error)) from None
 
 
 def shown(text) -> str:
@@ -65,17 +65,27 @@ def shown(text) -> str:
         return text.encode("utf-8", "replace").decode("utf-8")
 
 
-def data_lines(text):
+def data_lines(text, path=""):
     """(line number, text) of the lines that hold data or the header, split
     as str.splitlines() splits them, one at a time (a reader that needs only
-    the header does not split the rest)."""
+    the header does not split the rest); a line longer than MAX_LINE is a
+    TraceError of path's."""
     number, position, end = 0, 0, len(text)
     while position < end:
-        cut = _LINE_BREAK.search(text, position)
-        line, position = (text[position : cut.start()], cut.end()) if cut else (text[position:], end)
+        reach = min(end, position + MAX_LINE + 2)  # (a search that never looks past a line's bound)
+        cut = _LINE_BREAK.search(text, position, reach)
         number += 1
+        if cut is None and reach < end or (cut and cut.start() - position > MAX_LINE):
+            raise TraceError(path, number, 0, line_too_long())
+        line, position = (text[position : cut.start()], cut.end()) if cut else (text[position:], end)
         if line.strip() and not line.lstrip().startswith("#"):
             yield number, line
+
+
+def line_too_long(length: int | None = None) -> str:
+    """Why a line is refused: longer than MAX_LINE (its length, where it is known)."""
+    what = f"a line of {length:,} characters: more than" if length else "a line longer than"
+    return f"{what} the bound of {MAX_LINE:,} characters (so many columns, or no line ends?)"
 
 
 def counts_outside_quotes(line, characters):
@@ -165,7 +175,7 @@ def read_trace(
     that is not allowed is a TraceError at its place in the header.
     """
     text = read_text(path) if text is None else text.removeprefix("\ufeff")
-    lines = data_lines(text)
+    lines = data_lines(text, path)
     try:
         header_line, header = next(lines)
     except StopIteration:
@@ -179,17 +189,21 @@ def read_trace(
             header_line,
             1,
             f"no time column: one of the columns must be named "
-            f"{', '.join(TIME_NAMES[:-1])} or {TIME_NAMES[-1]} (found {names[0]!r})",
+            f"{', '.join(TIME_NAMES[:-1])} or {TIME_NAMES[-1]} (found {quoted(names[0])})",
         )
     if len(time_columns) > 1:
-        raise TraceError(path, header_line, time_columns[1] + 1, f"a second time column {names[time_columns[1]]!r}")
+        raise TraceError(
+            path, header_line, time_columns[1] + 1, f"a second time column {quoted(names[time_columns[1]])}"
+        )
     time_index = time_columns[0]
     seen: dict[str, int] = {}
     for i, name in enumerate(names):
         if not name:
             raise TraceError(path, header_line, i + 1, "a column without a name")
         if name in seen:
-            raise TraceError(path, header_line, i + 1, f"column {name!r} again (first in column {seen[name] + 1})")
+            raise TraceError(
+                path, header_line, i + 1, f"column {quoted(name)} again (first in column {seen[name] + 1})"
+            )
         seen[name] = i
         if i != time_index and known is not None:
             problem = known(name)
@@ -269,13 +283,13 @@ def _read_rows(path, lines, header: _Header, separator):
                     path,
                     number,
                     i + 1,
-                    f"{cells[i]!r} in column {names[i]!r} is not a number"
+                    f"{quoted(cells[i])} in column {quoted(names[i])} is not a number"
                     if cells[i]
-                    else f"an empty cell in column {names[i]!r}",
+                    else f"an empty cell in column {quoted(names[i])}",
                 )
             row.append(value)
         if not math.isfinite(row[0]):
-            raise TraceError(path, number, time_index + 1, f"time {cells[time_index]!r} is not a finite number")
+            raise TraceError(path, number, time_index + 1, f"time {quoted(cells[time_index])} is not a finite number")
         if row[0] < previous_time:
             raise TraceError(
                 path, number, time_index + 1, f"time goes backwards: {cells[time_index]} after {previous_time!r}"
@@ -322,8 +336,8 @@ def trace_chunks(
     shows, and read_trace reads or explains it. Both readers convert a
     number correctly rounded: the same bits (a test checks it)."""
     try:
-        file = open(path, "rb")  # (closed below, however the chunks end)
-    except OSError as error:
+        file = open_regular(path)  # (closed below, however the chunks end)
+    except TraceError as error:
         raise NotPlain(str(error)) from None
     with file:
         yield from _plain_chunks(file, known, chunk_bytes)
@@ -332,10 +346,10 @@ def trace_chunks(
 def _plain_chunks(file, known, chunk_bytes) -> Iterator[np.ndarray]:
     """trace_chunks' work on the open file (one opening for the header and the blocks)."""
     try:
-        header = file.readline().decode("utf-8-sig")
+        header = file.readline(MAX_LINE + 1).decode("utf-8-sig")
     except (OSError, UnicodeDecodeError) as error:
         raise NotPlain(str(error)) from None
-    if _separator(header) != "," or header.lstrip().startswith("#"):
+    if len(header) > MAX_LINE or _separator(header) != "," or header.lstrip().startswith("#"):
         raise NotPlain("not the plain dialect")
     names = split_cells(header, ",")
     times = [i for i, n in enumerate(names) if n in TIME_NAMES]
@@ -440,6 +454,8 @@ def last_time(path):
         end = file.seek(0, os.SEEK_END)
         size = 4096
         while True:
+            if size > 4 * MAX_LINE:
+                raise ValueError(line_too_long(size))
             begin = max(0, end - size)
             file.seek(begin)
             text = file.read(end - begin).rstrip()
@@ -459,6 +475,8 @@ def _line_blocks(file, size):
         data = rest + data
         cut = data.rfind(b"\n") + 1
         if cut == 0:
+            if len(data) > max(size, 4 * MAX_LINE):
+                raise NotPlain(line_too_long(len(data)))
             rest = data
             continue
         block, rest = data[:cut], data[cut:]

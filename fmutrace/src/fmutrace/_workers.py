@@ -48,6 +48,7 @@ from multiprocessing import Pipe
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
+from ._errors import InputError
 from ._fmu import UNPACK_ROOT, unpack_root
 from ._outcome import CaseOutcome, Status
 from ._plot import load_plotting
@@ -162,6 +163,8 @@ def _start_worker(settings: CaseSettings, others: list[_Worker]) -> _Worker:
                 os.dup2(said.fileno(), 2)
                 _serve(there, settings)
                 code = 0
+            except BaseException as error:  # (os._exit prints no traceback: its reason is its last words)
+                os.write(2, f"{type(error).__name__}: {error}\n".encode(errors="replace"))
             finally:
                 os._exit(code)
         there.close()
@@ -240,8 +243,12 @@ def _serve(parent: Connection, settings: CaseSettings):
         path, data, fmu, items = message
         if data is not None:
             fmus[path] = data
-        for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
-            parent.send_bytes(pickle.dumps(outcome))
+        try:
+            for outcome in run_cases(items, fmus[path], fmu, settings, on_start=started):
+                parent.send_bytes(pickle.dumps(outcome))
+        except InputError as error:  # the FMU's, not a case's (it cannot be unpacked): the campaign's to raise
+            parent.send_bytes(pickle.dumps(InputError(str(error))))  # (a TraceError's pickle would not load)
+            return
 
 
 def _die_with_parent():
@@ -493,7 +500,9 @@ class Pool:
                 if self.start_up is None:
                     self.start_up = worker.running_since - worker.started
                 continue
-            outcome: CaseOutcome = pickle.loads(record)
+            outcome = pickle.loads(record)
+            if isinstance(outcome, InputError):  # no case of the FMU can run: said once, as in this process
+                raise outcome
             i = worker.batch.popleft()[0]
             worker.running_since = None if self.announced else time.monotonic()  # (the next one's start)
             measure = self.measured[worker.first_case]

@@ -5,13 +5,16 @@
   fmutrace check FMU... [--role smoke-test|validation] [--report DIR] ...
 
 Exit status: errors.ExitStatus (0 success, 1 a difference or a failed
-simulation, 2 bad input, 130 interrupted); compare's is its worst case's.
+simulation, 2 bad input, 130 interrupted, 143 terminated); compare's is its
+worst case's.
 """
 
 import argparse
 import contextlib
 import os
+import signal
 import sys
+import threading
 from functools import partial
 
 from . import __version__
@@ -24,6 +27,7 @@ from ._fmu import Fmu, is_fmu_file
 from ._lsref import ROLES
 from ._simulation import SimulationOptions, simulate_chunks
 from ._outcome import Status, ran_again
+from ._reading import READ_LIMIT_VARIABLE
 from ._report import text
 from .recordings import is_recording
 from .recordings._align import CYCLE_LENGTHS, TIMINGS
@@ -193,14 +197,14 @@ def _compare_arguments(command):
     )
     where.add_argument(
         "--case-timeout",
-        type=_non_negative,
+        type=_positive,
         metavar="S",
         help="seconds a case may run: one over it is stopped and reported (--jobs 1 then runs in one worker process)",
     )
-    where.add_argument("--timeout", dest="case_timeout", type=_non_negative, help=argparse.SUPPRESS)  # its old name
+    where.add_argument("--timeout", dest="case_timeout", type=_positive, help=argparse.SUPPRESS)  # its old name
     where.add_argument(
         "--cluster-timeout",
-        type=_non_negative,
+        type=_positive,
         metavar="S",
         help="seconds to wait for the Dask cluster's results (default: no bound)",
     )
@@ -416,6 +420,8 @@ def _the_rest(count, report):
 def main(argv=None, out=None):
     out = out or sys.stdout
     args = parser().parse_args(argv)
+    main_thread = threading.current_thread() is threading.main_thread()  # (only it may set a handler)
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:
         return (run_command if args.command == "run" else compare_command)(args, out)
     except InputError as error:
@@ -428,11 +434,27 @@ def main(argv=None, out=None):
         where = f"{text(error.filename)}: " if error.filename else ""
         print(f"fmutrace: error: {where}{error.strerror or error}", file=sys.stderr)
         return ExitStatus.BAD_INPUT
-    except KeyboardInterrupt:
+    except MemoryError:  # (the read bound keeps a file from it; the bound raised, or the work's own size)
+        print(f"fmutrace: error: out of memory; {READ_LIMIT_VARIABLE}, if raised, bounds the files read whole",
+              file=sys.stderr)  # fmt: skip
+        return ExitStatus.BAD_INPUT
+    except KeyboardInterrupt as stop:
         journal = getattr(args, "report", None)
         hint = f"; the finished cases are in {journal}: --resume continues" if journal else ""
-        print(f"fmutrace: interrupted{hint}", file=sys.stderr)
-        return ExitStatus.INTERRUPTED
+        print(f"fmutrace: {'terminated (SIGTERM)' if isinstance(stop, Terminated) else 'interrupted'}{hint}",
+              file=sys.stderr)  # fmt: skip
+        return ExitStatus.TERMINATED if isinstance(stop, Terminated) else ExitStatus.INTERRUPTED
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM: the command ends as Ctrl-C ends it (its clean-up, a line), with its own status."""
+
+
+def _terminate(signum, frame):
+    raise Terminated
 
 
 if __name__ == "__main__":

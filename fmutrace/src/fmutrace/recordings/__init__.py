@@ -19,6 +19,7 @@ from collections import Counter
 from pathlib import Path
 
 from .._errors import InputError, TraceError
+from .._reading import open_regular
 from . import _mdf as mdf, _tables as tables, _text as texts, _twincat as twincat, _vendors as vendors
 from ._matching import Plan, last_component, plan
 from ._model import Channel, Recording
@@ -50,11 +51,11 @@ __all__ = [
 
 def read_file(path):
     """The Recording of one exported file."""
-    try:
-        with open(path, "rb") as file:
+    with open_regular(path) as file:  # (a FIFO or a device refused before a byte is read)
+        try:
             head = file.read(64)
-    except OSError as error:
-        raise TraceError(path, 0, 0, error.strerror or str(error)) from None
+        except OSError as error:
+            raise TraceError(path, 0, 0, error.strerror or str(error)) from None
     if mdf.sniff(head) is None:
         return mdf.read(path)
     text = texts.read(path)
@@ -105,11 +106,16 @@ def read_recording(paths):
 
 def is_recording(path):
     """Whether a path given to compare is a recording (a file, or a folder
-    without cases of the cross-check layout: no *_ref.csv in it)."""
+    without cases of the cross-check layout: no *_ref.csv in it); a FIFO or
+    a device is one too, refused by its kind as it is read."""
     path = os.fspath(path)
-    if os.path.isfile(path) or (os.pathsep in path and all(os.path.isfile(p) for p in path.split(os.pathsep))):
+    if os.path.exists(path) and not os.path.isdir(path):
+        return True
+    if os.pathsep in path and all(os.path.isfile(p) for p in path.split(os.pathsep)):
         return True
     if os.path.isdir(path):
+        if not os.access(path, os.R_OK | os.X_OK):  # (not searched: a case folder, whose reading says why)
+            return False
         seen = set()  # folders by identity: linked folders are searched (as find_cases does), a link loop ends
         for folder, subfolders, names in os.walk(path, followlinks=True):
             status = os.stat(folder)
@@ -178,9 +184,9 @@ def _unique(items):
 
 def _is_single_point(path):
     try:
-        with open(path, "rb") as file:
+        with open_regular(path) as file:
             head = file.read(4096)
-    except OSError:
+    except (OSError, InputError):
         return False
     try:
         decoded, _ = texts.decode(path, head)

@@ -34,7 +34,8 @@ import pyarrow as pa
 import pyarrow.csv as pcsv
 
 from .._errors import TraceError
-from .._traces import UNUSUAL_LINE_BREAKS, NotPlain, float64_values
+from .._reading import MAX_LINE, open_regular
+from .._traces import UNUSUAL_LINE_BREAKS, NotPlain, float64_values, line_too_long
 from . import TEXT_FORMATS, _mdf as mdf, _tables as tables
 from . import _grid as grids
 from . import _text as texts
@@ -52,7 +53,7 @@ class Table:
 
     def __init__(self, path, fmu, options):
         self.path = str(path)
-        with open(path, "rb") as file:
+        with open_regular(path) as file:
             head = file.read(HEAD_BYTES)
             at_end = not file.read(1)
         if mdf.sniff(head[:64]) is None:
@@ -94,13 +95,15 @@ class Table:
         columns are only split), for the pass over the time column."""
         codec = _CODECS[self.encoding]
         number = self.first_line
-        with open(self.path, "rb") as file:
+        with open_regular(self.path) as file:
             file.seek(self.body_start)
             rest, data = b"", b"x"
             while data:
                 data = file.read(block_bytes or BLOCK_BYTES)
                 block = rest + data
                 cut = block.rfind(b"\n") + 1 if data else len(block)
+                if cut == 0 and len(block) > 4 * MAX_LINE:
+                    raise TraceError(self.path, number, 0, line_too_long(len(block)))
                 block, rest = block[:cut], block[cut:]
                 if not data:  # the file's end: blank lines there end the table as in memory
                     lines = block.split(b"\n")

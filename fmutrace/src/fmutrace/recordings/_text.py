@@ -20,14 +20,12 @@ import re
 import numpy as np
 
 from .._errors import TraceError
+from .._reading import MAX_LINE, read_bytes
 from .._traces import counts_outside_quotes, parse_number
 
 SEPARATORS = ("\t", ";", ",", " ")
 _IEC_BASED = re.compile(r"^(?:[A-Za-z_]+#)?([+-]?)(2|8|16)#([0-9A-Fa-f_]+)$")
 _TYPED = re.compile(r"^[A-Za-z_]+#(.+)$")
-
-
-MAX_LINE = 1 << 22  # characters in a line of a recorder's export (100,000 channels of 40); a longer one is refused
 
 
 class Text:
@@ -84,12 +82,8 @@ def _strict(path, data, codec, label):
 
 
 def read(path):
-    """The Text of a file; TraceError if it cannot be read."""
-    try:
-        with open(path, "rb") as file:
-            data = file.read()
-    except OSError as error:
-        raise TraceError(path, 0, 0, error.strerror or str(error)) from None
+    """The Text of a file; TraceError if it cannot be read (_reading's bounds)."""
+    data = read_bytes(path)
     text, encoding = decode(path, data)
     return Text(path, text, encoding)
 
