@@ -8,9 +8,9 @@ Units: s, ms, us, ns (a number per sample), FILETIME (100 ns ticks since
 Integer stamps are subtracted as integers first, so FILETIME's 1.3e17
 ticks lose no resolution.
 
-A stamp belongs to the nearest cycle end; one further than OFF_CYCLE of a
-cycle from it is reported (recorders' clocks and printed decimals are
-not exact, a stamp that far off means another clock or another step).
+Each stamp belongs to its nearest cycle on the grid its channels fit
+(_clock: jitter, a recorder's own clock); one further than OFF_CYCLE of
+a cycle from it is reported.
 """
 
 import re
