@@ -12,7 +12,9 @@ at a 10 ms cycle (360,000 to 17,280,000 cycles) through fmutrace.
    recorder's row holds the input and the output of the same cycle, fmpy
    records the output at the end of the step).
    The same soak test is also written as one file of a recorder's table
-   export (time in ms, u and y in a row per cycle).
+   export (time in ms, u and y in a row per cycle), and once more with
+   stamps that jitter by up to 4 ms (40 % of the cycle; the cycle fit,
+   recordings/_clock.py, lays each row on its cycle).
 2. Prints, each in a fresh process: the wall time, user CPU time and the
    peak resident memory (VmHWM) of `fmutrace compare FMU CASE --report DIR`,
    of `fmutrace compare FMU RECORDING.csv --report DIR` (the one-file
@@ -41,6 +43,7 @@ import numpy as np
 
 MODEL = "RateLimiter"
 RECORDING = "recording.csv"  # the one-file recording beside the case folder
+JITTERED = "recording_jitter.csv"  # the same with stamps that jitter by up to 40 % of the cycle (whole ms)
 STEP = 0.01
 TARGET_SECONDS, TARGET_MEGABYTES = 60.0, 1024.0
 
@@ -71,14 +74,19 @@ def generator_key():
     ).hexdigest()[:16]
 
 
-def write_recording(path, cycles):
+def write_recording(path, cycles, jitter_ms=0, seed=7):
     """The same soak test as one file of a recorder's table export: a row per cycle, its time in ms, the
-    cycle's input u and its output y (the limiter passes u on: y = u in the same cycle)."""
+    cycle's input u and its output y (the limiter passes u on: y = u in the same cycle). jitter_ms: each
+    stamp that many ms early or late at most (uniform, whole ms), as a cyclic interrupt's start jitters;
+    the block takes its cycle from the step (nominal cycle lengths), so y is still u."""
     import pyarrow as pa
     import pyarrow.csv as pcsv
 
     _, u, _ = recording(cycles)
-    table = pa.table({"Time [ms]": np.arange(cycles, dtype=np.int64) * 10, "u": u, "y": u})
+    stamps = np.arange(cycles, dtype=np.int64) * 10
+    if jitter_ms:
+        stamps[1:] += np.random.default_rng(seed).integers(-jitter_ms, jitter_ms + 1, cycles - 1)
+    table = pa.table({"Time [ms]": stamps, "u": u, "y": u})
     pcsv.write_csv(table, path, write_options=pcsv.WriteOptions(quoting_style="none", batch_size=1 << 16))
 
 
@@ -90,6 +98,24 @@ def write_case(folder, cycles):
     (folder / f"{MODEL}_start.csv").write_text("rateUpPar,100\nrateDownPar,100\n")
     (folder / f"{MODEL}_ref.opt").write_text(f"StartTime,0\nStopTime,{float(time[-1])!r}\nStepSize,{STEP!r}\n")
     (folder / "README.md").write_text(f"# {cycles} cycles of 10 ms: a random walk the limiter passes on\n")
+
+
+def compare_recording(cli, fmu, path, cycles, long):
+    """(seconds, MB, user seconds) of fmutrace compare on a one-file recording of so many cycles, which
+    must pass, streamed if long (its report beside it)."""
+    report = path.parent / f"report_{path.stem}"
+    seconds, megabytes, status, output, user = measured(
+        cli
+        + ["compare", str(fmu), str(path), "--set", "rateUpPar=100", "--set", "rateDownPar=100"]
+        + ["--report", str(report)]
+    )
+    if status != 0 or f"{cycles} samples" not in output:
+        raise SystemExit(f"compare of {path} exited {status}:\n{output[-3000:]}")
+    # a case is always read in chunks; a long one-file recording is streamed, a short one (--smoke) read whole
+    streamed = [c.get("streamed", False) for c in json.loads((report / "results.json").read_text())["cases"]]
+    if streamed != [long]:
+        raise SystemExit(f"{path} was {'not ' * long}streamed")
+    return seconds, megabytes, user
 
 
 def generate(root, hours):
@@ -173,6 +199,7 @@ def main():
         elif kind == "generate":
             write_case(Path(rest[0]), int(rest[1]))
             write_recording(Path(rest[0]).parent / RECORDING, int(rest[1]))
+            write_recording(Path(rest[0]).parent / JITTERED, int(rest[1]), jitter_ms=4)
         else:
             fmpy_anchor(Path(rest[0]), Path(rest[1]))
         return 0
@@ -200,30 +227,10 @@ def main():
         if status != 0:
             raise SystemExit(f"compare of {hours:g} h exited {status}:\n{output[-3000:]}")
         one_file = case.parent / RECORDING
-        rec_seconds, rec_megabytes, status, output, rec_user = measured(
-            cli
-            + [
-                "compare",
-                str(fmu),
-                str(one_file),
-                "--set",
-                "rateUpPar=100",
-                "--set",
-                "rateDownPar=100",
-                "--report",
-                str(case.parent / "report_recording"),
-            ]
+        rec_seconds, rec_megabytes, rec_user = compare_recording(cli, fmu, one_file, cycles, streamable(one_file))
+        jit_seconds, jit_megabytes, jit_user = compare_recording(
+            cli, fmu, case.parent / JITTERED, cycles, streamable(one_file)
         )
-        if status != 0 or f"{cycles} samples" not in output:
-            raise SystemExit(f"compare of the {hours:g} h recording exited {status}:\n{output[-3000:]}")
-        # a case is always read in chunks; a long one-file recording is streamed, a short one (--smoke) read whole
-        long = streamable(one_file)
-        streamed = [
-            c.get("streamed", False)
-            for c in json.loads((case.parent / "report_recording" / "results.json").read_text())["cases"]
-        ]
-        if streamed != [long]:
-            raise SystemExit(f"the {hours:g} h recording was {'not ' * long}streamed")
         run_out = root / f"{hours:g}h" / "run_out.csv"
         run_seconds, run_megabytes, status, output, run_user = measured(
             cli
@@ -263,6 +270,9 @@ def main():
                 "recording_s": rec_seconds,
                 "recording_user_s": rec_user,
                 "recording_MB": rec_megabytes,
+                "jitter_s": jit_seconds,
+                "jitter_user_s": jit_user,
+                "jitter_MB": jit_megabytes,
                 "run_s": run_seconds,
                 "run_user_s": run_user,
                 "run_MB": run_megabytes,
@@ -274,6 +284,7 @@ def main():
             for what, s_, mb in (
                 ("compare", seconds, megabytes),
                 ("compare of the one-file recording", rec_seconds, rec_megabytes),
+                ("compare of the jittered recording", jit_seconds, jit_megabytes),
                 ("run", run_seconds, run_megabytes),
             ):
                 if s_ > TARGET_SECONDS or mb > TARGET_MEGABYTES:
@@ -284,14 +295,15 @@ def main():
     print()
     print(
         "| recording | cycles | compare s (user) | compare MB | one-file recording s (user) | recording MB "
-        "| run s (user) | run MB | read only s | read MB |"
+        "| jittered recording s (user) | jittered MB | run s (user) | run MB | read only s | read MB |"
     )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in rows:
         print(
             f"| {r['hours']:g} h | {r['cycles']:,} | {r['compare_s']:.1f} ({r['compare_user_s']:.1f}) | "
             f"{r['compare_MB']:.0f} | {r['recording_s']:.1f} ({r['recording_user_s']:.1f}) | "
-            f"{r['recording_MB']:.0f} | {r['run_s']:.1f} ({r['run_user_s']:.1f}) | {r['run_MB']:.0f} | "
+            f"{r['recording_MB']:.0f} | {r['jitter_s']:.1f} ({r['jitter_user_s']:.1f}) | {r['jitter_MB']:.0f} | "
+            f"{r['run_s']:.1f} ({r['run_user_s']:.1f}) | {r['run_MB']:.0f} | "
             f"{r['read_s']:.1f} | {r['read_MB']:.0f} |"
         )
     print("(MB: peak resident memory, VmHWM; user: the process's user CPU seconds)")
