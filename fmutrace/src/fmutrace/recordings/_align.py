@@ -33,7 +33,7 @@ from ._timebase import FINEST, OFF_CYCLE, _minus, as_read, cycle_times, finest_i
 
 TIMINGS = ("cycle", "fmi")
 CYCLE_LENGTHS = ("nominal", "recorded")
-MOST_NAMED = 10  # missing cycles named in a note (the rest counted)
+MOST_NAMED = 100  # missing cycles named in a note and in results.json (the rest counted)
 WHOLE = 1e-3  # of a tick: a stamp this close to a whole number of ticks is one (its decimals read back)
 
 
