@@ -118,14 +118,16 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         _, cells, line_numbers, times = block
         index = np.arange(row, row + len(times))
         row += len(times)
-        distance = cycles.grid.distance(times, index)
-        if not np.all(np.abs(distance) < 0.5):
+        far = np.abs(cycles.grid.distance(times, index))
+        largest = float(far.max())
+        if not largest < 0.5:
             raise NotPlain("a row nearer another cycle than its own")  # (the in-memory path numbers it so)
-        jitter.add(distance)
-        late = np.flatnonzero(np.abs(distance) > OFF_CYCLE)
-        if len(late) and off[1] is None:
-            off[1] = (int(line_numbers[late[0]]), float(times[late[0]]), int(index[late[0]]))
-        off[0] += len(late)
+        jitter.add_far(far, largest)
+        if largest > OFF_CYCLE:
+            late = np.flatnonzero(far > OFF_CYCLE)
+            if off[1] is None:
+                off[1] = (int(line_numbers[late[0]]), float(times[late[0]]), int(index[late[0]]))
+            off[0] += len(late)
         if drives:
             chunk = np.empty(len(index), dtype=[("time", np.float64)] + [(v, np.float64) for v, _ in drives])
             chunk["time"] = timebase.cycle_times(index, step)

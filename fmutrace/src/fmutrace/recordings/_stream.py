@@ -229,21 +229,17 @@ def time_column_pass(table, step, block_bytes=None):
     head's, its length is no misread unit; and by the stream's own: every
     row the cycle after the one before, on the grid of cycles the rows
     before it fit (clock.Line: the in-memory path's fit, on a recording
-    of a row per cycle; the run checks each row on the whole file's grid,
-    the pass each block on its rows' once they are SEARCH_WINDOW).
-    NotPlain otherwise."""
+    of a row per cycle; the pass checks the first SEARCH_WINDOW rows on
+    their line, the run each row on the whole file's). NotPlain otherwise."""
     recording = table.recording
     intervals = timebase.Intervals()
     line = clock.Line()
     rows, span = 0, 0.0
     first: list[np.ndarray] = []  # the first SEARCH_WINDOW rows' times: checked once their line is known
     for _, _, _, times in table.blocks(block_bytes, time_only=True):
-        index = np.arange(rows, rows + len(times))
-        if line.count >= clock.SEARCH_WINDOW:
-            _on_their_cycles(line.grid(step), index, times)
-        else:
+        if line.count < clock.SEARCH_WINDOW:  # (later rows: checked as the run reads them, _recording)
             first.append(times)
-        line.add(index, times)
+        line.add(rows, times)
         if first and line.count >= clock.SEARCH_WINDOW:
             _on_their_cycles(line.grid(step), np.arange(line.count), np.concatenate(first))
             first = []
