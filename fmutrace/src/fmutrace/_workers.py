@@ -190,24 +190,12 @@ def _spawn(there: Connection, said) -> subprocess.Popen:
         **{UNPACK_ROOT: unpack_root(), PARENT: str(os.getpid())},
     )
     command = [sys.executable, "-c", CHILD, str(there.fileno())]
+    inherit: dict = {"pass_fds": [there.fileno()]}  # the Connection's end, and nothing else, goes to the child
     if sys.platform == "win32":
         os.set_handle_inheritable(there.fileno(), True)
-        inherit = subprocess.STARTUPINFO(lpAttributeList={"handle_list": [there.fileno()]})
-        return subprocess.Popen(
-            command,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            stderr=said,
-            env=environment,
-            startupinfo=inherit,
-        )
+        inherit = {"startupinfo": subprocess.STARTUPINFO(lpAttributeList={"handle_list": [there.fileno()]})}
     return subprocess.Popen(
-        command,
-        stdin=subprocess.DEVNULL,
-        stdout=subprocess.DEVNULL,
-        stderr=said,
-        env=environment,
-        pass_fds=[there.fileno()],
+        command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=said, env=environment, **inherit
     )
 
 
