@@ -17,7 +17,7 @@
  * Mode too, where the standard has only continuous-time inputs (condition
  * 5), as importers such as OMSimulator set every input at each step; the
  * next cycle uses the values the instant before it is left with
- * (fmu_leave_instant), wherever they were set. */
+ * (fmu_latch_values), wherever they were set. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP

@@ -1,5 +1,4 @@
 #include "fmu_core.h"
-#include "fmu_model_exchange.h"
 
 #include <float.h>
 #include <limits.h>
@@ -64,7 +63,7 @@ void fmu_reset(FmuInstance *instance) {
         core->values[i] = model->variables[i].start;
     }
     core->mode = MODE_INSTANTIATED;
-    fmu_leave_instant(instance); /* latched: values this FMU could have */
+    fmu_latch_values(instance); /* values this FMU could have */
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
     if (instance->plan) instance->plan->valid = false; /* (a plan is only ever a cost saved) */
@@ -295,7 +294,7 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     instance->core.mode = instance->modelExchange ? MODE_EVENT : MODE_STEP;
     instance->core.cycles = 0;
     instance->core.eventTime = instance->core.time;
-    fmu_leave_instant(instance);
+    fmu_latch_values(instance);
     return fmu_report_status(instance);
 }
 

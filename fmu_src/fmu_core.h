@@ -13,6 +13,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "model.h"
 
@@ -291,6 +292,13 @@ static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function,
 RL_LINKAGE const char *fmu_mode_name(int mode);
 
 /* ---- shared with Model Exchange (fmu_model_exchange.c) ------------------ */
+
+/* The values the next cycle runs with are the current ones (the latch,
+ * FmuCore.latched): at the start, and when Model Exchange leaves an
+ * instant. Core data, set here so that the core calls no interface. */
+static inline void fmu_latch_values(FmuInstance *instance) {
+    memcpy(instance->core.latched, instance->core.values, sizeof instance->core.latched);
+}
 
 /* The kernel's configuration from the current values (the outputs of the
  * last cycle published first: they need its configuration). */
