@@ -118,7 +118,11 @@ def licence(stage):
     )
 
 
-INTERFACES = (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
+INTERFACES = (
+    ("CoSimulation", "Co-Simulation"),
+    ("ModelExchange", "Model Exchange"),
+    ("ScheduledExecution", "Scheduled Execution (the PLC cyclic interrupt OB as an input Clock)"),
+)
 LS_REF = "extra/org.fmi-standard.fmi-ls-ref"
 STANDALONE = '<p>(Also in <a href="fmi-ls-ref.html">fmi-ls-ref.html</a>, as the layered standard recommends.)</p>'
 
@@ -127,7 +131,8 @@ def interfaces(stage, version):
     """What the FMU carries, as a sentence: the interfaces its model
     description declares, its C sources, the layered standard."""
     root = ElementTree.parse(stage / "modelDescription.xml").getroot()
-    kinds = " and ".join(name for tag, name in INTERFACES if root.find(tag) is not None)
+    names = [name for tag, name in INTERFACES if root.find(tag) is not None]
+    kinds = ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
     carried = [f"FMI {version}.0 {kinds}", "its C sources (<code>sources/</code>, any platform can compile them)"]
     if (stage / LS_REF / "fmi-ls-manifest.xml").exists():
         carried.append("its reference experiments (FMI-LS-REF, below)")
@@ -169,7 +174,13 @@ def experiments(stage, model):
     return "\n".join(parts)
 
 
-def page(model, version, codes, licence_html, carried="", experiments_html=""):
+def clocks(stage):
+    """The Clocks of the staged model description (FMI 3: Scheduled Execution's cyclic interrupt), generate.py's."""
+    root = ElementTree.parse(stage / "modelDescription.xml").getroot()
+    return [clock.attrib for clock in root.iter("Clock")]
+
+
+def page(model, version, codes, licence_html, carried="", experiments_html="", clock_list=()):
     m = model["model"]
     style = (
         "body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}\n"
@@ -185,6 +196,20 @@ def page(model, version, codes, licence_html, carried="", experiments_html=""):
         f"<td>{v['variability']}</td><td>{cell(v.get('declaredType', v['type']))}</td><td>{cell(v.get('start'))}</td>"
         f"<td>{cell(v.get('unit'))}</td><td>{cell(v.get('description'))}</td></tr>"
         for v in model["variable"]
+    )
+    rows += "".join(
+        f"\n<tr><td><code>{cell(c['name'])}</code></td><td>{c['valueReference']}</td><td>{c['causality']}</td>"
+        f"<td>{c['variability']}</td><td>Clock ({cell(c['intervalVariability'])})</td><td></td><td></td>"
+        f"<td>{cell(c.get('description'))}</td></tr>"
+        for c in clock_list
+    )
+    scheduled = "".join(
+        f"<p>In Scheduled Execution the cyclic interrupt is the input Clock <code>{cell(c['name'])}</code>: the "
+        "importer's scheduler activates it at each tick, and each <code>fmi3ActivateModelPartition</code> runs one "
+        "PLC cycle at its activation time, with the outputs Co-Simulation gives after a step of one cycle. Its "
+        "interval and the first tick's delay are <code>cycleTime</code> (<code>fmi3GetIntervalDecimal</code>, "
+        "<code>fmi3GetShiftDecimal</code> in Initialization Mode).</p>"
+        for c in clock_list
     )
     enums = "".join(
         f"<h3>{html.escape(name)}</h3><p>{cell(e.get('description'))}</p><ul>"
@@ -220,6 +245,7 @@ input by at most the rising or falling rate times the cycle length, or follows i
 rules say so (bypass, duration run out, non-finite input, initial delay). With <code>cycleTime</code> &gt; 0 the
 block runs whole PLC cycles of that length inside each communication step; time is counted in whole cycles,
 so long runs do not drift.</p>
+{scheduled}
 <p><img src="ramp.png" alt="A typical ramp: the output follows a step of the input at the limited rates"></p>
 <h2>Variables</h2>
 <table><tr>{header}</tr>
@@ -265,6 +291,7 @@ experiments</title></head><body>
             licence(stage),
             interfaces(stage, int(version)),
             section.replace("</h2>", f"</h2>\n{STANDALONE}", 1),
+            clocks(stage),
         ),
         encoding="utf-8",
     )

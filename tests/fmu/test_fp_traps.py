@@ -155,7 +155,8 @@ def hostile_script(md):
         if refuse:
             refused.add(len(lines))
 
-    for variable in (v for v in md.modelVariables if v.causality in ("input", "parameter")):
+    # (FMI 3's Clock has no value to set: it ticks through fmi3ActivateModelPartition)
+    for variable in (v for v in md.modelVariables if v.causality in ("input", "parameter") and v.type != "Clock"):
         for hostile in HOSTILE:
             value = coerce(variable, hostile)
             if value is None:

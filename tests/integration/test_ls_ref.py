@@ -129,11 +129,20 @@ def test_the_documentation_names_the_interfaces_and_the_experiments(model, versi
         description = etree.fromstring(z.read("modelDescription.xml"))
     kinds = [
         name
-        for tag, name in (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
+        for tag, name in (
+            ("CoSimulation", "Co-Simulation"),
+            ("ModelExchange", "Model Exchange"),
+            ("ScheduledExecution", "Scheduled Execution"),
+        )
         if description.find(tag) is not None
     ]
-    assert kinds == ["Co-Simulation", "Model Exchange"]  # what every product model implements (docs/fmi.md)
-    assert f"It carries FMI {version}.0 Co-Simulation and Model Exchange" in page
+    # what every product model implements (docs/fmi.md); Scheduled Execution is FMI 3's
+    assert kinds == ["Co-Simulation", "Model Exchange"] + (["Scheduled Execution"] if version == 3 else [])
+    assert (
+        "It carries FMI 2.0 Co-Simulation and Model Exchange,"
+        if version == 2
+        else "It carries FMI 3.0 Co-Simulation, Model Exchange and Scheduled Execution (the PLC cyclic interrupt"
+    ) in page
     assert f"<pre>fmutrace check {model}.fmu</pre>" in page
     assert '<a href="fmi-ls-ref.html">' in page
     for text in (page, standalone):

@@ -57,7 +57,8 @@ def same_start(declared, start):
 def test_model_description_is_the_toml(model, version):
     source = toml(model)
     md = read_model_description(str(fmu_file(model, version)))
-    variables = md.modelVariables
+    # FMI 3's Clock of Scheduled Execution is the generator's, not the TOML's (test_scheduled_execution.py)
+    variables = [v for v in md.modelVariables if v.type != "Clock"]
     assert [v.name for v in variables] == [v["name"] for v in source["variable"]]
     for v, s in zip(variables, source["variable"], strict=True):
         assert v.valueReference == s["vr"]

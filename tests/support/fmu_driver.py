@@ -16,7 +16,7 @@ from fmpy.fmi2 import (
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
 )
-from fmpy.fmi3 import FMU3Model, FMU3Slave
+from fmpy.fmi3 import FMU3Model, FMU3ScheduledExecution, FMU3Slave
 
 REPO = Path(__file__).resolve().parents[2]
 TESTS = REPO / "tests"  # the working directory of the helper scripts (python -m support.x)
@@ -43,9 +43,21 @@ def unzipped(model, version):
 class Instance:
     """One FMU instance. Values are read and written by variable name."""
 
-    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None, model_exchange=False):
+    def __init__(
+        self,
+        model="RateLimiter",
+        version=2,
+        name="test",
+        logging=True,
+        unzipdir=None,
+        model_exchange=False,
+        scheduled=False,
+    ):
+        """scheduled: FMI 3 Scheduled Execution, through fmpy's own wrapper (its
+        preemption callbacks do nothing)."""
         self.version = version
         self.model_exchange = model_exchange
+        self.scheduled = scheduled
         self.unzipdir = unzipdir or unzipped(model, version)
         self.md = read_model_description(self.unzipdir)
         self.variables = {v.name: v for v in self.md.modelVariables}
@@ -62,7 +74,7 @@ class Instance:
             self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
             self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging)
         else:
-            self.fmu = (FMU3Model if model_exchange else FMU3Slave)(
+            self.fmu = (FMU3Model if model_exchange else FMU3ScheduledExecution if scheduled else FMU3Slave)(
                 guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name
             )
             self.fmu.instantiate(loggingOn=logging, logMessage=self._log3)
@@ -162,6 +174,13 @@ class Instance:
         if status <= 1:
             self.t = t + h
         return status
+
+    def raw_activate(self, t):
+        """fmi3ActivateModelPartition of the Clock at t, through ctypes alone; the FMI status."""
+        activate = self.fmu.dll.fmi3ActivateModelPartition
+        activate.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_double]
+        activate.restype = ctypes.c_int
+        return activate(self.fmu.component, self.vr("cyclicInterrupt"), t)
 
     def restore(self, state, t):
         """Set an FMU state taken at time t; the driver's clock goes back with it (set by the test, not read
