@@ -437,7 +437,6 @@ FmuStatus fmu_activate(FmuInstance *instance, const char *function, double activ
          * startTime + n*cycleTime it is Co-Simulation's cycle n */
         rl_cycle(&core->block, &instance->prepared, core->values[instance->inputVr],
                  rl_sum(activationTime, -core->startTime));
-        core->cycles++;
         instance->outputsStale = FMU_STALE_ALL;
     } else if (instance->outputsStale == FMU_FRESH) {
         instance->outputsStale = FMU_STALE_TIME;

@@ -56,7 +56,7 @@ typedef struct {
     RlState block;
     double startTime;
     double time;
-    uint64_t cycles; /* cycles run since the start (cycleTime > 0) */
+    uint64_t cycles; /* cycles run since the start (cycleTime > 0; Scheduled Execution counts none) */
     /* Model Exchange: the values as the last event instant left them, which
      * the next cycle runs with (latch), and that instant's time */
     double latched[FMU_MAX_VARIABLES];
