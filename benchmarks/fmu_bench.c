@@ -10,7 +10,8 @@
  * FMI 3 with a cycleTime: Scheduled Execution's activation beside
  * Co-Simulation's doStep of one cycle (the Clock's value reference read
  * from the modelDescription.xml two folders above the binary, as an FMU
- * and its stage are laid out).
+ * and its stage are laid out: the Scheduled Execution FMU's, whose binary
+ * is the Co-Simulation FMU's and whose description alone has the Clock).
  *
  * Under valgrind --tool=callgrind each measured loop is bracketed by client
  * requests (zero, then dump with the loop's name), so that the caller can

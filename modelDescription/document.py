@@ -3,7 +3,7 @@
 model's TOML file (the variables) and the staged FMU itself (a typical ramp,
 simulated with fmpy):
 
-    document.py MODEL.toml STAGED_FMU_DIR FMI_VERSION STATUS_SOURCE.c
+    document.py MODEL.toml STAGED_FMU_DIR FMI_VERSION STATUS_SOURCE.c PLOT_STAGED_FMU_DIR
 
 writes documentation/index.html and documentation/ramp.png, and the icon:
 model.png (FMI 2) or terminalsAndIcons/icon.png (FMI 3). Runs with the
@@ -148,13 +148,21 @@ def experiments(stage, model):
     if not files:
         return ""
     fmu = f"{model['model']['identifier']}.fmu"
+    # fmutrace runs Co-Simulation: the Scheduled Execution FMU's experiments run on the FMI 3 FMU of its binary
+    scheduled_only = ElementTree.parse(stage / "modelDescription.xml").getroot().find("CoSimulation") is None
+    where = (
+        " through Co-Simulation, on the FMI 3 FMU of the same name and binary (fmutrace is a Co-Simulation importer; "
+        "a Scheduled Execution importer runs them one activation per cycle)"
+        if scheduled_only
+        else ""
+    )
     parts = [
         '<h2 id="reference-experiments">Reference experiments (FMI-LS-REF)</h2>',
         f"<p>The FMU carries its hand-worked reference scenarios in <code>{LS_REF}/</code>: the manifest "
         "<code>fmi-ls-manifest.xml</code> lists every file with its SHA-256 and each reference signal's comparison "
         "criterion (an <code>org.fmutrace</code> annotation), each experiment file (MA-HS-Experiments) its "
         "experiments' times, parameter set (SSP <code>.ssv</code>), stimuli and reference (CSV). Run them all, "
-        f"compared with those criteria:</p><pre>fmutrace check {fmu}</pre>"
+        f"compared with those criteria{where}:</p><pre>fmutrace check {fmu}</pre>"
         f"<p>(<code>--role smoke-test</code> for the smoke test alone; fmutrace is in the project's repository.)</p>",
     ]
     for path in files:
@@ -208,7 +216,9 @@ def page(model, version, codes, licence_html, carried="", experiments_html="", c
         "importer's scheduler activates it at each tick, and each <code>fmi3ActivateModelPartition</code> runs one "
         "PLC cycle at its activation time, with the outputs Co-Simulation gives after a step of one cycle. Its "
         "interval and the first tick's delay are <code>cycleTime</code> (<code>fmi3GetIntervalDecimal</code>, "
-        "<code>fmi3GetShiftDecimal</code> in Initialization Mode).</p>"
+        "<code>fmi3GetShiftDecimal</code> in Initialization Mode). Co-Simulation and Model Exchange are in the FMI 3 "
+        "FMU of the same name, the same binary without the Clock (a Co-Simulation FMU with Clocks must have Event "
+        "Mode, FMI 3.0 section 4.4).</p>"
         for c in clock_list
     )
     enums = "".join(
@@ -267,7 +277,9 @@ recovered with a saved FMU state or reset.</p>
 """
 
 
-def main(toml, stage, version, status_source):
+def main(toml, stage, version, status_source, plot_stage):
+    """plot_stage: a staged FMU of the same binary with Co-Simulation, to draw the ramp (the stage itself,
+    but for the Scheduled Execution FMU's, fmi3's)."""
     model = tomllib.loads(Path(toml).read_text(encoding="utf-8"))
     stage = Path(stage).resolve()
     docs = stage / "documentation"
@@ -295,7 +307,7 @@ experiments</title></head><body>
         ),
         encoding="utf-8",
     )
-    ramp_plot(model, stage, docs / "ramp.png")
+    ramp_plot(model, Path(plot_stage).resolve(), docs / "ramp.png")
     if int(version) == 2:
         icon(model, stage / "model.png")
     else:

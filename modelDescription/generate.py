@@ -236,7 +236,16 @@ def fmi2_description(model, guid, sources):
     return "\n".join(out) + "\n"
 
 
-def fmi3_description(model, instantiation_token):
+# FMI 3's interfaces ship as two FMUs of one binary (docs/fmi.md, Scheduled Execution): Co-Simulation and Model
+# Exchange without a Clock, as FMI 2's, since a Co-Simulation FMU that declares Clocks must have Event Mode (FMI 3.0,
+# 4.4) and some Co-Simulation importers cannot load a Clock; Scheduled Execution alone, with its Clock. The folder
+# under the build tree that each is written to and packaged from (cmake/Fmu.cmake names the same).
+FMI3_VARIANTS = {"fmi3": "CoSimulation+ModelExchange", "fmi3-se": "ScheduledExecution"}
+
+
+def fmi3_description(model, instantiation_token, variant):
+    """The FMI 3 model description of one variant (a key of FMI3_VARIANTS)."""
+    scheduled = FMI3_VARIANTS[variant] == "ScheduledExecution"
     m = model["model"]
     root = attributes(
         modelName=m["identifier"],
@@ -250,11 +259,15 @@ def fmi3_description(model, instantiation_token):
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="3.0"{root}{attributes(generationTool=GENERATION_TOOL)}'
         ' variableNamingConvention="flat">',
-        f'  <ModelExchange{identifier} needsCompletedIntegratorStep="false" {states}/>',
-        f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}'
-        ' hasEventMode="false" providesIntermediateUpdate="false"/>',
-        f"  <ScheduledExecution{identifier} {states}/>",
     ]
+    if scheduled:
+        out.append(f"  <ScheduledExecution{identifier} {states}/>")
+    else:
+        out.append(f'  <ModelExchange{identifier} needsCompletedIntegratorStep="false" {states}/>')
+        out.append(
+            f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}'
+            ' hasEventMode="false" providesIntermediateUpdate="false"/>'
+        )
     out += common_head(model, 3)
     out.append("  <ModelVariables>")
     for v in model["variable"]:
@@ -269,7 +282,8 @@ def fmi3_description(model, instantiation_token):
         intervalVariability="fixed",
         priority=0,
     )
-    out.append(f"    <Clock{clock}/>")
+    if scheduled:
+        out.append(f"    <Clock{clock}/>")
     out.append("  </ModelVariables>")
     outputs = [v["vr"] for v in model["variable"] if v["causality"] == "output"]
     out.append("  <ModelStructure>")
@@ -375,7 +389,10 @@ def main():
     identifier = model["model"]["identifier"]
     files = {
         args.outdir / "fmi2" / "modelDescription.xml": fmi2_description(model, tok, args.fmi2_sources),
-        args.outdir / "fmi3" / "modelDescription.xml": fmi3_description(model, tok),
+        **{
+            args.outdir / variant / "modelDescription.xml": fmi3_description(model, tok, variant)
+            for variant in FMI3_VARIANTS
+        },
         args.outdir / "fmi3" / "buildDescription.xml": fmi3_build_description(model, args.fmi3_sources),
         args.outdir / f"{identifier}_variables.h": c_header(model, tok, args.model.name),
     }

@@ -178,7 +178,7 @@ INTERFACES = {
 def checked_in(model_description):
     """'Co-Simulation, Model Exchange and Scheduled Execution': the interfaces the FMU declares."""
     root = ET.parse(model_description).getroot()
-    names = [INTERFACES[element.tag] for element in root if element.tag in INTERFACES]
+    names = [name for tag, name in INTERFACES.items() if root.find(tag) is not None]
     return ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
 
 

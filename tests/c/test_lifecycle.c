@@ -1,7 +1,9 @@
 /* An FMU binary's lifecycle as an importer drives it (dlopen), FMI 2 and 3:
  *
- *   test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances>
+ *   test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances> [<staged SE FMU folder>]
  *
+ * (FMI 3 only, and required there: the Scheduled Execution FMU's folder, build/stage/fmi3-se/<Model>, whose model description
+ * declares the Clock; its binary is the Co-Simulation FMU's, and runs Scheduled Execution after 1.)
  * 1. a full simulation using every kind of call (set, step, get, FMU states,
  *    serialize and deserialize, reset, terminate, free), so that valgrind
  *    memcheck can watch all of it; then the same as Model Exchange (time
@@ -569,7 +571,8 @@ static unsigned first_real(const char *text, const char *causality) {
     exit(2);
 }
 
-static void read_description(const char *stage, char *identifier, size_t size) {
+/* the staged FMU's model description, in a buffer of its own kept until the next call */
+static const char *description_text(const char *stage) {
     char path[4096];
     snprintf(path, sizeof path, "%s/modelDescription.xml", stage);
     FILE *f = fopen(path, "rb");
@@ -581,6 +584,21 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     const size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = 0;
     fclose(f);
+    return text;
+}
+
+/* the Scheduled Execution FMU's Clock; that FMU declares nothing else of the binary's interfaces */
+static void read_clock(const char *stage, const char *identifier) {
+    const char *text = description_text(stage);
+    char number[32], se_identifier[256];
+    attribute(text, "<ScheduledExecution", "modelIdentifier=\"", se_identifier, sizeof se_identifier);
+    CHECK(strcmp(se_identifier, identifier) == 0);
+    CHECK(!strstr(text, "<CoSimulation") && !strstr(text, "<ModelExchange"));
+    clockVr = (unsigned)atoi(attribute(text, "<Clock ", "valueReference=\"", number, sizeof number));
+}
+
+static void read_description(const char *stage, char *identifier, size_t size) {
+    const char *text = description_text(stage);
     attribute(text, NULL, version == 2 ? "guid=\"" : "instantiationToken=\"", token, sizeof token);
     attribute(text, "<CoSimulation", "modelIdentifier=\"", identifier, size);
     uVr = first_real(text, "causality=\"input\"");
@@ -588,15 +606,16 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     /* every model has the parameter cycleTime */
     char number[32];
     cycleTimeVr = (unsigned)atoi(attribute(text, "name=\"cycleTime\"", "valueReference=\"", number, sizeof number));
-    if (version == 3) clockVr = (unsigned)atoi(attribute(text, "<Clock ", "valueReference=\"", number, sizeof number));
+    CHECK(!strstr(text, "<Clock") && !strstr(text, "<ScheduledExecution")); /* FMI 3.0, 4.4: the SE FMU's */
     if (strstr(text, "name=\"accelMax\"")) {
         accelVr = atoi(attribute(text, "name=\"accelMax\"", "valueReference=\"", number, sizeof number));
     }
 }
 
 int main(int argc, char **argv) {
-    if (argc != 5) {
-        fprintf(stderr, "usage: test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances>\n");
+    if (argc != (argc > 1 && atoi(argv[1]) == 3 ? 6 : 5)) {
+        fprintf(stderr, "usage: test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances> "
+                        "[<staged Scheduled Execution FMU folder> (FMI 3 only, required)]\n");
         return 2;
     }
     version = atoi(argv[1]);
@@ -612,7 +631,10 @@ int main(int argc, char **argv) {
     counting = 1;
     full_simulation();
     model_exchange_simulation();
-    if (version == 3) scheduled_execution_simulation();
+    if (version == 3) {
+        read_clock(argv[5], identifier);
+        scheduled_execution_simulation();
+    }
     instantiate_free(atol(argv[3]));
     many_instances(atoi(argv[4]));
     out_of_memory();

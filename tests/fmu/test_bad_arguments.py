@@ -691,7 +691,7 @@ def test_fmi3_scheduled_execution_refusals_give_a_reason(case, reason):
     """fmi3InstantiateScheduledExecution refuses a foreign token and a
     lockPreemption without its unlockPreemption: NULL, the reason to the
     logger when logging is on, and nothing called otherwise."""
-    fmu = Instance("RateLimiter", 3)
+    fmu = Instance("RateLimiter", 3, scheduled=True)
     try:
         function = fmu.fmu.dll.fmi3InstantiateScheduledExecution
         lock_type = ctypes.CFUNCTYPE(None)

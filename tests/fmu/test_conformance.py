@@ -23,7 +23,7 @@ from fmpy import __file__ as fmpy_file
 
 from fmpy.fmi2 import fmi2EventInfo
 
-from support.fmu_driver import Instance, call_status
+from support.fmu_driver import Instance, call_status, clock_vr
 
 STATES = ["Instantiated", "Initialization Mode", "Step Mode", "Terminated", "Error"]
 ALL = set(STATES)
@@ -397,7 +397,8 @@ def valid_call(fmu, name):
             "fmi2GetStringStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 1, buffer),
         }
     else:
-        clock = (c_uint * 1)(fmu.vr("cyclicInterrupt"))
+        # the Clock of the binary (declared by the Scheduled Execution FMU alone): refused in CS and ME
+        clock = (c_uint * 1)(clock_vr("RateLimiter"))
         calls = {
             "fmi3SetDebugLogging": lambda: raw(fmu, name, [c_void_p, c_bool, c_size_t, c_void_p], c, True, 0, None),
             "fmi3EnterInitializationMode": lambda: raw(
@@ -444,7 +445,7 @@ def valid_call(fmu, name):
             "fmi3GetFMUState": lambda: raw(fmu, name, [c_void_p, POINTER(c_void_p)], c, ctypes.byref(c_void_p())),
             # the Clock of Scheduled Execution
             "fmi3ActivateModelPartition": lambda: raw(
-                fmu, name, [c_void_p, c_uint, c_double], c, fmu.vr("cyclicInterrupt"), fmu.t + 0.1
+                fmu, name, [c_void_p, c_uint, c_double], c, clock[0], fmu.t + 0.1
             ),
             "fmi3GetIntervalDecimal": lambda: raw(
                 fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p], c, clock, 1, real, integer

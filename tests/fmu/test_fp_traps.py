@@ -155,8 +155,7 @@ def hostile_script(md):
         if refuse:
             refused.add(len(lines))
 
-    # (FMI 3's Clock has no value to set: it ticks through fmi3ActivateModelPartition)
-    for variable in (v for v in md.modelVariables if v.causality in ("input", "parameter") and v.type != "Clock"):
+    for variable in (v for v in md.modelVariables if v.causality in ("input", "parameter")):
         for hostile in HOSTILE:
             value = coerce(variable, hostile)
             if value is None:

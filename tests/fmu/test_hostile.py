@@ -19,8 +19,7 @@ HOSTILE = [math.nan, math.inf, -math.inf, -0.0, 5e-324, 2.2250738585072014e-308,
 def settable(model, version):
     fmu = Instance(model, version)
     try:
-        # (FMI 3's Clock has no value to set: it ticks through fmi3ActivateModelPartition)
-        return [v for v in fmu.md.modelVariables if v.causality in ("input", "parameter") and v.type != "Clock"]
+        return [v for v in fmu.md.modelVariables if v.causality in ("input", "parameter")]
     finally:
         fmu.free()
 

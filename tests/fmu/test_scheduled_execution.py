@@ -1,6 +1,7 @@
 """Scheduled Execution (docs/fmi.md, Scheduled Execution): every model's
-FMI 3 FMU runs the PLC's cyclic interrupt (OB) as an input Clock, one PLC
-cycle per activation. Driven by the scheduler of support.scheduled_execution,
+Scheduled Execution FMU (build/fmi3-se/, the FMI 3 binary with only that
+interface declared) runs the PLC's cyclic interrupt (OB) as an input Clock,
+one PLC cycle per activation. Driven by the scheduler of support.scheduled_execution,
 written from the standard's text, and compared with Co-Simulation stepping
 one cycle per step: the same outputs after each activation as after each
 step, bit for bit, for every reference scenario in both LREAL and REAL. Then
@@ -11,10 +12,12 @@ misuse, the preemption locks and FMU states."""
 import ctypes
 import math
 import struct
+import zipfile
 from ctypes import POINTER, c_bool, c_double, c_size_t, c_uint32, c_void_p
 
 import pytest
 
+from support.fmu_driver import fmu_file
 from support.importers import input_values
 from support.scenarios import discover
 from support.scheduled_execution import CHANGED, ERROR, OK, UNCHANGED, WARNING, Fmi3, Scheduler, library
@@ -177,14 +180,19 @@ def test_the_clock_interval_and_shift_are_cycle_time():
 
 
 def test_the_model_description_declares_the_clock():
-    """Every FMI 3 FMU: the Scheduled Execution interface and one input
-    Clock, periodic with a fixed interval given by the FMU (no
-    intervalDecimal), the priority Scheduled Execution requires, a value
-    reference no variable has."""
+    """Every Scheduled Execution FMU: that interface alone (a Co-Simulation
+    FMU with Clocks must have Event Mode, FMI 3.0 4.4), the binary of the
+    FMI 3 Co-Simulation FMU, and one input Clock, periodic with a fixed
+    interval given by the FMU (no intervalDecimal), the priority Scheduled
+    Execution requires, a value reference no variable has."""
     for model in {s.model for s in SCENARIOS}:
         _, md, clocks = library(model)
         assert md.scheduledExecution is not None
-        assert md.scheduledExecution.modelIdentifier == md.coSimulation.modelIdentifier
+        assert (md.coSimulation, md.modelExchange) == (None, None)
+        assert md.scheduledExecution.modelIdentifier == model
+        binary = f"binaries/x86_64-linux/{model}.so"
+        with zipfile.ZipFile(fmu_file(model, 3)) as cs, zipfile.ZipFile(fmu_file(model, 3, scheduled=True)) as se:
+            assert se.read(binary) == cs.read(binary)
         (clock,) = clocks
         assert (clock.name, clock.causality, clock.intervalVariability) == ("cyclicInterrupt", "input", "fixed")
         assert (clock.priority, clock.intervalDecimal) == (0, None)

@@ -12,16 +12,7 @@ What an importer cannot do is asserted, not skipped:
   without the enumerations;
 - both step on a fixed grid: a scenario whose inputs change between grid
   points (fmpy adds communication points there) is compared, bit for bit,
-  with fmpy's low-level API making the same calls on the same grid;
-- Ecos 0.7.2 aborts ("double free or corruption") while loading an FMI 3
-  model description that declares a Clock, as every FMI 3 FMU does for
-  Scheduled Execution (docs/fmi.md): that is asserted on each model's FMU,
-  and the scenarios run through Ecos on a copy whose model description has
-  the <Clock> element taken out, the binary and everything else the same
-  (Co-Simulation does not use the Clock)."""
-
-import re
-import zipfile
+  with fmpy's low-level API making the same calls on the same grid."""
 
 import sys
 
@@ -48,25 +39,8 @@ def enumerations_set(scenario, version):
     return sorted(n for n in names if kinds.get(n) == "Enumeration")
 
 
-def without_clock(fmu, folder):
-    """A copy of the FMU whose model description has no <Clock> element (Ecos cannot load one that has)."""
-    copy = folder / fmu.name
-    with zipfile.ZipFile(fmu) as source, zipfile.ZipFile(copy, "w", zipfile.ZIP_DEFLATED) as target:
-        for item in source.infolist():
-            data = source.read(item)
-            if item.filename == "modelDescription.xml":
-                data, n = re.subn(rb"\s*<Clock [^>]*/>", b"", data)
-                assert n == 1, "one Clock, Scheduled Execution's"
-            target.writestr(item, data)
-    return copy
-
-
-def run(importer, scenario, version, tmp_path, fmu=None):
+def run(importer, scenario, version, tmp_path):
     out = tmp_path / "result.csv"
-    if fmu is None:
-        fmu = fmu_path(BUILD_DIR, scenario.model, version)
-        if (importer, version) == ("ecospy", 3):
-            fmu = without_clock(fmu, tmp_path)
     process = run_bounded(
         [
             sys.executable,
@@ -74,7 +48,7 @@ def run(importer, scenario, version, tmp_path, fmu=None):
             "support.importers",
             importer,
             str(scenario.folder),
-            str(fmu),
+            str(fmu_path(BUILD_DIR, scenario.model, version)),
             str(out),
         ],
         timeout=300,
@@ -83,15 +57,6 @@ def run(importer, scenario, version, tmp_path, fmu=None):
     )
     assert process.returncode == 0, process.stderr[-3000:]
     return np.atleast_1d(read_csv(str(out))), process.stdout + process.stderr
-
-
-@pytest.mark.parametrize("model", sorted({s.model for s in SCENARIOS}))
-def test_ecos_aborts_on_an_fmi3_clock(model, tmp_path):
-    """What Ecos 0.7.2 cannot do, asserted so that a release that can shows
-    here: it aborts loading the FMI 3 FMU as it is, with its Clock."""
-    scenario = next(s for s in SCENARIOS if s.model == model)
-    with pytest.raises(AssertionError, match="double free or corruption"):
-        run("ecospy", scenario, 3, tmp_path, fmu=fmu_path(BUILD_DIR, model, 3))
 
 
 @pytest.mark.parametrize("importer,version", IMPORTERS, ids=[f"{i}-fmi{v}" for i, v in IMPORTERS])

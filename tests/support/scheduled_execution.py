@@ -92,7 +92,7 @@ def read_clocks(model_description):
 def library(model):
     """The FMU's shared library, its model description and its input Clocks, loaded once per process."""
     if model not in _libraries:
-        unzipdir = Path(unzipped(model, 3))
+        unzipdir = Path(unzipped(model, 3, scheduled=True))
         md = read_model_description(str(unzipdir))
         platform = {"linux": "x86_64-linux", "win32": "x86_64-windows", "darwin": "aarch64-darwin"}[sys.platform]
         suffix = {"linux": ".so", "win32": ".dll", "darwin": ".dylib"}[sys.platform]
