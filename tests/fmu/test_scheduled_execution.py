@@ -131,8 +131,8 @@ def scheduled(model="RateLimiter", locks=True, **start):
 
 
 def test_a_tick_late_or_early_runs_its_cycle_at_the_time_it_is_given():
-    """docs/rules.md, rule 3 and rule 6, worked by hand. cycleTime 0.5,
-    initMode inputValueDelayed with initDelay 1 s, rateUpPar 1 per s: the
+    """Worked by hand from docs/rules.md, rule 3; and docs/rules.md, rule 6.
+    cycleTime 0.5, initMode inputValueDelayed with initDelay 1 s, rateUpPar 1 per s: the
     cycles that end by 1 s pass u, later ones ramp 0.5 per cycle (the
     configured cycle, not the time since the last tick). On time, the tick
     of 1 s still passes u = 6; activated late at 1.2 s, the same cycle ends
