@@ -7,6 +7,12 @@
  * vr=value: Real start values set before initialisation (the benchmark of
  * a configuration with output limits and rates below 0 in use).
  *
+ * FMI 3 with a cycleTime: Scheduled Execution's activation beside
+ * Co-Simulation's doStep of one cycle (the Clock's value reference read
+ * from the modelDescription.xml two folders above the binary, as an FMU
+ * and its stage are laid out: the Scheduled Execution FMU's, whose binary
+ * is the Co-Simulation FMU's and whose description alone has the Clock).
+ *
  * Under valgrind --tool=callgrind each measured loop is bracketed by client
  * requests (zero, then dump with the loop's name), so that the caller can
  * read instructions per step from the dumps; natively the loops are timed. */
@@ -107,6 +113,9 @@ static struct {
     fmi3SetFloat64TYPE *fmi3SetFloat64;
     fmi3GetFloat64TYPE *fmi3GetFloat64;
     fmi3DoStepTYPE *fmi3DoStep;
+    fmi3InstantiateScheduledExecutionTYPE *fmi3InstantiateScheduledExecution;
+    fmi3ActivateModelPartitionTYPE *fmi3ActivateModelPartition;
+    long clockVr; /* -1: no Clock found */
 } F;
 
 static const fmi2CallbackFunctions callbacks = { log2_message, count_allocate, count_free, NULL, NULL };
@@ -145,7 +154,27 @@ static void load(const char *path) {
         LOAD(fmi3SetFloat64);
         LOAD(fmi3GetFloat64);
         LOAD(fmi3DoStep);
+        LOAD(fmi3InstantiateScheduledExecution);
+        LOAD(fmi3ActivateModelPartition);
     }
+}
+
+/* The Clock's value reference in the modelDescription.xml of the FMU whose
+ * binary is at path (<fmu>/binaries/<platform>/<name>.so); -1 if none. */
+static long clock_vr(const char *path) {
+    char description[4096];
+    const char *slash = strrchr(path, '/');
+    const int folder = slash ? (int)(slash - path) : 0;
+    snprintf(description, sizeof description, "%.*s/../../modelDescription.xml", folder, path);
+    FILE *file = fopen(description, "rb");
+    if (!file) return -1;
+    static char text[1 << 20];
+    const size_t n = fread(text, 1, sizeof text - 1, file);
+    fclose(file);
+    text[n] = 0;
+    const char *clock = strstr(text, "<Clock ");
+    const char *vr = clock ? strstr(clock, "valueReference=\"") : NULL;
+    return vr ? strtol(vr + strlen("valueReference=\""), NULL, 10) : -1;
 }
 
 static void must(int status, const char *what) {
@@ -187,6 +216,32 @@ static void start(void *c, double cycleTime) {
         must(F.fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3False, 0.0), "fmi3EnterInitializationMode");
         must(F.fmi3ExitInitializationMode(c), "fmi3ExitInitializationMode");
     }
+}
+
+/* Scheduled Execution: the preemption callbacks of an importer whose
+ * locks cost a call each (locked), or none (an importer that does not
+ * preempt) */
+static size_t preemptionLocks;
+static void lock_preemption(void) {
+    preemptionLocks++;
+}
+static void unlock_preemption(void) {
+    preemptionLocks--;
+}
+
+static void *start_scheduled(double cycleTime, int locked) {
+    void *c = F.fmi3InstantiateScheduledExecution("bench", F.token, NULL, fmi3False, fmi3False, NULL, log3_message,
+                                                  NULL, locked ? lock_preemption : NULL,
+                                                  locked ? unlock_preemption : NULL);
+    if (!c) {
+        fprintf(stderr, "fmu_bench: instantiation for Scheduled Execution failed\n");
+        exit(1);
+    }
+    set_real(c, (unsigned)F.cycleVr, cycleTime);
+    for (int i = 0; i < startCount; i++) set_real(c, startVrs[i], startValues[i]);
+    must(F.fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3False, 0.0), "fmi3EnterInitializationMode");
+    must(F.fmi3ExitInitializationMode(c), "fmi3ExitInitializationMode");
+    return c;
 }
 
 static void release(void *c) {
@@ -347,6 +402,41 @@ static double loop_instances(uint64_t steps, double cycleTime) {
     return (t1 - t0) * (double)steps / (double)(points * INSTANCES);
 }
 
+/* One activation per PLC cycle: set u, activate at the tick, get y (the
+ * counterpart of loop_cycle_1's set, doStep of one cycle, get). */
+static double loop_scheduled(uint64_t steps, double cycleTime, int locked, const char *label) {
+    void *c = start_scheduled(cycleTime, locked);
+    fmi3SetFloat64TYPE *setFloat64 = F.fmi3SetFloat64;
+    fmi3GetFloat64TYPE *getFloat64 = F.fmi3GetFloat64;
+    fmi3ActivateModelPartitionTYPE *activate = F.fmi3ActivateModelPartition;
+    const unsigned uVr = F.uVr, yVr = F.yVr, clock = (unsigned)F.clockVr;
+    double y = 0;
+    CALLGRIND_ZERO_STATS;
+    const double t0 = now();
+    for (uint64_t i = 0; i < steps; i++) {
+        double u = input(i);
+        setFloat64(c, &uVr, 1, &u, 1);
+        if (activate(c, clock, (double)(i + 1) * cycleTime) != fmi3OK) exit(1);
+        getFloat64(c, &yVr, 1, &y, 1);
+        *(volatile double *)&sink = y;
+    }
+    const double t1 = now();
+    CALLGRIND_DUMP_STATS_AT(label);
+    if (preemptionLocks != 0) {
+        fprintf(stderr, "fmu_bench: %zu preemption locks left held\n", preemptionLocks);
+        exit(1);
+    }
+    release(c);
+    return t1 - t0;
+}
+
+static double loop_activation(uint64_t steps, double cycleTime) {
+    return loop_scheduled(steps, cycleTime, 0, "activation");
+}
+static double loop_activation_locked(uint64_t steps, double cycleTime) {
+    return loop_scheduled(steps, cycleTime, 1, "activationLocked");
+}
+
 static double loop_step(uint64_t steps, double cycleTime) {
     return loop_fmu(steps, cycleTime, 1, "step");
 }
@@ -436,6 +526,7 @@ int main(int argc, char **argv) {
     if (repeats < 1) repeats = 1;
     if (repeats > 64) repeats = 64;
     load(argv[2]);
+    F.clockVr = F.version == 3 ? clock_vr(argv[2]) : -1;
 
     const double empty = median_ns(loop_empty, steps, 0.0, repeats);
     const double kernel = median_ns(loop_kernel, steps, 0.0, repeats);
@@ -452,6 +543,18 @@ int main(int argc, char **argv) {
         const double one = median_ns(loop_cycle_1, steps / 100 + 1, H, repeats);
         const double many = median_ns(loop_cycle_n, steps / 100 + 1, H / 100, repeats);
         printf("subcycle_extra_ns %.2f ns/cycle\n", (many - one) / 99);
+        if (F.clockVr >= 0) {
+            /* per PLC cycle, set u and get y included: Co-Simulation's
+             * doStep of one cycle (cycleTime = the step) and Scheduled
+             * Execution's activation, without and with preemption locks */
+            const double activation = median_ns(loop_activation, steps, H, repeats);
+            const double locked = median_ns(loop_activation_locked, steps, H, repeats);
+            const double cycleStep = median_ns(loop_cycle_1, steps, H, repeats);
+            printf("cycle_doStep_ns %.2f ns/cycle\n", cycleStep);
+            printf("activation_ns %.2f ns/cycle\n", activation);
+            printf("activation_locked_ns %.2f ns/cycle\n", locked);
+            printf("activation_over_doStep %.3f ratio\n", activation / cycleStep);
+        }
     }
     allocations();
     return 0;

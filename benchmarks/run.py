@@ -52,6 +52,11 @@ ANCHORS = {
 
 def model_info(build, model, version):
     stage = build / "stage" / f"fmi{version}" / model
+    scheduled = build / "stage" / "fmi3-se" / model  # cmake/Fmu.cmake's FMI3_SE_FOLDER
+    if version == 3 and scheduled.is_dir():
+        # the Scheduled Execution FMU's stage: the same binary, and the model description with the Clock that
+        # fmu_bench activates beside doStep (the Co-Simulation FMU declares none, FMI 3.0 4.4)
+        stage = scheduled
     md = read_model_description(str(stage / "modelDescription.xml"))
     vr = {v.name: v.valueReference for v in md.modelVariables}
     token = md.guid if version == 2 else md.instantiationToken

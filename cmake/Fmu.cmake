@@ -6,6 +6,9 @@
 # sources give the same bytes on any machine and for any user.
 # A fixture passes its own TOML, C sources (relative to the source tree) and
 # output folder: add_fmu(<Model> <2|3> TOML t SOURCES a.c ... OUTPUT_DIR d).
+# add_fmu(<Model> 3 SCHEDULED_EXECUTION), after add_fmu(<Model> 3): build/fmi3-se/<Model>.fmu, FMI 3
+# Scheduled Execution alone (with its Clock) on the same binary; build/fmi3/<Model>.fmu carries
+# Co-Simulation and Model Exchange without a Clock (FMI 3.0, 4.4; docs/fmi.md, Scheduled Execution).
 
 include(${CMAKE_CURRENT_LIST_DIR}/FmuSources.cmake)
 
@@ -13,14 +16,20 @@ add_custom_target(fmus ALL)
 
 set(FMU_ZIP_MTIME "2000-01-01 00:00:00 UTC")
 set(GENERATOR ${CMAKE_SOURCE_DIR}/modelDescription/generate.py)
+set(FMI3_SE_FOLDER fmi3-se)  # generate.py's FMI3_VARIANTS names the same
 
 function(add_fmu model version)
-  cmake_parse_arguments(PARSE_ARGV 2 ARG "" "TOML;OUTPUT_DIR" "SOURCES")
+  cmake_parse_arguments(PARSE_ARGV 2 ARG "SCHEDULED_EXECUTION" "TOML;OUTPUT_DIR" "SOURCES")
+  # the folder of this FMU's model description, stage and package; its binary is fmi<version>'s
+  set(folder fmi${version})
+  if(ARG_SCHEDULED_EXECUTION)
+    set(folder ${FMI3_SE_FOLDER})
+  endif()
   if(NOT TARGET zip_normalize)
     add_executable(zip_normalize ${CMAKE_SOURCE_DIR}/cmake/zip_normalize.c)
   endif()
   set(gen ${CMAKE_BINARY_DIR}/gen/${model})
-  set(stage ${CMAKE_BINARY_DIR}/stage/fmi${version}/${model})
+  set(stage ${CMAKE_BINARY_DIR}/stage/${folder}/${model})
   set(toml ${CMAKE_SOURCE_DIR}/modelDescription/${model}.toml)
   set(header ${gen}/${model}_variables.h)
   # a product model compiles its unit, which includes its sources; a fixture its own sources
@@ -38,7 +47,7 @@ function(add_fmu model version)
     fmu_unit(unit ${model} ${version} ${gen}/fmi${version})
     set(compiled ${unit})
     set(include_dirs ${FMU_INCLUDE_DIRS})
-    set(out_dir ${CMAKE_BINARY_DIR}/fmi${version})
+    set(out_dir ${CMAKE_BINARY_DIR}/${folder})
   endif()
   # what the model description lists (FMI 2 SourceFiles, FMI 3 buildDescription.xml)
   set(c_names)
@@ -59,6 +68,7 @@ function(add_fmu model version)
     string(REPLACE "fmi${version}" "fmi3" c_names3 "${c_names}")
     add_custom_command(
       OUTPUT ${gen}/fmi2/modelDescription.xml ${gen}/fmi3/modelDescription.xml
+             ${gen}/${FMI3_SE_FOLDER}/modelDescription.xml
              ${gen}/fmi3/buildDescription.xml ${header}
       COMMAND ${Python3_EXECUTABLE} ${GENERATOR} ${toml} ${gen}
               --fmi2-sources ${c_names2} --fmi3-sources ${c_names3}
@@ -68,20 +78,28 @@ function(add_fmu model version)
   endif()
 
   set(lib ${model}_fmi${version})
-  add_library(${lib} SHARED ${compiled} ${header})
-  add_dependencies(${lib} ${model}_description)
-  list(TRANSFORM include_dirs PREPEND ${CMAKE_SOURCE_DIR}/)
-  target_include_directories(${lib} PRIVATE ${include_dirs} ${gen} ${FMI_HEADERS_DIR})
-  target_link_libraries(${lib} PRIVATE m)
-  target_link_options(${lib} PRIVATE -Wl,-z,defs)
-  set_target_properties(${lib} PROPERTIES
-    OUTPUT_NAME ${model} PREFIX ""
-    LIBRARY_OUTPUT_DIRECTORY ${stage}/binaries/${platform})
+  set(copies)
+  if(ARG_SCHEDULED_EXECUTION)
+    # the same binary, built by add_fmu(<Model> 3)
+    list(APPEND copies
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/binaries/${platform}
+      COMMAND ${CMAKE_COMMAND} -E copy $<TARGET_FILE:${lib}> ${stage}/binaries/${platform}/)
+  else()
+    add_library(${lib} SHARED ${compiled} ${header})
+    add_dependencies(${lib} ${model}_description)
+    list(TRANSFORM include_dirs PREPEND ${CMAKE_SOURCE_DIR}/)
+    target_include_directories(${lib} PRIVATE ${include_dirs} ${gen} ${FMI_HEADERS_DIR})
+    target_link_libraries(${lib} PRIVATE m)
+    target_link_options(${lib} PRIVATE -Wl,-z,defs)
+    set_target_properties(${lib} PROPERTIES
+      OUTPUT_NAME ${model} PREFIX ""
+      LIBRARY_OUTPUT_DIRECTORY ${stage}/binaries/${platform})
+  endif()
 
   list(TRANSFORM sources PREPEND ${CMAKE_SOURCE_DIR}/ REGEX "^[^/]")
-  set(copies
+  list(APPEND copies
     COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/sources
-    COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
+    COMMAND ${CMAKE_COMMAND} -E copy ${gen}/${folder}/modelDescription.xml ${stage}/
     COMMAND ${CMAKE_COMMAND} -E copy ${sources} ${unit} ${header} ${stage}/sources/
     # the licence, where the FMI 3 standard puts its entry point (FMI 2 names no place; the same there)
     COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}/documentation/licenses
@@ -109,13 +127,15 @@ function(add_fmu model version)
     list(TRANSFORM doc_files PREPEND ${stage}/ OUTPUT_VARIABLE docs)
     add_custom_command(
       OUTPUT ${docs}
-      COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
+      ${copies}
       COMMAND ${RUN_FMU_TOOL} ${VENV_PYTHON} ${CMAKE_SOURCE_DIR}/modelDescription/document.py
               ${toml} ${stage} ${version} ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c
+              # the ramp is drawn by Co-Simulation, which the Scheduled Execution FMU does not declare
+              ${CMAKE_BINARY_DIR}/stage/fmi${version}/${model}
       DEPENDS ${lib} ${toml} ${CMAKE_SOURCE_DIR}/modelDescription/document.py ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.c
-              ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.h ${gen}/fmi${version}/modelDescription.xml
-              ${gen}/fmi${version}/entries_ls_ref.txt  # (its page lists the experiments: references.py below)
-      COMMENT "Documenting fmi${version}/${model}")
+              ${CMAKE_SOURCE_DIR}/fmu_src/rate_limiter.h ${gen}/${folder}/modelDescription.xml
+              ${gen}/${folder}/entries_ls_ref.txt  # (its page lists the experiments: references.py below)
+      COMMENT "Documenting ${folder}/${model}")
     list(APPEND entries ${doc_files})
   endif()
 
@@ -146,25 +166,31 @@ function(add_fmu model version)
     set(scenarios_dir ${CMAKE_SOURCE_DIR}/tests/scenarios/${model})
     file(GLOB_RECURSE scenario_files CONFIGURE_DEPENDS ${scenarios_dir}/*)
     list(JOIN entries "\n" entry_lines)
-    file(CONFIGURE OUTPUT ${gen}/fmi${version}/entries.txt CONTENT "${entry_lines}\n" @ONLY)
-    set(references ${gen}/fmi${version}/entries_ls_ref.txt)
-    # the state after the first half of the first scenario, from the staged FMU (state.py)
-    set(state ${gen}/fmi${version}/first_half.fmustate)
-    add_custom_command(
-      OUTPUT ${state}
-      COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
-      COMMAND ${RUN_FMU_TOOL} ${VENV_PYTHON} ${CMAKE_SOURCE_DIR}/modelDescription/state.py ${stage} ${version}
-              ${scenarios_dir} ${state}
-      DEPENDS ${lib} ${CMAKE_SOURCE_DIR}/modelDescription/state.py ${CMAKE_SOURCE_DIR}/modelDescription/references.py
-              ${gen}/fmi${version}/modelDescription.xml ${scenario_files}
-      COMMENT "Serializing a state of fmi${version}/${model}")
+    file(CONFIGURE OUTPUT ${gen}/${folder}/entries.txt CONTENT "${entry_lines}\n" @ONLY)
+    set(references ${gen}/${folder}/entries_ls_ref.txt)
+    # the state after the first half of the first scenario, from the staged FMU (state.py); none in the
+    # Scheduled Execution FMU, whose instances refuse a Co-Simulation state (docs/fmi.md)
+    set(state)
+    if(NOT ARG_SCHEDULED_EXECUTION)
+      set(state ${gen}/fmi${version}/first_half.fmustate)
+      add_custom_command(
+        OUTPUT ${state}
+        COMMAND ${CMAKE_COMMAND} -E copy ${gen}/fmi${version}/modelDescription.xml ${stage}/
+        COMMAND ${RUN_FMU_TOOL} ${VENV_PYTHON} ${CMAKE_SOURCE_DIR}/modelDescription/state.py ${stage} ${version}
+                ${scenarios_dir} ${state}
+        DEPENDS ${lib} ${CMAKE_SOURCE_DIR}/modelDescription/state.py ${CMAKE_SOURCE_DIR}/modelDescription/references.py
+                ${gen}/fmi${version}/modelDescription.xml ${scenario_files}
+        COMMENT "Serializing a state of fmi${version}/${model}")
+    endif()
     add_custom_command(
       OUTPUT ${references}
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${stage}
+      COMMAND ${CMAKE_COMMAND} -E copy ${gen}/${folder}/modelDescription.xml ${stage}/
       COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/modelDescription/references.py ${toml} ${scenarios_dir}
-              ${stage} ${gen}/fmi${version}/entries.txt ${references} ${state}
+              ${stage} ${gen}/${folder}/entries.txt ${references} ${state}
       DEPENDS ${CMAKE_SOURCE_DIR}/modelDescription/references.py ${toml} ${scenario_files}
-              ${gen}/fmi${version}/entries.txt ${state}
-      COMMENT "Writing the reference experiments of fmi${version}/${model}")
+              ${gen}/${folder}/entries.txt ${state} ${gen}/${folder}/modelDescription.xml
+      COMMENT "Writing the reference experiments of ${folder}/${model}")
     set(zip_entries --files-from=${references})
   endif()
 
@@ -176,13 +202,17 @@ function(add_fmu model version)
     COMMAND ${CMAKE_COMMAND} -E tar cf ${fmu} --format=zip "--mtime=${FMU_ZIP_MTIME}" ${zip_entries}
     COMMAND zip_normalize ${fmu}
     WORKING_DIRECTORY ${stage}
-    DEPENDS zip_normalize ${lib} ${sources} ${unit} ${header} ${gen}/fmi${version}/modelDescription.xml ${docs}
+    DEPENDS zip_normalize ${lib} ${sources} ${unit} ${header} ${gen}/${folder}/modelDescription.xml ${docs}
             ${CMAKE_SOURCE_DIR}/LICENSE ${references}
             ${cross_libraries}
-    COMMENT "Packaging fmi${version}/${model}.fmu")
-  add_custom_target(${lib}_fmu DEPENDS ${fmu})
+    COMMENT "Packaging ${folder}/${model}.fmu")
+  string(MAKE_C_IDENTIFIER ${model}_${folder}_fmu fmu_target)
+  add_custom_target(${fmu_target} DEPENDS ${fmu})
   foreach(target IN LISTS cross_targets)
-    add_dependencies(${lib}_fmu ${target})
+    add_dependencies(${fmu_target} ${target})
   endforeach()
-  add_dependencies(fmus ${lib}_fmu)
+  if(ARG_SCHEDULED_EXECUTION)
+    add_dependencies(${fmu_target} ${model}_fmi3_fmu)  # its binary and its plot are fmi3's
+  endif()
+  add_dependencies(fmus ${fmu_target})
 endfunction()

@@ -17,7 +17,7 @@
  * Mode too, where the standard has only continuous-time inputs (condition
  * 5), as importers such as OMSimulator set every input at each step; the
  * next cycle uses the values the instant before it is left with
- * (fmu_leave_instant), wherever they were set. */
+ * (fmu_latch_values), wherever they were set. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
@@ -90,7 +90,8 @@ typedef struct {
 /* a function of one interface: an instance of the other is refused */
 #define BEGIN_ONLY_AS(function, modes, fmuType) \
     BEGIN_AS(function, modes); \
-    if (I->modelExchange != ((fmuType) == fmi2ModelExchange)) return (fmi2Status)other_interface(I, FN)
+    if ((I->interfaceType == FMU_MODEL_EXCHANGE) != ((fmuType) == fmi2ModelExchange)) \
+    return (fmi2Status)other_interface(I, FN)
 
 /* a Model Exchange function (fmi_entries.h) */
 #define BEGIN_ME(name) BEGIN_ME_AS(#name, MODES_##name)
@@ -104,8 +105,8 @@ typedef struct {
 
 FMU_COLD static FmuStatus other_interface(FmuInstance *I, const char *function) {
     return fmu_error(I, function, "a %s function, and this instance was instantiated for %s",
-                     I->modelExchange ? "Co-Simulation" : "Model Exchange",
-                     I->modelExchange ? "Model Exchange" : "Co-Simulation");
+                     I->interfaceType == FMU_MODEL_EXCHANGE ? "Co-Simulation" : "Model Exchange",
+                     fmu_interface_name(I->interfaceType));
 }
 
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
@@ -166,7 +167,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     g->base.logFunction = functions->logger ? log_to_importer : NULL;
     g->base.logCategories = (loggingOn ? LOG_ALL : 0) | ALWAYS_LOGGED;
     g->base.errorMode = MODE_ERROR; /* FMI 2.0.4 section 2.1.3: only reads, reset or an FMU state lead on */
-    g->base.modelExchange = fmuType == fmi2ModelExchange;
+    g->base.interfaceType = fmuType == fmi2ModelExchange ? FMU_MODEL_EXCHANGE : FMU_CO_SIMULATION;
     g->base.allocate = allocate_state;
     g->base.release = release_state;
     fmu_init_instance(&g->base);

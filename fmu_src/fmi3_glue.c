@@ -1,5 +1,6 @@
-/* FMI 3.0 Co-Simulation (no event mode) and Model Exchange interfaces (no
- * clocks), shared by every model. */
+/* FMI 3.0 Co-Simulation (no event mode), Model Exchange and Scheduled
+ * Execution (one input Clock, the PLC's cyclic interrupt) interfaces,
+ * shared by every model. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -7,37 +8,41 @@
 #include "fmi_entries.h"
 
 /* Modes each function may be called in: FMI 3.0.2, section 2.3 (common
- * states), 3.2 (Model Exchange) and 4.2 (Co-Simulation without Event
- * Mode). "If any function called in super state FMU State Settable
+ * states), 3.2 (Model Exchange), 4.2 (Co-Simulation without Event Mode)
+ * and 5.2 (Scheduled Execution). "If any function called in super state FMU State Settable
  * returns fmi3Error, the FMU enters state Terminated" (2.3): there is no
  * Error state, a failed call leaves the instance Terminated (errorMode),
  * where the values can be read and the FMU-state functions, reset and
  * free are allowed. Step Mode is only ever a Co-Simulation instance's,
- * Event Mode and Continuous-Time Mode a Model Exchange instance's; the
+ * Clock Activation Mode a Scheduled Execution instance's, Event Mode and
+ * Continuous-Time Mode a Model Exchange instance's; the
  * functions of Model Exchange alone also refuse a Co-Simulation instance
  * (BEGIN_ME). Beyond the standard: the sets of Event Mode are taken in
  * Continuous-Time Mode too, where it has only continuous-time inputs, as
  * importers such as OMSimulator set every input at each step; the next
  * cycle uses the values the instant before it is left with
- * (fmu_leave_instant), wherever they were set. */
+ * (fmu_latch_values), wherever they were set. */
 #define INST MODE_INSTANTIATED
 #define INIT MODE_INITIALIZATION
 #define STEP MODE_STEP
 #define TERM MODE_TERMINATED
 #define EVENT MODE_EVENT
 #define CONT MODE_CONTINUOUS
-/* the super state FMU State Settable: every state of this FMU */
-#define SETTABLE (INST | INIT | STEP | EVENT | CONT | TERM)
+#define CLOCK MODE_CLOCK_ACTIVATION
+/* the super state FMU State Settable: every state of this FMU (Scheduled
+ * Execution's FMU-state functions are called between activations: this
+ * FMU's one model partition runs within fmi3ActivateModelPartition) */
+#define SETTABLE (INST | INIT | STEP | EVENT | CONT | CLOCK | TERM)
 /* the super state Initialized */
-#define INITIALIZED (STEP | EVENT | CONT | TERM)
+#define INITIALIZED (STEP | EVENT | CONT | CLOCK | TERM)
 
 #define MODES_fmi3SetDebugLogging SETTABLE
 #define MODES_fmi3EnterInitializationMode (INST)
 #define MODES_fmi3ExitInitializationMode (INIT)
-#define MODES_fmi3Terminate (STEP | EVENT | CONT)
+#define MODES_fmi3Terminate (STEP | EVENT | CONT | CLOCK)
 #define MODES_fmi3Reset SETTABLE
-#define MODES_Get (INIT | STEP | EVENT | CONT | TERM)
-#define MODES_Set (INST | INIT | STEP | EVENT | CONT)
+#define MODES_Get (INIT | STEP | EVENT | CONT | CLOCK | TERM)
+#define MODES_Set (INST | INIT | STEP | EVENT | CONT | CLOCK)
 #define MODES_fmi3GetFMUState SETTABLE
 #define MODES_fmi3SetFMUState SETTABLE
 #define MODES_fmi3FreeFMUState SETTABLE
@@ -45,6 +50,12 @@
 #define MODES_fmi3SerializeFMUState SETTABLE
 #define MODES_fmi3DeserializeFMUState SETTABLE
 #define MODES_fmi3DoStep (STEP)
+/* Scheduled Execution and its clock: the interval and shift of a fixed
+ * periodic Clock without intervalDecimal are asked in Initialization Mode,
+ * the interval again in Clock Activation Mode (2.2.9.3) */
+#define MODES_fmi3ActivateModelPartition (CLOCK)
+#define MODES_fmi3GetIntervalDecimal (INIT | CLOCK)
+#define MODES_fmi3GetShiftDecimal (INIT)
 /* Model Exchange */
 #define MODES_fmi3EnterEventMode (CONT)
 #define MODES_fmi3UpdateDiscreteStates (EVENT)
@@ -89,6 +100,10 @@
 typedef struct {
     FmuInstance base; /* first: an fmi3Instance is an FmuInstance */
     fmi3LogMessageCallback logMessage;
+    /* Scheduled Execution's critical sections (5.1.2), NULL otherwise or
+     * when the importer does not preempt */
+    fmi3LockPreemptionCallback lockPreemption;
+    fmi3UnlockPreemptionCallback unlockPreemption;
 } Fmi3Instance;
 
 /* The start of every entry point; name is its full name (fmi3DoStep), the modes it may
@@ -100,11 +115,17 @@ typedef struct {
     if (!I) return fmi3Error; \
     if (!(I->core.mode & (modes))) return (fmi3Status)fmu_mode_error(I, FN)
 
-/* a Model Exchange function: a Co-Simulation instance is refused */
+/* a Model Exchange function: an instance of another interface is refused */
 #define BEGIN_ME(name) BEGIN_ME_AS(#name, MODES_##name)
 #define BEGIN_ME_AS(function, modes) \
     BEGIN_AS(function, modes); \
-    if (!I->modelExchange) return (fmi3Status)fmu_error(I, FN, "%s", NO_EVENT_MODE)
+    if (I->interfaceType != FMU_MODEL_EXCHANGE) return (fmi3Status)other_interface(I, FN, FMU_MODEL_EXCHANGE)
+
+/* a Scheduled Execution function (the Clock's): an instance of another
+ * interface is refused, as the Clock ticks in Scheduled Execution only */
+#define BEGIN_SE(name) \
+    BEGIN_AS(#name, MODES_##name); \
+    if (I->interfaceType != FMU_SCHEDULED_EXECUTION) return (fmi3Status)other_interface(I, FN, FMU_SCHEDULED_EXECUTION)
 
 #define CHECK(expression) \
     do { \
@@ -112,8 +133,25 @@ typedef struct {
         if (status_ > FMU_WARNING) return (fmi3Status)status_; \
     } while (0)
 
-#define NO_EVENT_MODE "a Model Exchange function, and this instance was instantiated for Co-Simulation"
 #define NO_CS_EVENT_MODE "this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"
+
+/* A function of interface own called on an instance of another. */
+FMU_COLD static FmuStatus other_interface(FmuInstance *I, const char *function, FmuInterface own) {
+    return fmu_error(I, function, "a %s function, and this instance was instantiated for %s", fmu_interface_name(own),
+                     fmu_interface_name(I->interfaceType));
+}
+
+/* Scheduled Execution's critical sections: the values and the block,
+ * which an activation and the gets and sets of other tasks share. */
+static void lock_preemption(FmuInstance *instance) {
+    const Fmi3Instance *g = (const Fmi3Instance *)instance;
+    if (g->lockPreemption) g->lockPreemption();
+}
+
+static void unlock_preemption(FmuInstance *instance) {
+    const Fmi3Instance *g = (const Fmi3Instance *)instance;
+    if (g->unlockPreemption) g->unlockPreemption();
+}
 
 static void log_to_importer(FmuInstance *instance, FmuStatus status, const char *category, const char *message) {
     const Fmi3Instance *g = (const Fmi3Instance *)instance;
@@ -137,9 +175,9 @@ const char *fmi3GetVersion(void) {
 
 /* A new instance; NULL, said why, on the first problem: those of every
  * instance, then the interface's own (interfaceRefusal, if not NULL). */
-static fmi3Instance instantiate(const char *interfaceRefusal, bool modelExchange, fmi3String instanceName,
-                                fmi3String instantiationToken, fmi3Boolean loggingOn,
-                                fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
+static Fmi3Instance *instantiate(const char *interfaceRefusal, FmuInterface interfaceType, fmi3String instanceName,
+                                 fmi3String instantiationToken, fmi3Boolean loggingOn,
+                                 fmi3InstanceEnvironment instanceEnvironment, fmi3LogMessageCallback logMessage) {
     const char *reason = interfaceRefusal;
     if (!instanceName || !*instanceName) {
         reason = "instanceName is missing";
@@ -157,7 +195,7 @@ static fmi3Instance instantiate(const char *interfaceRefusal, bool modelExchange
     g->base.logFunction = logMessage ? log_to_importer : NULL;
     g->base.logCategories = loggingOn ? LOG_ALL : 0;
     g->base.errorMode = MODE_TERMINATED;
-    g->base.modelExchange = modelExchange;
+    g->base.interfaceType = interfaceType;
     g->base.allocate = allocate_state;
     g->base.release = release_state;
     fmu_init_instance(&g->base);
@@ -179,7 +217,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     const char *reason = eventModeUsed                        ? NO_CS_EVENT_MODE
                          : nRequiredIntermediateVariables > 0 ? "this FMU provides no intermediate update"
                                                               : NULL;
-    return instantiate(reason, false, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
+    return instantiate(reason, FMU_CO_SIMULATION, instanceName, instantiationToken, loggingOn, instanceEnvironment,
+                       logMessage);
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
@@ -188,7 +227,8 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3LogMessageCallback logMessage) {
     (void)resourcePath;
     (void)visible;
-    return instantiate(NULL, true, instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage);
+    return instantiate(NULL, FMU_MODEL_EXCHANGE, instanceName, instantiationToken, loggingOn, instanceEnvironment,
+                       logMessage);
 }
 
 void fmi3FreeInstance(fmi3Instance instance) {
@@ -225,7 +265,27 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
 }
 
 /* One value is the common call: straight-line code without a frame; any
- * other count goes through the loops (all checked before any is set). */
+ * other count goes through the loops (all checked before any is set).
+ * Scheduled Execution's Clock Activation Mode takes the out-of-line path
+ * (_preemptible): the call is a critical section there, so that neither it
+ * nor an activation sees the other half done; Co-Simulation's and Model
+ * Exchange's calls pay nothing for it. */
+#define BEGIN_ACCESS(function, modes, PREEMPTIBLE) \
+    FmuInstance *I = (FmuInstance *)instance; \
+    static const char FN[] = function; \
+    if (!I) return fmi3Error; \
+    if (!(I->core.mode & (modes) & ~CLOCK)) return PREEMPTIBLE(I, FN, vr, nvr, values, nValues)
+
+#define PREEMPTIBLE_ACCESS(NAME, ARRAY, MODES, CONST, TYPE) \
+    FMU_NOINLINE static fmi3Status NAME(FmuInstance *I, const char *FN, const fmi3ValueReference vr[], size_t nvr, \
+                                        CONST TYPE values[], size_t nValues) { \
+        if (!(I->core.mode & (MODES))) return (fmi3Status)fmu_mode_error(I, FN); \
+        lock_preemption(I); \
+        const fmi3Status status = ARRAY(I, FN, vr, nvr, values, nValues); \
+        unlock_preemption(I); \
+        return status; \
+    }
+
 #define ACCESSORS(GET, SET, TYPE, TYPE_MASK, TO_FMI) \
     FMU_NOINLINE static fmi3Status GET##_array(FmuInstance *I, const char *FN, const fmi3ValueReference vr[], \
                                                size_t nvr, TYPE values[], size_t nValues) { \
@@ -241,8 +301,10 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
         for (size_t i = 0; i < nvr; i++) fmu_set(I, vr[i], (double)values[i]); \
         return fmi3OK; \
     } \
+    PREEMPTIBLE_ACCESS(GET##_preemptible, GET##_array, MODES_##GET, , TYPE) \
+    PREEMPTIBLE_ACCESS(SET##_preemptible, SET##_array, MODES_##SET, const, TYPE) \
     fmi3Status GET(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, TYPE values[], size_t nValues) { \
-        BEGIN_AS(#GET, MODES_##GET); \
+        BEGIN_ACCESS(#GET, MODES_##GET, GET##_preemptible); \
         double v_; \
         if (nvr != 1 || nValues != 1 || !vr || !values) return GET##_array(I, FN, vr, nvr, values, nValues); \
         if (!fmu_get_one(I, FN, TYPE_MASK, vr[0], &v_)) return fmi3Error; \
@@ -251,7 +313,7 @@ static FmuStatus check_arrays(FmuInstance *I, const char *function, const fmi3Va
     } \
     fmi3Status SET(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const TYPE values[], \
                    size_t nValues) { \
-        BEGIN_AS(#SET, MODES_##SET); \
+        BEGIN_ACCESS(#SET, MODES_##SET, SET##_preemptible); \
         if (nvr != 1 || nValues != 1 || !vr || !values) return SET##_array(I, FN, vr, nvr, values, nValues); \
         return fmu_set_one(I, FN, TYPE_MASK, vr[0], (double)values[0]) ? fmi3OK : fmi3Error; \
     }
@@ -367,6 +429,183 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
 
 NUMBER_OF_NONE(fmi3GetNumberOfEventIndicators)
 NUMBER_OF_NONE(fmi3GetNumberOfContinuousStates)
+
+/* ---- Scheduled Execution: the PLC's cyclic interrupt as an input Clock ------
+ * (docs/fmi.md, Scheduled Execution). One model partition, the block's
+ * cycle, activated at each tick of the Clock (fmuModel.clockName), a fixed
+ * periodic Clock whose interval and shift are cycleTime; the variables are
+ * not clocked, so that Co-Simulation and Model Exchange keep them. */
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
+                                               fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                               fmi3InstanceEnvironment instanceEnvironment,
+                                               fmi3LogMessageCallback logMessage, fmi3ClockUpdateCallback clockUpdate,
+                                               fmi3LockPreemptionCallback lockPreemption,
+                                               fmi3UnlockPreemptionCallback unlockPreemption) {
+    (void)resourcePath;
+    (void)visible;
+    (void)clockUpdate; /* no output or countdown Clock to announce */
+    /* both or neither: an importer that does not preempt may give neither */
+    const char *reason = !lockPreemption != !unlockPreemption
+                             ? "lockPreemption and unlockPreemption must both be given, or neither"
+                             : NULL;
+    Fmi3Instance *g = instantiate(reason, FMU_SCHEDULED_EXECUTION, instanceName, instantiationToken, loggingOn,
+                                  instanceEnvironment, logMessage);
+    if (g) {
+        g->lockPreemption = lockPreemption;
+        g->unlockPreemption = unlockPreemption;
+    }
+    return g;
+}
+
+/* The Clock's value reference, else why not (a variable's, or none). */
+static FmuStatus check_clock(FmuInstance *I, const char *function, fmi3ValueReference vr) {
+    const ModelDefinition *model = I->model;
+    if (vr == model->clockVr) return FMU_OK;
+    if (vr < model->count) {
+        return fmu_error(I, function, "%s (value reference %u) is not a Clock; the Clock is %s (value reference %u)",
+                         model->variables[vr].name, vr, model->clockName, model->clockVr);
+    }
+    return fmu_error(I, function, "unknown Clock reference %u; the Clock is %s (value reference %u)", vr,
+                     model->clockName, model->clockVr);
+}
+
+static FmuStatus check_clocks(FmuInstance *I, const char *function, const fmi3ValueReference vr[], size_t nvr,
+                              const void *values) {
+    if (fmu_check_array(I, function, nvr, vr, values) != FMU_OK) return FMU_ERROR;
+    for (size_t i = 0; i < nvr; i++) {
+        if (check_clock(I, function, vr[i]) != FMU_OK) return FMU_ERROR;
+    }
+    return FMU_OK;
+}
+
+/* The Clock's interval: cycleTime, which must be set (finite, > 0). */
+static FmuStatus clock_interval(FmuInstance *I, const char *function, double *interval) {
+    *interval = fmu_configured_cycle(I);
+    if (*interval == 0) {
+        return fmu_error(I, function,
+                         "%s has no interval: cycleTime is not a PLC cycle (finite, > 0); set it to the interval of "
+                         "the cyclic interrupt OB or task",
+                         I->model->clockName);
+    }
+    return FMU_OK;
+}
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
+                                      fmi3Float64 activationTime) {
+    BEGIN_SE(fmi3ActivateModelPartition);
+    CHECK(check_clock(I, FN, clockReference));
+    lock_preemption(I);
+    const FmuStatus status = fmu_activate(I, FN, activationTime);
+    unlock_preemption(I);
+    return (fmi3Status)status;
+}
+
+/* Initialization Mode: the interval changed if it is not the one reported
+ * last (2.2.9.6); Clock Activation Mode: a fixed Clock's never changes. */
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                  fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[]) {
+    BEGIN_SE(fmi3GetIntervalDecimal);
+    CHECK(check_clocks(I, FN, vr, nvr, intervals));
+    if (nvr > 0 && !qualifiers) return (fmi3Status)fmu_error(I, FN, "the qualifier array is NULL");
+    if (nvr == 0) return fmi3OK;
+    double interval;
+    const bool preemptible = I->core.mode == CLOCK;
+    if (preemptible) lock_preemption(I);
+    const FmuStatus status = clock_interval(I, FN, &interval);
+    if (preemptible) unlock_preemption(I);
+    if (status != FMU_OK) return (fmi3Status)status;
+    const bool changed = !preemptible && interval != I->reportedInterval;
+    I->reportedInterval = interval;
+    for (size_t i = 0; i < nvr; i++) {
+        intervals[i] = interval;
+        qualifiers[i] = changed ? fmi3IntervalChanged : fmi3IntervalUnchanged;
+    }
+    return fmi3OK;
+}
+
+/* The first tick one cycle after the start, as Co-Simulation's first step
+ * and Model Exchange's first time event end the first cycle. */
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 shifts[]) {
+    BEGIN_SE(fmi3GetShiftDecimal);
+    CHECK(check_clocks(I, FN, vr, nvr, shifts));
+    if (nvr == 0) return fmi3OK;
+    double interval;
+    CHECK(clock_interval(I, FN, &interval));
+    for (size_t i = 0; i < nvr; i++) shifts[i] = interval;
+    return fmi3OK;
+}
+
+#define NO_FRACTION "the Clock's timing is decimal only (supportsFraction = false): use fmi3GetIntervalDecimal"
+#define CLOCK_FOLLOWS_CYCLE \
+    "the Clock's interval and shift are cycleTime's (a fixed periodic Clock without intervalDecimal): set cycleTime"
+
+#define NOT_OUTPUT_CLOCK "the Clock is an input Clock; fmi3GetClock reads output Clocks, and this FMU has none"
+#define SCHEDULED_ONLY \
+    "the Clock ticks in Scheduled Execution only (fmi3ActivateModelPartition); in Co-Simulation the " \
+    "communication step and in Model Exchange the time events run the cycles"
+
+/* The Clock functions this Clock has no use for, each refused with why;
+ * the value references first (a wrong one is the first mistake to name). */
+static fmi3Status refuse_clock_call(fmi3Instance instance, const char *function, const fmi3ValueReference vr[],
+                                    size_t nvr, const char *why) {
+    if (!instance) return fmi3Error;
+    FmuInstance *I = (FmuInstance *)instance;
+    CHECK(check_clocks(I, function, vr, nvr, vr));
+    return (fmi3Status)fmu_error(I, function, "%s", why);
+}
+
+fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                   fmi3UInt64 counters[], fmi3UInt64 resolutions[],
+                                   fmi3IntervalQualifier qualifiers[]) {
+    (void)counters;
+    (void)resolutions;
+    (void)qualifiers;
+    return refuse_clock_call(instance, "fmi3GetIntervalFraction", vr, nvr, NO_FRACTION);
+}
+
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 counters[],
+                                fmi3UInt64 resolutions[]) {
+    (void)counters;
+    (void)resolutions;
+    return refuse_clock_call(instance, "fmi3GetShiftFraction", vr, nvr, NO_FRACTION);
+}
+
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                  const fmi3Float64 intervals[]) {
+    (void)intervals;
+    return refuse_clock_call(instance, "fmi3SetIntervalDecimal", vr, nvr, CLOCK_FOLLOWS_CYCLE);
+}
+
+fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                   const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
+    (void)counters;
+    (void)resolutions;
+    return refuse_clock_call(instance, "fmi3SetIntervalFraction", vr, nvr, CLOCK_FOLLOWS_CYCLE);
+}
+
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                               const fmi3Float64 shifts[]) {
+    (void)shifts;
+    return refuse_clock_call(instance, "fmi3SetShiftDecimal", vr, nvr, CLOCK_FOLLOWS_CYCLE);
+}
+
+fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
+    (void)counters;
+    (void)resolutions;
+    return refuse_clock_call(instance, "fmi3SetShiftFraction", vr, nvr, CLOCK_FOLLOWS_CYCLE);
+}
+
+fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
+    (void)values;
+    return refuse_clock_call(instance, "fmi3GetClock", vr, nvr, NOT_OUTPUT_CLOCK);
+}
+
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock values[]) {
+    (void)values;
+    return refuse_clock_call(instance, "fmi3SetClock", vr, nvr, SCHEDULED_ONLY);
+}
 
 /* The FMI 3 functions this FMU does not provide: one file of their own. */
 #include "fmi3_unsupported.h"

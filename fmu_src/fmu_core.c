@@ -1,5 +1,4 @@
 #include "fmu_core.h"
-#include "fmu_model_exchange.h"
 
 #include <float.h>
 #include <limits.h>
@@ -18,7 +17,16 @@ const char *fmu_mode_name(int mode) {
     case MODE_ERROR: return "Error (after a failed call)";
     case MODE_EVENT: return "Event Mode";
     case MODE_CONTINUOUS: return "Continuous-Time Mode";
+    case MODE_CLOCK_ACTIVATION: return "Clock Activation Mode";
     default: return "unknown";
+    }
+}
+
+const char *fmu_interface_name(FmuInterface interfaceType) {
+    switch (interfaceType) {
+    case FMU_MODEL_EXCHANGE: return "Model Exchange";
+    case FMU_SCHEDULED_EXECUTION: return "Scheduled Execution";
+    default: return "Co-Simulation";
     }
 }
 
@@ -64,10 +72,11 @@ void fmu_reset(FmuInstance *instance) {
         core->values[i] = model->variables[i].start;
     }
     core->mode = MODE_INSTANTIATED;
-    fmu_leave_instant(instance); /* latched: values this FMU could have */
+    fmu_latch_values(instance); /* values this FMU could have */
     memset(&instance->prepared, 0, sizeof instance->prepared);
     instance->prepared.period = NAN;
     if (instance->plan) instance->plan->valid = false; /* (a plan is only ever a cost saved) */
+    instance->reportedInterval = NAN;
     /* the start values are the outputs until Initialization Mode */
     instance->outputsStale = FMU_FRESH;
     fmu_invalidate(instance);
@@ -185,6 +194,18 @@ static void publish(FmuInstance *instance, bool block) {
     instance->outputsStale = FMU_FRESH;
 }
 
+/* The sub-cycle length a configuration sets: 0 (one cycle per step) unless finite and > 0. */
+static double cycle_of(const RlConfig *config) {
+    const double c = config->cycleTime.value;
+    return isgreater(c, 0) && isfinite(c) ? c : 0.0;
+}
+
+double fmu_configured_cycle(const FmuInstance *instance) {
+    RlConfig config = instance->prepared.config; /* a copy: configure fills it, nothing else changes */
+    instance->model->configure(instance->core.values, &config);
+    return cycle_of(&config);
+}
+
 /* Kernel configuration from the current values; the cycle length and
  * limits are derived again before the next cycle. The outputs derived from
  * the last cycle are published first: they need its configuration. */
@@ -193,8 +214,7 @@ void fmu_configure(FmuInstance *instance) {
         publish(instance, true);
     }
     instance->modelMode = instance->model->configure(instance->core.values, &instance->prepared.config);
-    const double c = instance->prepared.config.cycleTime.value;
-    instance->cycleTime = isgreater(c, 0) && isfinite(c) ? c : 0.0;
+    instance->cycleTime = cycle_of(&instance->prepared.config);
     instance->prepareDue = true;
     instance->configDirty = false;
 }
@@ -227,7 +247,7 @@ void fmu_refuse_no_cycle(FmuInstance *instance) {
 static void initialize_block(FmuInstance *instance) {
     FmuCore *core = &instance->core;
     fmu_configure(instance);
-    if (instance->modelExchange) {
+    if (instance->interfaceType != FMU_CO_SIMULATION) {
         fmu_refuse_no_cycle(instance);
     }
     /* with cycleTime 0 the cycle length is only known at the first step */
@@ -277,12 +297,15 @@ void fmu_log_status(FmuInstance *instance) {
     instance->core.reportedStatus = p->status;
     if (rl_status_is_error(p->status)) {
         const FmuVariable *cause = &instance->model->variables[p->statusSource];
-        const bool noCycleInME = instance->modelExchange && p->status == RL_STATUS_NO_CYCLE;
+        const bool noCycle = instance->interfaceType != FMU_CO_SIMULATION && p->status == RL_STATUS_NO_CYCLE;
         fmu_log(instance, FMU_WARNING, "status 16#%04X: %s (%s = %g); the output holds%s", (unsigned)p->status,
                 rl_status_text(p->status), cause->name, instance->core.values[p->statusSource],
-                noCycleInME ? ". Model Exchange runs the block at the ends of its cycles: set cycleTime to the PLC "
-                              "cycle (the interval of the cyclic interrupt OB or task)"
-                            : "");
+                noCycle ? (instance->interfaceType == FMU_MODEL_EXCHANGE
+                               ? ". Model Exchange runs the block at the ends of its cycles: set cycleTime to the PLC "
+                                 "cycle (the interval of the cyclic interrupt OB or task)"
+                               : ". Scheduled Execution's clock ticks once per PLC cycle: set cycleTime to the PLC "
+                                 "cycle (the interval of the cyclic interrupt OB or task)")
+                        : "");
     } else {
         fmu_log(instance, FMU_OK, "status 16#%04X: %s", (unsigned)p->status, rl_status_text(p->status));
     }
@@ -292,10 +315,11 @@ FmuStatus fmu_exit_initialization(FmuInstance *instance) {
     initialize_block(instance);
     /* Model Exchange: Event Mode at the start time, whose instant the
      * first cycle takes its values from */
-    instance->core.mode = instance->modelExchange ? MODE_EVENT : MODE_STEP;
+    static const int firstMode[] = { MODE_STEP, MODE_EVENT, MODE_CLOCK_ACTIVATION }; /* by FmuInterface */
+    instance->core.mode = firstMode[instance->interfaceType];
     instance->core.cycles = 0;
     instance->core.eventTime = instance->core.time;
-    fmu_leave_instant(instance);
+    fmu_latch_values(instance);
     return fmu_report_status(instance);
 }
 
@@ -388,5 +412,35 @@ FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, doubl
     } else {
         fmu_disarm(instance);
     }
+    return fmu_report_status(instance);
+}
+
+/* The common path of an activation is the general one: it is one cycle,
+ * at most as often as the PLC's OB runs. */
+FmuStatus fmu_activate(FmuInstance *instance, const char *function, double activationTime) {
+    FmuCore *core = &instance->core;
+    if (!(isfinite(activationTime) && isgreater(activationTime, core->time))) {
+        return fmu_error(instance, function,
+                         "activationTime %.17g is not finite or not after the last activation (or the start) at %.17g",
+                         activationTime, core->time);
+    }
+    if (instance->configDirty) {
+        fmu_configure(instance);
+        fmu_refuse_no_cycle(instance);
+    }
+    const double cycle = instance->cycleTime;
+    if (cycle > 0) {
+        if (instance->prepareDue || instance->prepared.period != cycle) {
+            prepare(instance, cycle);
+        }
+        /* the cycle's time is the activation's: with the ticks at
+         * startTime + n*cycleTime it is Co-Simulation's cycle n */
+        rl_cycle(&core->block, &instance->prepared, core->values[instance->inputVr],
+                 rl_sum(activationTime, -core->startTime));
+        instance->outputsStale = FMU_STALE_ALL;
+    } else if (instance->outputsStale == FMU_FRESH) {
+        instance->outputsStale = FMU_STALE_TIME;
+    }
+    core->time = activationTime;
     return fmu_report_status(instance);
 }

@@ -1,6 +1,7 @@
 /* FMI-version independent part of every FMU: the instance, variable
- * access, the cycle scheduler and Co-Simulation's step (docs/fmi.md, Time:
- * the communication step is the PLC cycle), logging. Model Exchange
+ * access, the cycle scheduler, Co-Simulation's step (docs/fmi.md, Time:
+ * the communication step is the PLC cycle) and Scheduled Execution's
+ * activation (one PLC cycle per tick of the clock), logging. Model Exchange
  * (fmu_model_exchange.h) and FMU states (fmu_state.h) build on it.
  * fmi2_glue.c and fmi3_glue.c map the FMI C APIs onto them; a model
  * (model.h, models/<Model>.c) maps its variables onto the kernel. */
@@ -13,6 +14,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "model.h"
 
@@ -21,7 +23,8 @@ typedef enum { FMU_OK, FMU_WARNING, FMU_DISCARD, FMU_ERROR, FMU_FATAL } FmuStatu
 
 /* FMI modes as bits, so that each glue can state per function the set of
  * modes it is allowed in. Step Mode is Co-Simulation's, Event Mode and
- * Continuous-Time Mode are Model Exchange's; the others are shared. */
+ * Continuous-Time Mode are Model Exchange's, Clock Activation Mode is
+ * Scheduled Execution's (FMI 3 only); the others are shared. */
 typedef enum {
     MODE_INSTANTIATED = 1 << 0,
     MODE_INITIALIZATION = 1 << 1,
@@ -29,8 +32,12 @@ typedef enum {
     MODE_TERMINATED = 1 << 3,
     MODE_ERROR = 1 << 4,
     MODE_EVENT = 1 << 5,
-    MODE_CONTINUOUS = 1 << 6
+    MODE_CONTINUOUS = 1 << 6,
+    MODE_CLOCK_ACTIVATION = 1 << 7
 } FmuMode;
+
+/* The interface an instance was instantiated for. */
+typedef enum { FMU_CO_SIMULATION, FMU_MODEL_EXCHANGE, FMU_SCHEDULED_EXECUTION } FmuInterface;
 
 /* A step that would run more cycles than this is refused (no endless loop
  * on a tiny cycleTime or a huge step). */
@@ -49,7 +56,7 @@ typedef struct {
     RlState block;
     double startTime;
     double time;
-    uint64_t cycles; /* cycles run since the start (cycleTime > 0) */
+    uint64_t cycles; /* cycles run since the start (cycleTime > 0; Scheduled Execution counts none) */
     /* Model Exchange: the values as the last event instant left them, which
      * the next cycle runs with (latch), and that instant's time */
     double latched[FMU_MAX_VARIABLES];
@@ -82,6 +89,9 @@ struct FmuInstance {
      * there why it never exceeds the general one). */
     double fastPeriodReal, fastPeriodLreal, fastTolerance;
     double cycleTime; /* sub-cycle length, 0 = one cycle per step */
+    /* Scheduled Execution: the clock's interval as last reported
+     * (fmi3GetIntervalDecimal), NaN before; fmu_reset forgets it */
+    double reportedInterval;
     /* model->inputVr and outputVr, one load nearer. Every model's u is an
      * unranged, non-fixed Real input and its y a Real output (checked
      * against each model's TOML by test_model_description.py), so the
@@ -89,16 +99,16 @@ struct FmuInstance {
     unsigned inputVr, outputVr;
     const ModelDefinition *model;
     FmuLogFunction *logFunction;
-    int logCategories;  /* enabled categories */
-    int errorMode;      /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
-    bool modelExchange; /* instantiated for Model Exchange, not Co-Simulation */
-    void *environment;  /* the importer's instance environment */
+    int logCategories;          /* enabled categories */
+    int errorMode;              /* the mode a failed call leaves: FMI 2 Error, FMI 3 Terminated */
+    FmuInterface interfaceType; /* what it was instantiated for */
+    void *environment;          /* the importer's instance environment */
     /* memory for FMU states, as the importer provides it (FMI 2) or not */
     void *(*allocate)(FmuInstance *instance, size_t size);
     void (*release)(FmuInstance *instance, void *memory);
 };
 
-/* modelExchange and errorMode set first */
+/* interfaceType and errorMode set first */
 RL_LINKAGE void fmu_init_instance(FmuInstance *instance);
 /* What the instance holds beyond its own memory, released (before the glue frees it) */
 RL_LINKAGE void fmu_free_instance(FmuInstance *instance);
@@ -279,6 +289,17 @@ static inline bool fmu_step_fast(FmuInstance *instance, double t, double h) {
     return true; /* no status change: that needs a new configuration */
 }
 
+/* Scheduled Execution: the partition of the clock activated at
+ * activationTime, after the last activation (or the start): one PLC cycle
+ * of length cycleTime that ends then, whatever the time since the last
+ * (a late or early tick is the OB's jitter, seen by what measures the
+ * elapsed time); none without a valid cycleTime. */
+RL_LINKAGE FmuStatus fmu_activate(FmuInstance *instance, const char *function, double activationTime);
+
+/* The cycle length the parameters set now, 0 if none (not finite or not
+ * > 0); nothing derived from them changes. */
+RL_LINKAGE double fmu_configured_cycle(const FmuInstance *instance);
+
 /* Any step, with every check and the status report. */
 RL_LINKAGE FMU_NOINLINE FmuStatus fmu_do_step_general(FmuInstance *instance, const char *function, double t, double h);
 
@@ -289,13 +310,23 @@ static inline FmuStatus fmu_do_step(FmuInstance *instance, const char *function,
 }
 
 RL_LINKAGE const char *fmu_mode_name(int mode);
+/* "Co-Simulation", "Model Exchange" or "Scheduled Execution" */
+RL_LINKAGE const char *fmu_interface_name(FmuInterface interfaceType);
 
 /* ---- shared with Model Exchange (fmu_model_exchange.c) ------------------ */
+
+/* The values the next cycle runs with are the current ones (the latch,
+ * FmuCore.latched): at the start, and when Model Exchange leaves an
+ * instant. Core data, set here so that the core calls no interface. */
+static inline void fmu_latch_values(FmuInstance *instance) {
+    memcpy(instance->core.latched, instance->core.values, sizeof instance->core.latched);
+}
 
 /* The kernel's configuration from the current values (the outputs of the
  * last cycle published first: they need its configuration). */
 RL_LINKAGE FMU_NOINLINE void fmu_configure(FmuInstance *instance);
-/* Model Exchange, after fmu_configure: no cycle without cycleTime. */
+/* Model Exchange and Scheduled Execution, after fmu_configure: no cycle
+ * without cycleTime. */
 RL_LINKAGE void fmu_refuse_no_cycle(FmuInstance *instance);
 /* Sub-cycling: the cycles that end by the time end; *ran when one ran. */
 RL_LINKAGE FMU_NOINLINE FmuStatus fmu_run_cycles(FmuInstance *instance, const char *function, double end, double h,

@@ -30,10 +30,6 @@ static bool swap_latched(FmuInstance *instance) {
     return differ;
 }
 
-void fmu_leave_instant(FmuInstance *instance) {
-    memcpy(instance->core.latched, instance->core.values, sizeof instance->core.latched);
-}
-
 /* The cycles ended by now, run with the latched values: the values of now
  * set aside meanwhile, the configuration taken from the latched ones and
  * again from the current ones before the next cycle if they differ. */
@@ -77,7 +73,7 @@ FmuStatus fmu_update_discrete_states(FmuInstance *instance, const char *function
 }
 
 void fmu_enter_continuous_time_mode(FmuInstance *instance) {
-    fmu_leave_instant(instance);
+    fmu_latch_values(instance); /* the instant is left */
     instance->core.mode = MODE_CONTINUOUS;
 }
 
@@ -90,7 +86,7 @@ FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time)
     if (core->mode == MODE_EVENT && time != core->time) {
         /* a pure discrete-time FMU's next event instant (FMI 2.0.4,
          * section 3.2.3, fmi2SetTime in Event Mode): this one is left */
-        fmu_leave_instant(instance);
+        fmu_latch_values(instance); /* the instant is left */
         core->eventTime = time;
     }
     core->time = time;

@@ -1,7 +1,8 @@
 /* Model Exchange (docs/fmi.md, Model Exchange), for both FMI versions: no
  * continuous states, no event indicators; the cycle ends are time events,
  * and each cycle runs in Event Mode at its end with the values latched
- * when the instant before it was left. */
+ * when the instant before it was left (fmu_latch_values: Continuous-Time
+ * Mode entered, or the time set anew in Event Mode). */
 #ifndef FMU_MODEL_EXCHANGE_H
 #define FMU_MODEL_EXCHANGE_H
 
@@ -16,9 +17,6 @@ RL_LINKAGE FmuStatus fmu_update_discrete_states(FmuInstance *instance, const cha
                                                 double *nextEventTime);
 /* Continuous-Time Mode entered: the instant is left. */
 RL_LINKAGE void fmu_enter_continuous_time_mode(FmuInstance *instance);
-/* The instant is left (Continuous-Time Mode entered, or the time set anew
- * in Event Mode): its values are those of the next cycle. */
-RL_LINKAGE void fmu_leave_instant(FmuInstance *instance);
 /* fmi2SetTime / fmi3SetTime: a finite time, not before the last event. */
 RL_LINKAGE FmuStatus fmu_set_time(FmuInstance *instance, const char *function, double time);
 /* A call that passes arrays of continuous states or event indicators:

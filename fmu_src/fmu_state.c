@@ -130,7 +130,9 @@ static void serialize(const FmuInstance *instance, const FmuCore *s, unsigned ch
  * of the other one is refused). */
 static bool fmu_mode_possible(const FmuInstance *instance, int mode) {
     const int modes = MODE_INSTANTIATED | MODE_INITIALIZATION | MODE_TERMINATED | instance->errorMode |
-                      (instance->modelExchange ? MODE_EVENT | MODE_CONTINUOUS : MODE_STEP);
+                      (instance->interfaceType == FMU_MODEL_EXCHANGE        ? MODE_EVENT | MODE_CONTINUOUS
+                       : instance->interfaceType == FMU_SCHEDULED_EXECUTION ? MODE_CLOCK_ACTIVATION
+                                                                            : MODE_STEP);
     return mode > 0 && (mode & (mode - 1)) == 0 && (mode & modes) != 0; /* > 0: no mode - 1 overflow */
 }
 
@@ -290,7 +292,7 @@ FmuStatus fmu_set_state(FmuInstance *instance, const char *function, const void 
     if (!fmu_mode_possible(instance, ((const FmuState *)state)->core.mode)) {
         return fmu_error(instance, function, "an FMU state of %s, which this %s instance cannot be in",
                          fmu_mode_name(((const FmuState *)state)->core.mode),
-                         instance->modelExchange ? "Model Exchange" : "Co-Simulation");
+                         fmu_interface_name(instance->interfaceType));
     }
     restore(instance, &((const FmuState *)state)->core);
     return FMU_OK;

@@ -46,6 +46,10 @@ typedef struct {
     unsigned count;
     unsigned inputVr;  /* the cycle input u */
     unsigned outputVr; /* the output y: the block's state y */
+    /* FMI 3's input Clock, the PLC's cyclic interrupt (OB): not a value
+     * in the table, its value reference the first after it */
+    const char *clockName;
+    unsigned clockVr;
     /* The kernel's configuration from the current values; returns the
      * model's own mode (0 if it has none), which publish gets back with
      * the configuration of the last cycle. */
@@ -64,8 +68,8 @@ typedef struct {
  * uses it (rate_limiter.h, RL_LINKAGE). */
 #define FMU_MODEL(inputVr, outputVr, configure, publish, statusOutputs) \
     RL_DEFINITION const ModelDefinition fmuModel = { \
-        MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, inputVr, \
-        outputVr,         configure,   publish,        statusOutputs \
+        MODEL_IDENTIFIER, MODEL_TOKEN, modelVariables, MODEL_VARIABLE_COUNT, inputVr, outputVr, MODEL_CLOCK_NAME, \
+        MODEL_CLOCK_VR,   configure,   publish,        statusOutputs \
     }
 #ifndef RL_UNIT
 extern const ModelDefinition fmuModel;

@@ -3,7 +3,7 @@
 model's TOML file (the variables) and the staged FMU itself (a typical ramp,
 simulated with fmpy):
 
-    document.py MODEL.toml STAGED_FMU_DIR FMI_VERSION STATUS_SOURCE.c
+    document.py MODEL.toml STAGED_FMU_DIR FMI_VERSION STATUS_SOURCE.c PLOT_STAGED_FMU_DIR
 
 writes documentation/index.html and documentation/ramp.png, and the icon:
 model.png (FMI 2) or terminalsAndIcons/icon.png (FMI 3). Runs with the
@@ -118,7 +118,11 @@ def licence(stage):
     )
 
 
-INTERFACES = (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
+INTERFACES = (
+    ("CoSimulation", "Co-Simulation"),
+    ("ModelExchange", "Model Exchange"),
+    ("ScheduledExecution", "Scheduled Execution (the PLC cyclic interrupt OB as an input Clock)"),
+)
 LS_REF = "extra/org.fmi-standard.fmi-ls-ref"
 STANDALONE = '<p>(Also in <a href="fmi-ls-ref.html">fmi-ls-ref.html</a>, as the layered standard recommends.)</p>'
 
@@ -127,7 +131,8 @@ def interfaces(stage, version):
     """What the FMU carries, as a sentence: the interfaces its model
     description declares, its C sources, the layered standard."""
     root = ElementTree.parse(stage / "modelDescription.xml").getroot()
-    kinds = " and ".join(name for tag, name in INTERFACES if root.find(tag) is not None)
+    names = [name for tag, name in INTERFACES if root.find(tag) is not None]
+    kinds = ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
     carried = [f"FMI {version}.0 {kinds}", "its C sources (<code>sources/</code>, any platform can compile them)"]
     if (stage / LS_REF / "fmi-ls-manifest.xml").exists():
         carried.append("its reference experiments (FMI-LS-REF, below)")
@@ -143,13 +148,21 @@ def experiments(stage, model):
     if not files:
         return ""
     fmu = f"{model['model']['identifier']}.fmu"
+    # fmutrace runs Co-Simulation: the Scheduled Execution FMU's experiments run on the FMI 3 FMU of its binary
+    scheduled_only = ElementTree.parse(stage / "modelDescription.xml").getroot().find("CoSimulation") is None
+    where = (
+        " through Co-Simulation, on the FMI 3 FMU of the same name and binary (fmutrace is a Co-Simulation importer; "
+        "a Scheduled Execution importer runs them one activation per cycle)"
+        if scheduled_only
+        else ""
+    )
     parts = [
         '<h2 id="reference-experiments">Reference experiments (FMI-LS-REF)</h2>',
         f"<p>The FMU carries its hand-worked reference scenarios in <code>{LS_REF}/</code>: the manifest "
         "<code>fmi-ls-manifest.xml</code> lists every file with its SHA-256 and each reference signal's comparison "
         "criterion (an <code>org.fmutrace</code> annotation), each experiment file (MA-HS-Experiments) its "
         "experiments' times, parameter set (SSP <code>.ssv</code>), stimuli and reference (CSV). Run them all, "
-        f"compared with those criteria:</p><pre>fmutrace check {fmu}</pre>"
+        f"compared with those criteria{where}:</p><pre>fmutrace check {fmu}</pre>"
         f"<p>(<code>--role smoke-test</code> for the smoke test alone; fmutrace is in the project's repository.)</p>",
     ]
     for path in files:
@@ -169,7 +182,13 @@ def experiments(stage, model):
     return "\n".join(parts)
 
 
-def page(model, version, codes, licence_html, carried="", experiments_html=""):
+def clocks(stage):
+    """The Clocks of the staged model description (FMI 3: Scheduled Execution's cyclic interrupt), generate.py's."""
+    root = ElementTree.parse(stage / "modelDescription.xml").getroot()
+    return [clock.attrib for clock in root.iter("Clock")]
+
+
+def page(model, version, codes, licence_html, carried="", experiments_html="", clock_list=()):
     m = model["model"]
     style = (
         "body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.4}\n"
@@ -185,6 +204,22 @@ def page(model, version, codes, licence_html, carried="", experiments_html=""):
         f"<td>{v['variability']}</td><td>{cell(v.get('declaredType', v['type']))}</td><td>{cell(v.get('start'))}</td>"
         f"<td>{cell(v.get('unit'))}</td><td>{cell(v.get('description'))}</td></tr>"
         for v in model["variable"]
+    )
+    rows += "".join(
+        f"\n<tr><td><code>{cell(c['name'])}</code></td><td>{c['valueReference']}</td><td>{c['causality']}</td>"
+        f"<td>{c['variability']}</td><td>Clock ({cell(c['intervalVariability'])})</td><td></td><td></td>"
+        f"<td>{cell(c.get('description'))}</td></tr>"
+        for c in clock_list
+    )
+    scheduled = "".join(
+        f"<p>In Scheduled Execution the cyclic interrupt is the input Clock <code>{cell(c['name'])}</code>: the "
+        "importer's scheduler activates it at each tick, and each <code>fmi3ActivateModelPartition</code> runs one "
+        "PLC cycle at its activation time, with the outputs Co-Simulation gives after a step of one cycle. Its "
+        "interval and the first tick's delay are <code>cycleTime</code> (<code>fmi3GetIntervalDecimal</code>, "
+        "<code>fmi3GetShiftDecimal</code> in Initialization Mode). Co-Simulation and Model Exchange are in the FMI 3 "
+        "FMU of the same name, the same binary without the Clock (a Co-Simulation FMU with Clocks must have Event "
+        "Mode, FMI 3.0 section 4.4).</p>"
+        for c in clock_list
     )
     enums = "".join(
         f"<h3>{html.escape(name)}</h3><p>{cell(e.get('description'))}</p><ul>"
@@ -220,6 +255,7 @@ input by at most the rising or falling rate times the cycle length, or follows i
 rules say so (bypass, duration run out, non-finite input, initial delay). With <code>cycleTime</code> &gt; 0 the
 block runs whole PLC cycles of that length inside each communication step; time is counted in whole cycles,
 so long runs do not drift.</p>
+{scheduled}
 <p><img src="ramp.png" alt="A typical ramp: the output follows a step of the input at the limited rates"></p>
 <h2>Variables</h2>
 <table><tr>{header}</tr>
@@ -241,7 +277,9 @@ recovered with a saved FMU state or reset.</p>
 """
 
 
-def main(toml, stage, version, status_source):
+def main(toml, stage, version, status_source, plot_stage):
+    """plot_stage: a staged FMU of the same binary with Co-Simulation, to draw the ramp (the stage itself,
+    but for the Scheduled Execution FMU's, fmi3's)."""
     model = tomllib.loads(Path(toml).read_text(encoding="utf-8"))
     stage = Path(stage).resolve()
     docs = stage / "documentation"
@@ -265,10 +303,11 @@ experiments</title></head><body>
             licence(stage),
             interfaces(stage, int(version)),
             section.replace("</h2>", f"</h2>\n{STANDALONE}", 1),
+            clocks(stage),
         ),
         encoding="utf-8",
     )
-    ramp_plot(model, stage, docs / "ramp.png")
+    ramp_plot(model, Path(plot_stage).resolve(), docs / "ramp.png")
     if int(version) == 2:
         icon(model, stage / "model.png")
     else:

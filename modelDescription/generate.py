@@ -48,6 +48,22 @@ CAUSALITIES = {"independent", "parameter", "input", "output"}
 VARIABILITIES = {"continuous", "discrete", "fixed", "tunable"}
 FMI3_ELEMENT = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enumeration": "Enumeration"}
 UNITS = {"s": 'BaseUnit s="1"', "1/s": 'BaseUnit s="-1"'}
+# FMI 3's input Clock of Scheduled Execution: the PLC's cyclic interrupt (OB), one model partition that runs one
+# cycle per tick. Not a value of the core's table: its value reference is the first after the variables'. Periodic,
+# its interval cycleTime, a fixed parameter: intervalVariability "fixed" without intervalDecimal, so that the importer
+# asks fmi3GetIntervalDecimal and fmi3GetShiftDecimal in Initialization Mode (FMI 3.0.2, 2.2.9.3, fixed periodic
+# Clock); the first tick one cycle after the start, as Co-Simulation's first step and Model Exchange's first event.
+CLOCK_NAME = "cyclicInterrupt"
+CLOCK_DESCRIPTION = (
+    "The PLC's cyclic interrupt (OB) in Scheduled Execution: each activation runs one PLC cycle; "
+    "interval and shift cycleTime (fmi3GetIntervalDecimal, fmi3GetShiftDecimal)"
+)
+
+
+def clock_vr(model):
+    return len(model["variable"])
+
+
 LOG_CATEGORIES = [
     ("logStatusError", "Errors: a call that failed and why"),
     ("logStatusWarning", "Warnings: a change of the block's status word"),
@@ -78,8 +94,8 @@ def load(path):
         if v.get("unit") and v["unit"] not in UNITS:
             sys.exit(f"{where}: unit {v['unit']!r} is not defined in generate.py")
     names = [v["name"] for v in variables]
-    if len(set(names)) != len(names):
-        sys.exit(f"{path}: variable names must be unique")
+    if len(set(names)) != len(names) or CLOCK_NAME in names:
+        sys.exit(f"{path}: variable names must be unique, and none {CLOCK_NAME!r} (the clock's)")
     if not variables or variables[0]["name"] != "time" or variables[0]["causality"] != "independent":
         sys.exit(f"{path}: value reference 0 must be the independent variable time (the core publishes it there)")
     if len(variables) > max_variables():
@@ -220,7 +236,16 @@ def fmi2_description(model, guid, sources):
     return "\n".join(out) + "\n"
 
 
-def fmi3_description(model, instantiation_token):
+# FMI 3's interfaces ship as two FMUs of one binary (docs/fmi.md, Scheduled Execution): Co-Simulation and Model
+# Exchange without a Clock, as FMI 2's, since a Co-Simulation FMU that declares Clocks must have Event Mode (FMI 3.0,
+# 4.4) and some Co-Simulation importers cannot load a Clock; Scheduled Execution alone, with its Clock. The folder
+# under the build tree that each is written to and packaged from (cmake/Fmu.cmake names the same).
+FMI3_VARIANTS = {"fmi3": "CoSimulation+ModelExchange", "fmi3-se": "ScheduledExecution"}
+
+
+def fmi3_description(model, instantiation_token, variant):
+    """The FMI 3 model description of one variant (a key of FMI3_VARIANTS)."""
+    scheduled = FMI3_VARIANTS[variant] == "ScheduledExecution"
     m = model["model"]
     root = attributes(
         modelName=m["identifier"],
@@ -234,15 +259,31 @@ def fmi3_description(model, instantiation_token):
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="3.0"{root}{attributes(generationTool=GENERATION_TOOL)}'
         ' variableNamingConvention="flat">',
-        f'  <ModelExchange{identifier} needsCompletedIntegratorStep="false" {states}/>',
-        f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}'
-        ' hasEventMode="false" providesIntermediateUpdate="false"/>',
     ]
+    if scheduled:
+        out.append(f"  <ScheduledExecution{identifier} {states}/>")
+    else:
+        out.append(f'  <ModelExchange{identifier} needsCompletedIntegratorStep="false" {states}/>')
+        out.append(
+            f'  <CoSimulation{identifier} canHandleVariableCommunicationStepSize="true" {states}'
+            ' hasEventMode="false" providesIntermediateUpdate="false"/>'
+        )
     out += common_head(model, 3)
     out.append("  <ModelVariables>")
     for v in model["variable"]:
         element = FMI3_ELEMENT[v["type"]]
         out.append(f"    <{element}{attributes(**variable_attributes(v), **type_attributes(v))}/>")
+    clock = attributes(
+        name=CLOCK_NAME,
+        valueReference=clock_vr(model),
+        description=CLOCK_DESCRIPTION,
+        causality="input",
+        variability="discrete",
+        intervalVariability="fixed",
+        priority=0,
+    )
+    if scheduled:
+        out.append(f"    <Clock{clock}/>")
     out.append("  </ModelVariables>")
     outputs = [v["vr"] for v in model["variable"] if v["causality"] == "output"]
     out.append("  <ModelStructure>")
@@ -314,6 +355,8 @@ def c_header(model, instantiation_token, toml_name):
 
 #define MODEL_IDENTIFIER "{identifier}"
 #define MODEL_TOKEN "{instantiation_token}"
+#define MODEL_CLOCK_NAME "{CLOCK_NAME}"
+#define MODEL_CLOCK_VR {clock_vr(model)}
 
 enum {{
 {enum}
@@ -346,7 +389,10 @@ def main():
     identifier = model["model"]["identifier"]
     files = {
         args.outdir / "fmi2" / "modelDescription.xml": fmi2_description(model, tok, args.fmi2_sources),
-        args.outdir / "fmi3" / "modelDescription.xml": fmi3_description(model, tok),
+        **{
+            args.outdir / variant / "modelDescription.xml": fmi3_description(model, tok, variant)
+            for variant in FMI3_VARIANTS
+        },
         args.outdir / "fmi3" / "buildDescription.xml": fmi3_build_description(model, args.fmi3_sources),
         args.outdir / f"{identifier}_variables.h": c_header(model, tok, args.model.name),
     }

@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
 """Write the FMI-LS-REF folder of one FMU (docs/fmi.md, "Reference
 experiments"): its model's reference scenarios (tests/scenarios/<Model>/)
-as MA-HS-Experiments files, a smoke test and a validation set, each
+as MA-HS-Experiments files, a smoke test and a validation set (whose
+descriptions name the interfaces the scenarios were checked in: every one
+the staged model description declares, as tests/fmu/test_reference.py,
+test_model_exchange.py and test_scheduled_execution.py run each scenario
+through each), each
 scenario's stimuli, reference and parameter set (SSP 1.0 .ssv), the
 manifest (fmi-ls-manifest.xml) that lists every file with its SHA-256 and
 each reference's comparison criteria; then the FMU's sorted zip entries.
@@ -21,6 +25,7 @@ import math
 import shutil
 import sys
 import tomllib
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -162,6 +167,21 @@ def state_entry(scenario, state):
     )
 
 
+# the interface elements of a model description, as the experiments name them
+INTERFACES = {
+    "CoSimulation": "Co-Simulation",
+    "ModelExchange": "Model Exchange",
+    "ScheduledExecution": "Scheduled Execution",
+}
+
+
+def checked_in(model_description):
+    """'Co-Simulation, Model Exchange and Scheduled Execution': the interfaces the FMU declares."""
+    root = ET.parse(model_description).getroot()
+    names = [name for tag, name in INTERFACES.items() if root.find(tag) is not None]
+    return ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+
+
 def write(toml, scenarios_dir, stage, entries_in, entries_out, state=None):
     spec = tomllib.loads(Path(toml).read_text())
     model = spec["model"]["identifier"]
@@ -191,9 +211,18 @@ def write(toml, scenarios_dir, stage, entries_in, entries_out, state=None):
             files[s["parameters"]] = parameter_set(name, start, types).encode()
         scenarios.append(s)
 
+    checked = f"; each checked in {checked_in(Path(stage) / 'modelDescription.xml')}"
     roles = (
-        ("smoke-test", f"{model}: smoke test, the first {SMOKE_TESTS} reference scenarios", scenarios[:SMOKE_TESTS]),
-        ("validation", f"{model}: validation, all {len(scenarios)} hand-worked reference scenarios", scenarios),
+        (
+            "smoke-test",
+            f"{model}: smoke test, the first {SMOKE_TESTS} reference scenarios{checked}",
+            scenarios[:SMOKE_TESTS],
+        ),
+        (
+            "validation",
+            f"{model}: validation, all {len(scenarios)} hand-worked reference scenarios{checked}",
+            scenarios,
+        ),
     )
     manifest = [
         '<?xml version="1.0" encoding="UTF-8"?>',

@@ -1,7 +1,9 @@
 /* An FMU binary's lifecycle as an importer drives it (dlopen), FMI 2 and 3:
  *
- *   test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances>
+ *   test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances> [<staged SE FMU folder>]
  *
+ * (FMI 3 only, and required there: the Scheduled Execution FMU's folder, build/stage/fmi3-se/<Model>, whose model description
+ * declares the Clock; its binary is the Co-Simulation FMU's, and runs Scheduled Execution after 1.)
  * 1. a full simulation using every kind of call (set, step, get, FMU states,
  *    serialize and deserialize, reset, terminate, free), so that valgrind
  *    memcheck can watch all of it; then the same as Model Exchange (time
@@ -124,6 +126,7 @@ static int failures;
 static int version;
 static char token[128];
 static unsigned uVr, yVr, cycleTimeVr;
+static unsigned clockVr; /* FMI 3: Scheduled Execution's Clock */
 static int accelVr = -1; /* accelMax, where the model has it: its plan is made, kept and freed */
 
 #define F2(name) ((name##TYPE *)function(#name))
@@ -344,6 +347,59 @@ static void model_exchange_simulation(void) {
     printf("Model Exchange: %d cycles as time events, mismatches with Co-Simulation %d\n", CYCLES, mismatches);
 }
 
+/* FMI 3 Scheduled Execution: the Clock's interval and shift from
+ * cycleTime, one activation per cycle giving Co-Simulation's outputs, an
+ * FMU state in Clock Activation Mode, every activation, get and set there
+ * inside lockPreemption ... unlockPreemption */
+static long preemptionDepth, preemptionSections;
+static void lock_preemption(void) {
+    if (preemptionDepth++ == 0) preemptionSections++;
+}
+static void unlock_preemption(void) {
+    preemptionDepth--;
+}
+
+static void scheduled_execution_simulation(void) {
+    enum { CYCLES = 200 };
+    const double cycle = 0.01;
+    double expected[CYCLES];
+    void *cs = instantiate("reference");
+    CHECK(cs != NULL && set_real(cs, cycleTimeVr, cycle) == 0 && start(cs));
+    for (int k = 0; k < CYCLES; k++) {
+        set_u(cs, input(k, 2));
+        CHECK(step(cs, k * cycle, cycle) == 0);
+        expected[k] = get_y(cs);
+    }
+    release(cs);
+
+    void *c = F3(fmi3InstantiateScheduledExecution)("scheduled", token, NULL, fmi3False, fmi3False, NULL, log3_message,
+                                                    NULL, lock_preemption, unlock_preemption);
+    CHECK(c != NULL);
+    if (!c) return;
+    CHECK(set_real(c, cycleTimeVr, cycle) == 0);
+    CHECK(F3(fmi3EnterInitializationMode)(c, fmi3False, 0.0, 0.0, fmi3False, 0.0) == fmi3OK);
+    fmi3Float64 interval = 0, shift = 0;
+    fmi3IntervalQualifier qualifier = fmi3IntervalNotYetKnown;
+    CHECK(F3(fmi3GetIntervalDecimal)(c, &clockVr, 1, &interval, &qualifier) == fmi3OK);
+    CHECK(interval == cycle && qualifier == fmi3IntervalChanged);
+    CHECK(F3(fmi3GetShiftDecimal)(c, &clockVr, 1, &shift) == fmi3OK && shift == cycle);
+    CHECK(F3(fmi3ExitInitializationMode)(c) == fmi3OK);
+    CHECK(preemptionSections == 0);
+    int mismatches = 0;
+    for (int k = 0; k < CYCLES; k++) {
+        CHECK(set_u(c, input(k, 2)) == 0);
+        CHECK(F3(fmi3ActivateModelPartition)(c, clockVr, shift + k * interval) == fmi3OK);
+        mismatches += get_y(c) != expected[k];
+        if (k == CYCLES / 2) state_round_trip(c); /* between activations */
+    }
+    CHECK(mismatches == 0);
+    CHECK(preemptionDepth == 0 && preemptionSections == 3 * CYCLES);
+    CHECK(F3(fmi3Terminate)(c) == fmi3OK);
+    get_y(c);
+    release(c);
+    printf("Scheduled Execution: %d activations, mismatches with Co-Simulation %d\n", CYCLES, mismatches);
+}
+
 /* ---- 2. instantiate/free cycles leave nothing behind ------------------- */
 
 static void instantiate_free(long cycles) {
@@ -515,7 +571,8 @@ static unsigned first_real(const char *text, const char *causality) {
     exit(2);
 }
 
-static void read_description(const char *stage, char *identifier, size_t size) {
+/* the staged FMU's model description, in a buffer of its own kept until the next call */
+static const char *description_text(const char *stage) {
     char path[4096];
     snprintf(path, sizeof path, "%s/modelDescription.xml", stage);
     FILE *f = fopen(path, "rb");
@@ -527,6 +584,21 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     const size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = 0;
     fclose(f);
+    return text;
+}
+
+/* the Scheduled Execution FMU's Clock; that FMU declares nothing else of the binary's interfaces */
+static void read_clock(const char *stage, const char *identifier) {
+    const char *text = description_text(stage);
+    char number[32], se_identifier[256];
+    attribute(text, "<ScheduledExecution", "modelIdentifier=\"", se_identifier, sizeof se_identifier);
+    CHECK(strcmp(se_identifier, identifier) == 0);
+    CHECK(!strstr(text, "<CoSimulation") && !strstr(text, "<ModelExchange"));
+    clockVr = (unsigned)atoi(attribute(text, "<Clock ", "valueReference=\"", number, sizeof number));
+}
+
+static void read_description(const char *stage, char *identifier, size_t size) {
+    const char *text = description_text(stage);
     attribute(text, NULL, version == 2 ? "guid=\"" : "instantiationToken=\"", token, sizeof token);
     attribute(text, "<CoSimulation", "modelIdentifier=\"", identifier, size);
     uVr = first_real(text, "causality=\"input\"");
@@ -534,14 +606,16 @@ static void read_description(const char *stage, char *identifier, size_t size) {
     /* every model has the parameter cycleTime */
     char number[32];
     cycleTimeVr = (unsigned)atoi(attribute(text, "name=\"cycleTime\"", "valueReference=\"", number, sizeof number));
+    CHECK(!strstr(text, "<Clock") && !strstr(text, "<ScheduledExecution")); /* FMI 3.0, 4.4: the SE FMU's */
     if (strstr(text, "name=\"accelMax\"")) {
         accelVr = atoi(attribute(text, "name=\"accelMax\"", "valueReference=\"", number, sizeof number));
     }
 }
 
 int main(int argc, char **argv) {
-    if (argc != 5) {
-        fprintf(stderr, "usage: test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances>\n");
+    if (argc != (argc > 1 && atoi(argv[1]) == 3 ? 6 : 5)) {
+        fprintf(stderr, "usage: test_lifecycle <2|3> <staged FMU folder> <instantiations> <instances> "
+                        "[<staged Scheduled Execution FMU folder> (FMI 3 only, required)]\n");
         return 2;
     }
     version = atoi(argv[1]);
@@ -557,6 +631,10 @@ int main(int argc, char **argv) {
     counting = 1;
     full_simulation();
     model_exchange_simulation();
+    if (version == 3) {
+        read_clock(argv[5], identifier);
+        scheduled_execution_simulation();
+    }
     instantiate_free(atol(argv[3]));
     many_instances(atoi(argv[4]));
     out_of_memory();

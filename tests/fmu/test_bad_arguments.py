@@ -680,31 +680,36 @@ def test_fmi3_a_step_with_a_null_output_pointer_is_refused_and_the_time_stays():
         fmu.free()
 
 
-@pytest.mark.parametrize("interface", ["ScheduledExecution"])
-def test_fmi3_other_interfaces_are_refused_with_a_reason(interface):
-    """Co-Simulation and Model Exchange only: no instance of Scheduled
-    Execution; the reason goes to the logger when logging is on, and
-    nothing is called otherwise."""
-    fmu = Instance("RateLimiter", 3)
+@pytest.mark.parametrize(
+    "case,reason",
+    [
+        ("token", "the instantiationToken does not match this FMU's model description"),
+        ("one lock callback", "lockPreemption and unlockPreemption must both be given, or neither"),
+    ],
+)
+def test_fmi3_scheduled_execution_refusals_give_a_reason(case, reason):
+    """fmi3InstantiateScheduledExecution refuses a foreign token and a
+    lockPreemption without its unlockPreemption: NULL, the reason to the
+    logger when logging is on, and nothing called otherwise."""
+    fmu = Instance("RateLimiter", 3, scheduled=True)
     try:
-        function = getattr(fmu.fmu.dll, f"fmi3Instantiate{interface}")
-        function.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_void_p, fmi3LogMessageCallback] + [
-            c_void_p
-        ] * (3 if interface == "ScheduledExecution" else 0)
+        function = fmu.fmu.dll.fmi3InstantiateScheduledExecution
+        lock_type = ctypes.CFUNCTYPE(None)
+        function.argtypes = [c_char_p, c_char_p, c_char_p, c_bool, c_bool, c_void_p, fmi3LogMessageCallback]
+        function.argtypes += [c_void_p, lock_type, lock_type]
         function.restype = c_void_p
         messages = []
         log = fmi3LogMessageCallback(
             lambda env, status, category, message: messages.append((status, category, message))
         )
-        extra = [None] * (3 if interface == "ScheduledExecution" else 0)
+        lock = lock_type(lambda: None)
         token = fmu.md.instantiationToken.encode()
-        assert function(b"a", token, None, False, True, None, log, *extra) is None
-        assert messages == [
-            (3, b"logStatusError", b"this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution")
-        ]
+        args = (b"{wrong}", lock, lock) if case == "token" else (token, lock, lock_type())
+        assert function(b"a", args[0], None, False, True, None, log, None, *args[1:]) is None
+        assert messages == [(3, b"logStatusError", reason.encode())]
         messages.clear()
-        assert function(b"a", token, None, False, False, None, log, *extra) is None
-        assert function(b"a", token, None, False, True, None, fmi3LogMessageCallback(), *extra) is None
+        assert function(b"a", args[0], None, False, False, None, log, None, *args[1:]) is None
+        assert function(b"a", args[0], None, False, True, None, fmi3LogMessageCallback(), None, *args[1:]) is None
         assert messages == []
     finally:
         fmu.free()

@@ -1,16 +1,17 @@
 """FMI state-machine conformance: every exported function of the FMI API,
 called in every state of each interface (Co-Simulation: Instantiated,
 Initialization Mode, Step Mode, Terminated, and after an error; Model
-Exchange: Event Mode and Continuous-Time Mode instead of Step Mode) with
-valid arguments, returns what the standard's state table requires. A
-refusal is fmiError with exactly one log message naming the function;
-functions of capabilities this FMU does not declare (derivatives, clocks,
-Scheduled Execution, ...) refuse in every state, and the functions of one
-interface refuse an instance of the other.
+Exchange: Event Mode and Continuous-Time Mode instead of Step Mode; FMI 3
+Scheduled Execution: Clock Activation Mode) with valid arguments, returns
+what the standard's state table requires. A refusal is fmiError with
+exactly one log message naming the function; functions of capabilities
+this FMU does not declare (derivatives, Configuration Mode, output
+Clocks, ...) refuse in every state, and the functions of one interface
+refuse an instance of another.
 
 The allowed states below are written from the standards' tables (FMI
-2.0.4 sections 3.2.3 and 4.2.4; FMI 3.0 sections 2.3, 3.2 and 4.2), not
-read from the FMU's own tables."""
+2.0.4 sections 3.2.3 and 4.2.4; FMI 3.0 sections 2.3, 3.2, 4.2 and 5.2),
+not read from the FMU's own tables."""
 
 import ctypes
 import re
@@ -22,7 +23,7 @@ from fmpy import __file__ as fmpy_file
 
 from fmpy.fmi2 import fmi2EventInfo
 
-from support.fmu_driver import Instance, call_status
+from support.fmu_driver import Instance, call_status, clock_vr
 
 STATES = ["Instantiated", "Initialization Mode", "Step Mode", "Terminated", "Error"]
 ALL = set(STATES)
@@ -31,6 +32,11 @@ I, N, S, T, E = STATES  # noqa: E741 (the initials the tables below are written 
 EV, C = "Event Mode", "Continuous-Time Mode"
 ME_STATES = [I, N, EV, C, T, E]
 ME_ALL = set(ME_STATES)
+# Scheduled Execution's own state (FMI 3 only)
+CA = "Clock Activation Mode"
+SE_STATES = [I, N, CA, T, E]
+# the interfaces an instance is made for
+CS_, ME_, SE_ = "Co-Simulation", "Model Exchange", "Scheduled Execution"
 
 # FMI 2.0.4, Co-Simulation: function -> states in which it may be called.
 # (stepComplete, stepFailed and stepCanceled are Step Mode here: this FMU
@@ -184,6 +190,19 @@ FMI3_ME_ALLOWED = {
     "fmi3GetNumberOfContinuousStates": {I, EV, C},
 }
 
+# FMI 3.0, Scheduled Execution (section 5.2, State: Clock Activation Mode): the common states of 2.3 with
+# Clock Activation Mode where Co-Simulation has Step Mode: fmi3Set{VariableType} of inputs and tunable
+# parameters, fmi3Get{VariableType}, fmi3ActivateModelPartition, fmi3GetInterval, the FMU-state functions
+# (between activations) and fmi3Terminate there. The interval of a fixed periodic Clock without
+# intervalDecimal is asked in Initialization Mode and may be in Clock Activation Mode, its shift in
+# Initialization Mode (2.2.9.3, the table of Clock types).
+FMI3_SE_ALLOWED = {
+    **{name: {CA if s == S else s for s in states} for name, states in FMI3_ALLOWED.items() if name != "fmi3DoStep"},
+    "fmi3ActivateModelPartition": {CA},
+    "fmi3GetIntervalDecimal": {N, CA},
+    "fmi3GetShiftDecimal": {N},
+}
+
 # Calls this FMU takes where the standard's table has none (docs/fmi.md, Model Exchange): the sets of
 # Event Mode in Continuous-Time Mode too, as OMSimulator makes them at each integrator step (the next
 # cycle takes the values the instant before it is left with). Every other cell is the standard's.
@@ -194,21 +213,26 @@ BEYOND_THE_TABLE = {(2, f"fmi2Set{kind}", C) for kind in ("Integer", "Boolean", 
 # Functions of capabilities this FMU does not have, by the standards' chapters, and the reason each
 # refusal gives. FMI 2: Model Exchange (chapter 3); directional derivatives, input derivatives and output
 # derivatives (providesDirectionalDerivative, canInterpolateInputs and maxOutputDerivativeOrder are
-# false or 0). FMI 3: Model Exchange (chapter 3; Scheduled Execution's fmi3ActivateModelPartition too);
-# derivatives and dependencies (providesDirectionalDerivatives, providesAdjointDerivatives,
-# providesPerElementDependencies false; maxOutputDerivativeOrder 0); Event Mode, clocks and
-# Configuration Mode (hasEventMode false, no clocks, no structural parameters).
+# false or 0). FMI 3: derivatives and dependencies (providesDirectionalDerivatives,
+# providesAdjointDerivatives, providesPerElementDependencies false; maxOutputDerivativeOrder 0);
+# Co-Simulation's Event Mode (hasEventMode false); Configuration Mode (no structural parameters); and of
+# the Clock functions those its one Clock has no use for: it is an input Clock (no fmi3GetClock), ticks in
+# Scheduled Execution only (no fmi3SetClock, no clocked partition in Event Mode), decimal only
+# (supportsFraction false), with the interval and shift the FMU gives (no fmi3SetInterval, fmi3SetShift).
 FMI2_NO_DERIVATIVES = "this FMU provides no derivatives (see the model description)"
-FMI3_NO_SCHEDULED = "this FMU supports Co-Simulation and Model Exchange, not Scheduled Execution"
 FMI3_NO_DERIVATIVES = "this FMU provides no derivatives or dependencies (see the model description)"
-FMI3_NO_CLOCKS = "this FMU has no clocks or Configuration Mode"
+FMI3_NO_CONFIGURATION = "this FMU has no Configuration Mode (no structural parameters)"
+FMI3_NO_EVENT_CLOCKS = "this FMU's Clock ticks in Scheduled Execution only: no clocked partition in Event Mode"
+FMI3_NO_FRACTION = "the Clock's timing is decimal only (supportsFraction = false): use fmi3GetIntervalDecimal"
+FMI3_CLOCK_FOLLOWS_CYCLE = (
+    "the Clock's interval and shift are cycleTime's (a fixed periodic Clock without intervalDecimal): set cycleTime"
+)
 FMI3_NO_CS_EVENT_MODE = "this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"
 UNSUPPORTED = {
     **{
         f"fmi2{name}": FMI2_NO_DERIVATIVES
         for name in ("GetDirectionalDerivative", "SetRealInputDerivatives", "GetRealOutputDerivatives")
     },
-    "fmi3ActivateModelPartition": FMI3_NO_SCHEDULED,
     "fmi3EnterStepMode": FMI3_NO_CS_EVENT_MODE,
     **{
         f"fmi3{name}": FMI3_NO_DERIVATIVES
@@ -220,33 +244,29 @@ UNSUPPORTED = {
             "GetOutputDerivatives",
         )
     },
+    "fmi3EnterConfigurationMode": FMI3_NO_CONFIGURATION,
+    "fmi3ExitConfigurationMode": FMI3_NO_CONFIGURATION,
+    "fmi3EvaluateDiscreteStates": FMI3_NO_EVENT_CLOCKS,
+    "fmi3GetClock": "the Clock is an input Clock; fmi3GetClock reads output Clocks, and this FMU has none",
+    "fmi3SetClock": "the Clock ticks in Scheduled Execution only (fmi3ActivateModelPartition); in Co-Simulation the "
+    "communication step and in Model Exchange the time events run the cycles",
+    "fmi3GetIntervalFraction": FMI3_NO_FRACTION,
+    "fmi3GetShiftFraction": FMI3_NO_FRACTION,
     **{
-        f"fmi3{name}": FMI3_NO_CLOCKS
-        for name in (
-            "GetClock",
-            "SetClock",
-            "EnterConfigurationMode",
-            "ExitConfigurationMode",
-            "GetIntervalDecimal",
-            "GetIntervalFraction",
-            "GetShiftDecimal",
-            "GetShiftFraction",
-            "SetIntervalDecimal",
-            "SetIntervalFraction",
-            "SetShiftDecimal",
-            "SetShiftFraction",
-            "EvaluateDiscreteStates",
-        )
+        f"fmi3{name}": FMI3_CLOCK_FOLLOWS_CYCLE
+        for name in ("SetIntervalDecimal", "SetIntervalFraction", "SetShiftDecimal", "SetShiftFraction")
     },
 }
 
-# The refusal of a function of the other interface: its own text, or (fmi2DoStep, fmi3DoStep: Step Mode is
-# Co-Simulation's alone) the state's
-OTHER_INTERFACE = {
-    (2, False): "a Model Exchange function, and this instance was instantiated for Co-Simulation",
-    (2, True): "a Co-Simulation function, and this instance was instantiated for Model Exchange",
-    (3, False): "a Model Exchange function, and this instance was instantiated for Co-Simulation",
-}
+
+# The refusal of a function of another interface (the interface whose table has it): its own text, or
+# (fmi2DoStep, fmi3DoStep: Step Mode is Co-Simulation's alone; fmi3ActivateModelPartition: Clock
+# Activation Mode is Scheduled Execution's) the state's
+def other_interface_text(version, interface, owner):
+    if version == 2 and interface == ME_:
+        return "a Co-Simulation function, and this instance was instantiated for Model Exchange"
+    return f"a {owner} function, and this instance was instantiated for {interface}"
+
 
 # not called on an instance, or ending it
 NOT_INSTANCE_CALLS = {
@@ -298,7 +318,7 @@ def valid_call(fmu, name):
     def with_state(call):
         # a state taken in Initialization Mode on a second instance of the
         # same FMU: valid whatever state this instance is in
-        helper = Instance("RateLimiter", v, name="helper", model_exchange=fmu.model_exchange)
+        helper = Instance("RateLimiter", v, name="helper", model_exchange=fmu.model_exchange, scheduled=fmu.scheduled)
         try:
             helper.start()
             assert (
@@ -377,6 +397,8 @@ def valid_call(fmu, name):
             "fmi2GetStringStatus": lambda: raw(fmu, name, [c_void_p, c_int, c_void_p], c, 1, buffer),
         }
     else:
+        # the Clock of the binary (declared by the Scheduled Execution FMU alone): refused in CS and ME
+        clock = (c_uint * 1)(clock_vr("RateLimiter"))
         calls = {
             "fmi3SetDebugLogging": lambda: raw(fmu, name, [c_void_p, c_bool, c_size_t, c_void_p], c, True, 0, None),
             "fmi3EnterInitializationMode": lambda: raw(
@@ -421,6 +443,14 @@ def valid_call(fmu, name):
                 fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_size_t], c, boolean_vr, 1, flag, 1
             ),
             "fmi3GetFMUState": lambda: raw(fmu, name, [c_void_p, POINTER(c_void_p)], c, ctypes.byref(c_void_p())),
+            # the Clock of Scheduled Execution
+            "fmi3ActivateModelPartition": lambda: raw(
+                fmu, name, [c_void_p, c_uint, c_double], c, clock[0], fmu.t + 0.1
+            ),
+            "fmi3GetIntervalDecimal": lambda: raw(
+                fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p, c_void_p], c, clock, 1, real, integer
+            ),
+            "fmi3GetShiftDecimal": lambda: raw(fmu, name, [c_void_p, c_void_p, c_size_t, c_void_p], c, clock, 1, real),
             "fmi3DoStep": lambda: raw(
                 fmu,
                 name,
@@ -469,7 +499,9 @@ def valid_call(fmu, name):
 
         def serialize_then_deserialize():
             assert raw(fmu, ser_name, [c_void_p, c_void_p, c_void_p, c_size_t], c, state, buffer, 4096) in (0, 3)
-            helper = Instance("RateLimiter", v, name="serializer", model_exchange=fmu.model_exchange)
+            helper = Instance(
+                "RateLimiter", v, name="serializer", model_exchange=fmu.model_exchange, scheduled=fmu.scheduled
+            )
             try:  # serialized by a healthy instance of the same FMU
                 helper.start()
                 h = helper.fmu.component
@@ -504,6 +536,8 @@ def valid_call(fmu, name):
 def enter(fmu, state):
     if fmu.model_exchange:
         return enter_model_exchange(fmu, state)
+    if fmu.scheduled:
+        return enter_scheduled_execution(fmu, state)
     if state in (N, S, T):
         if fmu.version == 2:
             fmu.fmu.setupExperiment(startTime=0.0)
@@ -535,56 +569,71 @@ def enter_model_exchange(fmu, state):
         assert set_time(fmu.fmu.component, -1.0) == 3  # before the start: error
 
 
+def enter_scheduled_execution(fmu, state):
+    fmu.set(cycleTime=0.1)
+    if state == N:
+        fmu.enter_initialization()
+    elif state != I:
+        fmu.start()  # Clock Activation Mode
+    if state == T:
+        fmu.fmu.terminate()
+    if state == E:
+        assert fmu.raw_activate(-1.0) == 3  # before the start: error
+
+
 # the states as the refusals name them (FMI 2's Error state: after a failed call)
 STATE_TEXT = {
-    **{(v, state): state for v in (2, 3) for state in STATES + ME_STATES},
+    **{(v, state): state for v in (2, 3) for state in STATES + ME_STATES + SE_STATES},
     (2, E): "Error (after a failed call)",
 }
 
+INTERFACE_STATES = {CS_: STATES, ME_: ME_STATES, SE_: SE_STATES}
+INTERFACES = {2: (CS_, ME_), 3: (CS_, ME_, SE_)}
 CASES = [
-    (v, name, state, False)
+    (v, name, state, interface)
     for v in (2, 3)
+    for interface in INTERFACES[v]
     for name in sorted(exported_functions(v))
     if name not in NOT_INSTANCE_CALLS
-    for state in STATES
-] + [
-    (v, name, state, True)
-    for v in (2, 3)
-    for name in sorted(exported_functions(v))
-    if name not in NOT_INSTANCE_CALLS
-    for state in ME_STATES
+    for state in INTERFACE_STATES[interface]
 ]
 
 
-def allowed_table(version, model_exchange):
-    return {(2, False): FMI2_ALLOWED, (3, False): FMI3_ALLOWED, (2, True): FMI2_ME_ALLOWED, (3, True): FMI3_ME_ALLOWED}[
-        version, model_exchange
-    ]
+def allowed_table(version, interface):
+    return {
+        (2, CS_): FMI2_ALLOWED,
+        (3, CS_): FMI3_ALLOWED,
+        (2, ME_): FMI2_ME_ALLOWED,
+        (3, ME_): FMI3_ME_ALLOWED,
+        (3, SE_): FMI3_SE_ALLOWED,
+    }[version, interface]
 
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_every_function_is_allowed_somewhere_or_unsupported_for_a_reason(version):
     """The tables above cover the whole API: each exported function is in the state table, refused as a
     capability this FMU lacks, or (fmi2CancelStep: nothing to cancel) allowed in no state."""
-    cs, me = allowed_table(version, False), allowed_table(version, True)
-    rest = set(exported_functions(version)) - NOT_INSTANCE_CALLS - set(cs) - set(me) - set(UNSUPPORTED)
+    tables = set().union(*(allowed_table(version, interface) for interface in INTERFACES[version]))
+    rest = set(exported_functions(version)) - NOT_INSTANCE_CALLS - tables - set(UNSUPPORTED)
     assert rest == ({"fmi2CancelStep"} if version == 2 else set())
-    assert not (set(cs) | set(me)) & set(UNSUPPORTED)
+    assert not tables & set(UNSUPPORTED)
 
 
 @pytest.mark.parametrize(
-    "version,function,state,model_exchange",
+    "version,function,state,interface",
     CASES,
-    ids=lambda x: {True: "ME", False: "CS"}.get(x) if isinstance(x, bool) else None,
+    ids=lambda x: {CS_: "CS", ME_: "ME", SE_: "SE"}.get(x) if x in (CS_, ME_, SE_) else None,
 )
-def test_every_function_in_every_state(version, function, state, model_exchange):
-    table = allowed_table(version, model_exchange)
+def test_every_function_in_every_state(version, function, state, interface):
+    table = allowed_table(version, interface)
     allowed = table.get(function, set()) | {
-        s for v, f, s in BEYOND_THE_TABLE if (v, f) == (version, function) and model_exchange
+        s for v, f, s in BEYOND_THE_TABLE if (v, f) == (version, function) and interface == ME_
     }
-    other = allowed_table(version, not model_exchange)
+    owners = [
+        other for other in INTERFACES[version] if other != interface and function in allowed_table(version, other)
+    ]
     row = FMI3_AFTER_ERROR if version == 3 and state == E else state
-    fmu = Instance("RateLimiter", version, model_exchange=model_exchange)
+    fmu = Instance("RateLimiter", version, model_exchange=interface == ME_, scheduled=interface == SE_)
     try:
         enter(fmu, state)
         before = len(fmu.errors())
@@ -599,9 +648,9 @@ def test_every_function_in_every_state(version, function, state, model_exchange)
             assert new_errors[0][2].startswith(f"{function}: "), new_errors  # it names the function first
             if function in UNSUPPORTED:  # a capability this FMU does not have: says which
                 assert new_errors[0][2] == f"{function}: {UNSUPPORTED[function]}", new_errors
-            elif function not in table and function in other:  # the other interface's: says so, or the state
+            elif function not in table and owners:  # another interface's: says so, or the state
                 assert new_errors[0][2] in (
-                    f"{function}: {OTHER_INTERFACE.get((version, model_exchange))}",
+                    f"{function}: {other_interface_text(version, interface, owners[0])}",
                     f"{function}: not allowed in {STATE_TEXT[version, row]}",
                 ), new_errors
             else:  # refused for the state: says which

@@ -27,8 +27,14 @@ def schema():
     return manifest_schema()
 
 
-def carried(model, version):
-    with zipfile.ZipFile(fmu_file(model, version)) as z:
+# every FMU: FMI 2, FMI 3 Co-Simulation and Model Exchange, FMI 3 Scheduled Execution
+VARIANTS = pytest.mark.parametrize(
+    "version,scheduled", [(2, False), (3, False), (3, True)], ids=["fmi2", "fmi3", "fmi3-scheduled-execution"]
+)
+
+
+def carried(model, version, scheduled):
+    with zipfile.ZipFile(fmu_file(model, version, scheduled)) as z:
         prefix = f"{FOLDER}/"
         return {n[len(prefix) :]: z.read(n) for n in z.namelist() if n.startswith(prefix)}
 
@@ -44,10 +50,10 @@ def test_the_schema_accepts_the_standards_example_and_refuses_a_bad_role(schema)
     assert not schema.validate(example)
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_the_manifest_is_valid_and_its_checksums_hold(model, version, schema):
-    files = carried(model, version)
+def test_the_manifest_is_valid_and_its_checksums_hold(model, version, scheduled, schema):
+    files = carried(model, version, scheduled)
     manifest = etree.fromstring(files.pop("fmi-ls-manifest.xml"))
     assert schema.validate(manifest), schema.error_log
     listed = {}
@@ -59,13 +65,17 @@ def test_the_manifest_is_valid_and_its_checksums_hold(model, version, schema):
         assert hashlib.sha256(files[source]).hexdigest() == digest, source
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_the_experiments_are_the_scenarios_byte_for_byte(model, version):
-    files = carried(model, version)
+def test_the_experiments_are_the_scenarios_byte_for_byte(model, version, scheduled):
+    files = carried(model, version, scheduled)
     names = scenario_names(model)
     validation = etree.fromstring(files["validation.exp"])
     smoke = etree.fromstring(files["smoke-test.exp"])
+    # each says the interfaces its FMU declares, the ones the scenarios were checked in (tests/fmu)
+    checked = "Scheduled Execution" if scheduled else "Co-Simulation and Model Exchange"
+    for experiments in (validation, smoke):
+        assert experiments.get("description").endswith(f"; each checked in {checked}"), experiments.get("description")
     assert [e.get("name") for e in validation.iterfind("Experiment")] == names
     assert [e.get("name") for e in smoke.iterfind("Experiment")] == names[:3]
     for experiment in validation.iterfind("Experiment"):
@@ -85,7 +95,7 @@ def test_the_experiments_are_the_scenarios_byte_for_byte(model, version):
 
 @pytest.mark.parametrize("model", MODELS)
 def test_the_parameter_sets_are_the_start_values(model):
-    files = carried(model, 3)
+    files = carried(model, 3, False)
     validator = ssv_schema()
     validation = etree.fromstring(files["validation.exp"])
     for experiment in validation.iterfind("Experiment"):
@@ -110,7 +120,7 @@ def test_the_parameter_sets_are_the_start_values(model):
 
 
 def test_every_reference_carries_each_signals_criterion():
-    files = carried("RateLimiter", 3)
+    files = carried("RateLimiter", 3, False)
     manifest = etree.fromstring(files["fmi-ls-manifest.xml"])
     results = [r for r in manifest.iterfind("Related") if r.get("role") == "result"]
     assert len(results) == len(scenario_names("RateLimiter"))
@@ -120,36 +130,46 @@ def test_every_reference_carries_each_signals_criterion():
         assert criteria == dict.fromkeys(header, "exact")  # no scenario has its own: bit for bit
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_the_documentation_names_the_interfaces_and_the_experiments(model, version):
-    with zipfile.ZipFile(fmu_file(model, version)) as z:
+def test_the_documentation_names_the_interfaces_and_the_experiments(model, version, scheduled):
+    with zipfile.ZipFile(fmu_file(model, version, scheduled)) as z:
         page = z.read("documentation/index.html").decode()
         standalone = z.read("documentation/fmi-ls-ref.html").decode()  # where the standard recommends it
         description = etree.fromstring(z.read("modelDescription.xml"))
     kinds = [
         name
-        for tag, name in (("CoSimulation", "Co-Simulation"), ("ModelExchange", "Model Exchange"))
+        for tag, name in (
+            ("CoSimulation", "Co-Simulation"),
+            ("ModelExchange", "Model Exchange"),
+            ("ScheduledExecution", "Scheduled Execution"),
+        )
         if description.find(tag) is not None
     ]
-    assert kinds == ["Co-Simulation", "Model Exchange"]  # what every product model implements (docs/fmi.md)
-    assert f"It carries FMI {version}.0 Co-Simulation and Model Exchange" in page
+    # what every product model implements (docs/fmi.md); FMI 3's Scheduled Execution in an FMU of its own
+    assert kinds == (["Scheduled Execution"] if scheduled else ["Co-Simulation", "Model Exchange"])
+    assert (
+        "It carries FMI 3.0 Scheduled Execution (the PLC cyclic interrupt OB as an input Clock),"
+        if scheduled
+        else f"It carries FMI {version}.0 Co-Simulation and Model Exchange,"
+    ) in page
     assert f"<pre>fmutrace check {model}.fmu</pre>" in page
     assert '<a href="fmi-ls-ref.html">' in page
     for text in (page, standalone):
         assert f"<pre>fmutrace check {model}.fmu</pre>" in text
         for name in scenario_names(model):
             assert f"<li><code>{name}</code>" in text
-        assert f"<code>serialized-state/{scenario_names(model)[0]}.fmustate</code>" in text
+        # a state of Co-Simulation's, which a Scheduled Execution instance refuses: not in its FMU
+        assert (f"<code>serialized-state/{scenario_names(model)[0]}.fmustate</code>" in text) != scheduled
 
 
 BUDGET = 64 * 1024  # what the experiments may add to an FMU (docs/fmi.md)
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_the_experiments_stay_within_their_size_budget(model, version):
-    path = fmu_file(model, version)
+def test_the_experiments_stay_within_their_size_budget(model, version, scheduled):
+    path = fmu_file(model, version, scheduled)
     data = path.read_bytes()
     added = 0
     with zipfile.ZipFile(path) as z:

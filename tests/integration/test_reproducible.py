@@ -10,7 +10,7 @@ import zipfile
 
 import pytest
 
-from support.fmu_driver import BUILD_DIR, MODELS as PRODUCT_MODELS, REPO, fmu_file
+from support.fmu_driver import BUILD_DIR, MODELS as PRODUCT_MODELS, REPO, SCHEDULED_EXECUTION_FOLDER, fmu_file
 from support.process import run as run_bounded
 
 MODELS = PRODUCT_MODELS + ["PassThrough"]
@@ -31,17 +31,18 @@ def zip_mtime():
     return build_setting(r'set\(FMU_ZIP_MTIME "([^"]+)"\)', (REPO / "cmake" / "Fmu.cmake").read_text())
 
 
-def fmu_path(model, version):
-    path = fmu_file(model, version)
+def fmu_path(model, version, scheduled=False):
+    path = fmu_file(model, version, scheduled)
     return path if path.exists() else BUILD_DIR / "benchmarks" / f"fmi{version}" / f"{model}.fmu"
 
 
-def repackage(model, version, tmp_path, normalize):
+def repackage(model, version, tmp_path, normalize, scheduled=False):
     """Stage the FMU's files again, disturbed, and package them as the build does."""
-    built = fmu_path(model, version)
+    built = fmu_path(model, version, scheduled)
     names = zipfile.ZipFile(built).namelist()
     stage = tmp_path / "stage"
-    shutil.copytree(BUILD_DIR / "stage" / f"fmi{version}" / model, stage)
+    folder = SCHEDULED_EXECUTION_FOLDER if scheduled else f"fmi{version}"
+    shutil.copytree(BUILD_DIR / "stage" / folder / model, stage)
     for name in names:
         path = stage / name
         os.chmod(path, os.stat(path).st_mode | 0o020)  # as under umask 002
@@ -73,6 +74,13 @@ def test_fmu_bytes_depend_on_contents_alone(model, version, tmp_path):
     built, again = repackage(model, version, tmp_path, normalize=True)
     assert again == built
     assert zipfile.ZipFile(fmu_path(model, version)).testzip() is None
+
+
+@pytest.mark.parametrize("model", PRODUCT_MODELS)
+def test_scheduled_execution_fmu_bytes_depend_on_contents_alone(model, tmp_path):
+    built, again = repackage(model, 3, tmp_path, normalize=True, scheduled=True)
+    assert again == built
+    assert zipfile.ZipFile(fmu_path(model, 3, scheduled=True)).testzip() is None
 
 
 @pytest.mark.parametrize("version", [2, 3])

@@ -1,5 +1,5 @@
 """Static validators beside fmpy's: fmutool -check (FMU Manipulation
-Toolbox, FMI 2 and 3) and VDMCheck2 (INTO-CPS, FMI 2, the VDM model of the
+Toolbox, FMI 2 and 3, the Scheduled Execution FMUs too) and VDMCheck2 (INTO-CPS, FMI 2, the VDM model of the
 FMI 2 standard) find nothing in any FMU."""
 
 import os
@@ -12,12 +12,14 @@ from support.fmu_driver import MODELS, fmu_file
 from support.process import run as run_bounded
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize(
+    "version,scheduled", [(2, False), (3, False), (3, True)], ids=["fmi2", "fmi3", "fmi3-scheduled-execution"]
+)
 @pytest.mark.parametrize("model", MODELS)
-def test_fmutool_check(model, version):
+def test_fmutool_check(model, version, scheduled):
     fmutool = Path(sys.executable).parent / "fmutool"
     out = run_bounded(
-        [str(fmutool), "-input", str(fmu_file(model, version)), "-check"], timeout=120, what="fmutool -check"
+        [str(fmutool), "-input", str(fmu_file(model, version, scheduled)), "-check"], timeout=120, what="fmutool -check"
     )
     log = out.stdout + out.stderr
     assert out.returncode == 0, log

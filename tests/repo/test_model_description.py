@@ -22,14 +22,20 @@ FMI3_TYPE = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "Enume
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 
 
+# every FMU: FMI 2, FMI 3 Co-Simulation and Model Exchange, FMI 3 Scheduled Execution (the same binary)
+VARIANTS = pytest.mark.parametrize(
+    "version,scheduled", [(2, False), (3, False), (3, True)], ids=["fmi2", "fmi3", "fmi3-scheduled-execution"]
+)
+
+
 def toml(model):
     return tomllib.loads((REPO / "modelDescription" / f"{model}.toml").read_text())
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_fmpy_validate_finds_no_problem(model, version):
-    assert validate_fmu(str(fmu_file(model, version))) == []
+def test_fmpy_validate_finds_no_problem(model, version, scheduled):
+    assert validate_fmu(str(fmu_file(model, version, scheduled))) == []
 
 
 @pytest.mark.parametrize("version", [2, 3])
@@ -43,6 +49,21 @@ def test_capabilities(model, version):
     assert not cs.canBeInstantiatedOnlyOncePerProcess
 
 
+@VARIANTS
+@pytest.mark.parametrize("model", MODELS)
+def test_each_fmu_declares_its_interfaces(model, version, scheduled):
+    """The Co-Simulation and Model Exchange FMUs (FMI 2 and 3) declare no
+    Scheduled Execution; the Scheduled Execution FMU declares it alone."""
+    md = read_model_description(str(fmu_file(model, version, scheduled)))
+    declared = [md.coSimulation is not None, md.modelExchange is not None, md.scheduledExecution is not None]
+    assert declared == ([False, False, True] if scheduled else [True, True, False])
+    if scheduled:
+        se = md.scheduledExecution
+        assert se.modelIdentifier == model
+        assert se.canGetAndSetFMUstate and se.canSerializeFMUstate and not se.canBeInstantiatedOnlyOncePerProcess
+        assert md.instantiationToken == read_model_description(str(fmu_file(model, 3))).instantiationToken
+
+
 def same_start(declared, start):
     if declared is None:
         return start is None
@@ -52,12 +73,16 @@ def same_start(declared, start):
     return (math.isnan(a) and math.isnan(declared)) or a == declared
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_model_description_is_the_toml(model, version):
+def test_model_description_is_the_toml(model, version, scheduled):
     source = toml(model)
-    md = read_model_description(str(fmu_file(model, version)))
-    variables = md.modelVariables
+    md = read_model_description(str(fmu_file(model, version, scheduled)))
+    # the Scheduled Execution FMU's Clock is the generator's, not the TOML's (test_scheduled_execution.py); no
+    # other FMU has one (FMI 3.0, 4.4: a Co-Simulation FMU with Clocks needs Event Mode)
+    clocks = [v.name for v in md.modelVariables if v.type == "Clock"]
+    assert clocks == (["cyclicInterrupt"] if scheduled else [])
+    variables = [v for v in md.modelVariables if v.type != "Clock"]
     assert [v.name for v in variables] == [v["name"] for v in source["variable"]]
     for v, s in zip(variables, source["variable"], strict=True):
         assert v.valueReference == s["vr"]
@@ -130,12 +155,12 @@ def test_binary_exports_fmi_only_and_needs_libc_only(model, version, platform):
     assert set(needed) <= {"libc.so.6", "libm.so.6"}
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_sources_are_shipped(model, version):
-    with zipfile.ZipFile(fmu_file(model, version)) as z:
+def test_sources_are_shipped(model, version, scheduled):
+    with zipfile.ZipFile(fmu_file(model, version, scheduled)) as z:
         names = set(z.namelist())
-    md = read_model_description(str(fmu_file(model, version)))
+    md = read_model_description(str(fmu_file(model, version, scheduled)))
     files = md.buildConfigurations[0].sourceFileSets[0].sourceFiles
     assert files == [f"{model}_fmi{version}.c"]  # the FMU's one unit, which includes the rest (test_source_fmu.py)
     included = [
@@ -157,16 +182,16 @@ def png_size(data):
     return struct.unpack(">II", data[16:24])
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_documentation_and_icon_are_inside(model, version):
+def test_documentation_and_icon_are_inside(model, version, scheduled):
     """documentation/index.html (every variable, the status codes where the
     block has a status), the ramp plot it shows, and the model icon."""
-    with zipfile.ZipFile(fmu_file(model, version)) as z:
+    with zipfile.ZipFile(fmu_file(model, version, scheduled)) as z:
         page = z.read("documentation/index.html").decode()
         ramp = z.read("documentation/ramp.png")
         icon = z.read("model.png" if version == 2 else "terminalsAndIcons/icon.png")
-    md = read_model_description(str(fmu_file(model, version)))
+    md = read_model_description(str(fmu_file(model, version, scheduled)))
     for v in md.modelVariables:
         assert f"<code>{v.name}</code>" in page, v.name
     if any(v.name == "status" for v in md.modelVariables):
@@ -186,16 +211,16 @@ def start_attributes(xml, version):
     return {v.get("name"): v.get("start") for v in variables if v.get("start") is not None}
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@VARIANTS
 @pytest.mark.parametrize("model", MODELS)
-def test_start_values_are_finite_or_a_nan_that_means_something(model, version):
+def test_start_values_are_finite_or_a_nan_that_means_something(model, version, scheduled):
     """FMI Library and OMSimulator refuse INF start values: none in any
     model description (a "none" limit starts at the largest finite double,
     which the model reads as no limit). A NaN start is left only where NaN
     means something no finite value does (not connected: the parameter
     instead; no bypass value: the output follows the input), as the
     variable's description says."""
-    with zipfile.ZipFile(fmu_file(model, version)) as z:
+    with zipfile.ZipFile(fmu_file(model, version, scheduled)) as z:
         xml = z.read("modelDescription.xml").decode()
     starts = start_attributes(xml, version)
     assert starts and len(starts) == len([v for v in toml(model)["variable"] if "start" in v])

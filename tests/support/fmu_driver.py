@@ -16,7 +16,7 @@ from fmpy.fmi2 import (
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
 )
-from fmpy.fmi3 import FMU3Model, FMU3Slave
+from fmpy.fmi3 import FMU3Model, FMU3ScheduledExecution, FMU3Slave
 
 REPO = Path(__file__).resolve().parents[2]
 TESTS = REPO / "tests"  # the working directory of the helper scripts (python -m support.x)
@@ -28,30 +28,56 @@ MODELS = sorted(p.stem for p in (REPO / "modelDescription").glob("*.toml"))
 _unzipped = {}
 
 
-def fmu_file(model, version):
-    return BUILD_DIR / f"fmi{version}" / f"{model}.fmu"
+# the FMUs of FMI 3 Scheduled Execution alone, beside fmi3/'s Co-Simulation and Model Exchange (cmake/Fmu.cmake)
+SCHEDULED_EXECUTION_FOLDER = "fmi3-se"
 
 
-def unzipped(model, version):
+def fmu_file(model, version, scheduled=False):
+    """scheduled: the FMI 3 Scheduled Execution FMU (same binary, its own model description)."""
+    return BUILD_DIR / (SCHEDULED_EXECUTION_FOLDER if scheduled else f"fmi{version}") / f"{model}.fmu"
+
+
+def unzipped(model, version, scheduled=False):
     """The FMU extracted once per test session."""
-    key = (model, version)
+    key = (model, version, scheduled)
     if key not in _unzipped:
-        _unzipped[key] = extract(str(fmu_file(model, version)))
+        _unzipped[key] = extract(str(fmu_file(model, version, scheduled)))
     return _unzipped[key]
+
+
+def clock_vr(model):
+    """The value reference of the Clock cyclicInterrupt, as the Scheduled Execution FMU declares it; its binary is
+    the FMI 3 Co-Simulation and Model Exchange FMU's, whose model description has no Clock."""
+    md = read_model_description(unzipped(model, 3, scheduled=True))
+    (clock,) = (v for v in md.modelVariables if v.type == "Clock")
+    return clock.valueReference
 
 
 class Instance:
     """One FMU instance. Values are read and written by variable name."""
 
-    def __init__(self, model="RateLimiter", version=2, name="test", logging=True, unzipdir=None, model_exchange=False):
+    def __init__(
+        self,
+        model="RateLimiter",
+        version=2,
+        name="test",
+        logging=True,
+        unzipdir=None,
+        model_exchange=False,
+        scheduled=False,
+    ):
+        """scheduled: FMI 3 Scheduled Execution, through fmpy's own wrapper (its
+        preemption callbacks do nothing)."""
         self.version = version
+        self.model = model
         self.model_exchange = model_exchange
-        self.unzipdir = unzipdir or unzipped(model, version)
+        self.scheduled = scheduled
+        self.unzipdir = unzipdir or unzipped(model, version, scheduled)
         self.md = read_model_description(self.unzipdir)
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.messages = []
         self.t = 0.0
-        identifier = self.md.coSimulation.modelIdentifier
+        identifier = (self.md.scheduledExecution if scheduled else self.md.coSimulation).modelIdentifier
         if version == 2:
             self.fmu = (FMU2Model if model_exchange else FMU2Slave)(
                 guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name
@@ -62,7 +88,7 @@ class Instance:
             self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
             self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging)
         else:
-            self.fmu = (FMU3Model if model_exchange else FMU3Slave)(
+            self.fmu = (FMU3Model if model_exchange else FMU3ScheduledExecution if scheduled else FMU3Slave)(
                 guid=self.md.guid, unzipDirectory=self.unzipdir, modelIdentifier=identifier, instanceName=name
             )
             self.fmu.instantiate(loggingOn=logging, logMessage=self._log3)
@@ -162,6 +188,13 @@ class Instance:
         if status <= 1:
             self.t = t + h
         return status
+
+    def raw_activate(self, t):
+        """fmi3ActivateModelPartition of the Clock at t, through ctypes alone; the FMI status."""
+        activate = self.fmu.dll.fmi3ActivateModelPartition
+        activate.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_double]
+        activate.restype = ctypes.c_int
+        return activate(self.fmu.component, clock_vr(self.model), t)
 
     def restore(self, state, t):
         """Set an FMU state taken at time t; the driver's clock goes back with it (set by the test, not read
