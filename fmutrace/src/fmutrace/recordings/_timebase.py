@@ -369,12 +369,3 @@ def snapped_interval(best):
         if abs(rounded - best) <= SNAP * best:
             return rounded
     return best
-
-
-def cycles(times, step):
-    """(cycle index of each time, indices of those off their cycle end by
-    more than OFF_CYCLE of a cycle)."""
-    exact = times / step
-    index = np.rint(exact).astype(np.int64)
-    off = np.flatnonzero(np.abs(exact - index) > OFF_CYCLE)
-    return index, off
