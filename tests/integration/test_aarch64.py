@@ -12,7 +12,7 @@ import zipfile
 import pytest
 from fmpy import read_model_description
 
-from support.fmu_driver import BUILD_DIR, MODELS, fmu_file
+from support.fmu_driver import BUILD_DIR, MODELS, SCHEDULED_EXECUTION_FOLDER, fmu_file
 from support.process import run as run_bounded
 from support.run_trace import QEMU, halves, run_script, script
 from support.scenarios import discover
@@ -34,8 +34,10 @@ def test_every_fmi3_fmu_carries_an_aarch64_binary():
 
 
 def test_lifecycle_harness_under_emulation():
+    """The harness on FMI 3 runs the Co-Simulation and Model Exchange FMU and the Scheduled Execution one."""
+    stages = [BUILD_DIR / "stage" / folder / "RateLimiter" for folder in ("fmi3", SCHEDULED_EXECUTION_FOLDER)]
     done = run_bounded(
-        QEMU + [str(CROSS / "test_lifecycle"), "3", str(BUILD_DIR / "stage" / "fmi3" / "RateLimiter"), "2000", "200"],
+        QEMU + [str(CROSS / "test_lifecycle"), "3", str(stages[0]), "2000", "200", str(stages[1])],
         timeout=600,
         what="test_lifecycle under qemu-aarch64",
     )
