@@ -207,3 +207,61 @@ def test_decoded_can_signals_take_the_step_of_the_channels_mapped(tmp_path):
     assert done.stdout.count(f"WheelBasedVehicleSpeed: {off} of its {len(stamps)} time stamps are more") == 1
     assert f"jitter up to {100 * distance.max():.1f} % of a cycle" in done.stdout
     assert "ignored: EngineSpeed" in done.stdout
+
+
+RATE_LIMITER = BUILD_DIR / "fmi3" / "RateLimiter.fmu"
+
+
+def _cycles_by_intervals(stamps):
+    """An independent numbering of a sender's messages: each interval rounded to whole cycles of the
+    median interval (at least one: a message out of turn is on a cycle of its own), then the least-squares
+    line through (cycle, stamp). (its period, each stamp's distance from its cycle, the cycles missed)"""
+    intervals = np.diff(stamps)
+    cycles = np.concatenate([[0], np.cumsum(np.maximum(np.rint(intervals / np.median(intervals)), 1))])
+    period, phase = np.polyfit(cycles, stamps, 1)
+    return period, (stamps - phase) / period - cycles, int((np.diff(cycles) - 1).sum())
+
+
+@pytest.mark.parametrize(
+    "name, out_of_turn",
+    [
+        ("3BA199E2_00000164_00000001-60FE3F04.MF4.gz", False),  # 510 samples, 20 messages missing
+        ("3BA199E2_00000165_00000001-60FEB68B.MF4.gz", True),  # the first two messages 0.746 s apart
+        ("2F6913DB_00001089_00000001-63BEF5CD.MF4.gz", True),  # not finalized; 1.451 s, then 0.509 s
+    ],
+)
+def test_gps_messages_stamped_by_a_can_logger_compare_cycle_for_cycle(tmp_path, name, out_of_turn):
+    """CANmod.gps logs decoded with their DBC (asammdf, canmatrix), mapped as a user did: u=Speed,
+    y=Heading on RateLimiter. Each message comes about once a second, stamped by the logger's clock; some
+    are missing, and as the module starts one comes more than half a cycle out of turn. The case gets a
+    verdict (the FMU is no GPS: they differ), with the cycle, the jitter and the missing cycles that an
+    independent numbering of each channel's intervals gives (the two channels' stamps are 1 ms apart, so
+    fmutrace's one grid for both is within 0.1 % of a cycle of each channel's own line)."""
+    from asammdf import MDF
+
+    raw = MDF(str(_unpacked(f"canedge/{name}", tmp_path)))
+    decoded = raw.extract_bus_logging({"CAN": [(str(CORPUS / "canedge" / "gnss.dbc"), 0)]})
+    path = tmp_path / "decoded.mf4"
+    decoded.save(str(path), overwrite=True)
+    stamps = {n: np.asarray(decoded.get(n).timestamps, dtype=np.float64) for n in ("Speed", "Heading")}
+    raw.close()
+    decoded.close()
+    report = tmp_path / "report"
+    command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(RATE_LIMITER), str(path)]
+    maps = ["--map", "u=Speed", "--map", "y=Heading", "--report", str(report)]
+    done = run_bounded(command + maps, timeout=600, what="fmutrace compare")
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "FAIL" in done.stdout and "y differs first" in done.stdout
+    [case] = json.loads((report / "results.json").read_text())["cases"]
+    clock = case["clock"]
+    figures = [_cycles_by_intervals(s) for s in stamps.values()]
+    for period, _, missed in figures:
+        assert clock["cycle_s"] == pytest.approx(period, rel=1e-5)
+        assert clock["missing_cycles"] == missed
+    largest = max(float(np.abs(distance).max()) for _, distance, _ in figures)
+    assert clock["largest_percent"] == pytest.approx(100 * largest, abs=0.1)
+    assert f"jitter up to {clock['largest_percent']:.1f} % of a cycle" in done.stdout
+    put_apart = [m for m in case["messages"] if "more than half a cycle from their cycle" in m]
+    assert (largest > 0.5) == out_of_turn and len(put_apart) == (2 if out_of_turn else 0), put_apart
+    if out_of_turn:
+        assert put_apart[0].startswith("Speed: 1 of its") and put_apart[1].startswith("Heading: 1 of its")

@@ -327,6 +327,31 @@ def test_a_stamp_off_its_cycle_is_reported_and_two_on_one_cycle_refused(tmp_path
         align(recording, plan(recording, variables, "M"))
 
 
+def test_a_sample_more_than_half_a_cycle_out_of_turn_goes_to_the_free_cycle_beside_it(tmp_path):
+    """Thirty samples of a 10 ms cycle. The fourth is stamped 35.6 ms, 0.44 of a cycle before the 40 ms
+    of the fifth: both nearest to cycle 4, while cycle 3 has none. The sample is put on cycle 3 (0.56 of a
+    cycle after it, a message that came late), said in a note, and counted in the jitter; nothing is
+    missing. Stamped 14 ms instead, between the 10 and 20 ms of cycles 1 and 2, it has no free cycle
+    beside it: refused, as two samples on one cycle."""
+    variables = variables_of(u="input", y="output")
+    stamps = [0.0, 10.0, 20.0, 35.6] + [10.0 * k for k in range(4, 30)]
+    path = tmp_path / "late.csv"
+    path.write_text("time [ms];u;y\n" + "".join(f"{t};1;1\n" for t in stamps))
+    recording = normalise(read_recording(path)[0])
+    aligned = align(recording, plan(recording, variables, "M"))
+    said = [n for n in aligned.notes if "more than half a cycle" in n]
+    assert [n.split(":")[0] for n in said] == ["u", "y"]  # (each channel's own note)
+    assert said[0].startswith("u: 1 of its 30 samples are more than half a cycle from their cycle")
+    assert "line 5: t=0.0356 s, 0.5" in said[0] and "of a cycle after its cycle" in said[0]
+    assert 0.5 < aligned.clock["largest_percent"] / 100 < 0.6 and aligned.clock["missing_cycles"] == 0
+    assert aligned.inputs is not None and len(aligned.inputs) == 30
+    stamps[3] = 14.0
+    path.write_text("time [ms];u;y\n" + "".join(f"{t};1;1\n" for t in sorted(stamps)))
+    recording = normalise(read_recording(path)[0])
+    with pytest.raises(InputError, match=r"line 4: samples of u at t=0.01 s and t=0.014 s fall on the same cycle"):
+        align(recording, plan(recording, variables, "M"))
+
+
 # -- formats: recognised from the content, or refused with the reasons -----------------------
 def test_a_file_of_no_known_format_says_what_was_tried_and_why_not(tmp_path):
     path = tmp_path / "notes.txt"

@@ -82,9 +82,66 @@ def fitted_grid(recording, channels, names: Names = ()):
     )
 
 
-def _cycles_of(channel, grid, step, notes, names):
-    index = grid.index(channel.times)
-    off = np.flatnonzero(np.abs(grid.distance(channel.times, index)) > OFF_CYCLE)
+def _cycles_of(channel, grid, step, names, put_apart):
+    """The cycle of each sample of channel on grid: its nearest, or the one
+    _apart puts it on ({id(channel): the samples moved} in put_apart);
+    InputError for two samples on one cycle."""
+    nearest = grid.index(channel.times)
+    index, moved = _apart(nearest, grid.distance(channel.times, nearest))
+    if moved:
+        put_apart[id(channel)] = moved
+    repeated = np.flatnonzero(np.diff(index) == 0)
+    if len(repeated):
+        i = int(repeated[0])
+        raise InputError(
+            f"{channel.where(i + 1)}: samples of {channel.name} at t={shortest(as_read(channel.times[i]))} s and "
+            f"t={shortest(as_read(channel.times[i + 1]))} s fall on the same cycle of {shortest(step)} s, jitter of "
+            f"up to half a cycle allowed: the step is coarser than the recording (give the recorder's cycle with "
+            f"{name_of(names, 'step_size')})"
+        )
+    return index
+
+
+def _apart(index, distance):
+    """(index, the samples moved): index (each sample's nearest cycle, its
+    distance from it) with two samples that share a cycle put apart where
+    the stamps allow it: the one farther from that cycle, on its side, goes
+    to the neighbouring cycle if no sample has it (a message sent or
+    stamped more than half a cycle late or early, as a CAN sender starting
+    up does). Where the neighbour is taken too, or where more than
+    clock.FAR_SHARE of the samples would move (a step coarser than the
+    recording, not a sample out of turn), nothing moves (the caller
+    refuses the two)."""
+    repeated = np.flatnonzero(np.diff(index) == 0)
+    if not len(repeated) or len(repeated) > clock.FAR_SHARE * len(index):
+        return index, []
+    apart = index.copy()
+    moved = []
+    for i in repeated.tolist():
+        if apart[i] != apart[i + 1]:  # (a move before put these apart)
+            continue
+        cycle = int(apart[i])
+        early, late = float(distance[i]), float(distance[i + 1])
+        earlier_free = early < 0 and (i == 0 or apart[i - 1] < cycle - 1)
+        later_free = late > 0 and (i + 2 == len(apart) or apart[i + 2] > cycle + 1)
+        if earlier_free and (-early >= late or not later_free):
+            apart[i] = cycle - 1
+            moved.append(i)
+        elif later_free:
+            apart[i + 1] = cycle + 1
+            moved.append(i + 1)
+        else:
+            return index, []
+    return apart, moved
+
+
+def _note_cycles(channel, grid, index, moved, step, notes, names):
+    """The notes on channel's samples on their cycles: those more than
+    OFF_CYCLE off their nearest cycle, and those put apart from it (moved)."""
+    distance = grid.distance(channel.times, index)
+    far = np.abs(distance) > OFF_CYCLE
+    far[moved] = False
+    off = np.flatnonzero(far)
     if len(off):
         i = int(off[0])
         note = off_cycle_note(
@@ -97,16 +154,16 @@ def _cycles_of(channel, grid, step, notes, names):
                 note += f". Its own stamps fit a step of {shortest(own)} s ({name_of(names, step_size=own)})."
         if note not in notes:  # a channel that drives and is compared is said once
             notes.append(note)
-    repeated = np.flatnonzero(np.diff(index) == 0)
-    if len(repeated):
-        i = int(repeated[0])
-        raise InputError(
-            f"{channel.where(i + 1)}: samples of {channel.name} at t={shortest(as_read(channel.times[i]))} s and "
-            f"t={shortest(as_read(channel.times[i + 1]))} s fall on the same cycle of {shortest(step)} s, jitter of "
-            f"up to half a cycle allowed: the step is coarser than the recording (give the recorder's cycle with "
-            f"{name_of(names, 'step_size')})"
+    if moved:
+        i, first, largest = moved[0], float(distance[moved[0]]), float(np.abs(distance[moved]).max())
+        note = (
+            f"{channel.name}: {len(moved)} of its {len(index)} samples are more than half a cycle from their "
+            "cycle, each put on the neighbouring cycle no other sample has (its nearest holds a nearer sample); "
+            f"the first at {channel.where(i)}: t={shortest(as_read(channel.times[i]))} s, {abs(first):.3f} of a "
+            f"cycle {'after' if first > 0 else 'before'} its cycle (the largest {largest:.3f})"
         )
-    return index
+        if note not in notes:
+            notes.append(note)
 
 
 def off_cycle_note(name, off, samples, first, grid):
@@ -143,7 +200,18 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = (), c
     used = list({id(c): c for _, c in plan.drives + plan.compares}.values())  # (a channel may drive and be compared)
     grid = fitted_grid(recording, [c for c in used if len(c.times)], names)
     step = recording.step_size  # (the fit may have found the cycle the median interval missed)
-    index_of = {id(c): _cycles_of(c, grid, step, notes, names) for c in used}
+    put_apart: dict = {}  # id(channel) -> its samples put apart from their nearest cycle
+    index_of = {id(c): _cycles_of(c, grid, step, names, put_apart) for c in used}
+    if put_apart:
+        # samples put apart from their nearest cycle: the grid's line through every sample on its cycle
+        grid = clock.line(
+            np.concatenate([index_of[id(c)] for c in used]), np.concatenate([c.times for c in used]), grid
+        )
+        first = min(int(index[0]) for index in index_of.values() if len(index))
+        grid = clock.Grid(grid.period, grid.phase + first * grid.period)  # cycle 0 the first sample's
+        index_of = {key: index - first for key, index in index_of.items()}
+    for channel in used:
+        _note_cycles(channel, grid, index_of[id(channel)], put_apart.get(id(channel), []), step, notes, names)
     # inputs: every driven channel held on the union of their sample cycles
     inputs = None
     coarse = []

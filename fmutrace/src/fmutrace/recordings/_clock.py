@@ -134,10 +134,15 @@ def _arc(times, period):
 
 
 def _line(times, grid):
-    """The least-squares Grid of times numbered by grid (centred sums: exact
-    enough for 2^31 cycles)."""
-    index = grid.index(times).astype(np.float64)
-    if len(times) < 2 or index[0] == index[-1]:
+    """The least-squares Grid of times numbered by grid."""
+    return line(grid.index(times), times, grid)
+
+
+def line(index, times, grid):
+    """The least-squares Grid of times on their cycles index (centred sums:
+    exact enough for 2^31 cycles); grid's period where they span no cycle."""
+    index = np.asarray(index, dtype=np.float64)
+    if len(times) < 2 or index.min() == index.max():
         return Grid(grid.period, float(np.mean(times - index * grid.period)))
     index_mean, time_mean = index.mean(), times.mean()
     centred = index - index_mean
@@ -160,12 +165,14 @@ class Jitter:
         self.add_far(np.abs(np.asarray(distance, dtype=np.float64)))
 
     def add_far(self, far, largest=None):
-        """add() of distances already made positive, at most half a cycle (and their largest, if known)."""
+        """add() of distances already made positive (and their largest, if known); one over half a cycle
+        (a sample put apart from its nearest cycle) counts in the last bin."""
         if not len(far):
             return
         self.largest = max(self.largest, float(far.max()) if largest is None else largest)
         self.samples += len(far)
-        self.counts += np.bincount((far * (2 * HISTOGRAM_BINS)).astype(np.int64), minlength=HISTOGRAM_BINS + 1)
+        bins = np.minimum(far * (2 * HISTOGRAM_BINS), HISTOGRAM_BINS).astype(np.int64)
+        self.counts += np.bincount(bins, minlength=HISTOGRAM_BINS + 1)
 
     @property
     def typical(self):
