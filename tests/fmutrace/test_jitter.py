@@ -305,3 +305,58 @@ def test_recorded_cycle_lengths_need_every_cycle(tmp_path):
     [case] = compare("RateLimiter LREAL", path, "recorded", step_size=0.01).cases
     assert str(case.status) == "invalid"
     assert "replays every execution of the OB, but the recording samples only every 3 cycles" in case.messages[0]
+
+
+@pytest.mark.parametrize("model", ["RateLimiter LREAL", "Ramp (TIME in ms)"])
+def test_a_case_folder_replays_the_cycle_lengths_of_its_reference(tmp_path, model):
+    """A case folder (the FMI cross-check layout) whose _ref.opt says CycleLengths,recorded: each
+    reference row is one execution of the OB, a step from the row before for the interval between
+    their times (whole ms here, an OB that overruns every 7th cycle and jitters by 2 ms). The reference
+    is the FMU stepped so through fmpy's FMI calls (the input row of time t set before the step from t,
+    as the layout reads it): exact. Without the key (nominal steps) it is not; a perturbed row fails at
+    its time; a value of the key that is not one is refused at its line and column."""
+    name, version, start, input_name, output_name = MODELS[model]
+    _, executions = overrun(np.random.default_rng(7))
+    times = executions - executions[0]  # ms from the first execution
+    inputs = [_u(k) for k in range(len(times) - 1)]  # the first is 0, the input's start value
+    fmu = Instance(name, version)
+    fmu.start(**start)
+    outputs = [fmu.get(output_name)]
+    for k in range(1, len(times)):
+        fmu.set(**{input_name: inputs[k - 1]})
+        assert fmu.raw_step_at(times[k - 1] / 1000, (times[k] - times[k - 1]) / 1000) == 0
+        outputs.append(fmu.get(output_name))
+    fmu.fmu.terminate()
+    folder = tmp_path / "jittered"
+    folder.mkdir()
+    seconds = [repr(t / 1000) for t in times.tolist()]
+    (folder / f"{name}_in.csv").write_text(
+        f"time,{input_name}\n" + "".join(f"{t},{u!r}\n" for t, u in zip(seconds, inputs, strict=False))
+    )
+    (folder / f"{name}_start.csv").write_text("".join(f"{k},{v!r}\n" for k, v in start.items()))
+
+    def compare(opt, outputs):
+        (folder / f"{name}_ref.opt").write_text(opt)
+        (folder / f"{name}_ref.csv").write_text(
+            f"time,{output_name}\n" + "".join(f"{t},{y!r}\n" for t, y in zip(seconds, outputs, strict=True))
+        )
+        campaign = fmutrace.compare(str(fmu_file(name, version)), str(folder), run=RunOptions(jobs=1))
+        return campaign, campaign.cases[0]
+
+    campaign, case = compare("CycleLengths,recorded\n", outputs)
+    assert campaign.passed, case.messages
+    assert len(set(np.diff(times).tolist())) > 3  # (the steps were not all one length)
+    campaign, case = compare("", outputs)
+    assert not campaign.passed
+    at = len(outputs) // 2
+    perturbed = list(outputs)
+    perturbed[at] += 0.125
+    campaign, case = compare("RelTol,1e-6\nCycleLengths,recorded\n", perturbed)
+    assert not campaign.passed
+    assert any(f"differs first at t={seconds[at]}:" in m for m in case.messages), case.messages
+    campaign, case = compare("CycleLengths,sometimes\n", outputs)
+    assert str(case.status) == "invalid"
+    assert (
+        f"{name}_ref.opt, line 1, column 2: CycleLengths 'sometimes' is not one of nominal, recorded"
+        in (case.messages[0])
+    ), case.messages

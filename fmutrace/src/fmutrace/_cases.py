@@ -4,7 +4,10 @@
   <Model>_ref.csv    the reference trace (required)
   <Model>_in.csv     input signals (optional); a row holds from its time on
   <Model>_ref.opt    StartTime, StopTime, StepSize, RelTol (optional: the
-                     reference's first and last time, the FMU's default step)
+                     reference's first and last time, the FMU's default step);
+                     CycleLengths: nominal (the default: every step StepSize
+                     long) or recorded (one step from each reference row to
+                     the next, as long as their times are apart)
   <Model>_start.csv  start values, one "name,value" line each (optional)
   <Model>_criteria.csv  per-signal criteria, one "signal,mode" line each:
                      a variable's name or an fnmatch pattern, "*" for the
@@ -27,11 +30,14 @@ import numpy as np
 
 from ._comparison import Comparison, Mode, compare_traces, criteria_for, parse_mode
 from ._errors import InputError, TraceError
+from ._fmpy import Replay
 from ._fmu import Fmu
 from ._reading import absent, quoted
+from .recordings._align import CYCLE_LENGTHS
+from .recordings._timebase import decimal_resolution
 from ._traces import data_lines, parse_number, read_text, read_trace, split_cells, steps_problem
 
-OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol")
+OPTIONS = ("StartTime", "StopTime", "StepSize", "RelTol", "CycleLengths")
 FILES = ("_ref.csv", "_in.csv", "_ref.opt", "_start.csv", "_criteria.csv", "README.md")
 
 
@@ -67,6 +73,13 @@ def read_options(path, text, reference, fmu):
         key, literal = cells
         if key not in OPTIONS:
             raise TraceError(path, number, 1, f"unknown option {quoted(key)} (known: {', '.join(OPTIONS)})")
+        if key == "CycleLengths":
+            if literal.strip() not in CYCLE_LENGTHS:
+                raise TraceError(
+                    path, number, 2, f"CycleLengths {quoted(literal)} is not one of {', '.join(CYCLE_LENGTHS)}"
+                )
+            options[key] = literal.strip()
+            continue
         value = parse_number(literal)
         if value is None or not math.isfinite(value):
             raise TraceError(path, number, 2, f"{key} {quoted(literal)} is not a finite number")
@@ -90,6 +103,44 @@ def read_options(path, text, reference, fmu):
     if problem:
         raise TraceError(where, 0, 0, problem)
     return options
+
+
+def recorded_steps(path, reference, options) -> Replay:
+    """The Replay of a case whose _ref.opt says CycleLengths,recorded: each
+    reference row from StartTime to StopTime is one execution of the OB,
+    the first the initial state; step k runs from row k - 1's time for the
+    interval to row k's, at the resolution the times were written in (the
+    fewest decimals of a second that make every one whole: times in whole
+    ms are whole ms), and its result stands at row k's time. TraceError
+    (path: the reference) for times that do not make such steps."""
+    times = reference["time"]
+    start, stop = options["StartTime"], options["StopTime"]
+    rows = times[(times >= start) & (times <= stop)]
+    if len(rows) < 2 or rows[0] != start:
+        raise TraceError(
+            path,
+            0,
+            0,
+            f"CycleLengths recorded runs a step from each of its rows to the next: StartTime {start!r} is "
+            "not the time of one of them, or no row follows it",
+        )
+    back = np.flatnonzero(np.diff(rows) <= 0)
+    if len(back):
+        t = float(rows[back[0]])
+        raise TraceError(
+            path, 0, 0, f"CycleLengths recorded runs a step from each of its rows to the next: two rows at t={t!r} s"
+        )
+    digits = decimal_resolution(rows)
+    if digits is None:
+        raise TraceError(
+            path,
+            0,
+            0,
+            "CycleLengths recorded needs times of a resolution of 1 ns or coarser (a whole number of "
+            "ns each): the step lengths are read from them",
+        )
+    ticks = np.rint(rows * 10.0**digits).astype(np.int64)
+    return Replay(rows[:-1].copy(), np.diff(ticks) / 10.0**digits, rows.copy())
 
 
 def read_start_values(path, text, fmu):

@@ -5,11 +5,23 @@ failure as a SimulationError that quotes what the FMU said."""
 import contextlib
 import io
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from fmpy import simulate_fmu
 
 from ._errors import SimulationError
+
+
+class Replay(NamedTuple):
+    """Recorded cycle lengths: doStep(points[k], sizes[k]) for each step k
+    instead of the grid's (a size of 0: no doStep, the outputs held). The
+    inputs are set and the results stand at the grid's times, or at times
+    (the communication points, one more than the steps) where given."""
+
+    points: np.ndarray
+    sizes: np.ndarray
+    times: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -21,10 +33,9 @@ class Experiment:
     stop: float
     step: float
     relative_tolerance: float | None = None
-    # recorded cycle lengths: (points, sizes) of each of the (stop - start) / step steps, which doStep is called
-    # with instead of the grid's (a size of 0: no doStep, the outputs held); the results still stand at the
-    # grid's times. Only the Runner's own loop takes it (fmpy steps on a grid).
-    replay: tuple | None = None
+    # recorded cycle lengths, one Replay step for each of the (stop - start) / step steps (or for each of its
+    # times but the first). Only the Runner's own loop takes it (fmpy steps on a grid).
+    replay: Replay | None = None
 
 
 @dataclass(frozen=True)

@@ -32,10 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cases import load_case, read_criteria, read_options, read_start_values
+from ._cases import load_case, read_criteria, read_options, read_start_values, recorded_steps
 from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned, criteria_for, time_slack
 from ._errors import InputError, SimulationError
-from ._fmpy import Experiment, Signals
+from ._fmpy import Experiment, Replay, Signals
 from ._outcome import CaseOutcome, Status
 from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, as_script, draw, needs_tiles, page_data, page_tile
 from ._progress import SampleProgress
@@ -82,7 +82,7 @@ class ChunkedCase:
     more_messages: Callable | None = None
     started: float = field(default_factory=time.perf_counter)
     criteria: tuple = ()  # the case's own per-signal criteria: ((pattern, Mode), ...)
-    replay: tuple | None = None  # recorded cycle lengths: Experiment.replay
+    replay: Replay | None = None  # recorded cycle lengths: Experiment.replay
     clock: dict = field(default_factory=dict)  # a recording's cycle fit: CaseOutcome.clock
 
 
@@ -124,6 +124,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
     what is wrong in a file."""
     fmu, folder, name = target.fmu, Path(files.folder), files.name
     model = fmu.model
+    replay = None
     if whole:
         read = load_case(folder, fmu, name, files.texts)
         inputs, reference = read.inputs, read.reference
@@ -133,6 +134,8 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         table = None if inputs is None else (lambda: iter([inputs]))
         ref_chunks: Iterator = iter([reference])  # (one table)
         outputs, last = read.outputs, float(reference["time"][-1])
+        if options.get("CycleLengths") == "recorded":
+            replay = recorded_steps(folder / f"{model}_ref.csv", reference, options)
     else:
         ref_path, in_path = folder / f"{model}_ref.csv", folder / f"{model}_in.csv"
         try:
@@ -163,6 +166,8 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         bounds = np.zeros(2, dtype=[("time", np.float64)])
         bounds["time"] = [first_ref["time"][0], last]
         options = read_options(folder / f"{model}_ref.opt", texts.get(f"{model}_ref.opt"), bounds, fmu)
+        if options.get("CycleLengths") == "recorded":
+            raise NotPlain("the recorded cycle lengths are read from the whole reference")
         start_values = read_start_values(folder / f"{model}_start.csv", texts.get(f"{model}_start.csv"), fmu)
         criteria = read_criteria(folder / f"{model}_criteria.csv", texts.get(f"{model}_criteria.csv"), fmu)
         input_names, table = (), None
@@ -196,6 +201,7 @@ def _read_folder_case(files: CaseFiles, target, streaming: Streaming, whole: boo
         outputs,
         max(options["StopTime"], last),
         criteria=criteria,
+        replay=replay,
     )
 
 
@@ -205,7 +211,7 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
     chunk that needs read_trace (the caller reads the file whole)."""
     options, outputs, input_names = case.options, case.outputs, case.input_names
     start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
-    n = round((stop - start) / step)
+    n = round((stop - start) / step) if case.replay is None else len(case.replay.sizes)
     bar = streaming.progress or SampleProgress(n + 1)
     mode = criteria_for(settings.mode, case.criteria, target.fmu.discrete_names())
     state = _Comparer(case, mode, bar)

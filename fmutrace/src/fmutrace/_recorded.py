@@ -12,6 +12,7 @@ import numpy as np
 
 from ._cases import Case
 from ._errors import InputError
+from ._fmpy import Replay
 from ._names import shortest
 from .recordings import read_recording
 from .recordings._align import align
@@ -29,7 +30,7 @@ class RecordedCase(Case):
     shift: int = 1  # steps from a row's time to its output's (timing)
     cycles: dict = field(default_factory=dict)  # compared variable -> the cycle of each of its samples
     clock: dict = field(default_factory=dict)  # the cycle fit's figures (results.json's "clock")
-    replay: tuple | None = None  # cycle_lengths "recorded": (points, sizes) of every step
+    replay: Replay | None = None  # cycle_lengths "recorded"
 
     def explain(self, deviations) -> list:
         """What a failing comparison's reader needs beside the deviations:
@@ -105,9 +106,9 @@ def recorded_case(path, fmu, name, options: RecordingOptions) -> RecordedCase:
         notes=aligned.notes + matched.describe(),
         coarse=aligned.coarse,
         shift=1 if options.timing == "cycle" else 0,
-        cycles={v: aligned.grid.index(c.times) for v, c in matched.compares} if aligned.grid else {},
+        cycles={v: aligned.cycles[id(c)] for v, c in matched.compares},
         clock=aligned.clock,
-        replay=aligned.replay,
+        replay=None if aligned.replay is None else Replay(*aligned.replay),
     )
 
 

@@ -480,7 +480,9 @@ class Runner:
         """fast_path_problem's reasons that the names and the grid alone give."""
         start, stop, step = experiment.start, experiment.stop, experiment.step
         n = round((stop - start) / step)
-        if n < 1 or not math.isclose(start + n * step, stop):
+        if experiment.replay is not None and experiment.replay.times is not None:
+            pass  # (the steps are the replay's, from its first time to its last)
+        elif n < 1 or not math.isclose(start + n * step, stop):
             return "the stop time is not a whole number of steps from the start"
         if any(self.variables[name].shape for name in outputs):
             return "an array variable"
@@ -497,8 +499,13 @@ class Runner:
         if self.variable_step:
             events = input_events(inputs)
             events = events[(events > start) & (events < stop) & ~_close(events, start) & ~_close(events, stop)]
-            grid = start + np.rint((events - start) / step) * step  # Python's round() also rounds half to even
-            off = ~_close(grid, events)
+            points = experiment.replay.times if experiment.replay is not None else None
+            if points is not None:  # the recorded communication points: an event at one of them
+                at = np.searchsorted(points, events)
+                off = ~_close(points[np.minimum(at, len(points) - 1)], events) & ~_close(points[at - 1], events)
+            else:
+                grid = start + np.rint((events - start) / step) * step  # Python's round() also rounds half to even
+                off = ~_close(grid, events)
             if off.any():
                 return f"an input event at t={events[off][0]!r} between communication points"
         return None
@@ -606,11 +613,11 @@ class Runner:
             inputs.reach(start)  # the first window read (and its events checked) before the FMU is called
         with _quiet():
             fmu = self._instance()
-        n = round((stop - start) / step)
+        replay = experiment.replay
+        n = round((stop - start) / step) if replay is None else len(replay.sizes)
         size = min(n, steps_per_chunk)
         component, calls = self._component, self.calls
-        replay = experiment.replay
-        end = stop if replay is None else max(stop, float(replay[0][-1] + replay[1][-1]))  # the FMU's last time
+        end = stop if replay is None else max(stop, float(replay.points[-1] + replay.sizes[-1]))  # the FMU's last time
 
         # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
         getters: list[tuple] = []
@@ -660,9 +667,16 @@ class Runner:
 
         for k in range(0, n, size):
             m = min(size, n - k)
-            times, step_times, step_sizes = self._grid(start, step, k, m)
-            if replay is not None:  # the steps as recorded, their results at the grid's times
-                step_times, step_sizes = replay[0][k : k + m], replay[1][k : k + m]
+            if replay is not None and replay.times is not None:  # the steps and their times as recorded
+                times, step_times, step_sizes = (
+                    replay.times[k : k + m + 1],
+                    replay.points[k : k + m],
+                    replay.sizes[k : k + m],
+                )
+            else:
+                times, step_times, step_sizes = self._grid(start, step, k, m)
+            if replay is not None and replay.times is None:  # the steps as recorded, their results at the grid's
+                step_times, step_sizes = replay.points[k : k + m], replay.sizes[k : k + m]
             with _quiet():
                 if inputs is not None:
                     set_at, setters = inputs.steps(times[:-1])

@@ -29,12 +29,11 @@ from .._errors import InputError
 from .._names import Names, name_of, shortest
 from . import _clock as clock
 from ._model import TIME_DIVISORS, TIME_FACTORS
-from ._timebase import FINEST, OFF_CYCLE, _minus, as_read, cycle_times, finest_interval
+from ._timebase import FINEST, OFF_CYCLE, _minus, as_read, cycle_times, decimal_resolution, finest_interval
 
 TIMINGS = ("cycle", "fmi")
 CYCLE_LENGTHS = ("nominal", "recorded")
 MOST_NAMED = 100  # missing cycles named in a note and in results.json (the rest counted)
-WHOLE = 1e-3  # of a tick: a stamp this close to a whole number of ticks is one (its decimals read back)
 
 
 @dataclass
@@ -50,6 +49,7 @@ class Aligned:
     clock: dict = field(default_factory=dict)  # the figures of the fit: results.json's "clock"
     description: str = ""  # the fit in words: jitter, missing cycles
     replay: tuple | None = None  # cycle_lengths "recorded": (points, sizes) of every step (size 0: no doStep)
+    cycles: dict = field(default_factory=dict)  # id(channel) -> the cycle of each of its samples
 
 
 def fitted_grid(recording, channels, names: Names = ()):
@@ -135,10 +135,11 @@ def _apart(index, distance):
     return apart, moved
 
 
-def _note_cycles(channel, grid, index, moved, step, notes, names):
+def _cycle_notes(channel, grid, index, moved, step, names):
     """The notes on channel's samples on their cycles: those more than
     OFF_CYCLE off their nearest cycle, and those put apart from it (moved)."""
     distance = grid.distance(channel.times, index)
+    notes = []
     far = np.abs(distance) > OFF_CYCLE
     far[moved] = False
     off = np.flatnonzero(far)
@@ -152,18 +153,16 @@ def _note_cycles(channel, grid, index, moved, step, notes, names):
             own_grid = clock.fit(channel.times, own)
             if not (np.abs(own_grid.distance(channel.times, own_grid.index(channel.times))) > OFF_CYCLE).any():
                 note += f". Its own stamps fit a step of {shortest(own)} s ({name_of(names, step_size=own)})."
-        if note not in notes:  # a channel that drives and is compared is said once
-            notes.append(note)
+        notes.append(note)
     if moved:
         i, first, largest = moved[0], float(distance[moved[0]]), float(np.abs(distance[moved]).max())
-        note = (
+        notes.append(
             f"{channel.name}: {len(moved)} of its {len(index)} samples are more than half a cycle from their "
             "cycle, each put on the neighbouring cycle no other sample has (its nearest holds a nearer sample); "
             f"the first at {channel.where(i)}: t={shortest(as_read(channel.times[i]))} s, {abs(first):.3f} of a "
             f"cycle {'after' if first > 0 else 'before'} its cycle (the largest {largest:.3f})"
         )
-        if note not in notes:
-            notes.append(note)
+    return notes
 
 
 def off_cycle_note(name, off, samples, first, grid):
@@ -211,7 +210,9 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = (), c
         grid = clock.Grid(grid.period, grid.phase + first * grid.period)  # cycle 0 the first sample's
         index_of = {key: index - first for key, index in index_of.items()}
     for channel in used:
-        _note_cycles(channel, grid, index_of[id(channel)], put_apart.get(id(channel), []), step, notes, names)
+        for note in _cycle_notes(channel, grid, index_of[id(channel)], put_apart.get(id(channel), []), step, names):
+            if note not in notes:  # a channel that drives and is compared is said once
+                notes.append(note)
     # inputs: every driven channel held on the union of their sample cycles
     inputs = None
     coarse = []
@@ -243,6 +244,7 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = (), c
         last = max(last, int(cycles[-1]))
     stop = float(cycle_times(np.array([max(last + shift, 1)]), step)[0])
     aligned = Aligned(inputs=inputs, references=references, start_time=0.0, stop_time=stop, step_size=step, notes=notes)
+    aligned.cycles = index_of
     if coarse:
         aligned.coarse = _coarse_note(coarse, plan, index_of, step, names)
     executed = np.unique(np.concatenate([index_of[id(c)] for c in used]))
@@ -305,13 +307,17 @@ def _replay(recording, used, index_of, cycles, names):
         np.minimum.at(execution, index_of[id(channel)], ticks[id(channel)])
     ran = np.flatnonzero((cycles <= executed[-1]) & (execution[np.minimum(cycles, len(execution) - 1)] != none))
     stamps = execution[cycles[ran]]
-    sizes = np.zeros(len(cycles), dtype=np.float64)
-    if len(ran):
-        sizes[ran[0]] = recording.step_size
-        sizes[ran[1:]] = np.diff(stamps) / per_second
-    if (sizes < 0).any():
+    if (np.diff(stamps) < 0).any():
         raise InputError(f"{recording.label}: the recorded executions go back in time")
-    points = np.concatenate([[0.0], np.cumsum(sizes)[:-1]])
+    if not len(ran):
+        return np.zeros(len(cycles)), np.zeros(len(cycles))
+    # each step's start counted in whole ticks after the first execution's nominal step: no sum of floats
+    ticks = np.zeros(len(cycles), dtype=np.int64)
+    ticks[ran[1:]] = np.diff(stamps)
+    before = np.concatenate([[0], np.cumsum(ticks)[:-1]])
+    sizes = ticks / per_second
+    sizes[ran[0]] = recording.step_size
+    points = before / per_second + np.where(np.arange(len(cycles)) > ran[0], recording.step_size, 0.0)
     return points, sizes
 
 
@@ -325,11 +331,9 @@ def _ticks(recording, channels):
     if unit == "cycles":
         return {k: np.rint(v).astype(np.int64) for k, v in elapsed.items()}, 1 / recording.step_size
     per_unit = 1.0 if unit == "s" else TIME_DIVISORS.get(unit) or 1 / TIME_FACTORS[unit]
-    values = np.concatenate(list(elapsed.values()))
-    for digits in range(10):
-        scaled = values * 10.0**digits
-        if np.abs(scaled).max() < 2**53 and np.all(np.abs(scaled - np.rint(scaled)) <= WHOLE):
-            return {k: np.rint(v * 10.0**digits).astype(np.int64) for k, v in elapsed.items()}, per_unit * 10**digits
+    digits = decimal_resolution(np.concatenate(list(elapsed.values())))
+    if digits is not None:
+        return {k: np.rint(v * 10.0**digits).astype(np.int64) for k, v in elapsed.items()}, per_unit * 10**digits
     raise InputError(
         f"{recording.label}: its time stamps have no resolution of a whole power of ten of their unit: the recorded "
         "cycle lengths cannot be read from them"

@@ -284,6 +284,20 @@ def seconds(elapsed, unit, step=None):
     return elapsed * TIME_FACTORS[unit]
 
 
+WHOLE = 1e-3  # of a tick: a stamp this close to a whole number of ticks is one (its decimals read back)
+
+
+def decimal_resolution(values):
+    """The fewest decimals (0 to 9) of their unit that make every value
+    whole: a recorder's resolution, read back from the stamps it wrote
+    (a TIME in ms: 0); None where none does."""
+    for digits in range(10):
+        scaled = values * 10.0**digits
+        if not len(values) or (np.abs(scaled).max() < 2**53 and np.all(np.abs(scaled - np.rint(scaled)) <= WHOLE)):
+            return digits
+    return None
+
+
 def cycle_times(index, step):
     """The times index * step of whole cycles, each the double nearest the exact decimal product when
     the step is a short decimal (p / q): (index * p) / q, one rounding, so cycle 42 of 0.0001 s is
