@@ -125,6 +125,26 @@ def test_a_printed_10_ms_ramp_streamed_as_in_memory(tmp_path, monkeypatch):
     assert whole.passed and "step 0.01 s" in " ".join(whole.messages)
 
 
+@pytest.mark.parametrize("timing", ["cycle", "fmi"])
+@pytest.mark.parametrize("block", [40, 1 << 20])
+def test_recorded_cycle_lengths_streamed_as_in_memory(timing, block, tmp_path, monkeypatch):
+    """Stamps in ms that jitter by up to 4 ms of a 10 ms cycle, replayed with their recorded lengths
+    (RateLimiter, cycleTime 0, so each step's length shapes the ramp): the steps made block by block, in
+    chunks of 3 steps, are the ones made from the whole file: the same outcome, deviations and all (the
+    reference y is the input, which the ramp lags behind)."""
+    rng = np.random.default_rng(11)
+    stamps = np.arange(200) * 10 + np.concatenate([[0], rng.integers(-4, 5, 199)])
+    u = np.repeat([0.0, 3.0, -2.0, 5.0], 50)
+    path = tmp_path / "jittered.csv"
+    path.write_text("Time [ms];u;y\n" + "".join(f"{t};{v};{v}\n" for t, v in zip(stamps, u, strict=True)))
+    options = RecordingOptions(
+        cycle_lengths="recorded", timing=timing, start_values=(("rateUpPar", "40"), ("rateDownPar", "40"))
+    )
+    whole, streamed = outcomes(path, "RateLimiter", options=options, head=1 << 20, block=block, monkeypatch=monkeypatch)
+    same(whole, streamed)
+    assert not whole.passed and any("cycle lengths as recorded" in m for m in whole.messages)
+
+
 def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
     """A skipped cycle, an empty cell, a blank line inside, a step the head does not show: the stream
     refuses before anything is reported; the in-memory path reads or explains them."""

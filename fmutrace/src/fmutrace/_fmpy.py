@@ -5,12 +5,25 @@ failure as a SimulationError that quotes what the FMU said."""
 import contextlib
 import io
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from fmpy import simulate_fmu
 
 from ._errors import SimulationError
+
+
+class ReplaySteps(Protocol):
+    """What the Runner's loop asks of recorded cycle lengths (a Replay, or one made as a recording is read)."""
+
+    @property
+    def times(self) -> np.ndarray | None:
+        """The communication points, or None: the grid's."""
+
+    def steps(self, k: int, m: int) -> tuple: ...
+
+    @property
+    def end(self) -> float: ...
 
 
 class Replay(NamedTuple):
@@ -22,6 +35,15 @@ class Replay(NamedTuple):
     points: np.ndarray
     sizes: np.ndarray
     times: np.ndarray | None = None
+
+    def steps(self, k, m):
+        """(points, sizes) of steps k to k + m - 1 (asked for in order: a streamed replay reads them so)."""
+        return self.points[k : k + m], self.sizes[k : k + m]
+
+    @property
+    def end(self):
+        """The last step's end: the FMU's stop time."""
+        return float(self.points[-1] + self.sizes[-1]) if len(self.sizes) else 0.0
 
 
 @dataclass(frozen=True)
@@ -35,7 +57,7 @@ class Experiment:
     relative_tolerance: float | None = None
     # recorded cycle lengths, one Replay step for each of the (stop - start) / step steps (or for each of its
     # times but the first). Only the Runner's own loop takes it (fmpy steps on a grid).
-    replay: Replay | None = None
+    replay: ReplaySteps | None = None
 
 
 @dataclass(frozen=True)

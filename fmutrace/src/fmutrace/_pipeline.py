@@ -35,7 +35,7 @@ import numpy as np
 from ._cases import load_case, read_criteria, read_options, read_start_values, recorded_steps
 from ._comparison import Band, Criteria, Mode, Pointwise, Tube, Verdict, aligned, criteria_for, time_slack
 from ._errors import InputError, SimulationError
-from ._fmpy import Experiment, Replay, Signals
+from ._fmpy import Experiment, ReplaySteps, Signals
 from ._outcome import CaseOutcome, Status
 from ._plot import DETAIL, ZOOM_SAMPLES, Envelope, Figure, as_script, draw, needs_tiles, page_data, page_tile
 from ._progress import SampleProgress
@@ -82,7 +82,7 @@ class ChunkedCase:
     more_messages: Callable | None = None
     started: float = field(default_factory=time.perf_counter)
     criteria: tuple = ()  # the case's own per-signal criteria: ((pattern, Mode), ...)
-    replay: Replay | None = None  # recorded cycle lengths: Experiment.replay
+    replay: ReplaySteps | None = None  # recorded cycle lengths: Experiment.replay
     clock: dict = field(default_factory=dict)  # a recording's cycle fit: CaseOutcome.clock
 
 
@@ -211,7 +211,7 @@ def run_chunked_case(case: ChunkedCase, target, settings, streaming: Streaming =
     chunk that needs read_trace (the caller reads the file whole)."""
     options, outputs, input_names = case.options, case.outputs, case.input_names
     start, stop, step = options["StartTime"], options["StopTime"], options["StepSize"]
-    n = round((stop - start) / step) if case.replay is None else len(case.replay.sizes)
+    n = round((stop - start) / step) if case.replay is None or case.replay.times is None else len(case.replay.times) - 1
     bar = streaming.progress or SampleProgress(n + 1)
     mode = criteria_for(settings.mode, case.criteria, target.fmu.discrete_names())
     state = _Comparer(case, mode, bar)

@@ -22,6 +22,60 @@ from .recordings._timebase import OFF_CYCLE
 from .recordings._matching import plan
 
 
+SECONDS_OF_DECIMALS = ("s", "ms", "us", "ns", "FILETIME", "date")  # stamps whose resolution is a decimal of a second
+
+
+class _StreamedReplay:
+    """A Replay (recorded cycle lengths) of a streamed recording, its steps
+    made from the rows' stamps as the blocks are read (read: reads the next
+    block, which add()s its stamps; False at the end): every row is one
+    execution, in the cycle after the row before (stream.time_column_pass),
+    so step k executes row k + 1 - shift, for the interval since the row
+    before at the recorder's resolution (the first: one step size), as
+    recordings._align's replay makes them from a recording read whole.
+    Each step's start is counted in whole ticks: no sum of floats."""
+
+    times = None  # (the results stand at the grid's times)
+
+    def __init__(self, cycles, step, shift, read):
+        self.step, self.read = step, read
+        self.scale = 10.0**cycles.digits  # ticks per second
+        first, *second, last = cycles.ends
+        self.origin = self._ticks(second[0] if shift == 0 and second else first)  # the first step's row
+        self.first_row = 1 - shift
+        self.end = step + (self._ticks(last) - self.origin) / self.scale
+        self.row, self.before = 0, None  # the next row's index, the tick of the row before it
+        self.points: list[np.ndarray] = []  # steps made and not yet asked for
+        self.sizes: list[np.ndarray] = []
+        self.made = 0
+
+    def _ticks(self, seconds):
+        return np.rint(np.asarray(seconds, dtype=np.float64) * self.scale).astype(np.int64)
+
+    def add(self, times):
+        ticks = self._ticks(times)
+        before = np.concatenate([[ticks[0] if self.before is None else self.before], ticks[:-1]])
+        rows = self.row + np.arange(len(ticks))
+        self.row, self.before = self.row + len(ticks), int(ticks[-1])
+        steps = rows >= self.first_row
+        ticks, before, rows = ticks[steps], before[steps], rows[steps]
+        if (ticks < before).any():
+            raise NotPlain("recorded executions that go back in time (the in-memory path says)")
+        first = rows == self.first_row
+        self.sizes.append(np.where(first, self.step, (ticks - before) / self.scale))
+        self.points.append(np.where(first, 0.0, self.step + (before - self.origin) / self.scale))
+        self.made += len(rows)
+
+    def steps(self, k, m):
+        """(points, sizes) of steps k to k + m - 1, k the first not yet given."""
+        while self.made < k + m and self.read():
+            pass
+        points, sizes = np.concatenate(self.points), np.concatenate(self.sizes)
+        given = self.made - len(sizes)  # the index of the first step kept
+        self.points, self.sizes = [points[k + m - given :]], [sizes[k + m - given :]]
+        return points[k - given : k + m - given], sizes[k - given : k + m - given]
+
+
 def _once(chunks):
     """The input table's function for ChunkedCase: the stream's blocks can
     be read once; a second reading (fmpy's, for a trace the fast loop
@@ -96,15 +150,17 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
             return None
         step = recording.step_size
         shift = 1 if options.timing == "cycle" else 0
-        if options.cycle_lengths != "nominal":
-            return None  # (the in-memory path replays the recorded cycle lengths)
-        cycles = stream.time_column_pass(table, step, block_bytes)
+        recorded = options.cycle_lengths == "recorded"
+        if recorded and recording.time_unit not in SECONDS_OF_DECIMALS:
+            return None  # (the in-memory path takes the resolution of other clocks)
+        cycles = stream.time_column_pass(table, step, block_bytes, resolution=recorded)
         start_values = {n: fmu.start_value(n, v) for n, v in options.start_values}
     except (NotPlain, InputError, OSError, ValueError):
         return None
     drives, compares = matched.drives, matched.compares
     stop = float(timebase.cycle_times(np.array([max(cycles.last + shift, 1)]), step)[0])
-    pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": []}
+    pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": [], "steps": []}
+    replay = _StreamedReplay(cycles, step, shift, lambda: parse()) if recorded else None
     row = 0  # the next block's first row, which is its cycle (stream.time_column_pass)
     jitter = clock.Jitter()  # of every row on the grid, as the blocks are read
     off: list = [0, None]  # rows more than OFF_CYCLE off their cycle, and (line, seconds, cycle) of the first
@@ -139,6 +195,8 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         for variable, channel in compares:
             chunk[variable] = table.values(cells, line_numbers, channel.name)
         pending["refs"].append(chunk)
+        if replay is not None:
+            replay.add(times)
         return True
 
     def queue(kind):
@@ -170,6 +228,7 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         description = (
             f"{recording.format}: {cycles.rows} samples, time as {unit} ({recording.time_source}), "
             f"step {shortest(step)} s ({recording.step_source}), jitter {jitter.describe()}"
+            + (", cycle lengths as recorded" if recorded else "")
         )
         figures.update(clock_figures(cycles.grid, jitter, 1, 0, []))
         if passed:
@@ -189,6 +248,7 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         stop,
         more_messages,
         clock=figures,
+        replay=replay,
     )
     try:
         outcome = run_chunked_case(case, target, settings, streaming)

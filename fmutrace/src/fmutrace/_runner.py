@@ -614,10 +614,10 @@ class Runner:
         with _quiet():
             fmu = self._instance()
         replay = experiment.replay
-        n = round((stop - start) / step) if replay is None else len(replay.sizes)
+        n = round((stop - start) / step) if replay is None or replay.times is None else len(replay.times) - 1
         size = min(n, steps_per_chunk)
         component, calls = self._component, self.calls
-        end = stop if replay is None else max(stop, float(replay.points[-1] + replay.sizes[-1]))  # the FMU's last time
+        end = stop if replay is None else max(stop, replay.end)  # the FMU's last time
 
         # outputs: per FMI type in the recorder's order, into arrays kept for chunks of this size
         getters: list[tuple] = []
@@ -668,15 +668,11 @@ class Runner:
         for k in range(0, n, size):
             m = min(size, n - k)
             if replay is not None and replay.times is not None:  # the steps and their times as recorded
-                times, step_times, step_sizes = (
-                    replay.times[k : k + m + 1],
-                    replay.points[k : k + m],
-                    replay.sizes[k : k + m],
-                )
+                times, (step_times, step_sizes) = replay.times[k : k + m + 1], replay.steps(k, m)
             else:
                 times, step_times, step_sizes = self._grid(start, step, k, m)
             if replay is not None and replay.times is None:  # the steps as recorded, their results at the grid's
-                step_times, step_sizes = replay.points[k : k + m], replay.sizes[k : k + m]
+                step_times, step_sizes = replay.steps(k, m)
             with _quiet():
                 if inputs is not None:
                     set_at, setters = inputs.steps(times[:-1])

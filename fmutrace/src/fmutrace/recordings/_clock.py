@@ -14,8 +14,9 @@ line of period and phase by least squares over windows that grow from
 there, each numbered by the line of the one before (so a drift of the
 recorder's clock never puts a sample a cycle off); each sample's cycle is
 then its nearest one on the last line. A window holds at
-most FIT_SAMPLES samples, spread evenly over it, so a 48-hour recording
-costs a few passes over its stamps.
+most FIT_SAMPLES samples, spread evenly over it, but the last, which
+holds every sample (the line a recording read in blocks gets, clock.Line),
+so a 48-hour recording costs a few passes over its stamps.
 """
 
 from dataclasses import dataclass
@@ -81,9 +82,10 @@ def _fit(times, grid):
     while True:
         # each window numbered by the line of the one before (the first by the search), which the samples it
         # shares set: a window's line never numbers its own samples, which a narrow strip could tilt
-        grid = _line(times[: size : max(1, size // FIT_SAMPLES)], grid)
-        if size == len(times):
+        if size == len(times):  # the last line through every sample: the one a recording read in blocks gets
+            grid = _line(times, grid)
             break
+        grid = _line(times[: size : max(1, size // FIT_SAMPLES)], grid)
         size = min(len(times), int(size * GROWTH) + 1)
     first = int(grid.index(times[:1])[0])  # cycle 0 is the first sample's
     return Grid(grid.period, grid.phase + first * grid.period)

@@ -220,9 +220,11 @@ class Cycles:
     rows: int
     last: int  # the last row's cycle
     grid: clock.Grid  # the cycles the rows sit on (the recorder's clock): row k is cycle k
+    digits: int | None = None  # decimals of a second that make every stamp whole (asked for: resolution=True)
+    ends: tuple = ()  # (the first two rows' times, the last's), seconds (resolution=True)
 
 
-def time_column_pass(table, step, block_bytes=None):
+def time_column_pass(table, step, block_bytes=None, resolution=False):
     """The whole file's time column read once, before anything runs (only
     its cells converted), by the rules normalise applies to a whole
     recording: the step its intervals give (unless one was given) is the
@@ -230,13 +232,21 @@ def time_column_pass(table, step, block_bytes=None):
     row the cycle after the one before, on the grid of cycles the rows
     before it fit (clock.Line: the in-memory path's fit, on a recording
     of a row per cycle; the pass checks the first SEARCH_WINDOW rows on
-    their line, the run each row on the whole file's). NotPlain otherwise."""
+    their line, the run each row on the whole file's). resolution: the
+    recorder's too (Cycles.digits, Cycles.ends), for recorded cycle
+    lengths. NotPlain otherwise."""
     recording = table.recording
     intervals = timebase.Intervals()
     line = clock.Line()
     rows, span = 0, 0.0
     first: list[np.ndarray] = []  # the first SEARCH_WINDOW rows' times: checked once their line is known
+    digits, head = 0, np.zeros(0)
     for _, _, _, times in table.blocks(block_bytes, time_only=True):
+        if resolution:
+            found = timebase.decimal_resolution(times)
+            if found is None:
+                raise NotPlain("stamps of no decimal resolution (the in-memory path says)")
+            digits, head = max(digits, found), np.concatenate([head, times[: 2 - len(head)]])
         if line.count < clock.SEARCH_WINDOW:  # (later rows: checked as the run reads them, _recording)
             first.append(times)
         line.add(rows, times)
@@ -257,6 +267,8 @@ def time_column_pass(table, step, block_bytes=None):
         _on_their_cycles(grid, np.arange(line.count), np.concatenate(first))
     if clock.restep(grid, step) != step:
         raise NotPlain("the rows fit another step than their finest interval (the in-memory path says)")
+    if resolution:
+        return Cycles(rows, rows - 1, grid, digits, (*head.tolist(), span))
     return Cycles(rows, rows - 1, grid)
 
 
