@@ -558,6 +558,24 @@ def test_a_bad_journal_line_is_skipped_with_a_message_and_its_case_runs_again(tm
     assert sorted(c["case"] for c in results["cases"]) == ["one", "two"]
 
 
+def test_a_journal_line_longer_than_its_bound_is_skipped_unread(tmp_path):
+    """A second line of 64 MiB and more (a foreign or damaged file) is not read whole: the resume says it
+    is too long, runs that case again and keeps the entry after it."""
+    from fmutrace._journal import JOURNAL_LINE
+
+    report, lines = campaign_with_journal(tmp_path)
+    with open(report / "results.jsonl", "w") as journal:
+        journal.write(lines[0])
+        for _ in range(JOURNAL_LINE // (1 << 20) + 1):
+            journal.write("x" * (1 << 20))
+        journal.write("\n" + lines[2])
+    done = fmutrace("compare", PASS_THROUGH, tmp_path / "cases", "--report", report, "--resume")
+    no_traceback(done)
+    assert done.returncode == 0, output(done)
+    assert f"results.jsonl, line 2: longer than {JOURNAL_LINE:,} bytes; its case runs again" in done.stderr
+    assert "2 of 2 cases pass" in done.stdout
+
+
 # 5. Exit codes and no traceback
 
 

@@ -22,10 +22,12 @@ from typing import ClassVar
 from ._comparison import Mode
 from ._errors import InputError
 from ._names import Names, name_of
+from ._reading import MAX_LINE
 from ._outcome import CaseOutcome, Outcomes
 from ._traces import read_trace
 
 JOURNAL = "results.jsonl"
+JOURNAL_LINE = 16 * MAX_LINE  # bytes of a journal line read at most (a case's entry with every signal's verdict)
 LOCK = ".fmutrace.lock"
 
 
@@ -77,7 +79,7 @@ class ReportLock:
             _try_lock(self.file)
         except OSError:
             self.file.seek(1)
-            holder = self.file.read().strip() or "another process"
+            holder = self.file.read(80).strip() or "another process"  # (' pid N': a file of others' is cut)
             self.file.close()
             raise InputError(
                 f"{self.folder}: another campaign is writing this report folder ({holder}); wait for "
@@ -133,8 +135,8 @@ class Journal:
         self.done: dict[str, int] | None = {}  # key -> offset of the case's line, of a campaign resumed
         if resume and self.path.exists():
             with open(self.path, "rb") as journal:
-                first = journal.readline()
-                header = _parse(first) if first.strip() else None  # (empty: killed before its first line)
+                first = journal.readline(JOURNAL_LINE + 1)
+                header = _parse(first) if first.strip() and len(first) <= JOURNAL_LINE else None
                 if first.strip() and not (isinstance(header, dict) and isinstance(header.get("campaign"), dict)):
                     raise InputError(
                         f"{self.path}: its first line is damaged or not a fmutrace journal's, so which options "
@@ -146,15 +148,21 @@ class Journal:
                         f"the same ones, or start afresh without {name_of(names, 'resume')}"
                     )
                 offset, number = journal.tell(), 1
-                for line in journal:
+                while line := journal.readline(JOURNAL_LINE + 1):  # (no line of a damaged file held whole)
                     number += 1
-                    entry, problem = _entry(line)
+                    length, ended = len(line), line.endswith(b"\n")
+                    if length > JOURNAL_LINE:
+                        entry, problem = None, f"longer than {JOURNAL_LINE:,} bytes"
+                        more, ended = _past_the_line(journal)
+                        length += more
+                    else:
+                        entry, problem = _entry(line)
                     if problem is None:
                         self.done[entry["key"]] = offset
-                    elif line.endswith(b"\n"):  # (a last line without its end was cut short by a kill: no news)
+                    elif ended:  # (a last line without its end was cut short by a kill: no news)
                         warning = f"{self.path}, line {number}: {problem}; its case runs again"
                         print(f"fmutrace: warning: {warning}", file=sys.stderr)
-                    offset += len(line)
+                    offset += length
             self.file = open(self.path, "ab")
             if self.file.tell() and not _ends_a_line(self.path):
                 self.file.write(b"\n")  # close a line cut short by the kill: the next entry starts afresh
@@ -182,6 +190,16 @@ class Journal:
     def close(self):
         self.file.close()
         self.reader.close()
+
+
+def _past_the_line(journal):
+    """(bytes read, whether the line ended) reading past the rest of a line longer than JOURNAL_LINE."""
+    skipped = 0
+    while part := journal.readline(JOURNAL_LINE):
+        skipped += len(part)
+        if part.endswith(b"\n"):
+            return skipped, True
+    return skipped, False
 
 
 def _ends_a_line(path):
