@@ -125,32 +125,52 @@ def test_a_printed_10_ms_ramp_streamed_as_in_memory(tmp_path, monkeypatch):
     assert whole.passed and "step 0.01 s" in " ".join(whole.messages)
 
 
+@pytest.mark.parametrize("lengths", ["recorded", "nominal"])
+@pytest.mark.parametrize("overruns", [False, True])
 @pytest.mark.parametrize("timing", ["cycle", "fmi"])
 @pytest.mark.parametrize("block", [40, 1 << 20])
-def test_recorded_cycle_lengths_streamed_as_in_memory(timing, block, tmp_path, monkeypatch):
-    """Stamps in ms that jitter by up to 4 ms of a 10 ms cycle, replayed with their recorded lengths
-    (RateLimiter, cycleTime 0, so each step's length shapes the ramp): the steps made block by block, in
-    chunks of 3 steps, are the ones made from the whole file: the same outcome, deviations and all (the
-    reference y is the input, which the ramp lags behind)."""
+def test_jittered_stamps_streamed_as_in_memory(lengths, overruns, timing, block, tmp_path, monkeypatch):
+    """Stamps in ms that jitter by up to 4 ms of a 10 ms cycle (and, with overruns, a cycle skipped now
+    and then: cycles 1 and 2, 37, 100 to 103, 199), with recorded or nominal cycle lengths (RateLimiter,
+    cycleTime 0, so each step's length shapes the ramp): the cycles the stream finds block by block, and
+    the steps it makes in chunks of 3, are the ones made from the whole file: the same outcome,
+    deviations, notes and missing cycles (the reference y is the input, which the ramp lags behind)."""
     rng = np.random.default_rng(11)
-    stamps = np.arange(200) * 10 + np.concatenate([[0], rng.integers(-4, 5, 199)])
-    u = np.repeat([0.0, 3.0, -2.0, 5.0], 50)
+    cycles = np.arange(200)
+    if overruns:
+        cycles = np.setdiff1d(np.arange(204), [1, 2, 37, 100, 101, 102, 103, 199])
+    stamps = cycles * 10 + np.concatenate([[0], rng.integers(-4, 5, len(cycles) - 1)])
+    u = np.repeat([0.0, 3.0, -2.0, 5.0], 50)[: len(cycles)]
     path = tmp_path / "jittered.csv"
     path.write_text("Time [ms];u;y\n" + "".join(f"{t};{v};{v}\n" for t, v in zip(stamps, u, strict=True)))
     options = RecordingOptions(
-        cycle_lengths="recorded", timing=timing, start_values=(("rateUpPar", "40"), ("rateDownPar", "40"))
+        cycle_lengths=lengths, timing=timing, start_values=(("rateUpPar", "40"), ("rateDownPar", "40"))
     )
     whole, streamed = outcomes(path, "RateLimiter", options=options, head=1 << 20, block=block, monkeypatch=monkeypatch)
     same(whole, streamed)
-    assert not whole.passed and any("cycle lengths as recorded" in m for m in whole.messages)
+    lines = ("cycle_s", "phase_s")  # (the line's sums merged block by block: the last bits may differ)
+    assert {k: v for k, v in streamed.clock.items() if k not in lines} == {
+        k: v for k, v in whole.clock.items() if k not in lines
+    }
+    assert [streamed.clock[k] for k in lines] == pytest.approx([whole.clock[k] for k in lines], rel=1e-12)
+    assert not whole.passed and any(
+        ("cycle lengths as recorded" in m) == (lengths == "recorded") for m in whole.messages
+    )
+    assert whole.clock["missing_cycles"] == (8 if overruns else 0)
+    if overruns:
+        assert whole.clock["first_missing"] == [1, 2, 37, 100, 101, 102, 103, 199]
 
 
 def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
-    """A skipped cycle, an empty cell, a blank line inside, a step the head does not show: the stream
-    refuses before anything is reported; the in-memory path reads or explains them."""
+    """A repeated row (two on one cycle), an empty cell, a blank line inside, a step the head does not
+    show: the stream refuses before anything is reported; the in-memory path reads or explains them. A
+    skipped cycle (an overrun) the stream takes, as the in-memory path does."""
 
     def skipped(lines):
         return lines[:10] + lines[11:]
+
+    def repeated(lines):
+        return lines[:11] + lines[10:]
 
     def empty(lines):
         lines[12] = lines[12].replace(";4;", ";;")
@@ -159,10 +179,14 @@ def test_what_the_stream_leaves_to_the_in_memory_path(tmp_path, monkeypatch):
     def blank(lines):
         return lines[:12] + [""] + lines[12:]
 
-    for edit in (skipped, empty, blank):
+    for edit in (repeated, empty, blank):
         path = copy(tmp_path, "tia_portal_siemens.csv", edit, encoding="cp1252")
         whole, streamed = outcomes(path, "LGF_LimRateOfChangeCI", monkeypatch=monkeypatch)
         assert streamed is None, edit.__name__
+    path = copy(tmp_path, "tia_portal_siemens.csv", skipped, encoding="cp1252")
+    whole, streamed = outcomes(path, "LGF_LimRateOfChangeCI", monkeypatch=monkeypatch)
+    same(whole, streamed)
+    assert any("1 of " in m and "cycles have no sample" in m for m in streamed.messages), streamed.messages
     # the head's rows every 10 ms, the rest every 20 ms: the whole file's median interval is 20 ms
     rows = [(k * 10, 1.0) for k in range(12)] + [(120 + k * 20, 1.0) for k in range(40)]
     path = tmp_path / "two_steps.csv"
@@ -208,14 +232,14 @@ def test_a_recording_the_stream_gives_up_on_gets_the_in_memory_outcome_and_its_r
 
 
 def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch):
-    """A skipped cycle, time going backwards, a time cell that is no number
+    """A repeated row, time going backwards, a time cell that is no number
     (each past the head), a step the head does not show: the pass over the
     time column refuses the file before the FMU is instantiated (no run,
     no result file), and run_case gives the in-memory outcome, which names
     the file, line and column."""
 
-    def skipped(lines):
-        return lines[:16] + lines[17:]
+    def repeated(lines):
+        return lines[:17] + lines[16:]
 
     def backwards(lines):
         lines[16], lines[17] = lines[17], lines[16]
@@ -247,7 +271,7 @@ def test_a_bad_time_column_is_refused_before_the_fmu_runs(tmp_path, monkeypatch)
     monkeypatch.setattr(tempfile, "tempdir", str(temp))
 
     monkeypatch.setattr(stream, "HEAD_BYTES", 400)
-    for edit in (skipped, backwards, not_a_number):
+    for edit in (repeated, backwards, not_a_number):
         path = copy(tmp_path, "tia_portal_siemens.csv", edit, encoding="cp1252")
         assert len(b"".join(path.read_bytes().splitlines(keepends=True)[:16])) > 400  # the row is past the head
         assert refused(path, "LGF_LimRateOfChangeCI"), edit.__name__

@@ -17,7 +17,7 @@ from ._outcome import CaseOutcome, Status
 from ._recorded import first_differs, recorded_case
 from ._traces import NotPlain
 from .recordings import _clock as clock, _stream as stream, _timebase as timebase
-from .recordings._align import clock_figures, off_cycle_note
+from .recordings._align import MOST_NAMED, clock_figures, missing_note, off_cycle_note
 from .recordings._timebase import OFF_CYCLE
 from .recordings._matching import plan
 
@@ -28,12 +28,12 @@ SECONDS_OF_DECIMALS = ("s", "ms", "us", "ns", "FILETIME", "date")  # stamps whos
 class _StreamedReplay:
     """A Replay (recorded cycle lengths) of a streamed recording, its steps
     made from the rows' stamps as the blocks are read (read: reads the next
-    block, which add()s its stamps; False at the end): every row is one
-    execution, in the cycle after the row before (stream.time_column_pass),
-    so step k executes row k + 1 - shift, for the interval since the row
-    before at the recorder's resolution (the first: one step size), as
-    recordings._align's replay makes them from a recording read whole.
-    Each step's start is counted in whole ticks: no sum of floats."""
+    block, which add()s its rows; False at the end), as recordings._align's
+    replay makes them from a recording read whole: step k executes cycle
+    k + 1 - shift; a cycle with a row runs for the interval since the row
+    before at the recorder's resolution (the first one step size), a cycle
+    without one gets no doStep (size 0). Each step's start is counted in
+    whole ticks: no sum of floats."""
 
     times = None  # (the results stand at the grid's times)
 
@@ -41,10 +41,11 @@ class _StreamedReplay:
         self.step, self.read = step, read
         self.scale = 10.0**cycles.digits  # ticks per second
         first, *second, last = cycles.ends
-        self.origin = self._ticks(second[0] if shift == 0 and second else first)  # the first step's row
-        self.first_row = 1 - shift
+        self.origin = self._ticks(second[0] if shift == 0 and second else first)  # the first step's row's tick
         self.end = step + (self._ticks(last) - self.origin) / self.scale
-        self.row, self.before = 0, None  # the next row's index, the tick of the row before it
+        self.next_cycle = 1 - shift  # the cycle of the next step to make
+        self.tick = None  # the tick of the last row read
+        self.started = False  # a step with a row made (the first runs one step size)
         self.points: list[np.ndarray] = []  # steps made and not yet asked for
         self.sizes: list[np.ndarray] = []
         self.made = 0
@@ -52,19 +53,36 @@ class _StreamedReplay:
     def _ticks(self, seconds):
         return np.rint(np.asarray(seconds, dtype=np.float64) * self.scale).astype(np.int64)
 
-    def add(self, times):
+    def add(self, times, index):
+        """The steps through the cycle of the last of these rows (times, their cycles index)."""
         ticks = self._ticks(times)
-        before = np.concatenate([[ticks[0] if self.before is None else self.before], ticks[:-1]])
-        rows = self.row + np.arange(len(ticks))
-        self.row, self.before = self.row + len(ticks), int(ticks[-1])
-        steps = rows >= self.first_row
-        ticks, before, rows = ticks[steps], before[steps], rows[steps]
+        before = np.concatenate([[ticks[0] if self.tick is None else self.tick], ticks[:-1]])
+        self.tick = int(ticks[-1])
+        rows = index >= self.next_cycle
+        ticks, before, index = ticks[rows], before[rows], index[rows]
+        if not len(index):
+            return
         if (ticks < before).any():
             raise NotPlain("recorded executions that go back in time (the in-memory path says)")
-        first = rows == self.first_row
-        self.sizes.append(np.where(first, self.step, (ticks - before) / self.scale))
-        self.points.append(np.where(first, 0.0, self.step + (before - self.origin) / self.scale))
-        self.made += len(rows)
+        cycles = np.arange(self.next_cycle, int(index[-1]) + 1)
+        at = index - self.next_cycle  # each row's step among these
+        sizes = np.zeros(len(cycles))
+        sizes[at] = (ticks - before) / self.scale
+        points = np.zeros(len(cycles))
+        # each step starts at the row before it: the last row of a cycle before the step's
+        last_row = np.searchsorted(index, cycles, side="left") - 1  # (-1: the row before these)
+        start_tick = np.where(last_row >= 0, ticks[np.maximum(last_row, 0)], before[0])
+        if not self.started:
+            sizes[at[0]] = self.step
+            ran = cycles > index[0]  # (up to the first step with a row: from 0, its size one step)
+            points[ran] = self.step + (start_tick[ran] - self.origin) / self.scale
+            self.started = True
+        else:
+            points[:] = self.step + (start_tick - self.origin) / self.scale
+        self.sizes.append(sizes)
+        self.points.append(points)
+        self.made += len(cycles)
+        self.next_cycle = int(index[-1]) + 1
 
     def steps(self, k, m):
         """(points, sizes) of steps k to k + m - 1, k the first not yet given."""
@@ -161,23 +179,31 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
     stop = float(timebase.cycle_times(np.array([max(cycles.last + shift, 1)]), step)[0])
     pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": [], "steps": []}
     replay = _StreamedReplay(cycles, step, shift, lambda: parse()) if recorded else None
-    row = 0  # the next block's first row, which is its cycle (stream.time_column_pass)
+    before = -1  # the cycle of the row before the next block's
     jitter = clock.Jitter()  # of every row on the grid, as the blocks are read
     off: list = [0, None]  # rows more than OFF_CYCLE off their cycle, and (line, seconds, cycle) of the first
+    missing: list = [0, []]  # the cycles without a row: their count, and the first MOST_NAMED
 
     def parse():
-        """Reads the next block into both queues; False at the end."""
-        nonlocal row
+        """Reads the next block into the queues; False at the end."""
+        nonlocal before
         block = next(blocks, None)
         if block is None:
+            if not jitter.fits():
+                raise NotPlain("rows on no grid of cycles (the in-memory path says)")
             return False
         _, cells, line_numbers, times = block
-        index = np.arange(row, row + len(times))
-        row += len(times)
+        index = cycles.grid.index(times)
+        gaps = np.diff(np.concatenate([[before], index]))
+        if (gaps < 1).any():
+            raise NotPlain("two rows on one cycle on the whole file's grid (the in-memory path says)")
+        if (gaps > 1).any():
+            count, named = clock.missing(np.concatenate([[before], index]), MOST_NAMED - len(missing[1]))
+            missing[0] += count
+            missing[1] += named
+        before = int(index[-1])
         far = np.abs(cycles.grid.distance(times, index))
         largest = float(far.max())
-        if not largest < 0.5:
-            raise NotPlain("a row nearer another cycle than its own")  # (the in-memory path numbers it so)
         jitter.add_far(far, largest)
         if largest > OFF_CYCLE:
             late = np.flatnonzero(far > OFF_CYCLE)
@@ -196,7 +222,7 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
             chunk[variable] = table.values(cells, line_numbers, channel.name)
         pending["refs"].append(chunk)
         if replay is not None:
-            replay.add(times)
+            replay.add(times, index)
         return True
 
     def queue(kind):
@@ -223,6 +249,8 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
                     for _, channel in drives + compares
                 )
             )
+        if missing[0]:
+            notes.append(missing_note(missing[0], before + 1, missing[1]))
         notes += matched.describe()
         unit = timebase.UNIT_NAMES.get(recording.time_unit, recording.time_unit)
         description = (
@@ -230,10 +258,11 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
             f"step {shortest(step)} s ({recording.step_source}), jitter {jitter.describe()}"
             + (", cycle lengths as recorded" if recorded else "")
         )
-        figures.update(clock_figures(cycles.grid, jitter, 1, 0, []))
+        figures.update(clock_figures(cycles.grid, jitter, 1, missing[0], missing[1]))
         if passed:
             return [description] + notes
-        return [description] + _explain(table, deviations, dict((v, c) for v, c in compares), step, shift) + notes
+        explained = _explain(table, deviations, dict((v, c) for v, c in compares), step, shift, cycles.grid)
+        return [description] + explained + notes
 
     inputs = queue("inputs") if drives else None
     case = ChunkedCase(
@@ -258,23 +287,23 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
     return outcome
 
 
-def _explain(table, deviations, channels, step, shift):
-    """RecordedCase.explain's messages: each failing signal's recorded sample at its first deviation."""
+def _explain(table, deviations, channels, step, shift, grid):
+    """RecordedCase.explain's messages: each failing signal's recorded sample at its first deviation
+    (the row of its cycle on grid)."""
     wanted = {}
     for deviation in deviations:
         if deviation.name in channels and deviation.time is not None:
             wanted[deviation.name] = int(round(deviation.time / step)) - shift
     found = {}
-    row = 0
     if wanted:
         for _, cells, line_numbers, times in table.blocks():
+            index = grid.index(times)
             for name, cycle in wanted.items():
-                if name not in found and row <= cycle < row + len(times):
-                    i = cycle - row
-                    value = table.values(cells, line_numbers, channels[name].name)[i]
-                    found[name] = (int(line_numbers[i]), float(times[i]), float(value))
-            row += len(times)
-            if len(found) == len(wanted):
+                at = int(np.searchsorted(index, cycle))
+                if name not in found and at < len(index) and index[at] == cycle:
+                    value = table.values(cells, line_numbers, channels[name].name)[at]
+                    found[name] = (int(line_numbers[at]), float(times[at]), float(value))
+            if len(found) == len(wanted) or index[-1] >= max(wanted.values()):
                 break
     messages = []
     for deviation in deviations:

@@ -266,11 +266,17 @@ def _describe_clock(aligned, recording, used, index_of, grid, executed):
     aligned.clock = clock_figures(grid, jitter, every, count, first)
     aligned.description = f"jitter {jitter.describe()}"
     if count:
-        named = ", ".join(str(c) for c in first) + (f" and {count - len(first)} more" if count > len(first) else "")
-        aligned.notes.append(
-            f"{count} of {int(executed[-1] - executed[0]) + 1} cycles have no sample (cycles {named} from the first "
-            "sample's): the OB did not run them (an overrun), or the recorder missed them"
-        )
+        aligned.notes.append(missing_note(count, int(executed[-1] - executed[0]) + 1, first))
+
+
+def missing_note(count, cycles, first):
+    """The note on a recording that samples every cycle and has count of
+    its cycles without a sample (the first of them: first)."""
+    named = ", ".join(str(c) for c in first) + (f" and {count - len(first)} more" if count > len(first) else "")
+    return (
+        f"{count} of {cycles} cycles have no sample (cycles {named} from the first sample's): the OB did not run "
+        "them (an overrun), or the recorder missed them"
+    )
 
 
 def clock_figures(grid, jitter, every, missing, first_missing):

@@ -190,6 +190,13 @@ class Jitter:
             return "none (every stamp within 0.05 % of a cycle of its cycle)"
         return f"up to {100 * self.largest:.1f} % of a cycle (typical {100 * self.typical:.1f} %)"
 
+    def fits(self):
+        """fits() of the distances added (from their histogram)."""
+        if not self.samples:
+            return True
+        far = self.counts[int(FAR * 2 * HISTOGRAM_BINS) + 1 :].sum() / self.samples
+        return not (self.typical > NO_GRID and far > FAR_SHARE)
+
     def settings(self):
         """Its figures for results.json, in % of a cycle."""
         return {"largest_percent": round(100 * self.largest, 3), "typical_percent": round(100 * self.typical, 3)}
@@ -225,15 +232,17 @@ class Line:
     def __init__(self):
         self.count, self.mean_index, self.mean_time, self.index_squares, self.products = 0, 0.0, 0.0, 0.0, 0.0
 
-    def add(self, first, times):
-        """The pairs (first + k, times[k]): consecutive cycles from first (their centred sums in closed form,
-        the times' in two passes)."""
+    def add(self, index, times):
+        """The pairs (index[k], times[k]): their cycles, and their stamps (each block's centred sums in two
+        passes)."""
         n = len(times)
         if not n:
             return
-        mean_index, mean_time = first + (n - 1) / 2, float(times.mean())
-        squares = n * (n * n - 1) / 12
-        products = _dot(np.arange(n) - (n - 1) / 2, times)  # (the centred index sums to 0)
+        index = np.asarray(index, dtype=np.float64)
+        mean_index, mean_time = float(index.mean()), float(times.mean())
+        centred = index - mean_index
+        squares = _dot(centred, centred)
+        products = _dot(centred, times)  # (the centred index sums to 0)
         total = self.count + n
         d_index, d_time = mean_index - self.mean_index, mean_time - self.mean_time
         weight = self.count * n / total

@@ -219,7 +219,7 @@ class Cycles:
 
     rows: int
     last: int  # the last row's cycle
-    grid: clock.Grid  # the cycles the rows sit on (the recorder's clock): row k is cycle k
+    grid: clock.Grid  # the cycles the rows sit on (the recorder's clock): cycle 0 is the first row's
     digits: int | None = None  # decimals of a second that make every stamp whole (asked for: resolution=True)
     ends: tuple = ()  # (the first two rows' times, the last's), seconds (resolution=True)
 
@@ -228,52 +228,70 @@ def time_column_pass(table, step, block_bytes=None, resolution=False):
     """The whole file's time column read once, before anything runs (only
     its cells converted), by the rules normalise applies to a whole
     recording: the step its intervals give (unless one was given) is the
-    head's, its length is no misread unit; and by the stream's own: every
-    row the cycle after the one before, on the grid of cycles the rows
-    before it fit (clock.Line: the in-memory path's fit, on a recording
-    of a row per cycle; the pass checks the first SEARCH_WINDOW rows on
-    their line, the run each row on the whole file's). resolution: the
-    recorder's too (Cycles.digits, Cycles.ends), for recorded cycle
+    head's, its length is no misread unit; and by the stream's own: the
+    rows fitted to a grid of cycles as the in-memory path fits them (the
+    first SEARCH_WINDOW rows numbered by clock.fit, each later block by the
+    line of the rows before it, clock.Line), each row on a cycle after the
+    one before, a cycle now and then skipped (the OB did not run it) but
+    not every other one (a recorder sampling every k-th cycle: read whole).
+    The run numbers each row again on the whole file's line. resolution:
+    the recorder's too (Cycles.digits, Cycles.ends), for recorded cycle
     lengths. NotPlain otherwise."""
     recording = table.recording
     intervals = timebase.Intervals()
     line = clock.Line()
-    rows, span = 0, 0.0
-    first: list[np.ndarray] = []  # the first SEARCH_WINDOW rows' times: checked once their line is known
+    rows, span, last = 0, 0.0, -1
+    skipped = 0  # rows after a skipped cycle
+    first: list[np.ndarray] | None = []  # the first SEARCH_WINDOW rows' times: numbered once they are in
     digits, head = 0, np.zeros(0)
+
+    def number(times, grid):
+        nonlocal last, skipped
+        index = grid.index(times)
+        gaps = np.diff(np.concatenate([[last], index]))
+        if (gaps < 1).any():
+            raise NotPlain("two rows on one cycle, or time going back (the in-memory path says)")
+        skipped += int(np.count_nonzero(gaps > 1))
+        line.add(index, times)
+        last = int(index[-1])
+
     for _, _, _, times in table.blocks(block_bytes, time_only=True):
         if resolution:
             found = timebase.decimal_resolution(times)
             if found is None:
                 raise NotPlain("stamps of no decimal resolution (the in-memory path says)")
-            digits, head = max(digits, found), np.concatenate([head, times[: 2 - len(head)]])
-        if line.count < clock.SEARCH_WINDOW:  # (later rows: checked as the run reads them, _recording)
+            digits = max(digits, found)
+        head = np.concatenate([head, times[: 2 - len(head)]])
+        if first is None:
+            number(times, line.grid(step))
+        else:
             first.append(times)
-        line.add(rows, times)
-        if first and line.count >= clock.SEARCH_WINDOW:
-            _on_their_cycles(line.grid(step), np.arange(line.count), np.concatenate(first))
-            first = []
+            if sum(map(len, first)) >= clock.SEARCH_WINDOW:
+                window = np.concatenate(first)
+                number(window, clock.fit(window, step))
+                first = None
         rows, span = rows + len(times), float(times[-1])
         if not table.step_given:
             intervals.add(times)
             if len(intervals.values) > MAX_INTERVALS:
                 raise NotPlain("too many distinct intervals between stamps")
+    if first:
+        window = np.concatenate(first)
+        number(window, clock.fit(window, step))
+    if not rows:
+        raise NotPlain("no rows")
+    if 2 * skipped > rows:
+        raise NotPlain("samples every few cycles (the in-memory path reads them so)")
     if not table.step_given and timebase.snapped_interval(intervals.median() or step) != step:
         raise NotPlain("the whole file's interval is another step than its head's")
     if timebase.too_long(span) or timebase.too_many_steps(span / step, rows, recording.unit_given):
         raise NotPlain("the in-memory path refuses the length")
     grid = line.grid(step)
-    if first:
-        _on_their_cycles(grid, np.arange(line.count), np.concatenate(first))
+    zero = int(grid.index(head[:1])[0])  # cycle 0 is the first row's (as clock.fit makes it)
+    grid = clock.Grid(grid.period, grid.phase + zero * grid.period)
     if clock.restep(grid, step) != step:
         raise NotPlain("the rows fit another step than their finest interval (the in-memory path says)")
+    last = int(grid.index(np.array([span]))[0])
     if resolution:
-        return Cycles(rows, rows - 1, grid, digits, (*head.tolist(), span))
-    return Cycles(rows, rows - 1, grid)
-
-
-def _on_their_cycles(grid, index, times):
-    """NotPlain unless each row's nearest cycle on grid is its own: a
-    repeated or skipped cycle, time going back."""
-    if not np.array_equal(grid.index(times), index):
-        raise NotPlain("a repeated or skipped cycle")
+        return Cycles(rows, last, grid, digits, (*head.tolist(), span))
+    return Cycles(rows, last, grid)
