@@ -173,6 +173,27 @@ def test_a_map_to_a_can_logger_channel_without_samples_says_so():
         recorded_case(path, fmu, "can", RecordingOptions(maps={"y": "LIN_Frame.ID"}))
 
 
+def _decoded_compared(tmp_path, name, dbc, fmu, **maps):
+    """(each mapped signal's stamps, the finished command, its case in results.json) of `fmutrace compare`
+    on the CANedge log `name` decoded with `dbc` (asammdf), its signals mapped to the FMU's variables."""
+    from asammdf import MDF
+
+    raw = MDF(str(_unpacked(f"canedge/{name}", tmp_path)))
+    decoded = raw.extract_bus_logging({"CAN": [(str(CORPUS / "canedge" / dbc), 0)]})
+    path = tmp_path / "decoded.mf4"
+    decoded.save(str(path), overwrite=True)
+    stamps = [np.asarray(decoded.get(signal).timestamps, dtype=np.float64) for signal in dict.fromkeys(maps.values())]
+    raw.close()
+    decoded.close()
+    report = tmp_path / "report"
+    command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(fmu), str(path), "--report", str(report)]
+    for variable, signal in maps.items():
+        command += ["--map", f"{variable}={signal}"]
+    done = run_bounded(command, timeout=600, what="fmutrace compare")
+    cases = json.loads((report / "results.json").read_text())["cases"] if (report / "results.json").exists() else [{}]
+    return stamps, done, cases[0]
+
+
 def test_decoded_can_signals_take_the_step_of_the_channels_mapped(tmp_path):
     """FCBF0606 decoded with its DBC (asammdf, canmatrix): EngineSpeed every 0.1 s and
     WheelBasedVehicleSpeed about every 1 s, each message with its own stamps. The speed mapped alone
@@ -181,22 +202,12 @@ def test_decoded_can_signals_take_the_step_of_the_channels_mapped(tmp_path):
     lays them on the grid of cycles they fit, each on its own cycle, says how far they are from it
     (the jitter), and names those more than a tenth of a cycle off; this test counts them on the grid
     results.json reports, numbering each stamp on its nearest cycle as the grid's definition says."""
-    from asammdf import MDF
-
-    raw = MDF(str(CORPUS / "canedge" / "FCBF0606_00000001-60B621D9.MF4"))
-    decoded = raw.extract_bus_logging({"CAN": [(str(CORPUS / "canedge" / "CSS-Electronics-SAE-J1939-DEMO.dbc"), 0)]})
-    path = tmp_path / "decoded.mf4"
-    decoded.save(str(path), overwrite=True)
-    stamps = decoded.get("WheelBasedVehicleSpeed").timestamps
-    raw.close()
-    decoded.close()
-    report = tmp_path / "report"
-    command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(PASS_THROUGH), str(path)]
-    maps = ["--map", "u=WheelBasedVehicleSpeed", "--map", "y=WheelBasedVehicleSpeed", "--report", str(report)]
-    done = run_bounded(command + maps, timeout=600, what="fmutrace compare")
+    [stamps], done, case = _decoded_compared(
+        tmp_path, "FCBF0606_00000001-60B621D9.MF4", "CSS-Electronics-SAE-J1939-DEMO.dbc", PASS_THROUGH,
+        u="WheelBasedVehicleSpeed", y="WheelBasedVehicleSpeed",
+    )  # fmt: skip
     assert done.returncode == 0, done.stdout + done.stderr
     assert f"{len(stamps)} samples" in done.stdout and "step 1 s (the finest interval" in done.stdout
-    [case] = json.loads((report / "results.json").read_text())["cases"]
     clock = case["clock"]
     cycles = (stamps - stamps[0] - clock["phase_s"]) / clock["cycle_s"]
     numbers = np.rint(cycles)
@@ -237,24 +248,11 @@ def test_gps_messages_stamped_by_a_can_logger_compare_cycle_for_cycle(tmp_path, 
     verdict (the FMU is no GPS: they differ), with the cycle, the jitter and the missing cycles that an
     independent numbering of each channel's intervals gives (the two channels' stamps are 1 ms apart, so
     fmutrace's one grid for both is within 0.1 % of a cycle of each channel's own line)."""
-    from asammdf import MDF
-
-    raw = MDF(str(_unpacked(f"canedge/{name}", tmp_path)))
-    decoded = raw.extract_bus_logging({"CAN": [(str(CORPUS / "canedge" / "gnss.dbc"), 0)]})
-    path = tmp_path / "decoded.mf4"
-    decoded.save(str(path), overwrite=True)
-    stamps = {n: np.asarray(decoded.get(n).timestamps, dtype=np.float64) for n in ("Speed", "Heading")}
-    raw.close()
-    decoded.close()
-    report = tmp_path / "report"
-    command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(RATE_LIMITER), str(path)]
-    maps = ["--map", "u=Speed", "--map", "y=Heading", "--report", str(report)]
-    done = run_bounded(command + maps, timeout=600, what="fmutrace compare")
+    stamps, done, case = _decoded_compared(tmp_path, name, "gnss.dbc", RATE_LIMITER, u="Speed", y="Heading")
     assert done.returncode == 1, done.stdout + done.stderr
     assert "FAIL" in done.stdout and "y differs first" in done.stdout
-    [case] = json.loads((report / "results.json").read_text())["cases"]
     clock = case["clock"]
-    figures = [_cycles_by_intervals(s) for s in stamps.values()]
+    figures = [_cycles_by_intervals(s) for s in stamps]
     for period, _, missed in figures:
         assert clock["cycle_s"] == pytest.approx(period, rel=1e-5)
         assert clock["missing_cycles"] == missed
