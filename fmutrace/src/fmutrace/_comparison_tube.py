@@ -61,17 +61,25 @@ class Tube(Mode):
         the tube, to the nearest point of the reference's polyline within
         the tube's value of the sample, and that sample's time: how much of
         the tube's time a sample needed (a time allowance that hides a value
-        error uses all of it). (0, None) if none is inside."""
+        error uses all of it). (0, None) if none is inside. The sample named
+        is the first that needs the most, or, of those needing more than the
+        tube's time by no more than the times' rounding, the last."""
         times, values = reference["time"], reference[name].astype(np.float64)
-        most, at = 0.0, None
-        for t, v in zip(result["time"], result[name].astype(np.float64), strict=True):
-            if not times[0] <= t <= times[-1]:
-                continue
-            need = _distance_to_polyline(times, values, float(t), float(v), self.value, self.time + time_slack(t))
-            need = 0.0 if need <= time_slack(t) else need  # (the same instant, up to the times' rounding)
-            if need <= self.time + time_slack(t) and (at is None or need > most):
-                most, at = min(need, self.time), float(t)
-        return most, at
+        t, v = result["time"].astype(np.float64), result[name].astype(np.float64)
+        inside = (times[0] <= t) & (t <= times[-1])
+        t, v = t[inside], v[inside]
+        slack = time_slack(t)
+        need = _distances_to_polyline(times, values, t, v, self.value, self.time + slack)
+        need = np.where(need <= slack, 0.0, need)  # (the same instant, up to the times' rounding)
+        within = need <= self.time + slack
+        t, need = t[within], need[within]
+        if not len(need):
+            return 0.0, None
+        over = np.flatnonzero(need > self.time)
+        if len(over):
+            return self.time, float(t[over[-1]])
+        at = int(np.argmax(need))
+        return float(need[at]), float(t[at])
 
     def bands(self, result, reference, names):
         return {name: self.band(result, reference, name) for name in names}, ""
@@ -138,33 +146,45 @@ class Tube(Mode):
         return self.band(reference[whole & last_row], result, name, span)
 
 
-def _distance_to_polyline(times, values, t, v, width, reach):
-    """The smallest |tau - t| (at most reach; inf if none) at which the
-    polyline (times, values) lies within width of v."""
-    lo = int(np.searchsorted(times, t - reach, "left"))
-    hi = int(np.searchsorted(times, t + reach, "right"))
-    best = math.inf
-    for k in range(max(lo - 1, 0), min(hi + 1, len(times))):
-        t0, p0 = times[k], values[k]
-        if abs(p0 - v) <= width:
-            best = min(best, abs(t0 - t))
-        if k + 1 >= len(times):
-            continue
-        t1, p1 = times[k + 1], values[k + 1]
-        if math.isnan(p0) or math.isnan(p1) or t1 == t0:  # (a jump is reached at its time)
-            if t1 == t0 and min(p0, p1) - width <= v <= max(p0, p1) + width:
-                best = min(best, abs(t0 - t))
-            continue
-        if p1 == p0:
-            a, b = (0.0, 1.0) if abs(p0 - v) <= width else (1.0, 0.0)
-        else:
-            a, b = sorted(((v - width - p0) / (p1 - p0), (v + width - p0) / (p1 - p0)))
-        a, b = max(a, 0.0), min(b, 1.0)
-        if a > b:
-            continue
-        start, end = t0 + a * (t1 - t0), t0 + b * (t1 - t0)
-        best = min(best, 0.0 if start <= t <= end else min(abs(start - t), abs(end - t)))
+def _distances_to_polyline(times, values, t, v, width, reach):
+    """For each sample (t, v): the smallest |tau - t| (at most its reach;
+    inf if none) at which the polyline (times, values) lies within width of
+    v; a repeated time is a vertical jump, a NaN breaks the line (its
+    neighbours are reached at their times). Each segment near a sample is
+    taken in one pass over all the samples: as many passes as a reach
+    spans segments."""
+    n = len(times)
+    first = np.maximum(np.searchsorted(times, t - reach, "left") - 1, 0)
+    end = np.minimum(np.searchsorted(times, t + reach, "right") + 1, n)
+    best = np.full(len(t), np.inf)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for offset in range(int((end - first).max(initial=0))):
+            k = first + offset
+            active = k < end
+            k = np.minimum(k, n - 1)
+            t0, p0 = times[k], values[k]
+            _nearer(best, active & (np.abs(p0 - v) <= width), np.abs(t0 - t))
+            following = active & (k + 1 < n)
+            t1, p1 = times[np.minimum(k + 1, n - 1)], values[np.minimum(k + 1, n - 1)]
+            jump = t1 == t0
+            low, high = np.where(p1 < p0, p1, p0), np.where(p1 > p0, p1, p0)
+            _nearer(best, following & jump & (low - width <= v) & (v <= high + width), np.abs(t0 - t))
+            line = following & ~jump & ~np.isnan(p0) & ~np.isnan(p1)
+            flat = p1 == p0
+            near = np.abs(p0 - v) <= width
+            x, y = (v - width - p0) / (p1 - p0), (v + width - p0) / (p1 - p0)
+            a = np.where(flat, np.where(near, 0.0, 1.0), np.where(y < x, y, x))
+            b = np.where(flat, np.where(near, 1.0, 0.0), np.where(y < x, x, y))
+            a, b = np.where(a < 0.0, 0.0, a), np.where(b > 1.0, 1.0, b)
+            start, stop = t0 + a * (t1 - t0), t0 + b * (t1 - t0)
+            distance = np.where((start <= t) & (t <= stop), 0.0, np.minimum(np.abs(start - t), np.abs(stop - t)))
+            _nearer(best, line & ~(a > b), distance)
     return best
+
+
+def _nearer(best, where, distance):
+    """best lowered to distance where that is nearer (a NaN distance is none)."""
+    np.copyto(best, distance, where=where & (distance < best))
 
 
 def _polyline_at(times, values, at):
