@@ -8,7 +8,9 @@ at t = 1, one 0.5 s cycle rises by 1); tampered files and checksums."""
 import contextlib
 import hashlib
 import io
+import json
 import zipfile
+from xml.etree import ElementTree
 
 import pytest
 
@@ -171,6 +173,26 @@ def test_an_fmu_without_experiments_leaves_the_others_checked(tmp_path):
     assert [p.split(":")[0] for p in result.problems] == [f"{bare} carries no FMI-LS-REF experiments (no {MANIFEST})"]
     with pytest.raises(fmutrace.InputError, match="carries no FMI-LS-REF experiments"):
         fmutrace.check([bare, bare], run=ONE_JOB)
+
+
+def test_an_fmu_left_out_of_a_check_is_named_in_its_report_and_junit(tmp_path):
+    """check with a report and JUnit XML of an FMU without experiments and one with: results.json lists
+    it under not_run, summary.md and index.html name it, and the JUnit XML has an error for it."""
+    source = fmu_path(BUILD_DIR, "RateLimiter", 3)
+    bare = rewritten(source, tmp_path / "bare.fmu", {}, drop=lambda name: name.startswith(FOLDER))
+    report, junit = tmp_path / "report", tmp_path / "junit.xml"
+    status, out, err = command("check", bare, source, "--role", "smoke-test", "--report", report, "--junit", junit)
+    assert status == 2, out + err
+    results = json.loads((report / "results.json").read_text())
+    [left_out] = results["not_run"]
+    assert left_out.startswith(f"{bare} carries no FMI-LS-REF experiments") and left_out.endswith("not checked")
+    assert len(results["cases"]) == 3 and not results["passed"]
+    [said] = [line for line in (report / "summary.md").read_text().splitlines() if line.startswith("- not run: ")]
+    assert said.replace("\\", "").startswith(f"- not run: {bare} carries no FMI-LS-REF experiments")  # (unescaped)
+    assert f'<p class="not-run">not run: {bare} carries' in (report / "index.html").read_text()
+    suites = ElementTree.parse(junit).getroot()
+    [suite] = [s for s in suites if s.get("name") == "not run"]
+    assert suite.get("errors") == "1" and suite[0][0].get("message") == left_out
 
 
 # ---- an LS-REF FMU another tool wrote ------------------------------------------------

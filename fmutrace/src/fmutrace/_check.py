@@ -16,7 +16,7 @@ from ._journal import ReportLock
 from ._fmu import Fmu, unpack_root
 from ._lsref import write_cases
 from ._outcome import CampaignResult
-from ._report import output_problem, write_junit
+from ._report import output_problem, write_junit, write_report
 
 EXPERIMENTS = "experiments"
 MARKER = ".fmutrace-experiments"  # in experiments/: the folder is a check's, to replace
@@ -33,17 +33,23 @@ def check(fmus: Paths, *, role: str | None = None, report: str | PathLike | None
     cannot be checked so is left out, its message among the result's
     problems (exit code 2), and the others run; InputError if none can."""
     paths = [fmus] if isinstance(fmus, (str, PathLike)) else list(fmus)
+    junit = options.pop("junit", None)  # (written below, once the FMUs left out are known)
     if report:
         lock = ReportLock(report)  # before anything in the folder is touched (compare's own is this one)
         try:
             target = _experiments_folder(report)
+            if junit and output_problem(junit):  # (checked once the report folder is made: it may hold the file)
+                raise InputError(output_problem(junit))
             checked, made, problems = _write(paths, role, target)
             result = compare(checked, list(made), report=report, **options)
-            result.problems += problems
+            if problems:  # the report again, naming the FMUs left out
+                result.problems += problems
+                write_report(result, report)
+            if junit:
+                write_junit(result, junit)
             return result
         finally:
             lock.release()
-    junit = options.pop("junit", None)  # (written below, once the messages name what is left)
     if junit and output_problem(junit):
         raise InputError(output_problem(junit))
     # in the command's own folder of unpacked FMUs: a check killed leaves it to the next command to remove

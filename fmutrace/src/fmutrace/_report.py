@@ -154,6 +154,7 @@ def _results_json_head(campaign: CampaignResult) -> str:
         "counts": campaign.counts(),
         "where": campaign.where,
         "seconds": round(campaign.seconds, 3),
+        "not_run": [text(problem) for problem in campaign.problems],
     }
     return json.dumps(head)[:-1] + ', "cases": ['
 
@@ -203,6 +204,18 @@ def write_junit(campaign: CampaignResult, path):
                 out.write(
                     f"{case}>\n      <{kind} message={quoteattr(message)}>{escape(text(chr(10).join(o.messages)))}"
                     f"</{kind}>\n    </testcase>\n"
+                )
+            out.write("  </testsuite>\n")
+        if campaign.problems:  # (what could not run at all: an error each, in a suite of its own)
+            out.write(
+                f'  <testsuite name="not run" tests="{len(campaign.problems)}" failures="0" '
+                f'errors="{len(campaign.problems)}" time="0.000">\n'
+            )
+            for problem in campaign.problems:
+                message = quoteattr(text(problem))
+                out.write(
+                    f'    <testcase name={message} classname="not run">\n'
+                    f"      <error message={message}>{escape(text(problem))}</error>\n    </testcase>\n"
                 )
             out.write("  </testsuite>\n")
         out.write("</testsuites>\n")
@@ -403,8 +416,10 @@ def _summary(out, campaign: CampaignResult, criteria, rows, pngs):
     case, the failing ones first (rows: failing -> the file of their rows),
     a plot column where a case has a PNG."""
     verdict = "PASS" if campaign.passed else "FAIL"
+    not_run = "".join(f"- not run: {markdown(problem)}\n" for problem in campaign.problems)
     out.write(
-        f"# fmutrace: {verdict}\n\n{campaign.headline()}\n\nComparison: {criteria}.\n\n"
+        f"# fmutrace: {verdict}\n\n{campaign.headline()}\n\n{not_run + chr(10) if not_run else ''}"
+        f"Comparison: {criteria}.\n\n"
         + ("| case | FMU | result | seconds | plot |\n|---|---|---|---|---|\n" if pngs else "")
         + ("| case | FMU | result | seconds |\n|---|---|---|---|\n" if not pngs else "")
     )
@@ -448,7 +463,8 @@ def _index_head(campaign: CampaignResult, headline, criteria, tally: _Tally) -> 
         _head("fmutrace report", ASSETS)
         + f'<h1>fmutrace report</h1>\n<p class="headline" id="verdict" data-verdict="{verdict}">'
         f'<span class="badge {verdict}">{verdict.upper()}</span> {html.escape(headline)}</p>\n'
-        f'<section class="summary"><div class="numbers"><div class="number total">'
+        + "".join(f'<p class="not-run">not run: {html.escape(text(problem))}</p>\n' for problem in campaign.problems)
+        + '<section class="summary"><div class="numbers"><div class="number total">'
         f'<span id="count-total">{len(campaign.cases)}</span> cases</div>{numbers}'
         f'<div class="number time">{campaign.seconds:.1f} s on {html.escape(text(campaign.where))}</div></div>\n'
         f"<p>Comparison: {html.escape(text(criteria))}.{own}</p>\n"
