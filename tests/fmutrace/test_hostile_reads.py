@@ -668,3 +668,42 @@ def test_a_message_quoting_a_huge_name_is_cut(tmp_path):
     (case / "PassThrough_criteria.csv").write_text("z" * 3_000_000 + ",exact\n")
     done = fmutrace_command("compare", PASS_THROUGH, tmp_path / "cases", "--jobs", "1")
     refused(done, "PassThrough_criteria.csv, line 1, column 1: column 'zzzz", "characters, cut)")
+
+
+def test_a_campaigns_read_bound_travels_with_its_cases(tmp_path, monkeypatch):
+    """A Dask worker has its own environment, not the client's: the bound the client has when a campaign
+    starts (FMUTRACE_READ_LIMIT) goes with the cases' settings, and bounds a case run in a worker's
+    thread without the variable, and only that thread (another case, of a campaign without a bound, reads
+    the same 300 kB start file)."""
+    from fmutrace import Exact, RunOptions
+    from fmutrace import _executors
+    from fmutrace._worker import CaseSettings, Target, run_case, worker_fmu
+
+    case = write_case(tmp_path / "cases" / "one")
+    (case / "PassThrough_start.csv").write_text("# " + "x" * 300_000 + "\n")
+    given = []
+    monkeypatch.setattr(_executors, "run_case", lambda *args: given.append(args[-1]) or run_case(*args))
+    monkeypatch.setenv("FMUTRACE_READ_LIMIT", "200K")
+    fmutrace.compare(str(PASS_THROUGH), str(tmp_path / "cases"), run=RunOptions(jobs=1))
+    assert [settings.read_limit for settings in given] == [200 << 10]
+    monkeypatch.delenv("FMUTRACE_READ_LIMIT")
+
+    runner, fmu = worker_fmu(PASS_THROUGH.read_bytes(), str(PASS_THROUGH))
+    target = Target(runner, fmu, {"fmu": fmu.label, "fmu_file": str(PASS_THROUGH), "fmu_folder": "f"})
+    outcomes = {}
+
+    def in_a_thread(key, settings):
+        thread = threading.Thread(
+            target=lambda: outcomes.setdefault(key, run_case(str(case), key, None, target, settings))
+        )
+        thread.start()
+        thread.join(timeout=60)
+
+    in_a_thread("bound", CaseSettings(Exact(), read_limit=200 << 10))
+    in_a_thread("free", CaseSettings(Exact()))
+    assert str(outcomes["bound"].status) == "invalid"
+    assert (
+        "PassThrough_start.csv: 300,003 bytes: more than the read bound of 204,800 bytes"
+        in outcomes["bound"].messages[0]
+    )
+    assert outcomes["free"].passed, outcomes["free"].messages

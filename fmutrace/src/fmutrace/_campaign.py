@@ -24,7 +24,7 @@ from ._fmu import Fmu
 from ._journal import JOURNAL, Journal, JournaledOutcomes, ReportLock, campaign_key, case_key, fmu_digest
 from ._outcome import CampaignResult, KeptOutcomes, Status
 from ._progress import Progress
-from ._reading import read_bytes
+from ._reading import read_bytes, read_limit
 from .recordings import is_recording, recording_paths
 from .recordings._options import RecordingOptions
 from ._report import file_name, output_problem, write_case_files, write_junit, write_report
@@ -121,7 +121,7 @@ def compare(
             f.path: FmuFile(str(f.path), {"fmu": f.label, "fmu_file": str(f.path), "fmu_folder": folders[f.path]})
             for f in loaded
         },
-        settings=CaseSettings(mode, plots, recording, run.case_timeout, png),
+        settings=CaseSettings(mode, plots, recording, run.case_timeout, png, read_limit()),
     )
     executor = executor_for(run)
     key = campaign_key(work.fmu_bytes, mode, plots + " png" * png, recording.settings() if has_recordings else None)

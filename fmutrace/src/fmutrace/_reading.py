@@ -13,6 +13,8 @@ file makes it wait on a device or a FIFO, or allocate without a bound.
 """
 
 import os
+from contextlib import contextmanager
+from contextvars import ContextVar
 import stat
 import zipfile
 
@@ -26,8 +28,27 @@ QUOTE_CHARS = 60  # of a line or a cell in a message
 _UNITS = {"": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30}
 
 
+# a campaign's bound where its cases run (a Dask worker has its own environment, not the client's); a
+# context variable: each of a worker's threads runs a case of its own
+_CAMPAIGN_LIMIT: ContextVar[int | None] = ContextVar("campaign_read_limit", default=None)
+
+
+@contextmanager
+def campaign_read_limit(limit: int | None):
+    """read_limit() is limit (where given) in this thread until the block ends."""
+    token = _CAMPAIGN_LIMIT.set(limit)
+    try:
+        yield
+    finally:
+        _CAMPAIGN_LIMIT.reset(token)
+
+
 def read_limit() -> int:
-    """The read bound in bytes: FMUTRACE_READ_LIMIT if set, else READ_LIMIT."""
+    """The read bound in bytes: the campaign's where its cases run
+    (campaign_read_limit), else FMUTRACE_READ_LIMIT if set, else READ_LIMIT."""
+    campaign = _CAMPAIGN_LIMIT.get()
+    if campaign is not None:
+        return campaign
     text = os.environ.get(READ_LIMIT_VARIABLE, "").strip()
     if not text:
         return READ_LIMIT

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from ._comparison import Mode
 from ._fmu import Fmu
 from ._pipeline import CaseFiles, Streaming, run_folder_case
+from ._reading import campaign_read_limit
 from ._recording import run_recording
 from ._outcome import CaseOutcome
 from ._plot import load_plotting
@@ -33,6 +34,7 @@ class CaseSettings:
     recording: RecordingOptions = field(default_factory=RecordingOptions)  # how recordings are read
     case_timeout: float | None = None  # seconds a case may run in a child process (None: no bound)
     png: bool = False  # a plotted case gets a static PNG figure too (matplotlib), beside its interactive plot
+    read_limit: int | None = None  # the client's read bound, where the cases run (None: the worker's own)
 
 
 @dataclass(frozen=True)
@@ -57,11 +59,10 @@ def run_case(folder, name, texts, target: Target, settings: CaseSettings) -> Cas
     the recording there (read with settings.recording), on target: read,
     run and compared by the pipeline, plotted if asked."""
     streaming = Streaming(keep_result=settings.plots != "none")
-    if texts is None and is_recording(folder):  # (texts come with a case folder only)
-        outcome = run_recording(folder, name, target, settings, streaming)
-    else:
-        outcome = run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
-    return outcome
+    with campaign_read_limit(settings.read_limit):
+        if texts is None and is_recording(folder):  # (texts come with a case folder only)
+            return run_recording(folder, name, target, settings, streaming)
+        return run_folder_case(CaseFiles(folder, name, texts), target, settings, streaming)
 
 
 # the FMU's content hash -> (Runner, Fmu), kept from task to task in a worker process
