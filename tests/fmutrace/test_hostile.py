@@ -9,6 +9,8 @@ first step; its cases are worked by hand from that equation."""
 
 import json
 import os
+import shutil
+import tempfile
 import re
 import signal
 import subprocess
@@ -226,6 +228,33 @@ def test_a_killed_commands_unpack_folder_is_removed_by_the_next_one(tmp_path):
     no_traceback(done)
     assert done.returncode == 0, output(done)
     assert sorted(shared.iterdir()) == [other, live]
+
+
+def test_a_root_being_made_is_not_taken_for_an_abandoned_one(tmp_path, monkeypatch):
+    """Another command's clean-up that runs while this one makes its folder of unpacked FMUs (between
+    the owner file's creation and its lock, when that file is free to lock) leaves it alone: the folder is
+    named a root only once it is locked."""
+    from fmutrace import _fmu
+
+    monkeypatch.delenv(_fmu.UNPACK_ROOT, raising=False)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    locking = _fmu._lock
+
+    def cleaned_first(file):
+        monkeypatch.setattr(_fmu, "_lock", locking)
+        _fmu._remove_abandoned()  # (as another command's start would, at this moment)
+        locking(file)
+
+    monkeypatch.setattr(_fmu, "_lock", cleaned_first)
+    root = _fmu.unpack_root()
+    try:
+        assert os.path.basename(root).startswith("fmutrace-") and os.path.isfile(os.path.join(root, _fmu.OWNER))
+        assert [p.name for p in tmp_path.iterdir()] == [os.path.basename(root)]
+        _fmu._remove_abandoned()  # and later, while this process lives
+        assert os.path.isdir(root)
+    finally:
+        _fmu._owned.pop().close()
+        shutil.rmtree(root, ignore_errors=True)
 
 
 def test_local_workers_leave_no_unpacked_fmu_behind(tmp_path):

@@ -7,6 +7,7 @@ import hashlib
 import io
 import math
 import os
+import secrets
 import shutil
 import stat
 import sys
@@ -218,13 +219,30 @@ def unpack_root() -> str:
     root = os.environ.get(UNPACK_ROOT)
     if not (root and os.path.isdir(root)):
         _remove_abandoned()
-        root = tempfile.mkdtemp(prefix="fmutrace-")
-        atexit.register(_remove, root, os.getpid())
-        if _lock is not None:
-            _owned.append(open(os.path.join(root, OWNER), "w"))
+        if _lock is None:
+            root = tempfile.mkdtemp(prefix="fmutrace-")
+        else:  # named a root only once its OWNER is locked: another command's clean-up never takes it for dead
+            making = tempfile.mkdtemp(prefix=".fmutrace-making-")
+            _owned.append(open(os.path.join(making, OWNER), "w"))
             _lock(_owned[-1])
+            root = _named_root(making)
+        atexit.register(_remove, root, os.getpid())
         os.environ[UNPACK_ROOT] = root
     return root
+
+
+def _named_root(making):
+    """The folder making renamed to a root's name (fmutrace-<random>) that no other file has."""
+    for _ in range(100):
+        root = os.path.join(os.path.dirname(making), f"fmutrace-{secrets.token_hex(8)}")
+        if os.path.lexists(root):
+            continue
+        try:
+            os.rename(making, root)
+        except OSError:  # (taken since: another name)
+            continue
+        return root
+    raise InputError(f"{os.path.dirname(making)}: no free name for a folder of unpacked FMUs")
 
 
 if sys.platform == "win32":
@@ -245,7 +263,7 @@ def _remove_abandoned():
         return
     temporary = tempfile.gettempdir()
     try:
-        names = [n for n in os.listdir(temporary) if n.startswith("fmutrace-")]
+        names = [n for n in os.listdir(temporary) if n.startswith("fmutrace-")]  # (not one being made)
     except OSError:
         return
     for name in names:
