@@ -571,31 +571,21 @@ fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
     return refuse_clock_call(instance, "fmi3GetShiftFraction", vr, nvr, NO_FRACTION);
 }
 
-fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                  const fmi3Float64 intervals[]) {
-    (void)intervals;
-    return refuse_clock_call(instance, "fmi3SetIntervalDecimal", vr, nvr, CLOCK_FOLLOWS_CYCLE);
-}
-
-fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                   const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
-    (void)counters;
-    (void)resolutions;
-    return refuse_clock_call(instance, "fmi3SetIntervalFraction", vr, nvr, CLOCK_FOLLOWS_CYCLE);
-}
-
-fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                               const fmi3Float64 shifts[]) {
-    (void)shifts;
-    return refuse_clock_call(instance, "fmi3SetShiftDecimal", vr, nvr, CLOCK_FOLLOWS_CYCLE);
-}
-
-fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                const fmi3UInt64 counters[], const fmi3UInt64 resolutions[]) {
-    (void)counters;
-    (void)resolutions;
-    return refuse_clock_call(instance, "fmi3SetShiftFraction", vr, nvr, CLOCK_FOLLOWS_CYCLE);
-}
+/* The Clock's setters, Interval and Shift, each Decimal and Fraction: its
+ * timing is cycleTime's. Their values are not read. */
+#define REFUSED_CLOCK_SETTERS(DECIMAL, FRACTION) \
+    fmi3Status DECIMAL(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[]) { \
+        (void)values; \
+        return refuse_clock_call(instance, #DECIMAL, vr, nvr, CLOCK_FOLLOWS_CYCLE); \
+    } \
+    fmi3Status FRACTION(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 counters[], \
+                        const fmi3UInt64 resolutions[]) { \
+        (void)counters; \
+        (void)resolutions; \
+        return refuse_clock_call(instance, #FRACTION, vr, nvr, CLOCK_FOLLOWS_CYCLE); \
+    }
+REFUSED_CLOCK_SETTERS(fmi3SetIntervalDecimal, fmi3SetIntervalFraction)
+REFUSED_CLOCK_SETTERS(fmi3SetShiftDecimal, fmi3SetShiftFraction)
 
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
     (void)values;

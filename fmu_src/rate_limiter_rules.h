@@ -409,13 +409,18 @@ static inline double RL_NAME(rl_dydt)(double y, double yp, double period) {
 }
 
 /* d2ydt2 = (dydt - dydt of the cycle before) / T; that dydt is
- * (yPrevious - yBefore) / periodBefore, 0 where it did not move. */
+ * (yPrevious - yBefore) / periodBefore, 0 where it did not move. 0 where
+ * that dydt, the change or the quotient is not finite: a jump of the
+ * output beyond the arithmetic's largest value times T^2 (REAL, T = 1 ms:
+ * 3.4e32) overflows the quotient although both dydt are finite. */
 static inline double RL_NAME(rl_d2ydt2)(double dydt, const RlState *s, double period) {
     const RL_NUM moved = RL_NAME(rl_sum)((RL_NUM)s->yPrevious, -(RL_NUM)s->yBefore);
     const RL_NUM before = moved == 0 ? 0 : RL_NAME(rl_quotient)(moved, RL_ENTER(s->periodBefore));
     if (!isfinite(before)) return 0.0;
     const RL_NUM change = RL_NAME(rl_sum)((RL_NUM)dydt, -before);
-    return isfinite(change) ? (double)RL_NAME(rl_quotient)(change, RL_ENTER(period)) : 0.0;
+    if (!isfinite(change)) return 0.0;
+    const RL_NUM d2ydt2 = RL_NAME(rl_quotient)(change, RL_ENTER(period));
+    return isfinite(d2ydt2) ? (double)d2ydt2 : 0.0;
 }
 
 /* the step from yp reached the (signed) limit: yp + limit is at or past y */

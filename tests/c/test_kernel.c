@@ -1290,6 +1290,49 @@ static void test_real_dydt(void) {
     CHECK_BITS(outputs(&b).dydt, 1.5625);
 }
 
+/* d2ydt2 after a duration jump of about the largest value times T^2
+ * (rules.md, Outputs derived from the last cycle): both dydt finite, the
+ * quotient (dydt - dydt') / T beyond the arithmetic's range, so 0; no
+ * floating-point exception on the way. Worked in powers of 2 (exact):
+ * T = 2^-10 s, rateUp = 2^(k+10) per s, so 2^k per cycle; u = 2^(k+20);
+ * the duration is 3 cycles. Cycle 1: y = 2^k, dydt = 2^(k+10), d2ydt2 =
+ * 2^(k+20) (finite: kept). Cycle 2: y = 2^(k+1), d2ydt2 = 0. Cycle 3
+ * jumps: y = 2^(k+20), dydt = 2^(k+30) - 2^(k+11), (dydt - 2^(k+10)) / T
+ * = 2^(k+40) - 3 * 2^(k+20): beyond the largest value for k = 90 (REAL,
+ * 2^128) and k = 990 (LREAL, 2^1024). Cycle 4 at rest: dydt = 0, (0 -
+ * dydt') / T = -(2^(k+40) - 2^(k+21)), beyond it too. */
+static void test_d2ydt2_overflow_is_0(void) {
+    static const struct {
+        bool real;
+        int k;
+    } cases[] = { { true, 90 }, { false, 990 } };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const int k = cases[i].k;
+        const double T = ldexp(1.0, -10);
+        RlConfig c = defaults();
+        c.real = cases[i].real;
+        c.rateUp.value = ldexp(1.0, k + 10);
+        c.duration.value = 3 * T;
+        Block b;
+        start(&b, &c, 0.0, T);
+        const double u = ldexp(1.0, k + 20);
+        feclearexcept(FE_ALL_EXCEPT);
+        CHECK_BITS(cycle(&b, u), ldexp(1.0, k));
+        CHECK_BITS(outputs(&b).dydt, ldexp(1.0, k + 10));
+        CHECK_BITS(outputs(&b).d2ydt2, ldexp(1.0, k + 20));
+        CHECK_BITS(cycle(&b, u), ldexp(1.0, k + 1));
+        CHECK_BITS(outputs(&b).d2ydt2, 0.0);
+        CHECK_BITS(cycle(&b, u), u);
+        CHECK_BITS(outputs(&b).dydt, ldexp(1.0, k + 30) - ldexp(1.0, k + 11));
+        CHECK_BITS(outputs(&b).d2ydt2, 0.0);
+        CHECK_BITS(cycle(&b, u), u);
+        CHECK_BITS(outputs(&b).dydt, 0.0);
+        CHECK_BITS(outputs(&b).d2ydt2, 0.0);
+        CHECK_EQ(fetestexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW), 0);
+        feclearexcept(FE_ALL_EXCEPT);
+    }
+}
+
 /* the same bits, or both NaN (an invalid operation's NaN has the
  * platform's sign) */
 #define CHECK_SAME(actual, expected) \
@@ -1506,6 +1549,7 @@ int main(void) {
     test_real_slow_ramp();
     test_real_entry_values();
     test_real_dydt();
+    test_d2ydt2_overflow_is_0();
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures ? 1 : 0;
 }

@@ -306,18 +306,24 @@ static void to_event(void *c, double t) {
     }
 }
 
-static void model_exchange_simulation(void) {
-    enum { CYCLES = 200 };
-    const double cycle = 0.01;
-    double expected[CYCLES];
+/* What Model Exchange and Scheduled Execution must give: Co-Simulation's
+ * y after each of n cycles of cycleTime = cycle, the inputs input(k, 2). */
+static void co_simulation_outputs(double cycle, int n, double expected[]) {
     void *cs = instantiate("reference");
     CHECK(cs != NULL && set_real(cs, cycleTimeVr, cycle) == 0 && start(cs));
-    for (int k = 0; k < CYCLES; k++) {
+    for (int k = 0; k < n; k++) {
         set_u(cs, input(k, 2));
         CHECK(step(cs, k * cycle, cycle) == 0);
         expected[k] = get_y(cs);
     }
     release(cs);
+}
+
+static void model_exchange_simulation(void) {
+    enum { CYCLES = 200 };
+    const double cycle = 0.01;
+    double expected[CYCLES];
+    co_simulation_outputs(cycle, CYCLES, expected);
 
     void *c = instantiate_model_exchange("model exchange");
     CHECK(c != NULL);
@@ -363,14 +369,7 @@ static void scheduled_execution_simulation(void) {
     enum { CYCLES = 200 };
     const double cycle = 0.01;
     double expected[CYCLES];
-    void *cs = instantiate("reference");
-    CHECK(cs != NULL && set_real(cs, cycleTimeVr, cycle) == 0 && start(cs));
-    for (int k = 0; k < CYCLES; k++) {
-        set_u(cs, input(k, 2));
-        CHECK(step(cs, k * cycle, cycle) == 0);
-        expected[k] = get_y(cs);
-    }
-    release(cs);
+    co_simulation_outputs(cycle, CYCLES, expected);
 
     void *c = F3(fmi3InstantiateScheduledExecution)("scheduled", token, NULL, fmi3False, fmi3False, NULL, log3_message,
                                                     NULL, lock_preemption, unlock_preemption);

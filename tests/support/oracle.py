@@ -413,14 +413,16 @@ class RateLimiterOracle:
         return total
 
     def d2ydt2(self, dydt):
-        """(dydt - the dydt of the cycle before) / T"""
+        """(dydt - the dydt of the cycle before) / T; 0 where the dydt before, the change or the quotient is not
+        finite (rules.md: a quotient of finite values overflows after a jump of about the largest value times T^2)"""
         real = self.real
         moved = real(self.yp - self.ypp)
         before = 0.0 if moved == 0 else real(divide(moved, real(self.T_before)))
         if not finite(before):
             return 0.0
         change = real(dydt - before)
-        return real(divide(change, real(self.T))) if finite(change) else 0.0
+        d2ydt2 = real(divide(change, real(self.T))) if finite(change) else 0.0
+        return d2ydt2 if finite(d2ydt2) else 0.0
 
     def planned_time(self, uc):
         """The block's own plan: rule 6's cycles ahead on a copy at the same
