@@ -30,24 +30,20 @@ import pytest
 import fmutrace
 from fmutrace import _lsref
 from support.fmu_driver import BUILD_DIR
+from support.pass_through import (  # noqa: F401  (commands_start_from_the_defaults: autouse here)
+    INPUT,
+    PASS_THROUGH,
+    REF,
+    commands_start_from_the_defaults,
+    output,
+    run_fmutrace,
+    write_case,
+)
 from support.process import kill_session
-from support.process import run as run_bounded
 
-PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi2" / "PassThrough.fmu"
 RATE_LIMITER = BUILD_DIR / "fmi3" / "RateLimiter.fmu"
-OPT = "StartTime,0\nStopTime,0.5\nStepSize,0.1\nRelTol,1e-6\n"
-INPUT = "time,u\n0,1\n0.2,3\n"
-REF = "time,y\n0,0\n0.1,1\n0.2,1\n0.3,3\n0.4,3\n0.5,3\n"
 GiB = 1 << 30
 MEMORY_CAP = 3 * GiB  # the issue's: each memory attack ends with a named refusal inside it
-
-
-@pytest.fixture(autouse=True)
-def own_unpack_root(monkeypatch):
-    """Each command makes its own folder for unpacked FMUs (not the one an
-    in-process campaign of this test process made)."""
-    monkeypatch.delenv("FMUTRACE_UNPACK_ROOT", raising=False)
-    monkeypatch.delenv("FMUTRACE_READ_LIMIT", raising=False)
 
 
 def capped():
@@ -59,17 +55,7 @@ def capped():
 
 def fmutrace_command(*args, env=None, timeout=300, cap=True, preexec_fn=None):
     """The command, as users start it, in a process of its own (under the memory cap)."""
-    return run_bounded(
-        [sys.executable, "-m", "fmutrace", *map(os.fsdecode, args)],
-        timeout=timeout,
-        what="fmutrace " + " ".join(map(os.fsdecode, args[:2])),
-        env=env,
-        preexec_fn=preexec_fn or (capped if cap else None),
-    )
-
-
-def output(done):
-    return done.stdout + done.stderr
+    return run_fmutrace(*args, env=env, timeout=timeout, preexec_fn=preexec_fn or (capped if cap else None))
 
 
 def refused(done, *phrases, status=2):
@@ -81,14 +67,6 @@ def refused(done, *phrases, status=2):
     for phrase in phrases:
         assert phrase in done.stderr, done.stderr[-3000:]
     assert len(done.stderr) < 4000, f"a message of {len(done.stderr)} characters"
-
-
-def write_case(folder, ref=REF):
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    for name, text in (("PassThrough_ref.csv", ref), ("PassThrough_in.csv", INPUT), ("PassThrough_ref.opt", OPT)):
-        (folder / name).write_text(text)
-    return folder
 
 
 def sparse(path, size):
