@@ -119,6 +119,7 @@ def test_a_long_line_is_quoted_by_its_first_characters(tmp_path):
     refused(done, f"found {'x' * 60!r}... (1,000,000 characters)")
 
 
+@pytest.mark.slow
 def test_the_read_bound_is_raised_and_lowered_by_one_setting(tmp_path):
     """FMUTRACE_READ_LIMIT: 100M refuses a 300 MB _start.csv by its size;
     1G lets a 900 MB reference be read (refused at its first line instead
