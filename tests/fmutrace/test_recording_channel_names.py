@@ -120,7 +120,7 @@ def test_a_bad_cell_of_a_same_named_column_names_its_file_line_and_column(tmp_pa
     assert "'1.0.0'" in str(error.value) and SHARED in str(error.value)
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("version", [pytest.param(2, marks=pytest.mark.slow), 3])
 def test_the_modbusscope_sample_compares_its_chosen_column_exactly(version, tmp_path):
     """End to end: y is the column that holds y (3); the raw count in column 2 fails at cycle 1. The
     file is read in blocks (streamed), whose columns are found by the channels' names."""
