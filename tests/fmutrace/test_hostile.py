@@ -4,8 +4,7 @@ the user did not give, nothing written outside the report folder, names
 shown as text, a damaged journal refused, every failure an exit status of
 the documented table with one line of message and no traceback.
 
-The FMU is the PassThrough fixture: y(t + h) = u(t), y = 0 before the
-first step; its cases are worked by hand from that equation."""
+Its FMU is PassThrough, its case worked by hand (support/pass_through.py)."""
 
 import json
 import os
@@ -30,6 +29,7 @@ from support.pass_through import (  # noqa: F401  (commands_start_from_the_defau
     REF,
     commands_start_from_the_defaults,
     output,
+    signalled_campaign,
     write_case,
 )
 from support.pass_through import run_fmutrace as fmutrace
@@ -585,26 +585,7 @@ def test_ctrl_c_ends_the_command_with_130_and_one_line(tmp_path):
         (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.csv").write_text("time,y\n0,0\n1000000,1\n")
         (tmp_path / "cases" / f"c{n}" / "PassThrough_in.csv").write_text("time,u\n0,1\n")
         (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.opt").write_text(slow)
-    report = tmp_path / "report"
-    out, err = open(tmp_path / "out", "w+"), open(tmp_path / "err", "w+")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "fmutrace", "compare", str(PASS_THROUGH), str(tmp_path / "cases"), "--report",
-         str(report), "--plots", "none"],
-        stdout=out, stderr=err, start_new_session=True,
-    )  # fmt: skip
-    try:
-        deadline = time.monotonic() + 120
-        while not (report / "results.jsonl").exists() and time.monotonic() < deadline:
-            assert process.poll() is None, "the campaign ended before it was interrupted"
-            time.sleep(0.1)
-        time.sleep(0.5)
-        process.send_signal(signal.SIGINT)
-        code = process.wait(timeout=60)
-    finally:
-        kill_session(process)
-    out.seek(0)
-    err.seek(0)
-    stdout, stderr = out.read(), err.read()
+    code, stdout, stderr = signalled_campaign(tmp_path / "cases", tmp_path / "report", signal.SIGINT)
     assert "Traceback" not in stdout + stderr, stdout + stderr
     assert code == 130, stdout + stderr
     assert len(stderr.strip().splitlines()) == 1, stderr

@@ -8,8 +8,8 @@ the memory attacks under a cap of 3 GiB of address space, on sparse files
 that take no disk) and ends with a named refusal: no traceback, nothing
 written outside, no case dropped from the counts.
 
-The FMU is the PassThrough fixture: y(t + h) = u(t), y = 0 before the
-first step; its cases are worked by hand from that equation."""
+The FMU is the PassThrough fixture, its case worked by hand
+(support/pass_through.py)."""
 
 import hashlib
 import json
@@ -37,6 +37,7 @@ from support.pass_through import (  # noqa: F401  (commands_start_from_the_defau
     commands_start_from_the_defaults,
     output,
     run_fmutrace,
+    signalled_campaign,
     write_case,
 )
 from support.process import kill_session
@@ -513,24 +514,7 @@ def test_sigterm_ends_the_command_with_a_line(tmp_path):
     case = write_case(tmp_path / "cases" / "slow")
     (case / "PassThrough_ref.opt").write_text(slow)
     report = tmp_path / "report"
-    out, err = open(tmp_path / "out", "w+"), open(tmp_path / "err", "w+")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "fmutrace", "compare", str(PASS_THROUGH), str(tmp_path / "cases"), "--report",
-         str(report), "--plots", "none"],
-        stdout=out, stderr=err, start_new_session=True,
-    )  # fmt: skip
-    try:
-        deadline = time.monotonic() + 120
-        while not (report / "results.jsonl").exists() and time.monotonic() < deadline:
-            assert process.poll() is None, "the campaign ended before it was stopped"
-            time.sleep(0.1)
-        time.sleep(0.5)
-        process.send_signal(signal.SIGTERM)
-        code = process.wait(timeout=60)
-    finally:
-        kill_session(process)
-    err.seek(0)
-    stderr = err.read()
+    code, _, stderr = signalled_campaign(tmp_path / "cases", report, signal.SIGTERM)
     assert "Traceback" not in stderr, stderr
     assert code == 143, stderr
     assert stderr.strip().splitlines() == [

@@ -3,11 +3,15 @@ y(t + h) = u(t), y = 0 before the first step, and fmutrace's command as
 users start it: what the tests of hostile and careless use attack."""
 
 import os
+import subprocess
 import sys
+import tempfile
+import time
 
 import pytest
 
 from support.fmu_driver import BUILD_DIR
+from support.process import kill_session
 from support.process import run as run_bounded
 
 PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi2" / "PassThrough.fmu"
@@ -53,3 +57,28 @@ def write_case(folder, readme=None, ref=REF):
         with open(os.path.join(folder, b"README.md" if isinstance(folder, bytes) else "README.md"), "w") as file:
             file.write(readme)
     return folder
+
+
+def signalled_campaign(cases, report, signum):
+    """fmutrace compare of PassThrough on the folder cases into report, in
+    a session of its own, sent signum half a second after its journal
+    begins (within 120 s): its exit status, standard output and error."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "fmutrace", "compare", str(PASS_THROUGH), str(cases), "--report", str(report),
+             "--plots", "none"],
+            stdout=out, stderr=err, start_new_session=True,
+        )  # fmt: skip
+        try:
+            deadline = time.monotonic() + 120
+            while not (report / "results.jsonl").exists() and time.monotonic() < deadline:
+                assert process.poll() is None, "the campaign ended before the signal"
+                time.sleep(0.1)
+            time.sleep(0.5)
+            process.send_signal(signum)
+            code = process.wait(timeout=60)
+        finally:
+            kill_session(process)
+        out.seek(0)
+        err.seek(0)
+        return code, out.read(), err.read()
