@@ -109,6 +109,7 @@ def test_the_fmus_from_the_ini_file_and_a_recording_named(pytester):
     result.stdout.fnmatch_lines(["twincat_siemens.csv::twincat_siemens[[]LGF_LimRateOfChangeCI-fmi3[]] PASSED*"])
 
 
+@pytest.mark.slow
 def test_without_fmus_the_plugin_collects_nothing(pytester):
     root = cases(pytester)
     result = pytester.runpytest_subprocess(root)
