@@ -49,7 +49,7 @@ def report(scenario, found):
     return "\n".join([str(v) for v in found[:10]] + ["scenario: " + scenario.dumps()])
 
 
-# the random tests' models, FMI versions and arithmetics: the fast lane draws on two, which between
+# the random tests' models, FMI versions and arithmetic types: the fast lane draws on two, which between
 # them take each model, each version and each arithmetic; the slow lane on the other six
 FAST_DRAWS = {("RateLimiter", 3, LREAL), ("RateLimiterStatic", 2, REAL)}
 DRAWS = [
