@@ -49,6 +49,22 @@ def report(scenario, found):
     return "\n".join([str(v) for v in found[:10]] + ["scenario: " + scenario.dumps()])
 
 
+# the random tests' models, FMI versions and arithmetic types: the fast lane draws on two, which between
+# them take each model, each version and each arithmetic; the slow lane on the other six
+FAST_DRAWS = {("RateLimiter", 3, LREAL), ("RateLimiterStatic", 2, REAL)}
+DRAWS = [
+    pytest.param(
+        model,
+        version,
+        arithmetic,
+        id=f"{model}-{version}-{'LREAL' if arithmetic == LREAL else 'REAL'}",
+        marks=[] if (model, version, arithmetic) in FAST_DRAWS else [pytest.mark.slow],
+    )
+    for model in MODELS
+    for version in (2, 3)
+    for arithmetic in (LREAL, REAL)
+]
+
 # scenarios the random tests once failed on, as they printed them: every run replays them
 REGRESSIONS = sorted((Path(__file__).parent / "accel_regressions").glob("*.json"))
 
@@ -61,9 +77,7 @@ def test_scenarios_once_failed_hold_every_property(path, model_exchange):
     assert not found, report(scenario, found)
 
 
-@pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
-@pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("model,version,arithmetic", DRAWS)
 @settings(max_examples=40, deadline=None, suppress_health_check=HEALTH, phases=NO_SHRINK)
 @given(data=st.data())
 def test_every_property_holds_on_random_scenarios(model, version, arithmetic, data):
@@ -72,9 +86,7 @@ def test_every_property_holds_on_random_scenarios(model, version, arithmetic, da
     assert not found, report(scenario, found)
 
 
-@pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
-@pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("model,version,arithmetic", DRAWS)
 @settings(max_examples=20, deadline=None, suppress_health_check=HEALTH, phases=NO_SHRINK)
 @given(data=st.data())
 def test_model_exchange_gives_the_co_simulation_outputs_and_the_properties(model, version, arithmetic, data):
@@ -134,9 +146,7 @@ def run_against_oracle(scenario):
         fmu.free()
 
 
-@pytest.mark.parametrize("arithmetic", [LREAL, REAL], ids=["LREAL", "REAL"])
-@pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("model,version,arithmetic", DRAWS)
 @settings(max_examples=30, deadline=None, suppress_health_check=HEALTH, phases=NO_SHRINK)
 @given(data=st.data())
 def test_accel_max_zero_is_the_block_without_the_acceleration_limit(model, version, arithmetic, data):

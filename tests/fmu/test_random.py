@@ -348,8 +348,16 @@ def test_steps_that_end_no_cycle_change_no_output(version, skipped):
     )
 
 
-@pytest.mark.parametrize("version", [2, 3])
-@pytest.mark.parametrize("arithmetic", [LREAL, REAL])
+# the fast lane draws on FMI 3 in LREAL and FMI 2 in REAL, the slow lane on the other two
+@pytest.mark.parametrize(
+    "version,arithmetic",
+    [
+        (3, LREAL),
+        (2, REAL),
+        pytest.param(2, LREAL, marks=pytest.mark.slow),
+        pytest.param(3, REAL, marks=pytest.mark.slow),
+    ],
+)
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(start=parameters, run=steps, skipped=st.sets(st.integers(0, 39)), start_time=start_times)
 def test_rate_limiter_agrees_with_oracle(version, arithmetic, start, run, skipped, start_time):
@@ -392,7 +400,7 @@ def test_vendor_model_agrees_with_oracle_in_model_exchange(model, version, data)
     run_vendor_model(model, version, data, model_exchange=True)
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("version", [pytest.param(2, marks=pytest.mark.slow), 3])  # FMI 2: the slow lane
 @pytest.mark.parametrize("model", [m for m in MODELS if m != "RateLimiter"])
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())

@@ -62,7 +62,8 @@ DIALECTS = {
 }
 
 
-@pytest.mark.parametrize("version", [2, 3])
+# every dialect on FMI 3 in the fast lane, on FMI 2 in the slow lane
+@pytest.mark.parametrize("version", [pytest.param(2, marks=pytest.mark.slow), 3])
 @pytest.mark.parametrize("dialect", DIALECTS)
 def test_each_csv_dialect_on_a_foreign_fmu(dialect, version, tmp_path):
     write_case(tmp_path / "step", "PassThrough", STEP_REF, DIALECTS[dialect], STEP_OPT)
@@ -163,7 +164,7 @@ def lag_case(folder, transform=lambda t, x: x, start=None):
     return write_case(folder, "FirstOrderLag", ref, inputs, LAG_OPT, start)
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("version", [pytest.param(2, marks=pytest.mark.slow), 3])
 def test_exact_mode_passes_bit_for_bit_and_fails_on_one_ulp(version, tmp_path):
     lag_case(tmp_path / "lag")
     assert fmutrace_cli("compare", LAG[version], tmp_path).returncode == 0
@@ -573,6 +574,7 @@ def readme_example():
     return block.group(1)
 
 
+@pytest.mark.slow
 def test_the_readme_pytest_example_runs(tmp_path):
     """The example as a user copies it into a test file; 'build/' is this
     run's build folder."""

@@ -117,6 +117,7 @@ def test_a_killed_client_resumes_without_recomputing(tmp_path):
     assert code == 0 and "on the journal" in out  # all done: nothing runs
 
 
+@pytest.mark.slow
 def test_without_options_the_command_plots_only_the_failing_cases_beyond_500(tmp_path):
     """The command's default is the documented one: a plot and a result CSV
     for every case up to 500 (test_fmutrace.py's report test: every case
@@ -340,7 +341,7 @@ def test_a_case_whose_process_is_killed_once_runs_again_and_passes(jobs, killed_
     assert (RAN_AGAIN + KILLED).replace("'", "&#x27;") in (report / "index.html").read_text()
 
 
-@pytest.mark.parametrize("jobs", [1, 2])
+@pytest.mark.parametrize("jobs", [pytest.param(1, marks=pytest.mark.slow), 2])
 def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     """The hanging case is stopped once its timeout has passed (not before),
     the campaign goes on to the cases after it, and the command ends (finish
@@ -359,6 +360,7 @@ def test_a_case_that_hangs_is_stopped_after_the_timeout(jobs, tmp_path):
     assert results["case_17"]["status"] == "error" and results["case_17"]["seconds"] >= 3
 
 
+@pytest.mark.slow
 def test_spawned_workers_give_what_this_process_gives(tmp_path, monkeypatch):
     """Where a worker cannot be forked (another thread runs, or not Linux) it
     is a new Python: the same outcomes as in this process, the crashing case
@@ -381,7 +383,7 @@ def test_spawned_workers_give_what_this_process_gives(tmp_path, monkeypatch):
     ]
 
 
-@pytest.mark.parametrize("plots,count,workers", [("none", 6, 1), ("png", 24, 2)])
+@pytest.mark.parametrize("plots,count,workers", [("none", 6, 1), pytest.param("png", 24, 2, marks=pytest.mark.slow)])
 def test_the_default_starts_the_workers_the_work_pays_for(plots, count, workers, tmp_path):
     """By default a second worker starts only when the work left pays for
     its start-up, measured: 6 cases of a millisecond or so run in one (a
@@ -429,6 +431,7 @@ def windows_code_path(monkeypatch):
     monkeypatch.delattr(os, "set_blocking")
 
 
+@pytest.mark.slow
 def test_the_windows_code_path_runs_a_campaign_with_a_worker_killed_from_outside(killed_once, tmp_path, monkeypatch):
     """A campaign of 300 cases on spawned workers waited on portably, one
     worker killed with SIGKILL from outside in the middle and the fixture's

@@ -145,6 +145,7 @@ def value_of(name):
     return st.one_of(st.sampled_from([0.0, -1.0, 10.0, math.nan, math.inf]), st.floats(-100, 100))
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
 @given(trace=random_traces(), version=st.sampled_from([2, 3]))
 def test_random_traces_bit_for_bit(trace, version):
@@ -153,6 +154,7 @@ def test_random_traces_bit_for_bit(trace, version):
     assert same_bits(fast, plain)
 
 
+@pytest.mark.slow
 def test_random_traces_take_the_fast_loop_mostly():
     """The property test above is not vacuous: most of its traces run the
     fast loop, some fmpy's (derandomized: the same traces on every run)."""
@@ -506,6 +508,7 @@ FINITE_REPRS = st.floats(allow_nan=False, allow_infinity=False).map(repr)
 DECIMALS = st.from_regex(r"\A[+-]?([0-9]{1,25}(\.[0-9]{0,25})?|\.[0-9]{1,25})([eE][+-]?[0-9]{1,3})?\Z")
 
 
+@pytest.mark.slow
 @settings(max_examples=2000, deadline=None)
 @given(texts=st.lists(st.one_of(DECIMALS, FINITE_REPRS), min_size=1, max_size=6))
 def test_the_row_reader_in_c_reads_every_decimal_as_python_does(texts):

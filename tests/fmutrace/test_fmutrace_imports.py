@@ -220,20 +220,28 @@ def test_import_fmutrace_loads_no_heavy_package_and_no_posix_module():
     assert not [m for m in loaded if m.split(".")[0] in POSIX_ONLY and m.startswith("fmutrace")]
 
 
+PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
+
+
+def step_case(case):
+    """A PassThrough case in the folder case: u steps from 0 to 1 at 0.2,
+    y follows one step later (y(t + h) = u(t))."""
+    case.mkdir(parents=True)
+    (case / "PassThrough_in.csv").write_text("time,u\n0,0\n0.2,1\n")
+    (case / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,1\n0.4,1\n")
+    (case / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
+    return case
+
+
 def test_a_campaign_of_plain_cases_loads_no_heavy_package(tmp_path):
     """pandas (which pyarrow's to_numpy, pa.array and pa.table import where it
     is installed) costs a short campaign a third of a second in every
     process; matplotlib is loaded for a PNG only. Read, run, compared, its
     result file and plot data written."""
-    case = tmp_path / "cases" / "step"
-    case.mkdir(parents=True)
-    (case / "PassThrough_in.csv").write_text("time,u\n0,0\n0.2,1\n")
-    (case / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,1\n0.4,1\n")
-    (case / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
-    fmu = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
+    step_case(tmp_path / "cases" / "step")
     loaded = run_python(
         "import sys, fmutrace\n"
-        f"c = fmutrace.compare({str(fmu)!r}, {str(tmp_path / 'cases')!r}, plots='all', "
+        f"c = fmutrace.compare({str(PASS_THROUGH)!r}, {str(tmp_path / 'cases')!r}, plots='all', "
         f"report={str(tmp_path / 'report')!r}, run=fmutrace.RunOptions(jobs=1))\n"
         "assert c.passed, c.summary()\n"
         "print(' '.join(sorted(sys.modules)))"
@@ -327,16 +335,9 @@ def test_a_command_that_needs_a_missing_extra_names_its_pip_install_line(module,
         import samples  # (the generator beside the recordings: asammdf's own writer)
     finally:
         sys.path.pop(0)
-    case = tmp_path / "cases" / "step"
-    case.mkdir(parents=True)
-    (case / "PassThrough_in.csv").write_text("time,u\n0,0\n0.2,1\n")
-    (case / "PassThrough_ref.csv").write_text("time,y\n0,0\n0.1,0\n0.2,0\n0.3,1\n0.4,1\n")
-    (case / "PassThrough_ref.opt").write_text("StartTime,0\nStopTime,0.4\nStepSize,0.1\n")
-    fmu = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
-    given = [str(fmu), str(case)]
+    given = [str(PASS_THROUGH), str(step_case(tmp_path / "cases" / "step"))]
     if module == "asammdf":
-        fmu = BUILD_DIR / "fmi3" / "LGF_LimRateOfChangeCI.fmu"
-        given = [str(fmu), str(samples.write_mdf(tmp_path / "ramp.mf4"))]
+        given = [str(BUILD_DIR / "fmi3" / "LGF_LimRateOfChangeCI.fmu"), str(samples.write_mdf(tmp_path / "ramp.mf4"))]
     command = ["compare", *given, *(a.format(tmp=tmp_path) for a in args)]
     done = subprocess.run(
         [sys.executable, "-c", WITHOUT.format(module=module) + f"sys.exit(cli.main({command!r}))"],

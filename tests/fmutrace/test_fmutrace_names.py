@@ -5,20 +5,20 @@ Tube(time=..., value=...), the command's user --step-size or --tube-time
 module but the command's writes a flag into a message."""
 
 import ast
+import contextlib
+import io
 import re
-import sys
 from pathlib import Path
 
 import pytest
 
 import fmutrace
+from fmutrace import cli
 from fmutrace._names import name_of
 from fmutrace.cli import FLAGS
 from support.fmu_driver import BUILD_DIR
-from support.process import run as run_bounded
 
 PACKAGE = Path(__file__).resolve().parents[2] / "fmutrace" / "src" / "fmutrace"
-FMUTRACE = Path(sys.executable).parent / "fmutrace"
 SIEMENS = BUILD_DIR / "fmi3" / "LGF_LimRateOfChangeCI.fmu"
 PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"
 RECORDINGS = Path(__file__).parents[1] / "recordings"
@@ -106,8 +106,16 @@ def test_the_callers_words_are_no_setting():
 
 
 def command(*args):
-    done = run_bounded([str(FMUTRACE), "compare", *map(str, args)], timeout=600, what="fmutrace compare")
-    return done.stdout + done.stderr
+    """What the command fmutrace compare args prints: its entry point
+    (fmutrace.cli:main) run in this process, which spares each message a
+    second interpreter's start-up."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            cli.main(["compare", *map(str, args)], out=out)
+        except SystemExit:  # argparse's usage errors end the command
+            pass
+    return out.getvalue() + err.getvalue()
 
 
 def in_python(fmu, path, **options):

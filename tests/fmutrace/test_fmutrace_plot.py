@@ -80,6 +80,7 @@ def pixels(png: bytes):
     return imread(io.BytesIO(png), format="png")
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:No artists with labels found")
 def test_a_reused_layout_draws_what_a_new_figure_draws():
     plot._layouts().clear()
@@ -96,6 +97,7 @@ def test_a_reused_layout_draws_what_a_new_figure_draws():
     assert reused_layouts == 5
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:No artists with labels found")
 def test_the_cases_above_are_different_pictures():
     """The comparison above could fail: each case draws its own picture,

@@ -58,7 +58,8 @@ EVERY_CYCLE = [
 ]
 
 
-@pytest.mark.parametrize("version", [2, 3])
+# every format on FMI 3 in the fast lane, on FMI 2 in the slow lane
+@pytest.mark.parametrize("version", [pytest.param(2, marks=pytest.mark.slow), 3])
 @pytest.mark.parametrize("name, fmus, options, label", EVERY_CYCLE, ids=[e[0] for e in EVERY_CYCLE])
 def test_every_cycle_recordings_pass_exactly(name, fmus, options, label, version):
     done = compare(fmus[version], SAMPLES / name, *options)

@@ -4,8 +4,7 @@ the user did not give, nothing written outside the report folder, names
 shown as text, a damaged journal refused, every failure an exit status of
 the documented table with one line of message and no traceback.
 
-The FMU is the PassThrough fixture: y(t + h) = u(t), y = 0 before the
-first step; its cases are worked by hand from that equation."""
+Its FMU is PassThrough, its case worked by hand (support/pass_through.py)."""
 
 import json
 import os
@@ -25,52 +24,25 @@ import pytest
 
 from fmutrace import RunOptions, _report, compare
 from support.fmu_driver import BUILD_DIR
+from support.pass_through import (  # noqa: F401  (commands_start_from_the_defaults: autouse here)
+    INPUT,
+    OPT,
+    PASS_THROUGH,
+    REF,
+    commands_start_from_the_defaults,
+    output,
+    signalled_campaign,
+    write_case,
+)
+from support.pass_through import run_fmutrace as fmutrace
 from support.process import kill_session
 from support.process import run as run_bounded
 
-PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi2" / "PassThrough.fmu"
 RAMP = BUILD_DIR / "fmi3" / "Ramp.fmu"
-# PassThrough on h = 0.1: u is 1 up to 0.2 and 3 from then on
-OPT = "StartTime,0\nStopTime,0.5\nStepSize,0.1\nRelTol,1e-6\n"
-INPUT = "time,u\n0,1\n0.2,3\n"
-REF = "time,y\n0,0\n0.1,1\n0.2,1\n0.3,3\n0.4,3\n0.5,3\n"
-
-
-@pytest.fixture(autouse=True)
-def own_unpack_root(monkeypatch):
-    """Each command here makes its own folder for unpacked FMUs: not the one
-    an in-process campaign of this test process made (its children inherit it)."""
-    monkeypatch.delenv("FMUTRACE_UNPACK_ROOT", raising=False)
-
-
-def fmutrace(*args, env=None, timeout=300):
-    """The command, as users start it, in a process of its own."""
-    return run_bounded(
-        [sys.executable, "-m", "fmutrace", *map(os.fsdecode, args)],
-        timeout=timeout,
-        what="fmutrace " + " ".join(map(os.fsdecode, args[:2])),
-        env=env,
-    )
-
-
-def output(done):
-    return done.stdout + done.stderr
 
 
 def no_traceback(done):
     assert "Traceback" not in output(done), output(done)
-
-
-def write_case(folder, readme=None, ref=REF):
-    """A PassThrough case in folder (str or bytes: a name that is not UTF-8)."""
-    os.makedirs(folder, exist_ok=True)
-    for name, text in (("PassThrough_ref.csv", ref), ("PassThrough_in.csv", INPUT), ("PassThrough_ref.opt", OPT)):
-        with open(os.path.join(folder, os.fsencode(name) if isinstance(folder, bytes) else name), "w") as file:
-            file.write(text)
-    if readme is not None:
-        with open(os.path.join(folder, b"README.md" if isinstance(folder, bytes) else "README.md"), "w") as file:
-            file.write(readme)
-    return folder
 
 
 def files_under(folder):
@@ -660,26 +632,7 @@ def test_ctrl_c_ends_the_command_with_130_and_one_line(tmp_path):
         (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.csv").write_text("time,y\n0,0\n1000000,1\n")
         (tmp_path / "cases" / f"c{n}" / "PassThrough_in.csv").write_text("time,u\n0,1\n")
         (tmp_path / "cases" / f"c{n}" / "PassThrough_ref.opt").write_text(slow)
-    report = tmp_path / "report"
-    out, err = open(tmp_path / "out", "w+"), open(tmp_path / "err", "w+")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "fmutrace", "compare", str(PASS_THROUGH), str(tmp_path / "cases"), "--report",
-         str(report), "--plots", "none"],
-        stdout=out, stderr=err, start_new_session=True,
-    )  # fmt: skip
-    try:
-        deadline = time.monotonic() + 120
-        while not (report / "results.jsonl").exists() and time.monotonic() < deadline:
-            assert process.poll() is None, "the campaign ended before it was interrupted"
-            time.sleep(0.1)
-        time.sleep(0.5)
-        process.send_signal(signal.SIGINT)
-        code = process.wait(timeout=60)
-    finally:
-        kill_session(process)
-    out.seek(0)
-    err.seek(0)
-    stdout, stderr = out.read(), err.read()
+    code, stdout, stderr = signalled_campaign(tmp_path / "cases", tmp_path / "report", signal.SIGINT)
     assert "Traceback" not in stdout + stderr, stdout + stderr
     assert code == 130, stdout + stderr
     assert len(stderr.strip().splitlines()) == 1, stderr

@@ -8,8 +8,8 @@ the memory attacks under a cap of 3 GiB of address space, on sparse files
 that take no disk) and ends with a named refusal: no traceback, nothing
 written outside, no case dropped from the counts.
 
-The FMU is the PassThrough fixture: y(t + h) = u(t), y = 0 before the
-first step; its cases are worked by hand from that equation."""
+The FMU is the PassThrough fixture, its case worked by hand
+(support/pass_through.py)."""
 
 import hashlib
 import json
@@ -30,24 +30,21 @@ import pytest
 import fmutrace
 from fmutrace import _lsref
 from support.fmu_driver import BUILD_DIR
+from support.pass_through import (  # noqa: F401  (commands_start_from_the_defaults: autouse here)
+    INPUT,
+    PASS_THROUGH,
+    REF,
+    commands_start_from_the_defaults,
+    output,
+    run_fmutrace,
+    signalled_campaign,
+    write_case,
+)
 from support.process import kill_session
-from support.process import run as run_bounded
 
-PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi2" / "PassThrough.fmu"
 RATE_LIMITER = BUILD_DIR / "fmi3" / "RateLimiter.fmu"
-OPT = "StartTime,0\nStopTime,0.5\nStepSize,0.1\nRelTol,1e-6\n"
-INPUT = "time,u\n0,1\n0.2,3\n"
-REF = "time,y\n0,0\n0.1,1\n0.2,1\n0.3,3\n0.4,3\n0.5,3\n"
 GiB = 1 << 30
 MEMORY_CAP = 3 * GiB  # the issue's: each memory attack ends with a named refusal inside it
-
-
-@pytest.fixture(autouse=True)
-def own_unpack_root(monkeypatch):
-    """Each command makes its own folder for unpacked FMUs (not the one an
-    in-process campaign of this test process made)."""
-    monkeypatch.delenv("FMUTRACE_UNPACK_ROOT", raising=False)
-    monkeypatch.delenv("FMUTRACE_READ_LIMIT", raising=False)
 
 
 def capped():
@@ -59,17 +56,7 @@ def capped():
 
 def fmutrace_command(*args, env=None, timeout=300, cap=True, preexec_fn=None):
     """The command, as users start it, in a process of its own (under the memory cap)."""
-    return run_bounded(
-        [sys.executable, "-m", "fmutrace", *map(os.fsdecode, args)],
-        timeout=timeout,
-        what="fmutrace " + " ".join(map(os.fsdecode, args[:2])),
-        env=env,
-        preexec_fn=preexec_fn or (capped if cap else None),
-    )
-
-
-def output(done):
-    return done.stdout + done.stderr
+    return run_fmutrace(*args, env=env, timeout=timeout, preexec_fn=preexec_fn or (capped if cap else None))
 
 
 def refused(done, *phrases, status=2):
@@ -81,14 +68,6 @@ def refused(done, *phrases, status=2):
     for phrase in phrases:
         assert phrase in done.stderr, done.stderr[-3000:]
     assert len(done.stderr) < 4000, f"a message of {len(done.stderr)} characters"
-
-
-def write_case(folder, ref=REF):
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    for name, text in (("PassThrough_ref.csv", ref), ("PassThrough_in.csv", INPUT), ("PassThrough_ref.opt", OPT)):
-        (folder / name).write_text(text)
-    return folder
 
 
 def sparse(path, size):
@@ -141,6 +120,7 @@ def test_a_long_line_is_quoted_by_its_first_characters(tmp_path):
     refused(done, f"found {'x' * 60!r}... (1,000,000 characters)")
 
 
+@pytest.mark.slow
 def test_the_read_bound_is_raised_and_lowered_by_one_setting(tmp_path):
     """FMUTRACE_READ_LIMIT: 100M refuses a 300 MB _start.csv by its size;
     1G lets a 900 MB reference be read (refused at its first line instead
@@ -534,24 +514,7 @@ def test_sigterm_ends_the_command_with_a_line(tmp_path):
     case = write_case(tmp_path / "cases" / "slow")
     (case / "PassThrough_ref.opt").write_text(slow)
     report = tmp_path / "report"
-    out, err = open(tmp_path / "out", "w+"), open(tmp_path / "err", "w+")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "fmutrace", "compare", str(PASS_THROUGH), str(tmp_path / "cases"), "--report",
-         str(report), "--plots", "none"],
-        stdout=out, stderr=err, start_new_session=True,
-    )  # fmt: skip
-    try:
-        deadline = time.monotonic() + 120
-        while not (report / "results.jsonl").exists() and time.monotonic() < deadline:
-            assert process.poll() is None, "the campaign ended before it was stopped"
-            time.sleep(0.1)
-        time.sleep(0.5)
-        process.send_signal(signal.SIGTERM)
-        code = process.wait(timeout=60)
-    finally:
-        kill_session(process)
-    err.seek(0)
-    stderr = err.read()
+    code, _, stderr = signalled_campaign(tmp_path / "cases", report, signal.SIGTERM)
     assert "Traceback" not in stderr, stderr
     assert code == 143, stderr
     assert stderr.strip().splitlines() == [

@@ -47,7 +47,12 @@ def same(whole, long):
     assert [d.to_json() for d in long.deviations] == [d.to_json() for d in deviations]
 
 
-@pytest.mark.parametrize("mode", TUBES, ids=["narrow", "few-steps", "wide"])
+# the narrow tube in the fast lane (the varied references below take all three there)
+@pytest.mark.parametrize(
+    "mode",
+    [TUBES[0], pytest.param(TUBES[1], marks=pytest.mark.slow), pytest.param(TUBES[2], marks=pytest.mark.slow)],
+    ids=["narrow", "few-steps", "wide"],
+)
 def test_every_reference_scenario_in_a_tube_chunked_as_in_memory(mode):
     for folder in FOLDERS:  # single input rows and inputs between communication points (fmpy's loop) too
         whole, long = outcomes(folder, folder.parent.name, mode, 1, 8)
@@ -192,7 +197,9 @@ def tube_bounds_one_by_one(reference_time, reference_values, times, widths, span
     return lower, upper
 
 
-@pytest.mark.parametrize("seed", range(12))
+# seeds 0, 4 and 8 draw references longer than two sparse tables (QUERIES);
+# 8 keeps them in the fast lane, 0 and 4 run in the slow lane
+@pytest.mark.parametrize("seed", [pytest.param(s, marks=pytest.mark.slow) if s in (0, 4) else s for s in range(12)])
 def test_the_tubes_bounds_at_once_are_the_bounds_one_sample_at_a_time(seed):
     """Random references (repeated times, NaN samples, steps of several
     sizes), the result's times on and off them, tubes from none to wider

@@ -47,6 +47,7 @@ def test_pytest_is_no_dependency_of_fmutrace_and_the_plugin_its_entry_point():
     assert project["entry-points"]["pytest11"] == {"fmutrace": "fmutrace.pytest_plugin"}
 
 
+@pytest.mark.slow
 def test_the_reference_scenarios_are_items_named_by_the_case_and_pass(pytester):
     root = cases(pytester, SCENARIOS)
     collected = pytester.runpytest_subprocess(*fmu_args(3, 2), root, "--collect-only", "-q")
@@ -72,6 +73,7 @@ def test_a_failing_item_shows_the_case_messages(pytester):
     assert "Traceback" not in result.stdout.str()
 
 
+@pytest.mark.slow
 def test_k_x_lf_and_junit_work_on_the_items(pytester):
     root = cases(pytester, ("asymmetric", "step_down", "step_up"), wrong=("asymmetric", "step_down"))
     chosen = pytester.runpytest_subprocess(*fmu_args(3, 2), root, "-k", "step_up and fmi2")
@@ -107,6 +109,7 @@ def test_the_fmus_from_the_ini_file_and_a_recording_named(pytester):
     result.stdout.fnmatch_lines(["twincat_siemens.csv::twincat_siemens[[]LGF_LimRateOfChangeCI-fmi3[]] PASSED*"])
 
 
+@pytest.mark.slow
 def test_without_fmus_the_plugin_collects_nothing(pytester):
     root = cases(pytester)
     result = pytester.runpytest_subprocess(root)

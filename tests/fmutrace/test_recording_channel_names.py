@@ -19,6 +19,7 @@ from fmutrace.cli import FLAGS
 from fmutrace.recordings import normalise, plan, read_recording
 from fmutrace.recordings._options import RecordingOptions
 from support.fmu_driver import BUILD_DIR
+from support.mdf import mdf_of_groups
 from support.process import run as run_bounded
 
 SAMPLES = Path(__file__).parents[1] / "recordings"
@@ -119,7 +120,7 @@ def test_a_bad_cell_of_a_same_named_column_names_its_file_line_and_column(tmp_pa
     assert "'1.0.0'" in str(error.value) and SHARED in str(error.value)
 
 
-@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("version", [pytest.param(2, marks=pytest.mark.slow), 3])
 def test_the_modbusscope_sample_compares_its_chosen_column_exactly(version, tmp_path):
     """End to end: y is the column that holds y (3); the raw count in column 2 fails at cycle 1. The
     file is read in blocks (streamed), whose columns are found by the channels' names."""
@@ -192,22 +193,10 @@ def test_scope_view_channels_of_one_symbol_or_one_name_are_chosen_by_column(tmp_
         assert [(v, c.values.tolist()) for v, c in result.compares] == [("y", [7.0, 8.0])]
 
 
-def _mdf(path, version, groups):
-    """An MDF file of asammdf's own writer: groups: [[(name, values)]], 0.25 s apart."""
-    from asammdf import MDF, Signal
-
-    mdf = MDF(version=version)
-    for group in groups:
-        signals = [Signal(np.array(v, dtype=float), np.arange(len(v)) * 0.25, name=n) for n, v in group]
-        mdf.append(signals)
-    mdf.save(str(path), overwrite=True)
-    mdf.close()
-    return path
-
-
 def test_an_mdf_2_file_is_named_mdf_2(tmp_path):
-    path = _mdf(tmp_path / "old.mdf", "2.00", [[("value", samples.SIEMENS["value"])]])
-    assert path.read_bytes()[:12] == b"MDF     2.00"  # the identification block: asammdf wrote MDF 2.00
+    values = samples.SIEMENS["value"]
+    path = mdf_of_groups(tmp_path / "old.mdf", [(np.arange(len(values)) * 0.25, {"value": values})], version="2.00")
+    assert Path(path).read_bytes()[:12] == b"MDF     2.00"  # the identification block: asammdf wrote MDF 2.00
     recording = read_one(path)
     assert recording.format == "ASAM MDF 2"
     assert [(c.name, c.values.tolist()) for c in recording.channels] == [("value", samples.SIEMENS["value"])]
@@ -215,7 +204,7 @@ def test_an_mdf_2_file_is_named_mdf_2(tmp_path):
 
 def test_mdf_channels_of_one_name_in_several_groups_are_each_kept_and_chosen_by_name(tmp_path):
     """MDF channels have no columns: the K-th channel of a name is NAME#K, in the file's order."""
-    path = _mdf(tmp_path / "two.mf4", "4.10", [[("y", [0, 1]), ("u", [0, 2])], [("y", [5, 6])]])
+    path = mdf_of_groups(tmp_path / "two.mf4", [([0, 0.25], {"y": [0, 1], "u": [0, 2]}), ([0, 0.25], {"y": [5, 6]})])
     recording = read_one(path)
     assert [c.name for c in recording.channels] == ["y#1", "u", "y#2"]
     with pytest.raises(InputError) as error:

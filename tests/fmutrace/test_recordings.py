@@ -22,6 +22,7 @@ from fmutrace.recordings._options import RecordingOptions
 from fmutrace.recordings._text import decode, numbers
 from fmutrace._traces import split_cells as split
 from fmutrace.recordings._timebase import parse_date, unit_in_name
+from support.mdf import mdf_of_groups
 from support.oracle import oracle_for
 
 SAMPLES = Path(__file__).parents[1] / "recordings"
@@ -691,23 +692,11 @@ def _fmu_of(**causalities):
     )
 
 
-def _mdf_of_groups(path, groups):
-    """An MDF4 file with a channel group per (stamps, {name: values}), by asammdf's writer."""
-    from asammdf import MDF, Signal
-
-    mdf = MDF(version="4.10")
-    for stamps, signals in groups:
-        mdf.append([Signal(np.asarray(v, dtype=float), np.asarray(stamps), name=n) for n, v in signals.items()])
-    mdf.save(str(path), overwrite=True)
-    mdf.close()
-    return str(path)
-
-
 def test_the_step_comes_from_the_mapped_channels_not_from_unmapped_faster_ones(tmp_path):
     """A CAN log: Speed and Heading each 1 s apart (from t = 0.3 s), other messages at 100 Hz from t = 0."""
     fast = np.arange(500) / 100
     slow = 0.3 + np.arange(5)
-    path = _mdf_of_groups(
+    path = mdf_of_groups(
         tmp_path / "can.mf4",
         [(fast, {"EngineTemp": fast * 0, "Rpm": fast}), (slow, {"Speed": np.arange(5)}), (slow, {"Heading": [5] * 5})],
     )
@@ -722,7 +711,7 @@ def test_the_step_comes_from_the_mapped_channels_not_from_unmapped_faster_ones(t
 def test_an_unmapped_channel_at_time_zero_does_not_set_the_origin(tmp_path):
     """An XCP measurement: a calibration value at t = 0, the mapped channels every 1 ms from 0.5 ms."""
     daq = 0.0005 + np.arange(100) / 1000
-    path = _mdf_of_groups(
+    path = mdf_of_groups(
         tmp_path / "xcp.mf4", [([0.0], {"Calibration": [1.0]}), (daq, {"u": np.arange(100), "y": np.arange(100)})]
     )
     case = recorded_case(path, _fmu_of(u="input", y="output"), "xcp", RecordingOptions())
@@ -734,7 +723,7 @@ def test_an_unmapped_channel_at_time_zero_does_not_set_the_origin(tmp_path):
 
 def test_a_channel_off_the_grid_is_named_with_the_step_that_would_fit_it(tmp_path):
     """u every 0.25 s, y every 0.3 s: y's stamps are off a 0.25 s grid; a step of 0.3 s fits them."""
-    path = _mdf_of_groups(
+    path = mdf_of_groups(
         tmp_path / "two_rates.mf4",
         [(np.arange(13) * 0.25, {"u": np.zeros(13)}), (np.arange(10) * 0.3, {"y": np.zeros(10)})],
     )

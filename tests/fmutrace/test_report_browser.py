@@ -206,6 +206,7 @@ def test_a_failing_campaign(browser, tmp_path):
     assert console_errors(browser) == []
 
 
+@pytest.mark.slow
 def test_a_long_trace_opens_framed_and_refines_as_it_is_zoomed(browser, tmp_path):
     """A trace of 360,001 steps of 10 ms (an hour) whose reference is off
     by one at t = 2500 s: its page's data stays small (the overview under
