@@ -5,18 +5,15 @@ last place. Expected verdicts are worked by hand from the criteria's
 definitions (docs/fmutrace.md, Comparison), never taken from fmutrace's
 output."""
 
-import contextlib
-import io
-
 import numpy as np
 import pytest
 
 import fmutrace
-from fmutrace import cli
 from fmutrace import Tube, write_trace
 from fmutrace._comparison import compare_traces
 from fmutrace._pipeline import CaseFiles, Streaming, run_folder_case
 from fmutrace._worker import CaseSettings, Target, worker_fmu
+from support.cli import fmutrace_in_process
 from support.fmu_driver import BUILD_DIR
 from support.scenarios import fmu_path
 
@@ -388,10 +385,8 @@ def test_a_case_folder_carries_its_criteria(tmp_path):
 
 
 def command(*args):
-    out = io.StringIO()
-    with contextlib.redirect_stderr(io.StringIO()) as err:
-        status = cli.main(["compare", str(fmu_path(BUILD_DIR, "RateLimiter", 3)), *map(str, args)], out=out)
-    return status, out.getvalue(), err.getvalue()
+    done = fmutrace_in_process("compare", fmu_path(BUILD_DIR, "RateLimiter", 3), *args)
+    return done.returncode, done.stdout, done.stderr
 
 
 def test_the_command_checks_a_tube_both_ways_unless_told_one_side(tmp_path):

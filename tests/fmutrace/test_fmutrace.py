@@ -1,4 +1,5 @@
-"""fmutrace end to end, through its console script: on the project's FMUs
+"""fmutrace end to end, through its command's entry point (in this
+process, support.cli; the README's examples start the console script): on the project's FMUs
 and on FMUs it did not write (the PassThrough and FirstOrderLag fixtures).
 Every reference here is worked by hand from the fixture's equation or
 computed by an oracle in this file, never taken from an FMU's output.
@@ -12,7 +13,6 @@ import math
 import re
 import shutil
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,19 +20,17 @@ from junitparser import JUnitXml
 
 import fmutrace
 from support.fmu_driver import BUILD_DIR, REPO
+from support.cli import fmutrace_in_process
 from support.process import run as run_bounded
 from support.scenarios import SCENARIO_ROOT
 
-FMUTRACE = Path(sys.executable).parent / "fmutrace"
 PASS_THROUGH = {v: BUILD_DIR / "benchmarks" / f"fmi{v}" / "PassThrough.fmu" for v in (2, 3)}
 LAG = {v: BUILD_DIR / "fixtures" / f"fmi{v}" / "FirstOrderLag.fmu" for v in (2, 3)}
 RATE_LIMITER = {v: BUILD_DIR / f"fmi{v}" / "RateLimiter.fmu" for v in (2, 3)}
 
 
 def fmutrace_cli(*args, cwd=None):
-    return run_bounded(
-        [str(FMUTRACE), *map(str, args)], timeout=600, what="fmutrace " + " ".join(map(str, args[:2])), cwd=cwd
-    )
+    return fmutrace_in_process(*args, cwd=cwd)
 
 
 def write_case(folder, model, ref, inputs=None, opt=None, start=None):

@@ -5,17 +5,15 @@ Tube(time=..., value=...), the command's user --step-size or --tube-time
 module but the command's writes a flag into a message."""
 
 import ast
-import contextlib
-import io
 import re
 from pathlib import Path
 
 import pytest
 
 import fmutrace
-from fmutrace import cli
 from fmutrace._names import name_of
 from fmutrace.cli import FLAGS
+from support.cli import fmutrace_in_process
 from support.fmu_driver import BUILD_DIR
 
 PACKAGE = Path(__file__).resolve().parents[2] / "fmutrace" / "src" / "fmutrace"
@@ -106,21 +104,16 @@ def test_the_callers_words_are_no_setting():
 
 
 def command(*args):
-    """What the command fmutrace compare args prints: its entry point
-    (fmutrace.cli:main) run in this process, which spares each message a
-    second interpreter's start-up."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            cli.main(["compare", *map(str, args)], out=out)
-        except SystemExit:  # argparse's usage errors end the command
-            pass
-    return out.getvalue() + err.getvalue()
+    """What the command fmutrace compare args prints (its entry point run in this process)."""
+    done = fmutrace_in_process("compare", *args)
+    return done.stdout + done.stderr
 
 
 def in_python(fmu, path, **options):
-    """The messages a library call gives for the recording at path."""
-    campaign = fmutrace.compare(fmu, path, recording=fmutrace.RecordingOptions(**options))
+    """The messages a library call gives for the recording at path (its case run in this process)."""
+    campaign = fmutrace.compare(
+        fmu, path, recording=fmutrace.RecordingOptions(**options), run=fmutrace.RunOptions(jobs=1)
+    )
     return "\n".join(m for outcome in campaign.cases for m in outcome.messages)
 
 

@@ -1,5 +1,5 @@
-"""`fmutrace compare FMU RECORDING...` end to end, through its console
-script and the built FMUs (the Siemens block and RateLimiter), on the
+"""`fmutrace compare FMU RECORDING...` end to end, through its command's
+entry point (in this process, support.cli) and the built FMUs (the Siemens block and RateLimiter), on the
 sample recordings of tests/recordings (written from each export's
 documented structure, values worked by hand: tests/recordings/samples.py)
 and on variants of them written here: perturbed, coarsely sampled, bad."""
@@ -12,13 +12,12 @@ import pytest
 
 import fmutrace
 from support.fmu_driver import BUILD_DIR
-from support.process import run as run_bounded
+from support.cli import fmutrace_in_process
 
 SAMPLES = Path(__file__).parents[1] / "recordings"
 sys.path.insert(0, str(SAMPLES))
 import samples  # noqa: E402
 
-FMUTRACE = Path(sys.executable).parent / "fmutrace"
 SIEMENS = {v: BUILD_DIR / f"fmi{v}" / "LGF_LimRateOfChangeCI.fmu" for v in (2, 3)}
 RATE_LIMITER = {v: BUILD_DIR / f"fmi{v}" / "RateLimiter.fmu" for v in (2, 3)}
 PASS_THROUGH = BUILD_DIR / "benchmarks" / "fmi3" / "PassThrough.fmu"  # y is u, each cycle
@@ -33,7 +32,7 @@ WINCC_MAPS = [
 
 
 def compare(*args):
-    return run_bounded([str(FMUTRACE), "compare", *map(str, args)], timeout=600, what="fmutrace compare")
+    return fmutrace_in_process("compare", *args)
 
 
 def tia_rows():

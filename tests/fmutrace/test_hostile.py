@@ -92,6 +92,7 @@ def test_an_fmu_is_unpacked_into_a_private_folder_never_one_planted(tmp_path):
 FAULTY = BUILD_DIR / "fixtures" / "fmi3" / "Faulty.fmu"  # PassThrough's equation; u = 13 crashes, u = 17 hangs
 
 
+@pytest.mark.slow
 def test_children_killed_leave_no_unpacked_fmu_behind(tmp_path):
     """--case-timeout runs the cases in child processes: one killed at its
     timeout (u = 17 hangs) and one crashed (u = 13) cannot remove what they
@@ -135,6 +136,7 @@ def alive(pid):
         return False
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parent-death signal is Linux's")
 def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
     """The command killed with SIGKILL while its child hangs in the FMU's
@@ -168,6 +170,7 @@ def test_a_child_running_a_hanging_case_dies_with_the_command(tmp_path):
         kill_session(command)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX: the owner's lock tells a live campaign's folder")
 def test_a_killed_commands_unpack_folder_is_removed_by_the_next_one(tmp_path):
     """A command killed with SIGKILL cannot remove its folder of unpacked
@@ -229,6 +232,7 @@ def test_a_root_being_made_is_not_taken_for_an_abandoned_one(tmp_path, monkeypat
         shutil.rmtree(root, ignore_errors=True)
 
 
+@pytest.mark.slow
 def test_local_workers_leave_no_unpacked_fmu_behind(tmp_path):
     """--jobs 2: the local worker processes unpack into the command's folder,
     removed when the command ends, however the workers are stopped."""
@@ -248,6 +252,7 @@ def test_local_workers_leave_no_unpacked_fmu_behind(tmp_path):
 # 2. Text from users' files shown as text everywhere
 
 
+@pytest.mark.slow
 def test_tex_like_text_in_a_name_or_readme_is_drawn_as_text(tmp_path):
     """$...$ in a case's README and folder name is not matplotlib's
     mathtext: the plot is drawn (a broken formula used to abort the whole
@@ -295,6 +300,7 @@ def test_control_characters_in_names_leave_junit_xml_valid(tmp_path):
     assert names == ["ctl\ufffd\ufffd[31mred"]
 
 
+@pytest.mark.slow
 def test_a_name_that_is_not_utf8_is_shown_with_replacement_characters(tmp_path):
     """A case folder named in Latin-1 bytes: the campaign runs, the name is
     shown with U+FFFD in the output, the pages, results.json and junit.xml."""
@@ -310,6 +316,7 @@ def test_a_name_that_is_not_utf8_is_shown_with_replacement_characters(tmp_path):
     assert [c.get("name") for c in ET.parse(junit).getroot().iter("testcase")] == ["r\ufffdsum\ufffd"]
 
 
+@pytest.mark.slow
 def test_paths_given_that_are_not_utf8_are_printed_with_replacement_characters(tmp_path):
     """--report and --junit named in Latin-1 bytes, printed to a strict UTF-8
     standard output (a terminal's): the lines that name them show U+FFFD."""
@@ -325,6 +332,7 @@ def test_paths_given_that_are_not_utf8_are_printed_with_replacement_characters(t
     assert os.path.isfile(os.path.join(report, b"index.html")) and os.path.isfile(junit)
 
 
+@pytest.mark.slow
 def test_a_250_byte_name_becomes_a_file_name_shortened_with_a_hash(tmp_path):
     """A case folder of 250 bytes (the file system allows 255): its result
     file and plot get names that fit, distinct for two names that share
@@ -403,6 +411,7 @@ def test_a_link_in_the_report_folder_does_not_lead_its_files_outside(tmp_path):
     assert "outside the report folder" in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+@pytest.mark.slow
 def test_two_recordings_of_one_file_name_keep_their_own_results(tmp_path):
     """a/rec.csv and b/rec.csv: two cases of two names, each with its own
     result file (the second used to overwrite the first's)."""
@@ -491,6 +500,7 @@ def campaign_with_journal(tmp_path):
     return report, (report / "results.jsonl").read_text().splitlines(keepends=True)
 
 
+@pytest.mark.slow
 def test_a_journal_with_a_damaged_header_is_refused(tmp_path):
     """Its header line damaged, a journal no longer says which options made
     its verdicts: resuming it under other options (--abs-tol 1e6) is refused
@@ -504,6 +514,7 @@ def test_a_journal_with_a_damaged_header_is_refused(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+@pytest.mark.slow
 def test_the_same_fmu_named_by_another_path_resumes_from_the_journal(tmp_path):
     """A journal knows an FMU by its bytes: the campaign resumed with a copy
     of the FMU elsewhere takes every case from the journal, runs none again,
@@ -521,6 +532,7 @@ def test_the_same_fmu_named_by_another_path_resumes_from_the_journal(tmp_path):
     assert cases and all(c["fmu_file"] == str(copy) for c in cases), cases
 
 
+@pytest.mark.slow
 def test_a_journal_of_another_program_is_refused(tmp_path):
     """A JSON first line that is not a campaign's header (a list): exit 2, one line."""
     report, lines = campaign_with_journal(tmp_path)
@@ -531,6 +543,7 @@ def test_a_journal_of_another_program_is_refused(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "damage",
     [
@@ -559,6 +572,7 @@ def test_a_bad_journal_line_is_skipped_with_a_message_and_its_case_runs_again(tm
     assert sorted(c["case"] for c in results["cases"]) == ["one", "two"]
 
 
+@pytest.mark.slow
 def test_a_journal_line_longer_than_its_bound_is_skipped_unread(tmp_path):
     """A second line of 64 MiB and more (a foreign or damaged file) is not read whole: the resume says it
     is too long, runs that case again and keeps the entry after it."""
@@ -580,6 +594,7 @@ def test_a_journal_line_longer_than_its_bound_is_skipped_unread(tmp_path):
 # 5. Exit codes and no traceback
 
 
+@pytest.mark.slow
 def test_a_report_folder_that_is_a_file_is_bad_input(tmp_path):
     write_case(tmp_path / "cases" / "one")
     (tmp_path / "report").write_text("not a folder")
@@ -589,6 +604,7 @@ def test_a_report_folder_that_is_a_file_is_bad_input(tmp_path):
     assert done.stderr.startswith("fmutrace: error: ") and len(done.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_a_report_folder_that_cannot_be_written_is_bad_input(tmp_path):
     """A read-only report folder (as root, whom modes do not stop: a folder
     under a file stands in for it)."""
@@ -609,6 +625,7 @@ def test_a_report_folder_that_cannot_be_written_is_bad_input(tmp_path):
     assert done.stderr.startswith("fmutrace: error: ") and len(done.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_an_fmu_without_a_binary_for_this_platform_is_bad_input(tmp_path):
     """PassThrough without its Linux binary: run says so in one line, exit 2."""
     fmu = tmp_path / "windows_only.fmu"
@@ -624,6 +641,7 @@ def test_an_fmu_without_a_binary_for_this_platform_is_bad_input(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+@pytest.mark.slow
 def test_ctrl_c_ends_the_command_with_130_and_one_line(tmp_path):
     """SIGINT (Ctrl-C) in the middle of a campaign: exit 130, one line, no traceback."""
     slow = "StartTime,0\nStopTime,1000000\nStepSize,0.01\nRelTol,1e-6\n"  # 10^8 steps a case: seconds
@@ -638,6 +656,7 @@ def test_ctrl_c_ends_the_command_with_130_and_one_line(tmp_path):
     assert len(stderr.strip().splitlines()) == 1, stderr
 
 
+@pytest.mark.slow
 def test_no_copy_of_the_tests_fmus_is_left_in_the_temporary_folder(tmp_path):
     """A campaign in its own temporary folder leaves nothing there (its
     unpacked FMU removed at exit)."""
@@ -652,6 +671,7 @@ def test_no_copy_of_the_tests_fmus_is_left_in_the_temporary_folder(tmp_path):
     assert not list(shared.iterdir())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("identification,version,name", [(b"MDF     ", 410, "damaged"), (b"UnFinMF ", 411, "logger")])
 def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(identification, version, name, tmp_path):
     """An MDF 4 file marked not finalized (as a CAN logger leaves its file, 'UnFinMF ', too), its
@@ -670,6 +690,7 @@ def test_a_damaged_mdf_file_leaves_no_copy_and_no_traceback(identification, vers
     assert not list(shared.iterdir())
 
 
+@pytest.mark.slow
 def test_a_small_mdf_file_declaring_more_samples_than_the_bound_is_refused_before_reading(tmp_path):
     """Issue 37: a small MDF4 file whose channel group declares 300 million samples (its cycle count,
     the uint64 after the CG block's record id) is refused at once, naming the file, channel, count and
@@ -694,6 +715,7 @@ def test_a_small_mdf_file_declaring_more_samples_than_the_bound_is_refused_befor
     ) in done.stderr
 
 
+@pytest.mark.slow
 def test_recording_options_on_case_folders_are_not_left_unused_silently(tmp_path):
     """--step-size and --set read recordings; given with case folders alone
     they change nothing, and the command says so (the case passes as its
@@ -713,6 +735,7 @@ def bounded_memory():
     resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("times", [("--step-size", "1e-12", "--stop-time", "1"), ("--stop-time", "1e300")])
 def test_run_refuses_more_steps_than_the_bound_before_it_allocates(tmp_path, times):
     """fmutrace run --step-size 1e-12 (10^12 steps) or a stop time of 1e300:
@@ -728,6 +751,7 @@ def test_run_refuses_more_steps_than_the_bound_before_it_allocates(tmp_path, tim
     assert "more than the bound of 200,000,000 steps" in done.stderr, done.stderr
 
 
+@pytest.mark.slow
 def test_a_recording_of_millions_of_columns_is_refused_at_once(tmp_path):
     """A CSV recording of 2.5 million columns (a 21 MB header line: 9 + 2.5e6
     'c' + 16,388,890 digits + 2,499,999 commas; and one row): refused naming
@@ -750,6 +774,7 @@ def test_a_recording_of_millions_of_columns_is_refused_at_once(tmp_path):
 # 6. Numbers
 
 
+@pytest.mark.slow
 def test_an_underscore_is_no_digit_separator_in_a_case_file(tmp_path):
     """'1_0' is Python's literal for 10, not a number of a CSV file: the case
     is invalid, its message at the cell (a recording reads IEC's 1_000 on purpose)."""
@@ -761,6 +786,7 @@ def test_an_underscore_is_no_digit_separator_in_a_case_file(tmp_path):
     assert "PassThrough_in.csv, line 3, column 2: '1_0' in column 'u' is not a number" in done.stderr, done.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("line", ["StepSize,inf", "StopTime,inf", "StartTime,-inf"])
 def test_a_case_time_that_is_not_finite_is_refused(line, tmp_path):
     case = write_case(tmp_path / "cases" / "infinite")
@@ -775,6 +801,7 @@ def test_a_case_time_that_is_not_finite_is_refused(line, tmp_path):
     ), done.stderr
 
 
+@pytest.mark.slow
 def test_a_case_of_more_steps_than_the_bound_is_refused_before_it_runs(tmp_path):
     """StopTime 1e300 at 0.1 s: the case is invalid at once (the run's bound: one bound for every way to ask)."""
     case = write_case(tmp_path / "cases" / "endless")
@@ -789,6 +816,7 @@ def test_a_case_of_more_steps_than_the_bound_is_refused_before_it_runs(tmp_path)
     assert time.monotonic() - started < 60
 
 
+@pytest.mark.slow
 def test_a_plot_that_cannot_be_drawn_costs_the_figure_not_the_verdict(tmp_path, monkeypatch):
     from fmutrace import _pipeline
 
@@ -808,6 +836,7 @@ def test_a_plot_that_cannot_be_drawn_costs_the_figure_not_the_verdict(tmp_path, 
     assert (tmp_path / "report" / "index.html").exists()
 
 
+@pytest.mark.slow
 def test_a_time_stamp_that_is_not_finite_is_refused_in_a_recording(tmp_path):
     """A recording's time stamp nan (or inf): exit 2 and the cell, not a comparison at a garbage time."""
     recording = tmp_path / "rec.csv"

@@ -84,6 +84,7 @@ def with_env(**variables):
 # 1. Every read bounded, devices and FIFOs refused by name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("jobs", [["--jobs", "1"], []], ids=["in this process", "in workers"])
 @pytest.mark.parametrize("name", ["PassThrough_ref.csv", "PassThrough_in.csv", "PassThrough_ref.opt"])
 def test_a_2_gib_case_file_is_refused_by_the_read_bound(tmp_path, name, jobs):
@@ -101,6 +102,7 @@ def test_a_2_gib_case_file_is_refused_by_the_read_bound(tmp_path, name, jobs):
     assert (tmp_path / "report" / "index.html").is_file() and (tmp_path / "report" / "results.json").is_file()
 
 
+@pytest.mark.slow
 def test_a_300_mb_line_is_refused_and_not_quoted(tmp_path):
     """A 300 MB reference of one line (sparse: NUL bytes), within the read
     bound: refused at its line, the message short (a 300 MB header line
@@ -167,12 +169,14 @@ def test_a_device_or_fifo_as_a_case_file_is_refused_by_name(tmp_path, name, targ
     assert "1 of 2 cases pass" in done.stdout, done.stdout
 
 
+@pytest.mark.slow
 def test_a_recording_that_is_a_fifo_is_refused_by_name(tmp_path):
     os.mkfifo(tmp_path / "rec.csv")
     done = fmutrace_command("compare", PASS_THROUGH, tmp_path / "rec.csv", timeout=120)
     refused(done, "rec.csv: a FIFO, not a regular file: not read")
 
 
+@pytest.mark.slow
 def test_a_6_gib_fmu_is_refused_by_the_read_bound(tmp_path):
     """A valid FMU behind 6 GiB of zeros (a zip may carry data before its
     entries; sparse): refused by its size before it is read whole."""
@@ -197,6 +201,7 @@ def deflated_zeros(archive, name, size):
             entry.write(block)
 
 
+@pytest.mark.slow
 def test_a_huge_resources_entry_is_refused_before_it_is_unpacked(tmp_path):
     """A resources/ entry inflating past the read bound (64 MiB here, to
     keep the test short; 6 GiB took 52 s per worker): refused once, naming
@@ -223,6 +228,7 @@ def ls_ref_reference(fmu):
     return found[0].files["references"]
 
 
+@pytest.mark.slow
 def test_a_zip_bomb_in_an_ls_ref_reference_is_refused_before_it_is_inflated(tmp_path):
     """An LS-REF reference.csv replaced by 128 MiB of zeros deflated to
     under 1 MB, the bound 64 MiB (to keep the test short; 8.5 MB to 4 GiB
@@ -243,6 +249,7 @@ def test_a_zip_bomb_in_an_ls_ref_reference_is_refused_before_it_is_inflated(tmp_
 # 2. Outputs as the user named them
 
 
+@pytest.mark.slow
 def test_junit_into_a_link_writes_the_file_it_leads_to(tmp_path):
     """--junit names a link to the user's file: the XML goes into that file,
     the link stays a link (it was replaced by a regular file)."""
@@ -273,6 +280,7 @@ def test_junit_into_a_fifo_is_written_into_it(tmp_path):
     assert got and [c.get("name") for c in ET.fromstring(got[0]).iter("testcase")] == ["one"]
 
 
+@pytest.mark.slow
 def test_junit_into_a_missing_folder_is_an_error_and_makes_no_folder(tmp_path):
     write_case(tmp_path / "cases" / "one")
     done = fmutrace_command("compare", PASS_THROUGH, tmp_path / "cases", "--junit", tmp_path / "no" / "dir" / "j.xml")
@@ -289,6 +297,7 @@ def test_junit_into_a_missing_folder_is_an_error_and_makes_no_folder(tmp_path):
 # 3. The report folder is the user's
 
 
+@pytest.mark.slow
 def test_check_does_not_replace_a_users_experiments_folder(tmp_path):
     """report/experiments holds the user's own file: check refuses it, the
     file stays (it was deleted without a word)."""
@@ -300,6 +309,7 @@ def test_check_does_not_replace_a_users_experiments_folder(tmp_path):
     assert (report / "experiments" / "notes.txt").read_text() == "mine"
 
 
+@pytest.mark.slow
 def test_check_refuses_a_link_from_its_experiments_folder_to_outside(tmp_path):
     """report/experiments is a link to a folder outside: refused, nothing
     written or deleted there (outside/checked was deleted)."""
@@ -313,6 +323,7 @@ def test_check_refuses_a_link_from_its_experiments_folder_to_outside(tmp_path):
     assert sorted(p.relative_to(outside) for p in outside.rglob("*")) == [Path("checked"), Path("checked/keep")]
 
 
+@pytest.mark.slow
 def test_check_replaces_its_own_experiments_and_a_second_check_waits_its_turn(tmp_path):
     """A check's experiments/ is replaced by the next check; a check into a
     report another campaign holds (its lock) is refused before it changes
@@ -358,6 +369,7 @@ def modes_binding():
             assert libc.prctl(24, capability, 0, 0, 0) == 0, os.strerror(ctypes.get_errno())  # PR_CAPBSET_DROP
 
 
+@pytest.mark.slow
 def test_a_folder_or_file_without_permission_is_an_invalid_case(tmp_path):
     """A chmod-000 case folder and a chmod-000 input: each is an invalid
     case that says why; none vanishes from the counts ('2 of 3')."""
@@ -382,6 +394,7 @@ def test_a_folder_or_file_without_permission_is_an_invalid_case(tmp_path):
 # 5. A worker's reason reaches the user
 
 
+@pytest.mark.slow
 def test_an_fmu_with_illegal_zip_paths_says_so_once_with_any_jobs(tmp_path):
     """An entry named with a backslash (fmpy refuses to unpack it): one
     line, the reason, exit 2, with --jobs 2 as with --jobs 1 (each case
@@ -408,6 +421,7 @@ def no_file_beyond_4_kib():
     resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("jobs", ["1", "2"])
 def test_a_workers_errno_reaches_the_user(tmp_path, jobs):
     """The FMU cannot be unpacked for a reason of the machine's (a file
@@ -426,6 +440,7 @@ def test_a_workers_errno_reaches_the_user(tmp_path, jobs):
 # 6. The smaller points
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("address", ["garbage://x", "tcp://[::1"])
 def test_a_scheduler_address_that_is_none_is_a_clear_error(tmp_path, address):
     write_case(tmp_path / "cases" / "one")
@@ -434,6 +449,7 @@ def test_a_scheduler_address_that_is_none_is_a_clear_error(tmp_path, address):
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
 
 
+@pytest.mark.slow
 def test_an_underscore_is_no_digit_separator_in_a_mode(tmp_path):
     """'tol:abs=1_0' in a case's criteria is not abs = 10 (the docs: 1_0 is no number)."""
     case = write_case(tmp_path / "cases" / "one")
@@ -442,6 +458,7 @@ def test_an_underscore_is_no_digit_separator_in_a_mode(tmp_path):
     refused(done, "abs '1_0' is not a number")
 
 
+@pytest.mark.slow
 def test_a_line_break_in_an_ssp_parameter_name_is_refused():
     """An SSP parameter named 'k\\nRateLimiter_extra,1' would add a line of
     its own to the case's _start.csv."""
@@ -454,6 +471,7 @@ def test_a_line_break_in_an_ssp_parameter_name_is_refused():
         _lsref.parameter_lines("the FMU", "p.ssv", ssv)
 
 
+@pytest.mark.slow
 def test_a_line_break_in_an_experiment_attribute_is_refused(tmp_path):
     """An experiment's stopTime '2&#10;StepSize,1e-9' would add an option line to the case's .opt file
     (each experiment file changed, the manifest's checksums made theirs)."""
@@ -476,6 +494,7 @@ def test_a_line_break_in_an_experiment_attribute_is_refused(tmp_path):
     refused(done, "'s stopTime '2\\nStepSize,1e-9' holds a line break")
 
 
+@pytest.mark.slow
 def test_a_checks_messages_name_the_fmu_not_a_vanished_temporary_file(tmp_path):
     """check without a report: a reference the FMU carries with a cell that
     is no number is named by the FMU and its experiment (the message named
@@ -500,6 +519,7 @@ def test_a_checks_messages_name_the_fmu_not_a_vanished_temporary_file(tmp_path):
     assert f"{fmu}: experiment " in (tmp_path / "j.xml").read_text()
 
 
+@pytest.mark.slow
 def test_a_case_timeout_of_0_is_refused(tmp_path):
     write_case(tmp_path / "cases" / "one")
     done = fmutrace_command("compare", PASS_THROUGH, tmp_path / "cases", "--case-timeout", "0", cap=False)
@@ -508,6 +528,7 @@ def test_a_case_timeout_of_0_is_refused(tmp_path):
         fmutrace.RunOptions(case_timeout=0)
 
 
+@pytest.mark.slow
 def test_sigterm_ends_the_command_with_a_line(tmp_path):
     """SIGTERM in the middle of a campaign: 143 and one line that says so (it ended without a word)."""
     slow = "StartTime,0\nStopTime,1000000\nStepSize,0.01\n"  # 10^8 steps: seconds
@@ -522,6 +543,7 @@ def test_sigterm_ends_the_command_with_a_line(tmp_path):
     ]
 
 
+@pytest.mark.slow
 def test_a_killed_checks_temporary_cases_are_removed_by_the_next_command(tmp_path):
     """check without a report, killed (SIGKILL) while its cases run: the
     next command removes the cases it wrote (a killed check left its
@@ -551,6 +573,7 @@ def test_a_killed_checks_temporary_cases_are_removed_by_the_next_command(tmp_pat
     assert not list(shared.iterdir()), list(shared.rglob("*"))
 
 
+@pytest.mark.slow
 def test_the_same_fmu_given_twice_is_one_fmu(tmp_path):
     """The same FMU named twice (once through a link): its cases run once (72 rows linked to 36 pages)."""
     write_case(tmp_path / "cases" / "one")
@@ -623,6 +646,7 @@ def bounded():
     modes_binding()
 
 
+@pytest.mark.slow
 def test_a_message_quoting_a_huge_name_is_cut(tmp_path):
     """A criteria file naming a signal of 3,000,000 characters (within the
     line bound): the message that quotes it is cut to its first 2,000

@@ -9,7 +9,6 @@ or refuses it for the one correct reason."""
 import json
 import gzip
 import hashlib
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -21,8 +20,8 @@ from fmutrace._recorded import recorded_case
 from fmutrace.recordings._options import RecordingOptions
 from fmutrace.recordings import normalise, read_file
 from support import scope_view
+from support.cli import fmutrace_in_process
 from support.fmu_driver import BUILD_DIR
-from support.process import run as run_bounded
 
 CORPUS = Path(__file__).parents[1] / "recordings" / "corpus"
 
@@ -146,8 +145,7 @@ def test_a_scope_view_export_through_the_command_on_the_channels_mapped(tmp_path
     path = _unpacked("pytcs/tc3_scope_3_4_3145_3-default.csv.gz", tmp_path)
 
     def compare(*maps):
-        command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(PASS_THROUGH), str(path)]
-        return run_bounded(command + [a for m in maps for a in ("--map", m)], timeout=600, what="fmutrace compare")
+        return fmutrace_in_process("compare", PASS_THROUGH, path, *[a for m in maps for a in ("--map", m)])
 
     done = compare("u=var_REAL32", "y=var_REAL32")
     assert done.returncode == 0, done.stdout + done.stderr
@@ -186,10 +184,10 @@ def _decoded_compared(tmp_path, name, dbc, fmu, **maps):
     raw.close()
     decoded.close()
     report = tmp_path / "report"
-    command = [str(Path(sys.executable).parent / "fmutrace"), "compare", str(fmu), str(path), "--report", str(report)]
+    command = ["compare", fmu, path, "--report", report]
     for variable, signal in maps.items():
         command += ["--map", f"{variable}={signal}"]
-    done = run_bounded(command, timeout=600, what="fmutrace compare")
+    done = fmutrace_in_process(*command)
     cases = json.loads((report / "results.json").read_text())["cases"] if (report / "results.json").exists() else [{}]
     return stamps, done, cases[0]
 
