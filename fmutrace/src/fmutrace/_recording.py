@@ -177,7 +177,7 @@ def run_streamed_recording(path, name, target, settings, streaming: Streaming = 
         return None
     drives, compares = matched.drives, matched.compares
     stop = float(timebase.cycle_times(np.array([max(cycles.last + shift, 1)]), step)[0])
-    pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": [], "steps": []}
+    pending: dict[str, list[np.ndarray]] = {"inputs": [], "refs": []}
     replay = _StreamedReplay(cycles, step, shift, lambda: parse()) if recorded else None
     before = -1  # the cycle of the row before the next block's
     jitter = clock.Jitter()  # of every row on the grid, as the blocks are read
