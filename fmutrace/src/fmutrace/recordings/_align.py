@@ -82,14 +82,12 @@ def fitted_grid(recording, channels, names: Names = ()):
     )
 
 
-def _cycles_of(channel, grid, step, names, put_apart):
-    """The cycle of each sample of channel on grid: its nearest, or the one
-    _apart puts it on ({id(channel): the samples moved} in put_apart);
-    InputError for two samples on one cycle."""
+def _cycles_of(channel, grid, step, names):
+    """(the cycle of each sample of channel on grid, the samples put apart):
+    each sample's nearest cycle, or the one _apart puts it on; InputError
+    for two samples on one cycle."""
     nearest = grid.index(channel.times)
     index, moved = _apart(nearest, grid.distance(channel.times, nearest))
-    if moved:
-        put_apart[id(channel)] = moved
     repeated = np.flatnonzero(np.diff(index) == 0)
     if len(repeated):
         i = int(repeated[0])
@@ -99,7 +97,7 @@ def _cycles_of(channel, grid, step, names, put_apart):
             f"up to half a cycle allowed: the step is coarser than the recording (give the recorder's cycle with "
             f"{name_of(names, 'step_size')})"
         )
-    return index
+    return index, moved
 
 
 def _apart(index, distance):
@@ -199,8 +197,9 @@ def align(recording, plan, timing="cycle", label="the FMU", names: Names = (), c
     used = list({id(c): c for _, c in plan.drives + plan.compares}.values())  # (a channel may drive and be compared)
     grid = fitted_grid(recording, [c for c in used if len(c.times)], names)
     step = recording.step_size  # (the fit may have found the cycle the median interval missed)
-    put_apart: dict = {}  # id(channel) -> its samples put apart from their nearest cycle
-    index_of = {id(c): _cycles_of(c, grid, step, names, put_apart) for c in used}
+    numbered = {id(c): _cycles_of(c, grid, step, names) for c in used}
+    index_of = {key: index for key, (index, _) in numbered.items()}
+    put_apart = {key: moved for key, (_, moved) in numbered.items() if moved}  # from their nearest cycle
     if put_apart:
         # samples put apart from their nearest cycle: the grid's line through every sample on its cycle
         grid = clock.line(
